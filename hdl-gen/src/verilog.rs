@@ -1,0 +1,381 @@
+//! A small typed writer for Verilog-2005: modules, ports, wires, registers, assigns, clocked
+//! always blocks, instances and generate loops. Expressions stay strings — the structure is
+//! what must be right, and every emitter goes through this one printer so the output has one
+//! style: ANSI ports, two-space indent, one declaration per line.
+
+use std::fmt::Write;
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Dir {
+    Input,
+    Output,
+}
+
+/// A port. `format` is the fixed-point format, printed beside the port and in the manifest.
+#[derive(Clone, Debug)]
+pub struct Port {
+    pub name: String,
+    pub dir: Dir,
+    pub width: u32,
+    pub signed: bool,
+    /// Driven from a register (`output reg`).
+    pub reg: bool,
+    /// Declared with a range even at width 1, so lanes can be indexed when P = 1.
+    pub vector: bool,
+    pub format: String,
+    pub doc: String,
+}
+
+impl Port {
+    pub fn input(name: &str, width: u32, format: &str, doc: &str) -> Port {
+        Port { name: name.into(), dir: Dir::Input, width, signed: false, reg: false, vector: false, format: format.into(), doc: doc.into() }
+    }
+    pub fn output(name: &str, width: u32, format: &str, doc: &str) -> Port {
+        Port { dir: Dir::Output, ..Port::input(name, width, format, doc) }
+    }
+    pub fn signed(mut self) -> Port {
+        self.signed = true;
+        self
+    }
+    pub fn reg(mut self) -> Port {
+        self.reg = true;
+        self
+    }
+    pub fn vector(mut self) -> Port {
+        self.vector = true;
+        self
+    }
+}
+
+/// Statements inside a clocked always block.
+#[derive(Clone, Debug)]
+pub enum Stmt {
+    /// Non-blocking assignment.
+    Set(String, String),
+    If(String, Vec<Stmt>, Vec<Stmt>),
+    Comment(String),
+}
+
+pub fn set(lhs: impl Into<String>, rhs: impl Into<String>) -> Stmt {
+    Stmt::Set(lhs.into(), rhs.into())
+}
+
+#[derive(Clone, Debug)]
+pub enum Item {
+    Blank,
+    Comment(String),
+    /// `wire [w-1:0] name;` or, with a value, `wire [w-1:0] name = value;`.
+    Wire { name: String, width: u32, signed: bool, value: Option<String> },
+    /// A lane bus driven elsewhere, declared with a range even at width 1.
+    Bus { name: String, width: u32 },
+    Reg { name: String, width: u32, signed: bool },
+    /// `localparam [w-1:0] NAME = value;` (width 0: unsized).
+    Localparam { name: String, width: u32, value: String },
+    Assign(String, String),
+    /// `always @(posedge clk)`.
+    Always(Vec<Stmt>),
+    Instance { module: String, name: String, params: Vec<(String, String)>, conns: Vec<(String, String)> },
+    /// `for (var = 0; var < count; var = var + 1) begin : label ... end` in a generate region.
+    ForGenerate { var: String, count: u32, label: String, body: Vec<Item> },
+    /// `if (cond) begin : label ... end else begin : label2 ... end` inside a generate region.
+    IfGenerate { cond: String, then: (String, Vec<Item>), els: (String, Vec<Item>) },
+    /// A ROM load: `initial $readmemh(file, mem);` — the only `initial` SPEC allows.
+    ReadMemH { file: String, mem: String },
+    /// `reg [w-1:0] name [0:depth-1];`
+    Memory { name: String, width: u32, depth: u32 },
+}
+
+pub fn wire(name: &str, width: u32, value: impl Into<String>) -> Item {
+    Item::Wire { name: name.into(), width, signed: false, value: Some(value.into()) }
+}
+pub fn swire(name: &str, width: u32, value: impl Into<String>) -> Item {
+    Item::Wire { name: name.into(), width, signed: true, value: Some(value.into()) }
+}
+/// A wire driven elsewhere (by `assign`s or an instance).
+pub fn net(name: &str, width: u32) -> Item {
+    Item::Wire { name: name.into(), width, signed: false, value: None }
+}
+/// A lane bus driven elsewhere, indexable at any width.
+pub fn bus(name: &str, width: u32) -> Item {
+    Item::Bus { name: name.into(), width }
+}
+pub fn reg(name: &str, width: u32) -> Item {
+    Item::Reg { name: name.into(), width, signed: false }
+}
+pub fn sreg(name: &str, width: u32) -> Item {
+    Item::Reg { name: name.into(), width, signed: true }
+}
+pub fn assign(lhs: impl Into<String>, rhs: impl Into<String>) -> Item {
+    Item::Assign(lhs.into(), rhs.into())
+}
+pub fn comment(text: impl Into<String>) -> Item {
+    Item::Comment(text.into())
+}
+
+#[derive(Clone, Debug)]
+pub struct Param {
+    pub name: String,
+    pub value: String,
+    pub doc: String,
+}
+
+#[derive(Clone, Debug)]
+pub struct Module {
+    pub name: String,
+    /// Lines of the header comment (configuration, formats, structure).
+    pub header: Vec<String>,
+    pub params: Vec<Param>,
+    pub ports: Vec<Port>,
+    pub body: Vec<Item>,
+}
+
+/// `[w-1:0] ` or nothing for one bit.
+fn range(width: u32) -> String {
+    vrange(width, false)
+}
+
+fn vrange(width: u32, vector: bool) -> String {
+    if width == 1 && !vector {
+        String::new()
+    } else {
+        format!("[{}:0] ", width - 1)
+    }
+}
+
+fn sign(signed: bool) -> &'static str {
+    if signed {
+        "signed "
+    } else {
+        ""
+    }
+}
+
+/// `{{n{x[msb]}}, x}`: sign-extends `x` (of `from` bits) to `to` bits.
+pub fn sext(x: &str, from: u32, to: u32) -> String {
+    assert!(to >= from, "sext narrows {x} from {from} to {to}");
+    if to == from {
+        x.to_string()
+    } else if from == 1 {
+        format!("{{{to}{{{x}}}}}")
+    } else {
+        format!("{{{{{}{{{x}[{}]}}}}, {x}}}", to - from, from - 1)
+    }
+}
+
+/// `{{n{1'b0}}, x}`: zero-extends.
+pub fn zext(x: &str, from: u32, to: u32) -> String {
+    assert!(to >= from, "zext narrows {x} from {from} to {to}");
+    if to == from {
+        x.to_string()
+    } else {
+        format!("{{{}'d0, {x}}}", to - from)
+    }
+}
+
+/// Bit `b` of a `width`-bit net: a one-bit net cannot be bit-selected in Verilog-2005.
+pub fn bit(x: &str, width: u32, b: u32) -> String {
+    if width == 1 {
+        x.to_string()
+    } else {
+        format!("{x}[{b}]")
+    }
+}
+
+/// A sized decimal constant.
+pub fn lit(width: u32, value: u64) -> String {
+    format!("{width}'d{value}")
+}
+
+impl Module {
+    pub fn render(&self) -> String {
+        let mut o = String::new();
+        for line in &self.header {
+            if line.is_empty() {
+                o.push_str("//\n");
+            } else {
+                writeln!(o, "// {line}").unwrap();
+            }
+        }
+        o.push_str("\n`default_nettype none\n\n");
+        write!(o, "module {}", self.name).unwrap();
+        if !self.params.is_empty() {
+            o.push_str(" #(\n");
+            for (k, p) in self.params.iter().enumerate() {
+                let comma = if k + 1 < self.params.len() { "," } else { "" };
+                writeln!(o, "  parameter {} = {}{comma}  // {}", p.name, p.value, p.doc).unwrap();
+            }
+            o.push(')');
+        }
+        o.push_str(" (\n");
+        let decls: Vec<String> = self
+            .ports
+            .iter()
+            .map(|p| {
+                let dir = match p.dir {
+                    Dir::Input => "input  wire ",
+                    Dir::Output if p.reg => "output reg  ",
+                    Dir::Output => "output wire ",
+                };
+                format!("{dir}{}{}{}", sign(p.signed), vrange(p.width, p.vector), p.name)
+            })
+            .collect();
+        let pad = decls.iter().map(|d| d.len()).max().unwrap_or(0) + 1;
+        for (k, (d, p)) in decls.iter().zip(&self.ports).enumerate() {
+            let comma = if k + 1 < self.ports.len() { "," } else { " " };
+            let note = match (p.format.as_str(), p.doc.as_str()) {
+                ("", doc) => doc.to_string(),
+                (f, "") => f.to_string(),
+                (f, doc) => format!("{f}; {doc}"),
+            };
+            writeln!(o, "  {d}{comma}{:w$}// {note}", "", w = pad - d.len()).unwrap();
+        }
+        o.push_str(");\n");
+        render_items(&mut o, &self.body, 1);
+        o.push_str("\nendmodule\n\n`default_nettype wire\n");
+        o
+    }
+}
+
+fn indent(o: &mut String, level: usize) {
+    for _ in 0..level {
+        o.push_str("  ");
+    }
+}
+
+fn render_items(o: &mut String, items: &[Item], level: usize) {
+    for item in items {
+        if !matches!(item, Item::Blank) {
+            indent(o, level);
+        }
+        match item {
+            Item::Blank => o.push('\n'),
+            Item::Comment(c) => writeln!(o, "// {c}").unwrap(),
+            Item::Wire { name, width, signed, value } => {
+                write!(o, "wire {}{}{name}", sign(*signed), range(*width)).unwrap();
+                match value {
+                    Some(v) => writeln!(o, " = {v};").unwrap(),
+                    None => o.push_str(";\n"),
+                }
+            }
+            Item::Bus { name, width } => writeln!(o, "wire {}{name};", vrange(*width, true)).unwrap(),
+            Item::Reg { name, width, signed } => writeln!(o, "reg {}{}{name};", sign(*signed), range(*width)).unwrap(),
+            Item::Localparam { name, width, value } => {
+                let r = if *width == 0 { String::new() } else { range(*width) };
+                writeln!(o, "localparam {r}{name} = {value};").unwrap()
+            }
+            Item::Assign(l, r) => writeln!(o, "assign {l} = {r};").unwrap(),
+            Item::Always(stmts) => {
+                o.push_str("always @(posedge clk) begin\n");
+                render_stmts(o, stmts, level + 1);
+                indent(o, level);
+                o.push_str("end\n");
+            }
+            Item::Instance { module, name, params, conns } => {
+                write!(o, "{module} ").unwrap();
+                if !params.is_empty() {
+                    let ps: Vec<String> = params.iter().map(|(k, v)| format!(".{k}({v})")).collect();
+                    write!(o, "#({}) ", ps.join(", ")).unwrap();
+                }
+                writeln!(o, "{name} (").unwrap();
+                for (k, (port, sig)) in conns.iter().enumerate() {
+                    indent(o, level + 1);
+                    let comma = if k + 1 < conns.len() { "," } else { "" };
+                    writeln!(o, ".{port}({sig}){comma}").unwrap();
+                }
+                indent(o, level);
+                o.push_str(");\n");
+            }
+            Item::ForGenerate { var, count, label, body } => {
+                writeln!(o, "genvar {var};").unwrap();
+                indent(o, level);
+                o.push_str("generate\n");
+                indent(o, level + 1);
+                writeln!(o, "for ({var} = 0; {var} < {count}; {var} = {var} + 1) begin : {label}").unwrap();
+                render_items(o, body, level + 2);
+                indent(o, level + 1);
+                o.push_str("end\n");
+                indent(o, level);
+                o.push_str("endgenerate\n");
+            }
+            Item::IfGenerate { cond, then, els } => {
+                writeln!(o, "if ({cond}) begin : {}", then.0).unwrap();
+                render_items(o, &then.1, level + 1);
+                indent(o, level);
+                writeln!(o, "end else begin : {}", els.0).unwrap();
+                render_items(o, &els.1, level + 1);
+                indent(o, level);
+                o.push_str("end\n");
+            }
+            Item::ReadMemH { file, mem } => writeln!(o, "initial $readmemh({file}, {mem});").unwrap(),
+            Item::Memory { name, width, depth } => {
+                writeln!(o, "reg {}{name} [0:{}];", range(*width), depth - 1).unwrap()
+            }
+        }
+    }
+}
+
+fn render_stmts(o: &mut String, stmts: &[Stmt], level: usize) {
+    for s in stmts {
+        indent(o, level);
+        match s {
+            Stmt::Set(l, r) => writeln!(o, "{l} <= {r};").unwrap(),
+            Stmt::Comment(c) => writeln!(o, "// {c}").unwrap(),
+            Stmt::If(cond, then, els) => {
+                writeln!(o, "if ({cond}) begin").unwrap();
+                render_stmts(o, then, level + 1);
+                indent(o, level);
+                match els.as_slice() {
+                    [] => o.push_str("end\n"),
+                    // `else if` chains read flatter than nested blocks.
+                    [nested @ Stmt::If(..)] => {
+                        o.push_str("end else ");
+                        let mut inner = String::new();
+                        render_stmts(&mut inner, std::slice::from_ref(nested), level);
+                        o.push_str(inner.trim_start());
+                    }
+                    _ => {
+                        o.push_str("end else begin\n");
+                        render_stmts(o, els, level + 1);
+                        indent(o, level);
+                        o.push_str("end\n");
+                    }
+                }
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn renders_a_small_module() {
+        let m = Module {
+            name: "t".into(),
+            header: vec!["A test.".into()],
+            params: vec![],
+            ports: vec![
+                Port::input("clk", 1, "", "clock"),
+                Port::input("a", 4, "UQ4.0", "").signed(),
+                Port::output("y", 4, "", "").reg(),
+            ],
+            body: vec![Item::Always(vec![Stmt::If(
+                "a[3]".into(),
+                vec![set("y", "a")],
+                vec![Stmt::If("a[2]".into(), vec![set("y", "4'd1")], vec![set("y", "4'd0")])],
+            )])],
+        };
+        let text = m.render();
+        assert!(text.contains("input  wire signed [3:0] a,"), "{text}");
+        assert!(text.contains("output reg  [3:0] y "), "{text}");
+        assert!(text.contains("end else if (a[2]) begin\n"), "{text}");
+    }
+
+    #[test]
+    fn extensions() {
+        assert_eq!(sext("d", 4, 6), "{{2{d[3]}}, d}");
+        assert_eq!(sext("d", 4, 4), "d");
+        assert_eq!(zext("d", 4, 6), "{2'd0, d}");
+    }
+}
