@@ -97,23 +97,27 @@ impl BfpiPlan {
     /// `width`-bit wire, so sums wrap modulo 2^width (harmless: every *output* fits).
     /// Returns lane `i` = `(i+1)*di` for `i = 0..p`.
     pub fn evaluate(&self, di: i64, width: u32) -> Vec<i64> {
+        let mut lanes = vec![0; self.p as usize];
+        self.evaluate_into(di, width, &mut vec![0; self.p as usize + 1], &mut lanes);
+        lanes
+    }
+
+    /// `evaluate` without allocating: `nodes` has room for p + 1 values, `lanes` for p.
+    pub fn evaluate_into(&self, di: i64, width: u32, nodes: &mut [i64], lanes: &mut [i64]) {
         let wrap = |v: i64| (v << (64 - width)) >> (64 - width);
-        let mut node = vec![0i64; self.p as usize + 1];
-        node[1] = wrap(di);
+        nodes[1] = wrap(di);
         for a in &self.adders {
-            let x = node[a.a as usize].wrapping_shl(a.a_shift);
-            let y = node[a.b as usize].wrapping_shl(a.b_shift);
-            node[a.value as usize] = wrap(match a.op {
+            let x = nodes[a.a as usize].wrapping_shl(a.a_shift);
+            let y = nodes[a.b as usize].wrapping_shl(a.b_shift);
+            nodes[a.value as usize] = wrap(match a.op {
                 Op::Add => x.wrapping_add(y),
                 Op::Sub => x.wrapping_sub(y),
             });
         }
-        (1..=self.p)
-            .map(|c| {
-                let (odd, s) = Self::multiple(c);
-                wrap(node[odd as usize].wrapping_shl(s))
-            })
-            .collect()
+        for (lane, c) in lanes.iter_mut().zip(1..=self.p) {
+            let (odd, s) = Self::multiple(c);
+            *lane = wrap(nodes[odd as usize].wrapping_shl(s));
+        }
     }
 }
 

@@ -1,0 +1,314 @@
+//! Builds the RTL into linkable models: generate the Verilog (or take it from COSIM_RTL_DIR),
+//! verilate it, read the file list from the generated `*_classes.mk`, compile with cc at -O2
+//! and link statically. A model whose inputs (RTL, shim, Verilator version) are unchanged since
+//! the last build is neither re-verilated nor recompiled.
+
+use golden::{Align, Config};
+use std::fmt::Write as _;
+use std::fs;
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+/// The segment widths built by default, each in both alignments; each p's BFPI is built too.
+const BUILT_P: [u32; 7] = [1, 2, 4, 8, 16, 32, 64];
+
+#[derive(Clone, Copy, PartialEq)]
+enum Kind {
+    Segment,
+    Bfpi,
+}
+
+struct Model {
+    /// Symbol prefix of the shim and suffix of the Verilator class (`V<tag>`).
+    tag: String,
+    kind: Kind,
+    cfg: Config,
+    top: String,
+    /// Clocks from input transfer to first output valid (0: combinational).
+    latency: u32,
+    /// Verilog sources: (file name, text).
+    sources: Vec<(String, String)>,
+}
+
+fn main() {
+    println!("cargo:rerun-if-changed=build.rs");
+    println!("cargo:rerun-if-changed=csrc/shim.h");
+    println!("cargo:rerun-if-env-changed=COSIM_RTL_DIR");
+    let out = PathBuf::from(std::env::var("OUT_DIR").unwrap());
+    let models = match std::env::var_os("COSIM_RTL_DIR") {
+        Some(dir) => {
+            let dir = PathBuf::from(dir);
+            println!("cargo:rerun-if-changed={}", dir.display());
+            models_from_dir(&dir)
+        }
+        None => generated_models(),
+    };
+    let verilator = Verilator::find();
+    let mut globals = Vec::new();
+    for m in &models {
+        globals = build_model(&verilator, &out, m);
+    }
+    build_runtime(&verilator, &out, &globals);
+    println!("cargo:rustc-link-search=native={}", out.display());
+    for m in &models {
+        println!("cargo:rustc-link-lib=static={}", m.tag);
+    }
+    println!("cargo:rustc-link-lib=static=verilated_rt");
+    println!("cargo:rustc-link-lib=stdc++");
+    println!("cargo:rustc-link-lib=pthread");
+    println!("cargo:rustc-link-lib=atomic");
+    fs::write(out.join("models.rs"), models_rs(&models)).unwrap();
+}
+
+fn generated_models() -> Vec<Model> {
+    let mut models = Vec::new();
+    for p in BUILT_P {
+        for align in Align::ALL {
+            let cfg = Config { p, align, ..Config::default() };
+            let files = hdl_gen::generate(&hdl_gen::Options { cfg, prefix: String::new() });
+            let sources: Vec<(String, String)> =
+                files.into_iter().filter(|f| f.name.ends_with(".v")).map(|f| (f.name, f.contents)).collect();
+            let names = hdl_gen::Names::new("", &cfg);
+            if align == Align::Span {
+                let bfpi = sources.iter().filter(|(n, _)| *n == format!("{}.v", names.bfpi)).cloned().collect();
+                models.push(Model { tag: format!("bfpi_p{p}"), kind: Kind::Bfpi, cfg, top: names.bfpi.clone(), latency: 0, sources: bfpi });
+            }
+            let latency = hdl_gen::segment::LATENCY;
+            models.push(Model { tag: format!("seg_p{p}_{align}"), kind: Kind::Segment, cfg, top: names.segment, latency, sources });
+        }
+    }
+    models
+}
+
+/// The models described by `DIR/manifest.json`, as `hdl-gen generate` writes it: the Verilog is
+/// read from DIR as it is, so hand-edited or third-party RTL is checked against golden.
+fn models_from_dir(dir: &Path) -> Vec<Model> {
+    let fail = |what: String| -> ! { panic!("COSIM_RTL_DIR={}: {what}", dir.display()) };
+    let text = fs::read_to_string(dir.join("manifest.json")).unwrap_or_else(|e| fail(format!("cannot read manifest.json: {e}")));
+    let m: serde_json::Value = serde_json::from_str(&text).unwrap_or_else(|e| fail(format!("manifest.json: {e}")));
+    let param = |k: &str| m["parameters"][k].as_u64().unwrap_or_else(|| fail(format!("manifest has no parameters.{k}"))) as u32;
+    let align: Align = m["parameters"]["align"].as_str().unwrap_or("span").parse().unwrap_or_else(|e| fail(e));
+    let cfg = Config::new(param("p"), param("frac"), param("xbits"), align).unwrap_or_else(|e| fail(e));
+    let modules = m["modules"].as_array().unwrap_or_else(|| fail("manifest has no modules".into()));
+    let mut sources = Vec::new();
+    for module in modules {
+        let file = module["file"].as_str().unwrap_or_else(|| fail("a module has no file".into()));
+        let text = fs::read_to_string(dir.join(file)).unwrap_or_else(|e| fail(format!("cannot read {file}: {e}")));
+        sources.push((file.to_string(), text));
+    }
+    let module_of = |role: &str| modules.iter().find(|x| x["role"] == role);
+    let top_of = |role: &str| module_of(role).and_then(|x| x["name"].as_str()).map(str::to_string);
+    let latency_of = |role: &str| module_of(role).and_then(|x| x["latency"].as_u64()).unwrap_or(0) as u32;
+    let mut models = Vec::new();
+    if let Some(top) = top_of("bfpi") {
+        let file = format!("{top}.v");
+        let src = sources.iter().filter(|(n, _)| *n == file).cloned().collect();
+        models.push(Model { tag: format!("bfpi_p{}", cfg.p), kind: Kind::Bfpi, cfg, top, latency: 0, sources: src });
+    }
+    if let Some(top) = top_of("segment_shader") {
+        let latency = latency_of("segment_shader");
+        models.push(Model { tag: format!("seg_p{}_{}", cfg.p, cfg.align), kind: Kind::Segment, cfg, top, latency, sources });
+    }
+    if models.is_empty() {
+        fail("manifest lists no bfpi or segment_shader module".into());
+    }
+    models
+}
+
+struct Verilator {
+    root: PathBuf,
+    version: String,
+}
+
+impl Verilator {
+    fn find() -> Verilator {
+        let missing = || -> ! {
+            panic!(
+                "\n\nverilator was not found on PATH. The co-simulation harness needs it.\n\
+                 Install Debian's package:   apt-get install -y verilator\n\
+                 (or run ./scripts/test, which installs it when missing)\n\n"
+            )
+        };
+        let version = Command::new("verilator").arg("--version").output().unwrap_or_else(|_| missing());
+        if !version.status.success() {
+            missing();
+        }
+        let root = Command::new("verilator").args(["--getenv", "VERILATOR_ROOT"]).output().unwrap_or_else(|_| missing());
+        Verilator {
+            root: PathBuf::from(String::from_utf8_lossy(&root.stdout).trim()),
+            version: String::from_utf8_lossy(&version.stdout).trim().to_string(),
+        }
+    }
+
+    fn include(&self) -> [PathBuf; 2] {
+        [self.root.join("include"), self.root.join("include/vltstd")]
+    }
+}
+
+/// The compiler set-up Verilator's own makefile uses, at -O2 whatever the cargo profile.
+fn cc_build(v: &Verilator) -> cc::Build {
+    let mut b = cc::Build::new();
+    b.cpp(true)
+        .opt_level(2)
+        .debug(false)
+        .warnings(false)
+        .cargo_metadata(false)
+        .flag("-std=gnu++17")
+        .flag("-faligned-new")
+        .flag("-fcf-protection=none");
+    for d in ["VM_COVERAGE", "VM_SC", "VM_TRACE", "VM_TRACE_FST", "VM_TRACE_VCD"] {
+        b.define(d, "0");
+    }
+    for i in v.include() {
+        b.include(i);
+    }
+    b
+}
+
+/// Verilates and compiles one model unless its key (everything the result depends on) is the
+/// one recorded by the last build. Returns the runtime files its makefile asks for.
+fn build_model(v: &Verilator, out: &Path, m: &Model) -> Vec<String> {
+    let obj = out.join("obj").join(&m.tag);
+    let rtl = out.join("rtl").join(&m.tag);
+    let class = format!("V{}", m.tag);
+    let shim = shim_cpp(m, &class);
+    let mut key = format!("{}\n{}\n{}\n{}\n", v.version, m.top, include_str!("csrc/shim.h"), shim);
+    for (name, text) in &m.sources {
+        write!(key, "== {name}\n{text}").unwrap();
+    }
+    let key_file = obj.join("build.key");
+    let classes_mk = obj.join(format!("{class}_classes.mk"));
+    let lib = out.join(format!("lib{}.a", m.tag));
+    let fresh = fs::read_to_string(&key_file).map_or(false, |k| k == key) && lib.exists() && classes_mk.exists();
+    if !fresh {
+        let _ = fs::remove_dir_all(&obj);
+        let _ = fs::remove_dir_all(&rtl);
+        fs::create_dir_all(&obj).unwrap();
+        fs::create_dir_all(&rtl).unwrap();
+        let mut files = Vec::new();
+        for (name, text) in &m.sources {
+            fs::write(rtl.join(name), text).unwrap();
+            files.push(rtl.join(name));
+        }
+        let status = Command::new("verilator")
+            .args(["--cc", "-O3", "--x-assign", "fast", "--x-initial", "unique", "-Wno-fatal"])
+            .args(["--prefix", &class, "--top-module", &m.top])
+            .arg("-Mdir")
+            .arg(&obj)
+            .args(&files)
+            .status()
+            .expect("running verilator");
+        assert!(status.success(), "verilator failed on {} ({})", m.top, rtl.display());
+    }
+    let mk = Classes::read(&classes_mk);
+    if !fresh {
+        let shim_path = obj.join("shim.cpp");
+        fs::write(&shim_path, &shim).unwrap();
+        let mut b = cc_build(v);
+        b.include(&obj).include(Path::new(env!("CARGO_MANIFEST_DIR")).join("csrc")).out_dir(&obj).file(&shim_path);
+        for c in &mk.model {
+            b.file(obj.join(format!("{c}.cpp")));
+        }
+        b.compile(&m.tag);
+        fs::rename(obj.join(format!("lib{}.a", m.tag)), &lib).unwrap();
+        fs::write(&key_file, &key).unwrap();
+    }
+    mk.global
+}
+
+/// Verilator's runtime (`verilated.cpp`, `verilated_threads.cpp`, as the makefile lists them),
+/// compiled once for every model.
+fn build_runtime(v: &Verilator, out: &Path, globals: &[String]) {
+    let obj = out.join("obj").join("runtime");
+    let key = format!("{}\n{}\n", v.version, globals.join(" "));
+    let lib = out.join("libverilated_rt.a");
+    if fs::read_to_string(obj.join("build.key")).map_or(false, |k| k == key) && lib.exists() {
+        return;
+    }
+    fs::create_dir_all(&obj).unwrap();
+    let mut b = cc_build(v);
+    b.out_dir(&obj);
+    for g in globals {
+        b.file(v.root.join("include").join(format!("{g}.cpp")));
+    }
+    b.compile("verilated_rt");
+    fs::rename(obj.join("libverilated_rt.a"), &lib).unwrap();
+    fs::write(obj.join("build.key"), key).unwrap();
+}
+
+/// The file lists of a `V*_classes.mk`.
+struct Classes {
+    model: Vec<String>,
+    global: Vec<String>,
+}
+
+impl Classes {
+    fn read(path: &Path) -> Classes {
+        let text = fs::read_to_string(path).unwrap_or_else(|e| panic!("reading {}: {e}", path.display()));
+        let mut model = Vec::new();
+        let mut global = Vec::new();
+        let mut current: Option<&mut Vec<String>> = None;
+        for line in text.lines() {
+            let line = line.trim();
+            if let Some((var, _)) = line.split_once("+=") {
+                current = match var.trim() {
+                    "VM_CLASSES_FAST" | "VM_CLASSES_SLOW" | "VM_SUPPORT_FAST" | "VM_SUPPORT_SLOW" => Some(&mut model),
+                    "VM_GLOBAL_FAST" | "VM_GLOBAL_SLOW" => Some(&mut global),
+                    _ => None,
+                };
+            } else if line.is_empty() || line.starts_with('#') {
+                current = None;
+            } else if let Some(list) = current.as_deref_mut() {
+                list.extend(line.trim_end_matches('\\').split_whitespace().map(str::to_string));
+            }
+        }
+        assert!(!model.is_empty(), "{} lists no model files", path.display());
+        Classes { model, global }
+    }
+}
+
+fn shim_cpp(m: &Model, class: &str) -> String {
+    let expand = match m.kind {
+        Kind::Segment => format!("SEGSHADE_SEGMENT_SHIM({class}, {}, {})", m.tag, m.cfg.p),
+        Kind::Bfpi => format!("SEGSHADE_BFPI_SHIM({class}, {}, {})", m.tag, (m.cfg.p * m.cfg.mw()).div_ceil(8)),
+    };
+    format!("// Generated by build.rs.\n#include \"{class}.h\"\n#include \"shim.h\"\n{expand}\n")
+}
+
+fn models_rs(models: &[Model]) -> String {
+    let mut s = String::from("// Generated by build.rs: the models linked into this crate.\n");
+    let mut seg = String::new();
+    let mut bfpi = String::new();
+    for m in models {
+        let (inp, outp, list) = match m.kind {
+            Kind::Segment => ("SegIn", "SegOut", &mut seg),
+            Kind::Bfpi => ("BfpiIn", "BfpiOut", &mut bfpi),
+        };
+        let t = &m.tag;
+        writeln!(
+            s,
+            "extern \"C\" {{\n    fn {t}_new(seed: u64) -> *mut c_void;\n    fn {t}_free(h: *mut c_void);\n    \
+             fn {t}_step(h: *mut c_void, i: *const {inp}, o: *mut {outp});\n}}"
+        )
+        .unwrap();
+        let c = &m.cfg;
+        let align = match c.align {
+            Align::Span => "Span",
+            Align::Screen => "Screen",
+        };
+        writeln!(
+            list,
+            "    ModelInfo {{ tag: \"{t}\", top: \"{}\", latency: {}, cfg: Config {{ p: {}, frac: {}, xbits: {}, align: Align::{align} }}, \
+             new: {t}_new, free: {t}_free, step: {t}_step }},",
+            m.top, m.latency, c.p, c.frac, c.xbits
+        )
+        .unwrap();
+    }
+    write!(
+        s,
+        "pub static SEGMENT_MODELS: &[ModelInfo<SegIn, SegOut>] = &[\n{seg}];\n\
+         pub static BFPI_MODELS: &[ModelInfo<BfpiIn, BfpiOut>] = &[\n{bfpi}];\n"
+    )
+    .unwrap();
+    s
+}

@@ -1,0 +1,93 @@
+// extern "C" shims between the Rust harness and verilated models: one call per clock, all
+// inputs in one struct and all outputs in another. Each model gets its own VerilatedContext,
+// so models are independent and may live on different threads.
+//
+// A per-model translation unit written by build.rs includes the model's header and expands
+// one of the SEGSHADE_*_SHIM macros with the model's class and the symbol prefix.
+
+#include <cstdint>
+#include <cstring>
+#include "verilated.h"
+
+static_assert(__BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__, "lane buses are copied byte-wise");
+
+// Packed lane buses of any width, copied as little-endian bytes (lane i of 8-bit lanes is
+// byte i). Verilator stores buses up to 64 bits as integers and wider ones as VlWide.
+template <class T> static inline void segshade_copy(uint8_t* dst, const T& v, size_t bytes) {
+    std::memcpy(dst, &v, bytes);
+}
+template <std::size_t N> static inline void segshade_copy(uint8_t* dst, const VlWide<N>& v, size_t bytes) {
+    std::memcpy(dst, v.data(), bytes);
+}
+
+struct SegIn {
+    uint32_t in_x, in_len, in_i0, in_di;  // in_di: two's complement masked to DW bits
+    uint8_t rst, in_valid, out_ready;
+};
+
+struct SegOut {
+    uint32_t out_x;
+    uint8_t in_ready, out_valid, out_last;
+    uint8_t pix[256];   // lane i in byte i
+    uint8_t mask[32];   // lane i in bit i % 8 of byte i / 8
+};
+
+template <class M> struct SegshadeModel {
+    VerilatedContext ctx;
+    M* top;
+    explicit SegshadeModel(uint64_t seed) {
+        // Registers start random, so a design that relies on power-up values fails its tests.
+        ctx.randReset(2);
+        ctx.randSeed(static_cast<int>(seed & 0x7fffffff));
+        top = new M(&ctx, "top");
+    }
+    ~SegshadeModel() {
+        top->final();
+        delete top;
+    }
+};
+
+// Inputs are applied with the clock low and the outputs sampled there: they are the values
+// the rising edge sees, so a transfer happens in this call iff valid && ready in the result.
+#define SEGSHADE_SEGMENT_SHIM(CLASS, SYM, P)                                                 \
+    extern "C" void* SYM##_new(uint64_t seed) { return new SegshadeModel<CLASS>(seed); }      \
+    extern "C" void SYM##_free(void* h) { delete static_cast<SegshadeModel<CLASS>*>(h); }     \
+    extern "C" void SYM##_step(void* h, const SegIn* in, SegOut* out) {                       \
+        CLASS* m = static_cast<SegshadeModel<CLASS>*>(h)->top;                                \
+        m->clk = 0;                                                                           \
+        m->rst = in->rst;                                                                     \
+        m->in_valid = in->in_valid;                                                           \
+        m->out_ready = in->out_ready;                                                         \
+        m->in_x = in->in_x;                                                                   \
+        m->in_len = in->in_len;                                                               \
+        m->in_i0 = in->in_i0;                                                                 \
+        m->in_di = in->in_di;                                                                 \
+        m->eval();                                                                            \
+        out->in_ready = m->in_ready;                                                          \
+        out->out_valid = m->out_valid;                                                        \
+        out->out_last = m->out_last;                                                          \
+        out->out_x = m->out_x;                                                                \
+        segshade_copy(out->pix, m->out_pix, P);                                               \
+        segshade_copy(out->mask, m->out_mask, (P + 7) / 8);                                   \
+        m->clk = 1;                                                                           \
+        m->eval();                                                                            \
+    }
+
+struct BfpiIn {
+    uint32_t di;  // two's complement masked to DW bits
+};
+
+struct BfpiOut {
+    uint8_t inc[1024];  // the packed inc bus, little-endian
+};
+
+// The BFPI is combinational: one evaluation per call, no clock.
+#define SEGSHADE_BFPI_SHIM(CLASS, SYM, BYTES)                                                \
+    extern "C" void* SYM##_new(uint64_t seed) { return new SegshadeModel<CLASS>(seed); }      \
+    extern "C" void SYM##_free(void* h) { delete static_cast<SegshadeModel<CLASS>*>(h); }     \
+    extern "C" void SYM##_step(void* h, const BfpiIn* in, BfpiOut* out) {                     \
+        CLASS* m = static_cast<SegshadeModel<CLASS>*>(h)->top;                                \
+        m->di = in->di;                                                                       \
+        m->eval();                                                                            \
+        segshade_copy(out->inc, m->inc, BYTES);                                               \
+    }

@@ -1,0 +1,96 @@
+//! `cosim`: streams random triangles through one verilated segment shader and checks every
+//! segment and frame against the golden model. Ends with `N passed, M failed` (triangles).
+
+use clap::Parser;
+use golden::setup::Screen;
+use golden::Align;
+use rand::rngs::StdRng;
+use rand::SeedableRng;
+use std::process::ExitCode;
+use std::time::Instant;
+use verilator_harness::cosim::{Report, SegmentCosim, Traffic};
+use verilator_harness::ffi::{segment_model, SEGMENT_MODELS};
+use verilator_harness::stimulus::random_triangle;
+
+#[derive(Parser)]
+#[command(about = "Co-simulate the generated segment shader against the golden model")]
+struct Args {
+    /// Segment width of the model to run.
+    #[arg(long, default_value_t = 8)]
+    p: u32,
+    /// Segmentation of the model to run.
+    #[arg(long, default_value = "span", value_parser = ["span", "screen"])]
+    align: String,
+    /// Random triangles to stream.
+    #[arg(long, default_value_t = 10_000)]
+    triangles: usize,
+    /// Seed of the triangles and of the traffic (default: fresh, printed).
+    #[arg(long)]
+    seed: Option<u64>,
+    #[arg(long, default_value_t = 640, value_parser = clap::value_parser!(u32).range(1..=65536))]
+    width: u32,
+    #[arg(long, default_value_t = 480, value_parser = clap::value_parser!(u32).range(1..=65536))]
+    height: u32,
+    /// `random`: random input gaps and output backpressure; `full`: both ends always ready
+    /// (the shader's own throughput).
+    #[arg(long, default_value = "random", value_parser = ["random", "full"])]
+    traffic: String,
+    /// Triangles painted into one frame between frame checks.
+    #[arg(long, default_value_t = 64, value_parser = clap::value_parser!(u64).range(1..))]
+    batch: u64,
+}
+
+fn main() -> ExitCode {
+    let args = Args::parse();
+    let align: Align = args.align.parse().expect("clap checked it");
+    let Some(info) = segment_model(args.p, align) else {
+        let built: Vec<&str> = SEGMENT_MODELS.iter().map(|m| m.tag).collect();
+        eprintln!("error: --p {} --align {align}: no such model in this build (built: {})", args.p, built.join(", "));
+        return ExitCode::from(2);
+    };
+    let screen = Screen { width: args.width, height: args.height };
+    if let Err(e) = screen.check_for(&info.cfg) {
+        eprintln!("error: --width/--height: {e}");
+        return ExitCode::from(2);
+    }
+    let seed = args.seed.unwrap_or_else(|| verilator_harness::seed("cosim"));
+    let traffic = if args.traffic == "full" { Traffic::FULL } else { Traffic::RANDOM };
+    println!("model {} ({}), screen {}x{}, seed {seed}, traffic {}", info.tag, info.top, screen.width, screen.height, args.traffic);
+
+    let mut rng = StdRng::seed_from_u64(seed);
+    let mut sim = SegmentCosim::new(info, seed, traffic);
+    let mut report = Report::default();
+    let start = Instant::now();
+    let mut done = 0;
+    while done < args.triangles {
+        let n = (args.batch as usize).min(args.triangles - done);
+        let batch: Vec<_> = (0..n).map(|_| random_triangle(&mut rng, &screen)).collect();
+        sim.run_triangles(&screen, &batch, done, &mut report);
+        done += n;
+    }
+    let secs = start.elapsed().as_secs_f64();
+
+    for m in &report.mismatches {
+        println!("MISMATCH (seed {seed}) {m}");
+    }
+    println!("triangles:  {}", report.triangles);
+    println!("spans:      {}", report.spans);
+    println!("segments:   {} compared", report.segments);
+    println!("pixels:     {} compared", report.pixels);
+    println!("mismatches: {}", report.mismatch_count);
+    println!("cycles:     {}", report.cycles);
+    println!("pixels per clock: {:.3}", report.pixels_per_clock());
+    println!("worst |pixel - exact|: {:.3}", report.max_error);
+    println!(
+        "wall: {secs:.2} s, {:.0} segments/s, {:.0} pixels/s, {:.0} clocks/s",
+        report.segments as f64 / secs,
+        report.pixels as f64 / secs,
+        report.cycles as f64 / secs
+    );
+    println!("{} passed, {} failed", report.passed_count(), report.failed_count());
+    if report.ok() {
+        ExitCode::SUCCESS
+    } else {
+        ExitCode::from(1)
+    }
+}

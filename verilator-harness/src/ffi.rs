@@ -1,0 +1,142 @@
+//! The verilated models, as safe Rust values. Every model has three C symbols (new, step,
+//! free); `step` takes every input of one clock in one struct and returns every output in
+//! another, so a clock costs one FFI call whatever the port count.
+
+use golden::{Align, Config};
+use std::ffi::c_void;
+
+/// Inputs of `segment_shader_p<P>` for one clock.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default)]
+pub struct SegIn {
+    pub in_x: u32,
+    pub in_len: u32,
+    pub in_i0: u32,
+    /// Two's complement, masked to DW bits (Verilator requires unused bits to be zero).
+    pub in_di: u32,
+    pub rst: u8,
+    pub in_valid: u8,
+    pub out_ready: u8,
+}
+
+/// Outputs of `segment_shader_p<P>`, sampled just before the rising edge.
+#[repr(C)]
+#[derive(Clone, Copy)]
+pub struct SegOut {
+    pub out_x: u32,
+    pub in_ready: u8,
+    pub out_valid: u8,
+    pub out_last: u8,
+    /// Lane i in byte i.
+    pub pix: [u8; 256],
+    /// Lane i in bit i % 8 of byte i / 8.
+    pub mask: [u8; 32],
+}
+
+impl Default for SegOut {
+    fn default() -> Self {
+        SegOut { out_x: 0, in_ready: 0, out_valid: 0, out_last: 0, pix: [0; 256], mask: [0; 32] }
+    }
+}
+
+impl SegOut {
+    pub fn lane_enabled(&self, i: u32) -> bool {
+        self.mask[(i / 8) as usize] >> (i % 8) & 1 == 1
+    }
+}
+
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default)]
+pub struct BfpiIn {
+    pub di: u32,
+}
+
+#[repr(C)]
+#[derive(Clone, Copy)]
+pub struct BfpiOut {
+    /// The packed `inc` bus, little-endian.
+    pub inc: [u8; 1024],
+}
+
+impl Default for BfpiOut {
+    fn default() -> Self {
+        BfpiOut { inc: [0; 1024] }
+    }
+}
+
+impl BfpiOut {
+    /// Lane `i` of `width` bits (at most 56), sign-extended.
+    pub fn lane(&self, i: u32, width: u32) -> i64 {
+        let lo = (i * width) as usize;
+        let mut word = [0u8; 8];
+        let bytes = &self.inc[lo / 8..(lo / 8 + 8).min(self.inc.len())];
+        word[..bytes.len()].copy_from_slice(bytes);
+        let v = u64::from_le_bytes(word) >> (lo % 8);
+        ((v << (64 - width)) as i64) >> (64 - width)
+    }
+}
+
+/// A linked model: its configuration and its three symbols.
+pub struct ModelInfo<I: 'static, O: 'static> {
+    /// `seg_p8_span`, `bfpi_p8`, ...: also the Verilator class suffix.
+    pub tag: &'static str,
+    /// Verilog top-level module.
+    pub top: &'static str,
+    /// Clocks from an input transfer to the first output valid, as the generator states it.
+    pub latency: u32,
+    pub cfg: Config,
+    pub new: unsafe extern "C" fn(u64) -> *mut c_void,
+    pub free: unsafe extern "C" fn(*mut c_void),
+    pub step: unsafe extern "C" fn(*mut c_void, *const I, *mut O),
+}
+
+include!(concat!(env!("OUT_DIR"), "/models.rs"));
+
+/// The segment-shader model built for `p` and `align`, if this build has one.
+pub fn segment_model(p: u32, align: Align) -> Option<&'static ModelInfo<SegIn, SegOut>> {
+    SEGMENT_MODELS.iter().find(|m| m.cfg.p == p && m.cfg.align == align)
+}
+
+/// One instance of a verilated model with its own VerilatedContext.
+pub struct Rtl<I: 'static, O: 'static> {
+    handle: *mut c_void,
+    info: &'static ModelInfo<I, O>,
+}
+
+// Each instance owns its context and is only touched through &mut self.
+unsafe impl<I, O> Send for Rtl<I, O> {}
+
+impl<I, O: Default> Rtl<I, O> {
+    /// `seed` randomizes the registers' power-up values, so only a real reset makes them known.
+    pub fn new(info: &'static ModelInfo<I, O>, seed: u64) -> Self {
+        let handle = unsafe { (info.new)(seed) };
+        assert!(!handle.is_null(), "model {} failed to construct", info.tag);
+        Rtl { handle, info }
+    }
+
+    pub fn info(&self) -> &'static ModelInfo<I, O> {
+        self.info
+    }
+
+    /// One clock: apply `input` with the clock low, sample the outputs, raise the clock.
+    pub fn step_into(&mut self, input: &I, output: &mut O) {
+        unsafe { (self.info.step)(self.handle, input, output) }
+    }
+
+    pub fn step(&mut self, input: &I) -> O {
+        let mut out = O::default();
+        self.step_into(input, &mut out);
+        out
+    }
+}
+
+impl<I, O> Drop for Rtl<I, O> {
+    fn drop(&mut self) {
+        unsafe { (self.info.free)(self.handle) }
+    }
+}
+
+/// A two's complement value masked to `width` bits, as Verilator stores a signed port.
+pub fn to_port(v: i64, width: u32) -> u32 {
+    (v as u64 & ((1u64 << width) - 1)) as u32
+}

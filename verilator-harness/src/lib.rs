@@ -1,0 +1,23 @@
+//! Co-simulation of segshade's generated RTL against the golden model, through Verilator.
+//!
+//! `build.rs` verilates and links the models; [`ffi`] wraps them; [`stimulus`] makes random
+//! and directed triangles; [`cosim`] streams their spans through a model with random valid
+//! gaps and backpressure and checks every segment and the final frames.
+
+pub mod cosim;
+pub mod ffi;
+pub mod stimulus;
+
+/// The seed of a random test: `COSIM_SEED` when set (to replay a failure), else a fresh one.
+/// Printed either way, so every failure can be replayed.
+pub fn seed(test: &str) -> u64 {
+    let seed = match std::env::var("COSIM_SEED") {
+        Ok(s) => s.trim().parse().unwrap_or_else(|_| panic!("COSIM_SEED='{s}' is not a whole number")),
+        Err(_) => std::time::SystemTime::now()
+            .duration_since(std::time::UNIX_EPOCH)
+            .map(|d| d.as_nanos() as u64 ^ (std::process::id() as u64) << 32)
+            .unwrap_or(1),
+    };
+    eprintln!("{test}: seed {seed} (replay with COSIM_SEED={seed})");
+    seed
+}
