@@ -5,7 +5,9 @@
 pub mod bfpi;
 pub mod format;
 pub mod raster;
+pub mod rom;
 pub mod segment;
 pub mod setup;
+pub mod specular;
 
 pub use format::{Align, Config, Span};

@@ -1,0 +1,401 @@
+//! ROM images: the one place their contents are computed, and their text formats.
+//!
+//! The specular unit has two ROMs (SPEC §3): the BRDF ROM holding the `cos^k` curves and
+//! the n-table ("NK") ROM that turns `n` into a table select and an argument scale. Their
+//! words are computed here from a [`SpecularPlan`], once; the golden model looks its
+//! answers up in these very words, and every exporter writes these very words, so the
+//! RTL, the model and the files cannot drift apart.
+//!
+//! Three text formats are written and read back: `$readmemh` hex (what the generated
+//! Verilog loads), Intel MIF and Xilinx COE (for vendor IP flows). Output is deterministic:
+//! no dates, no tool versions.
+
+use crate::specular::SpecularPlan;
+use serde::{Deserialize, Serialize};
+use std::fmt::Write as _;
+
+/// Default file names of the two images, also the default of the RTL's file parameter.
+pub const BRDF_HEX: &str = "specular_brdf_rom.hex";
+pub const NK_HEX: &str = "specular_nk_rom.hex";
+
+/// One ROM image: `depth = words.len()` words of `width` bits each.
+#[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub struct Rom {
+    pub name: String,
+    pub width: u32,
+    pub words: Vec<u64>,
+}
+
+/// The text formats a ROM image can be written in.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum RomFormat {
+    /// Verilog `$readmemh`: one word per line, `//` comments.
+    Hex,
+    /// Intel (Altera) Memory Initialization File.
+    Mif,
+    /// Xilinx coefficient file.
+    Coe,
+}
+
+impl RomFormat {
+    pub const ALL: [RomFormat; 3] = [RomFormat::Hex, RomFormat::Mif, RomFormat::Coe];
+    pub fn extension(self) -> &'static str {
+        match self {
+            RomFormat::Hex => "hex",
+            RomFormat::Mif => "mif",
+            RomFormat::Coe => "coe",
+        }
+    }
+}
+
+impl std::str::FromStr for RomFormat {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s {
+            "hex" => Ok(RomFormat::Hex),
+            "mif" => Ok(RomFormat::Mif),
+            "coe" => Ok(RomFormat::Coe),
+            _ => Err(format!("unknown ROM format '{s}' (expected hex, mif or coe)")),
+        }
+    }
+}
+
+/// Bits needed to address `depth` words (at least 1, so a port never has width 0).
+pub fn addr_bits(depth: usize) -> u32 {
+    (usize::BITS - depth.saturating_sub(1).leading_zeros()).max(1)
+}
+
+impl Rom {
+    /// A ROM; panics if a word does not fit `width`, because that is a bug in its builder.
+    pub fn new(name: &str, width: u32, words: Vec<u64>) -> Rom {
+        assert!((1..=64).contains(&width), "ROM width {width} out of 1..64");
+        if width < 64 {
+            if let Some((a, w)) = words.iter().enumerate().find(|(_, &w)| w >> width != 0) {
+                panic!("ROM {name}: word {w:#x} at {a} does not fit {width} bits");
+            }
+        }
+        Rom { name: name.to_string(), width, words }
+    }
+
+    pub fn depth(&self) -> usize {
+        self.words.len()
+    }
+    pub fn addr_bits(&self) -> u32 {
+        addr_bits(self.depth())
+    }
+    /// Storage in bits: what "fewer bits" in SPEC §4 counts.
+    pub fn bits(&self) -> u64 {
+        self.depth() as u64 * self.width as u64
+    }
+    fn hex_digits(&self) -> usize {
+        self.width.div_ceil(4) as usize
+    }
+
+    pub fn to_text(&self, format: RomFormat) -> String {
+        match format {
+            RomFormat::Hex => self.to_hex(),
+            RomFormat::Mif => self.to_mif(),
+            RomFormat::Coe => self.to_coe(),
+        }
+    }
+
+    /// `$readmemh` image: a comment line, then one zero-padded lowercase word per line.
+    pub fn to_hex(&self) -> String {
+        let d = self.hex_digits();
+        let mut s = format!("// {}: {} x {} bits\n", self.name, self.depth(), self.width);
+        for w in &self.words {
+            let _ = writeln!(s, "{w:0d$x}");
+        }
+        s
+    }
+
+    /// Intel MIF, one `address : word;` line per word (no run-length ranges, so a diff of two
+    /// images reads line by line).
+    pub fn to_mif(&self) -> String {
+        let d = self.hex_digits();
+        let mut s = format!(
+            "-- {}: {} x {} bits\nWIDTH={};\nDEPTH={};\nADDRESS_RADIX=UNS;\nDATA_RADIX=HEX;\n\nCONTENT BEGIN\n",
+            self.name,
+            self.depth(),
+            self.width,
+            self.width,
+            self.depth()
+        );
+        for (a, w) in self.words.iter().enumerate() {
+            let _ = writeln!(s, "\t{a} : {w:0d$X};");
+        }
+        s.push_str("END;\n");
+        s
+    }
+
+    /// Xilinx COE: radix 16, comma-separated vector ending in `;`.
+    pub fn to_coe(&self) -> String {
+        let d = self.hex_digits();
+        let mut s = format!(
+            "; {}: {} x {} bits\nmemory_initialization_radix=16;\nmemory_initialization_vector=\n",
+            self.name,
+            self.depth(),
+            self.width
+        );
+        for (a, w) in self.words.iter().enumerate() {
+            let end = if a + 1 == self.depth() { ';' } else { ',' };
+            let _ = writeln!(s, "{w:0d$x}{end}");
+        }
+        if self.words.is_empty() {
+            s.push_str(";\n");
+        }
+        s
+    }
+
+    /// Reads any of the three formats back into a ROM of the given name and width.
+    pub fn parse(name: &str, width: u32, format: RomFormat, text: &str) -> Result<Rom, String> {
+        let words = match format {
+            RomFormat::Hex => parse_hex(text)?,
+            RomFormat::Mif => {
+                let (w, words) = parse_mif(text)?;
+                if w != width {
+                    return Err(format!("MIF declares WIDTH={w}, expected {width}"));
+                }
+                words
+            }
+            RomFormat::Coe => parse_coe(text)?,
+        };
+        if width < 64 {
+            if let Some((a, w)) = words.iter().enumerate().find(|(_, &w)| w >> width != 0) {
+                return Err(format!("word {w:#x} at address {a} does not fit {width} bits"));
+            }
+        }
+        Ok(Rom { name: name.to_string(), width, words })
+    }
+}
+
+fn put(words: &mut Vec<u64>, addr: usize, w: u64) -> Result<(), String> {
+    // Cap the growth so a corrupt `@ffffffff` cannot allocate gigabytes.
+    if addr >= 1 << 24 {
+        return Err(format!("address {addr:#x} is beyond any ROM this project builds"));
+    }
+    if words.len() <= addr {
+        words.resize(addr + 1, 0);
+    }
+    words[addr] = w;
+    Ok(())
+}
+
+fn strip_c_comments(text: &str) -> Result<String, String> {
+    let mut out = String::with_capacity(text.len());
+    let mut rest = text;
+    while let Some(i) = rest.find('/') {
+        out.push_str(&rest[..i]);
+        let tail = &rest[i..];
+        if tail.starts_with("//") {
+            rest = tail.find('\n').map_or("", |j| &tail[j..]);
+        } else if tail.starts_with("/*") {
+            let j = tail.find("*/").ok_or("unterminated /* comment")?;
+            out.push(' ');
+            rest = &tail[j + 2..];
+        } else {
+            return Err("stray '/' in hex image".into());
+        }
+    }
+    out.push_str(rest);
+    Ok(out)
+}
+
+/// `$readmemh` text: whitespace-separated hex words, `//` and `/* */` comments, `@addr`
+/// jumps; locations never written read as 0. `_` inside a number is ignored as in Verilog.
+pub fn parse_hex(text: &str) -> Result<Vec<u64>, String> {
+    let mut words = Vec::new();
+    let mut addr = 0usize;
+    for tok in strip_c_comments(text)?.split_whitespace() {
+        let (jump, digits) = match tok.strip_prefix('@') {
+            Some(d) => (true, d),
+            None => (false, tok),
+        };
+        let digits: String = digits.chars().filter(|&c| c != '_').collect();
+        let v = u64::from_str_radix(&digits, 16).map_err(|e| format!("bad hex token '{tok}': {e}"))?;
+        if jump {
+            addr = v as usize;
+        } else {
+            put(&mut words, addr, v)?;
+            addr += 1;
+        }
+    }
+    Ok(words)
+}
+
+fn radix_of(s: &str) -> Result<u32, String> {
+    match s.trim().to_ascii_uppercase().as_str() {
+        "HEX" | "16" => Ok(16),
+        "UNS" | "DEC" | "10" => Ok(10),
+        "BIN" | "2" => Ok(2),
+        "OCT" | "8" => Ok(8),
+        r => Err(format!("unsupported radix '{r}'")),
+    }
+}
+
+fn num(s: &str, radix: u32) -> Result<u64, String> {
+    u64::from_str_radix(s.trim(), radix).map_err(|e| format!("bad number '{}': {e}", s.trim()))
+}
+
+/// Intel MIF: the header's WIDTH, DEPTH and radices, then `addr : w w ...;` or
+/// `[lo..hi] : w;` lines; `--` and `% %` comments. Returns (width, words of DEPTH).
+pub fn parse_mif(text: &str) -> Result<(u32, Vec<u64>), String> {
+    let mut clean = String::with_capacity(text.len());
+    let mut in_pct = false;
+    for line in text.lines() {
+        let line = line.split("--").next().unwrap_or("");
+        for c in line.chars() {
+            if c == '%' {
+                in_pct = !in_pct;
+            } else if !in_pct {
+                clean.push(c);
+            }
+        }
+        clean.push('\n');
+    }
+    let upper = clean.to_ascii_uppercase();
+    let body_at = upper.find("CONTENT").ok_or("MIF has no CONTENT section")?;
+    let (mut width, mut depth, mut ar, mut dr) = (None, None, 16, 16);
+    for stmt in upper[..body_at].split(';') {
+        if let Some((k, v)) = stmt.split_once('=') {
+            match k.trim() {
+                "WIDTH" => width = Some(num(v, 10)? as u32),
+                "DEPTH" => depth = Some(num(v, 10)? as usize),
+                "ADDRESS_RADIX" => ar = radix_of(v)?,
+                "DATA_RADIX" => dr = radix_of(v)?,
+                other => return Err(format!("unknown MIF header field '{other}'")),
+            }
+        }
+    }
+    let width = width.ok_or("MIF has no WIDTH")?;
+    let depth = depth.ok_or("MIF has no DEPTH")?;
+    let body = &upper[body_at + "CONTENT".len()..];
+    let body = body.trim_start().strip_prefix("BEGIN").ok_or("MIF CONTENT without BEGIN")?;
+    let end = body.rfind("END").ok_or("MIF CONTENT without END")?;
+    let mut words = vec![0u64; depth];
+    for stmt in body[..end].split(';').map(str::trim).filter(|s| !s.is_empty()) {
+        let (a, d) = stmt.split_once(':').ok_or_else(|| format!("bad MIF line '{stmt}'"))?;
+        let a = a.trim();
+        let (lo, hi) = match a.strip_prefix('[').and_then(|r| r.strip_suffix(']')) {
+            Some(r) => {
+                let (lo, hi) = r.split_once("..").ok_or_else(|| format!("bad MIF range '{a}'"))?;
+                (num(lo, ar)? as usize, Some(num(hi, ar)? as usize))
+            }
+            None => (num(a, ar)? as usize, None),
+        };
+        let data: Vec<u64> = d.split_whitespace().map(|t| num(t, dr)).collect::<Result<_, _>>()?;
+        // A range repeats its (single) word; a plain address takes a run of words.
+        let cells: Vec<(usize, u64)> = match hi {
+            Some(hi) if data.len() == 1 => (lo..=hi).map(|i| (i, data[0])).collect(),
+            Some(_) => return Err(format!("MIF range '{a}' needs exactly one word")),
+            None => data.iter().enumerate().map(|(i, &w)| (lo + i, w)).collect(),
+        };
+        for (i, w) in cells {
+            *words.get_mut(i).ok_or_else(|| format!("MIF address {i} beyond DEPTH={depth}"))? = w;
+        }
+    }
+    Ok((width, words))
+}
+
+/// Xilinx COE: `memory_initialization_radix=R;` and `memory_initialization_vector=` followed
+/// by words separated by commas or whitespace, ended by `;`. `;` starts a comment elsewhere.
+pub fn parse_coe(text: &str) -> Result<Vec<u64>, String> {
+    // A line starting with ';' is a comment; elsewhere ';' ends a statement.
+    let body: String =
+        text.lines().filter(|l| !l.trim_start().starts_with(';')).flat_map(|l| [l, "\n"]).collect();
+    let mut radix = 10;
+    let mut vector = None;
+    for stmt in body.split(';').map(str::trim).filter(|s| !s.is_empty()) {
+        let (k, v) = stmt.split_once('=').ok_or_else(|| format!("bad COE statement '{stmt}'"))?;
+        match k.trim().to_ascii_lowercase().as_str() {
+            "memory_initialization_radix" => radix = num(v, 10)? as u32,
+            "memory_initialization_vector" => vector = Some(v.to_string()),
+            other => return Err(format!("unknown COE key '{other}'")),
+        }
+    }
+    let v = vector.ok_or("COE has no memory_initialization_vector")?;
+    v.split(|c: char| c == ',' || c.is_whitespace())
+        .filter(|t| !t.is_empty())
+        .map(|t| num(t, radix))
+        .collect()
+}
+
+/// The BRDF ROM: the plan's tables packed back to back, table `t` at `base_t..base_t+len_t`.
+/// Each word is [`SpecularPlan::brdf_word`]: computed there so the sizing checks and this
+/// image agree by construction.
+pub fn brdf_rom(plan: &SpecularPlan) -> Rom {
+    let mut words = Vec::with_capacity(plan.brdf_depth() as usize);
+    for (t, table) in plan.tables.iter().enumerate() {
+        debug_assert_eq!(words.len() as u32, table.base);
+        words.extend((0..table.len).map(|i| plan.brdf_word(t, i)));
+    }
+    Rom::new("specular_brdf_rom", plan.word_bits, words)
+}
+
+/// The n-table ROM: address `n`, word `{sel, M}` ([`SpecularPlan::nk_word`]); every n outside
+/// 1..=1000 holds 0, the invalid-n code.
+pub fn nk_rom(plan: &SpecularPlan) -> Rom {
+    let words = (0..crate::specular::NK_DEPTH as u32).map(|n| plan.nk_word(n)).collect();
+    Rom::new("specular_nk_rom", plan.nk_width(), words)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn sample() -> Rom {
+        Rom::new("t", 13, (0..300u64).map(|i| (i * 7919 + 3) % (1 << 13)).collect())
+    }
+
+    #[test]
+    fn rom_round_trips_through_every_format() {
+        for rom in [sample(), Rom::new("one", 1, vec![1, 0, 1]), Rom::new("e", 8, vec![])] {
+            for f in RomFormat::ALL {
+                let text = rom.to_text(f);
+                let back = Rom::parse(&rom.name, rom.width, f, &text).unwrap();
+                assert_eq!(back.words, rom.words, "{f:?}\n{text}");
+                assert_eq!(text, back.to_text(f), "{f:?} output is not a fixed point");
+            }
+        }
+    }
+
+    #[test]
+    fn rom_real_images_round_trip() {
+        let plan = SpecularPlan::patent();
+        for rom in [brdf_rom(&plan), nk_rom(&plan)] {
+            for f in RomFormat::ALL {
+                let back = Rom::parse(&rom.name, rom.width, f, &rom.to_text(f)).unwrap();
+                assert_eq!(back, rom);
+            }
+        }
+    }
+
+    #[test]
+    fn rom_text_layout_is_fixed() {
+        let r = Rom::new("x", 12, vec![0xabc, 1]);
+        assert_eq!(r.to_hex(), "// x: 2 x 12 bits\nabc\n001\n");
+        assert_eq!(r.to_coe().lines().skip(3).collect::<Vec<_>>(), ["abc,", "001;"]);
+        assert!(r.to_mif().contains("\t0 : ABC;\n\t1 : 001;\nEND;\n"));
+    }
+
+    #[test]
+    fn rom_parsers_accept_what_tools_write() {
+        let hex = "/* hdr */ 0a // c\n@4 1_f\n 2\n";
+        assert_eq!(parse_hex(hex).unwrap(), vec![0xa, 0, 0, 0, 0x1f, 2]);
+        let mif = "% c % WIDTH = 8 ; DEPTH=6;\nADDRESS_RADIX=HEX;DATA_RADIX=UNS;\n\
+                   CONTENT BEGIN\n [0..2] : 9; -- three nines\n 3 : 1 2 3;\nEND;";
+        assert_eq!(parse_mif(mif).unwrap(), (8, vec![9, 9, 9, 1, 2, 3]));
+        let coe = "; comment\nmemory_initialization_radix = 2;\nmemory_initialization_vector = 1 10,\n11;";
+        assert_eq!(parse_coe(coe).unwrap(), vec![1, 2, 3]);
+        assert!(parse_hex("zz").is_err());
+        assert!(parse_mif("WIDTH=4;DEPTH=1;CONTENT BEGIN 1 : 0; END;").is_err());
+        assert!(Rom::parse("x", 4, RomFormat::Hex, "1f").is_err());
+    }
+
+    #[test]
+    fn rom_addr_bits() {
+        assert_eq!((addr_bits(0), addr_bits(1), addr_bits(2), addr_bits(3)), (1, 1, 1, 2));
+        assert_eq!((addr_bits(1024), addr_bits(1025), addr_bits(3000)), (10, 11, 12));
+    }
+}
