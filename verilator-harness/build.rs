@@ -16,6 +16,7 @@ const BUILT_P: [u32; 7] = [1, 2, 4, 8, 16, 32, 64];
 enum Kind {
     Segment,
     Bfpi,
+    Specular,
 }
 
 struct Model {
@@ -26,7 +27,7 @@ struct Model {
     top: String,
     /// Clocks from input transfer to first output valid (0: combinational).
     latency: u32,
-    /// Verilog sources: (file name, text).
+    /// Verilog sources and ROM images: (file name, text).
     sources: Vec<(String, String)>,
 }
 
@@ -62,10 +63,24 @@ fn main() {
 
 fn generated_models() -> Vec<Model> {
     let mut models = Vec::new();
+    let spec = hdl_gen::generate(&hdl_gen::Options::default());
+    let spec_names = hdl_gen::specular::SpecNames::new("");
+    models.push(Model {
+        tag: "spec".into(),
+        kind: Kind::Specular,
+        cfg: Config::default(),
+        top: spec_names.unit.clone(),
+        latency: hdl_gen::Options::default().specular_unit().plan().latency(),
+        sources: spec
+            .into_iter()
+            .filter(|f| f.name.ends_with(".hex") || f.name.starts_with("specular_"))
+            .map(|f| (f.name, f.contents))
+            .collect(),
+    });
     for p in BUILT_P {
         for align in Align::ALL {
             let cfg = Config { p, align, ..Config::default() };
-            let files = hdl_gen::generate(&hdl_gen::Options { cfg, prefix: String::new() });
+            let files = hdl_gen::generate(&hdl_gen::Options { cfg, ..Default::default() });
             let sources: Vec<(String, String)> =
                 files.into_iter().filter(|f| f.name.ends_with(".v")).map(|f| (f.name, f.contents)).collect();
             let names = hdl_gen::Names::new("", &cfg);
@@ -90,12 +105,18 @@ fn models_from_dir(dir: &Path) -> Vec<Model> {
     let align: Align = m["parameters"]["align"].as_str().unwrap_or("span").parse().unwrap_or_else(|e| fail(e));
     let cfg = Config::new(param("p"), param("frac"), param("xbits"), align).unwrap_or_else(|e| fail(e));
     let modules = m["modules"].as_array().unwrap_or_else(|| fail("manifest has no modules".into()));
-    let mut sources = Vec::new();
-    for module in modules {
-        let file = module["file"].as_str().unwrap_or_else(|| fail("a module has no file".into()));
+    let read = |file: &str| {
         let text = fs::read_to_string(dir.join(file)).unwrap_or_else(|e| fail(format!("cannot read {file}: {e}")));
-        sources.push((file.to_string(), text));
-    }
+        (file.to_string(), text)
+    };
+    let files_of = |roles: &[&str]| -> Vec<(String, String)> {
+        modules
+            .iter()
+            .filter(|x| roles.iter().any(|r| x["role"] == *r))
+            .map(|x| read(x["file"].as_str().unwrap_or_else(|| fail("a module has no file".into()))))
+            .collect()
+    };
+    let sources = files_of(&["bfpi", "segment_shader"]);
     let module_of = |role: &str| modules.iter().find(|x| x["role"] == role);
     let top_of = |role: &str| module_of(role).and_then(|x| x["name"].as_str()).map(str::to_string);
     let latency_of = |role: &str| module_of(role).and_then(|x| x["latency"].as_u64()).unwrap_or(0) as u32;
@@ -109,8 +130,17 @@ fn models_from_dir(dir: &Path) -> Vec<Model> {
         let latency = latency_of("segment_shader");
         models.push(Model { tag: format!("seg_p{}_{}", cfg.p, cfg.align), kind: Kind::Segment, cfg, top, latency, sources });
     }
+    if let Some(top) = top_of("specular_unit") {
+        let mut src = files_of(&["specular_unit", "rom"]);
+        for rom in ["brdf_rom", "nk_rom"] {
+            let file = m["specular"][rom]["file"].as_str().unwrap_or_else(|| fail(format!("manifest has no specular.{rom}.file")));
+            src.push(read(file));
+        }
+        let latency = latency_of("specular_unit");
+        models.push(Model { tag: "spec".into(), kind: Kind::Specular, cfg, top, latency, sources: src });
+    }
     if models.is_empty() {
-        fail("manifest lists no bfpi or segment_shader module".into());
+        fail("manifest lists no bfpi, segment_shader or specular_unit module".into());
     }
     models
 }
@@ -188,11 +218,23 @@ fn build_model(v: &Verilator, out: &Path, m: &Model) -> Vec<String> {
         let mut files = Vec::new();
         for (name, text) in &m.sources {
             fs::write(rtl.join(name), text).unwrap();
-            files.push(rtl.join(name));
+            if name.ends_with(".v") {
+                files.push(rtl.join(name));
+            }
         }
+        // $readmemh opens its file when the model starts, from wherever the test runs: name
+        // the images by absolute path.
+        let images: Vec<String> = match m.kind {
+            Kind::Specular => [("BRDF_FILE", golden::rom::BRDF_HEX), ("NK_FILE", golden::rom::NK_HEX)]
+                .iter()
+                .map(|(param, file)| format!("-G{param}=\"{}\"", rtl.join(file).display()))
+                .collect(),
+            _ => Vec::new(),
+        };
         let status = Command::new("verilator")
             .args(["--cc", "-O3", "--x-assign", "fast", "--x-initial", "unique", "-Wno-fatal"])
             .args(["--prefix", &class, "--top-module", &m.top])
+            .args(&images)
             .arg("-Mdir")
             .arg(&obj)
             .args(&files)
@@ -271,6 +313,7 @@ fn shim_cpp(m: &Model, class: &str) -> String {
     let expand = match m.kind {
         Kind::Segment => format!("SEGSHADE_SEGMENT_SHIM({class}, {}, {})", m.tag, m.cfg.p),
         Kind::Bfpi => format!("SEGSHADE_BFPI_SHIM({class}, {}, {})", m.tag, (m.cfg.p * m.cfg.mw()).div_ceil(8)),
+        Kind::Specular => format!("SEGSHADE_SPECULAR_SHIM({class}, {})", m.tag),
     };
     format!("// Generated by build.rs.\n#include \"{class}.h\"\n#include \"shim.h\"\n{expand}\n")
 }
@@ -279,10 +322,12 @@ fn models_rs(models: &[Model]) -> String {
     let mut s = String::from("// Generated by build.rs: the models linked into this crate.\n");
     let mut seg = String::new();
     let mut bfpi = String::new();
+    let mut spec = String::new();
     for m in models {
         let (inp, outp, list) = match m.kind {
             Kind::Segment => ("SegIn", "SegOut", &mut seg),
             Kind::Bfpi => ("BfpiIn", "BfpiOut", &mut bfpi),
+            Kind::Specular => ("SpecIn", "SpecOut", &mut spec),
         };
         let t = &m.tag;
         writeln!(
@@ -307,7 +352,8 @@ fn models_rs(models: &[Model]) -> String {
     write!(
         s,
         "pub static SEGMENT_MODELS: &[ModelInfo<SegIn, SegOut>] = &[\n{seg}];\n\
-         pub static BFPI_MODELS: &[ModelInfo<BfpiIn, BfpiOut>] = &[\n{bfpi}];\n"
+         pub static BFPI_MODELS: &[ModelInfo<BfpiIn, BfpiOut>] = &[\n{bfpi}];\n\
+         pub static SPECULAR_MODELS: &[ModelInfo<SpecIn, SpecOut>] = &[\n{spec}];\n"
     )
     .unwrap();
     s

@@ -4,9 +4,13 @@
 pub mod bfpi;
 pub mod manifest;
 pub mod output;
+pub mod rom;
 pub mod segment;
+pub mod specular;
 pub mod verilog;
+pub mod wrapper;
 
+pub use bfpi::BfpiArch;
 use golden::Config;
 
 pub const VERSION: &str = env!("CARGO_PKG_VERSION");
@@ -39,11 +43,25 @@ pub fn check_prefix(prefix: &str) -> Result<(), String> {
     }
 }
 
-/// What `generate` is asked for.
-#[derive(Clone, Debug)]
+/// What `generate` is asked for. `Options { cfg, ..Default::default() }` takes the defaults.
+#[derive(Clone, Debug, Default)]
 pub struct Options {
     pub cfg: Config,
     pub prefix: String,
+    /// How the increments are formed: SPEC's shift-and-add BFPI, or a comparison form.
+    pub bfpi_arch: BfpiArch,
+    /// The specular unit's tables (`--brdf-k`); `None` is the patent's set and n ranges.
+    pub brdf: Option<golden::specular::SpecularPlan>,
+}
+
+impl Options {
+    /// The specular unit these options describe, with its ROM images.
+    pub fn specular_unit(&self) -> golden::specular::SpecularUnit {
+        match &self.brdf {
+            Some(plan) => golden::specular::SpecularUnit::new(plan.clone()),
+            None => golden::specular::SpecularUnit::default(),
+        }
+    }
 }
 
 /// One output file, name relative to the output folder.
@@ -56,12 +74,18 @@ pub struct GeneratedFile {
 /// Every file of one configuration, in a fixed order. Pure: no clock, no environment.
 pub fn generate(opts: &Options) -> Vec<GeneratedFile> {
     let names = Names::new(&opts.prefix, &opts.cfg);
-    let modules = [bfpi::module(&opts.cfg, &names), segment::module(&opts.cfg, &names)];
+    let mut modules: Vec<verilog::Module> = bfpi::module_for(&opts.cfg, &names, opts.bfpi_arch).into_iter().collect();
+    modules.push(segment::module_with(&opts.cfg, &names, opts.bfpi_arch));
+    let unit = opts.specular_unit();
+    modules.extend(specular::modules(&opts.cfg, &unit, &specular::SpecNames::new(&opts.prefix)));
     let mut files: Vec<GeneratedFile> = modules
         .iter()
         .map(|m| GeneratedFile { name: format!("{}.v", m.name), contents: m.render() })
         .collect();
-    files.push(GeneratedFile { name: "manifest.json".into(), contents: manifest::render(opts, &names, &modules) });
+    for (name, rom) in [(golden::rom::BRDF_HEX, unit.brdf_rom()), (golden::rom::NK_HEX, unit.nk_rom())] {
+        files.push(GeneratedFile { name: name.into(), contents: rom.to_hex() });
+    }
+    files.push(GeneratedFile { name: "manifest.json".into(), contents: manifest::render(opts, &names, &modules, &unit) });
     files.push(GeneratedFile { name: manifest::CORE_FILE.into(), contents: manifest::core_file(opts, &names, &modules) });
     files
 }

@@ -1,6 +1,8 @@
 //! `hdl-gen`: the command line of the segshade generator.
 
-use clap::{Parser, Subcommand};
+use clap::{Args, Parser, Subcommand};
+use golden::rom::RomFormat;
+use golden::specular::{BrdfK, SpecularPlan};
 use golden::{Align, Config};
 use hdl_gen::{check_prefix, generate, output, Options};
 use std::path::PathBuf;
@@ -32,10 +34,88 @@ enum Command {
         /// String prepended to every module name.
         #[arg(long, default_value = "", value_parser = parse_prefix)]
         prefix: String,
+        /// Increments: shift-add (SPEC's BFPI), or the comparison forms naive (`*` by constants)
+        /// and tree (doubling tree in the shader, no BFPI) used by scripts/synth.
+        #[arg(long = "bfpi-arch", default_value = "shift-add", value_parser = ["shift-add", "naive", "tree"])]
+        bfpi_arch: String,
+        #[command(flatten)]
+        brdf: BrdfArgs,
         /// Output folder (created if missing).
         #[arg(long)]
         out: PathBuf,
     },
+    /// Print or write one of the specular unit's ROM images.
+    Rom {
+        /// Which image: the BRDF tables or the n-table.
+        #[arg(long, value_parser = ["brdf", "nk"])]
+        table: String,
+        /// $readmemh hex, Intel MIF or Xilinx COE.
+        #[arg(long, default_value = "hex", value_parser = ["hex", "mif", "coe"])]
+        format: String,
+        #[command(flatten)]
+        brdf: BrdfArgs,
+        /// File to write (standard output without it).
+        #[arg(long)]
+        out: Option<PathBuf>,
+    },
+    /// Write a synthesis harness for one generated module: every input and output registered,
+    /// talking to the outside through three pins (used by scripts/synth).
+    SynthWrapper {
+        /// A folder written by `generate` (its manifest.json lists the module's ports).
+        #[arg(long)]
+        rtl: PathBuf,
+        /// The module to wrap, as named in manifest.json.
+        #[arg(long)]
+        module: String,
+        /// The Verilog file to write; the harness module is `<module>_synth`.
+        #[arg(long)]
+        out: PathBuf,
+    },
+}
+
+/// The specular unit's table set, shared by every command that builds the unit.
+#[derive(Args)]
+struct BrdfArgs {
+    /// BRDF table set: a list of k (ascending, 1..64; each n then takes its least-error table),
+    /// or `auto` to choose the set with the least ROM that meets --max-rel-error.
+    /// Default: the patent's 1,2,4,16 with its n ranges.
+    #[arg(long = "brdf-k", value_parser = parse_brdf_k)]
+    brdf_k: Option<BrdfK>,
+    /// With `--brdf-k auto`: largest relative error of the approximation inside the epicentre,
+    /// as a fraction (0.01) or a percentage (1%).
+    #[arg(long = "max-rel-error", value_parser = parse_rel_error, requires = "brdf_k")]
+    max_rel_error: Option<f64>,
+}
+
+impl BrdfArgs {
+    /// The plan, or `None` for the patent's own (the default).
+    fn plan(&self) -> Result<Option<SpecularPlan>, String> {
+        let choice = match (&self.brdf_k, self.max_rel_error) {
+            (None, _) => return Ok(None),
+            (Some(BrdfK::Auto { .. }), Some(e)) => BrdfK::Auto { max_err: e },
+            (Some(BrdfK::List(_)), Some(_)) => return Err("--max-rel-error goes with --brdf-k auto".into()),
+            (Some(b), None) => b.clone(),
+        };
+        SpecularPlan::from_brdf_k(&choice).map(Some).map_err(|e| format!("--brdf-k {choice}: {e}"))
+    }
+}
+
+fn parse_brdf_k(s: &str) -> Result<BrdfK, String> {
+    s.parse()
+}
+
+fn parse_rel_error(s: &str) -> Result<f64, String> {
+    let (num, scale) = match s.strip_suffix('%') {
+        Some(n) => (n, 0.01),
+        None => (s, 1.0),
+    };
+    let e: f64 = num.trim().parse().map_err(|_| format!("'{s}' is not a number"))?;
+    let e = e * scale;
+    if e.is_finite() && e > 0.0 && e < 1.0 {
+        Ok(e)
+    } else {
+        Err(format!("'{s}' is not a relative error between 0 and 1 (or 0% and 100%)"))
+    }
 }
 
 fn parse_p(s: &str) -> Result<u32, String> {
@@ -52,12 +132,37 @@ fn parse_prefix(s: &str) -> Result<String, String> {
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
-        Command::Generate { p, frac, xbits, align, prefix, out } => {
+        Command::Generate { p, frac, xbits, align, prefix, bfpi_arch, brdf, out } => {
             let align: Align = align.parse().expect("clap checked the alignment");
+            let bfpi_arch = bfpi_arch.parse().expect("clap checked the bfpi arch");
             Config::new(p, frac, xbits, align)
-                .and_then(|cfg| output::write_all(&out, &generate(&Options { cfg, prefix })))
+                .and_then(|cfg| Ok(Options { cfg, prefix, bfpi_arch, brdf: brdf.plan()? }))
+                .and_then(|opts| output::write_all(&out, &generate(&opts)))
                 .map(|()| eprintln!("wrote {}", out.display()))
         }
+        Command::Rom { table, format, brdf, out } => brdf.plan().and_then(|plan| {
+            let unit = Options { brdf: plan, ..Options::default() }.specular_unit();
+            let rom = if table == "brdf" { unit.brdf_rom() } else { unit.nk_rom() };
+            let format = match format.as_str() {
+                "hex" => RomFormat::Hex,
+                "mif" => RomFormat::Mif,
+                _ => RomFormat::Coe,
+            };
+            let text = rom.to_text(format);
+            match out {
+                Some(path) => output::write_one(&path, text.as_bytes()).map(|()| eprintln!("wrote {}", path.display())),
+                None => {
+                    print!("{text}");
+                    Ok(())
+                }
+            }
+        }),
+        Command::SynthWrapper { rtl, module, out } => std::fs::read_to_string(rtl.join("manifest.json"))
+            .map_err(|e| format!("cannot read {}: {e}", rtl.join("manifest.json").display()))
+            .and_then(|text| hdl_gen::wrapper::ports_from_manifest(&text, &module))
+            .and_then(|ports| hdl_gen::wrapper::module(&module, &ports))
+            .and_then(|m| output::write_one(&out, m.render().as_bytes()))
+            .map(|()| eprintln!("wrote {}", out.display())),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -2,8 +2,11 @@
 //! `generate` wrote, derived from the same module descriptions that print the Verilog.
 
 use crate::verilog::{Dir, Module};
-use crate::{segment, Names, Options, VERSION};
+use crate::specular::SpecNames;
+use crate::{segment, BfpiArch, Names, Options, VERSION};
 use golden::bfpi::{Adder, BfpiPlan};
+use golden::rom::{BRDF_HEX, NK_HEX};
+use golden::specular::{SpecularGeometry, SpecularUnit};
 use serde::Serialize;
 
 pub const CORE_FILE: &str = "segshade.core";
@@ -14,7 +17,29 @@ struct Manifest<'a> {
     parameters: Parameters<'a>,
     formats: Formats,
     modules: Vec<ModuleEntry>,
-    bfpi: Bfpi,
+    /// The shift-and-add graph; absent for the comparison forms (`--bfpi-arch naive|tree`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    bfpi: Option<Bfpi>,
+    specular: Specular,
+}
+
+/// The specular unit's configuration: k-set, n ranges, tables, ROM geometry, pipeline.
+#[derive(Serialize)]
+struct Specular {
+    module: String,
+    brdf_rom: RomEntry,
+    nk_rom: RomEntry,
+    #[serde(flatten)]
+    geometry: SpecularGeometry,
+}
+
+#[derive(Serialize)]
+struct RomEntry {
+    module: String,
+    file: &'static str,
+    depth: usize,
+    width: u32,
+    bits: u64,
 }
 
 #[derive(Serialize)]
@@ -30,6 +55,9 @@ struct Parameters<'a> {
     xbits: u32,
     align: &'static str,
     prefix: &'a str,
+    /// Only written for the comparison forms, so the default output stays as it was.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    bfpi_arch: Option<&'static str>,
 }
 
 #[derive(Serialize)]
@@ -90,20 +118,32 @@ fn ports(m: &Module) -> Vec<PortEntry> {
         .collect()
 }
 
-pub fn render(opts: &Options, names: &Names, modules: &[Module]) -> String {
+pub fn render(opts: &Options, names: &Names, modules: &[Module], unit: &SpecularUnit) -> String {
     let cfg = &opts.cfg;
     let plan = BfpiPlan::new(cfg.p);
+    let spec = SpecNames::new(&opts.prefix);
     let entry = |m: &Module| {
         let (role, latency, throughput) = if m.name == names.bfpi {
             ("bfpi", 0, "combinational")
-        } else {
+        } else if m.name == names.segment {
             ("segment_shader", segment::LATENCY, "one segment per clock")
+        } else if m.name == spec.unit {
+            ("specular_unit", unit.plan().latency(), "one pixel per clock")
+        } else {
+            ("rom", 1, "one word per clock")
         };
         ModuleEntry { name: m.name.clone(), file: format!("{}.v", m.name), role, latency, throughput, ports: ports(m) }
     };
     let manifest = Manifest {
         generator: Generator { name: "segshade hdl-gen", version: VERSION },
-        parameters: Parameters { p: cfg.p, frac: cfg.frac, xbits: cfg.xbits, align: cfg.align.name(), prefix: &opts.prefix },
+        parameters: Parameters {
+            p: cfg.p,
+            frac: cfg.frac,
+            xbits: cfg.xbits,
+            align: cfg.align.name(),
+            prefix: &opts.prefix,
+            bfpi_arch: (opts.bfpi_arch != BfpiArch::ShiftAdd).then(|| opts.bfpi_arch.name()),
+        },
         formats: Formats {
             intensity: format!("UQ8.{}", cfg.frac),
             increment: format!("signed Q8.{}", cfg.frac),
@@ -114,19 +154,38 @@ pub fn render(opts: &Options, names: &Names, modules: &[Module]) -> String {
             accumulator_bits: cfg.aw(),
         },
         modules: modules.iter().map(entry).collect(),
-        bfpi: Bfpi {
+        bfpi: (opts.bfpi_arch == BfpiArch::ShiftAdd).then(|| Bfpi {
             module: names.bfpi.clone(),
             adder_count: plan.adder_count(),
             depth: plan.depth(),
             lower_bound: (cfg.p / 2).saturating_sub(1),
             adders: plan.adders.clone(),
+        }),
+        specular: Specular {
+            module: spec.unit.clone(),
+            brdf_rom: RomEntry {
+                module: spec.brdf.clone(),
+                file: BRDF_HEX,
+                depth: unit.brdf_rom().depth(),
+                width: unit.brdf_rom().width,
+                bits: unit.brdf_rom().bits(),
+            },
+            nk_rom: RomEntry {
+                module: spec.nk.clone(),
+                file: NK_HEX,
+                depth: unit.nk_rom().depth(),
+                width: unit.nk_rom().width,
+                bits: unit.nk_rom().bits(),
+            },
+            geometry: unit.plan().geometry(),
         },
     };
     serde_json::to_string_pretty(&manifest).expect("manifest serializes") + "\n"
 }
 
 /// A FuseSoC CAPI2 core for the generated files: a default target with the segment shader as
-/// top level, and a Verilator lint target.
+/// top level, a `specular` target with the specular unit, and a Verilator lint target. The ROM
+/// images are copied into the tool's work folder, where `$readmemh` looks for them.
 pub fn core_file(opts: &Options, names: &Names, modules: &[Module]) -> String {
     let cfg = &opts.cfg;
     let mut files = String::new();
@@ -137,17 +196,25 @@ pub fn core_file(opts: &Options, names: &Names, modules: &[Module]) -> String {
         "CAPI=2:\n\
          # Generated by segshade hdl-gen {VERSION}; do not edit.\n\
          name: segshade:shading:{top}:{VERSION}\n\
-         description: Segment Gouraud shader, P = {p}, F = {f}, XW = {xw}, align = {align}\n\
+         description: Segment Gouraud shader and specular unit, P = {p}, F = {f}, XW = {xw}, align = {align}\n\
          \n\
          filesets:\n\
          \x20 rtl:\n\
          \x20   files:\n{files}\
          \x20   file_type: verilogSource\n\
+         \x20 rom:\n\
+         \x20   files:\n\
+         \x20     - {BRDF_HEX}: {{copyto: {BRDF_HEX}}}\n\
+         \x20     - {NK_HEX}: {{copyto: {NK_HEX}}}\n\
+         \x20   file_type: user\n\
          \n\
          targets:\n\
          \x20 default:\n\
-         \x20   filesets: [rtl]\n\
+         \x20   filesets: [rtl, rom]\n\
          \x20   toplevel: {top}\n\
+         \x20 specular:\n\
+         \x20   filesets: [rtl, rom]\n\
+         \x20   toplevel: {spec_top}\n\
          \x20 lint:\n\
          \x20   default_tool: verilator\n\
          \x20   filesets: [rtl]\n\
@@ -157,6 +224,7 @@ pub fn core_file(opts: &Options, names: &Names, modules: &[Module]) -> String {
          \x20       mode: lint-only\n\
          \x20       verilator_options: [-Wall]\n",
         top = names.segment,
+        spec_top = SpecNames::new(&opts.prefix).unit,
         p = cfg.p,
         f = cfg.frac,
         xw = cfg.xbits,

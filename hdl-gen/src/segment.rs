@@ -7,10 +7,14 @@
 //! registers, while the accumulator steps by P*dI (BFPI lane P-1) to the next segment. The next
 //! span loads in the same clock the last segment of the current one leaves, so spans follow
 //! each other with no bubble.
+//!
+//! With `--bfpi-arch tree` (a comparison form) there is no BFPI: lane `j + 2^k` is lane `j` plus
+//! `dI << k`, a doubling tree of P - 1 accumulator-wide adders, and the step is `dI << log2 P`.
 
 use crate::verilog::{
     assign, bit, bus, comment, lit, net, reg, set, sext, sreg, swire, wire, zext, Item, Module, Port, Stmt,
 };
+use crate::bfpi::BfpiArch;
 use crate::Names;
 use golden::{Align, Config};
 
@@ -44,7 +48,12 @@ pub fn ports(cfg: &Config) -> Vec<Port> {
     ]
 }
 
+/// The shader with the default increment form (SPEC §3's BFPI).
 pub fn module(cfg: &Config, names: &Names) -> Module {
+    module_with(cfg, names, BfpiArch::default())
+}
+
+pub fn module_with(cfg: &Config, names: &Names, arch: BfpiArch) -> Module {
     let (p, xw, f, log2p) = (cfg.p, cfg.xbits, cfg.frac, cfg.log2p());
     let (iw, dw, mw, aw) = (cfg.iw(), cfg.dw(), cfg.mw(), cfg.aw());
     let rw = rem_width(cfg);
@@ -65,7 +74,11 @@ pub fn module(cfg: &Config, names: &Names) -> Module {
         },
         format!("Latency: first segment valid {LATENCY} clocks after the span's transfer; one segment per clock after that,"),
         "across span boundaries too, while out_ready is high.".into(),
-        format!("Increments: {} (shift-and-add, no multipliers).", names.bfpi),
+        match arch {
+            BfpiArch::ShiftAdd => format!("Increments: {} (shift-and-add, no multipliers).", names.bfpi),
+            BfpiArch::Naive => format!("Increments: {} (naive comparison form: `*` by constants).", names.bfpi),
+            BfpiArch::Tree => "Increments: doubling tree, lane j + 2^k = lane j + (dI << k) (comparison form, no BFPI).".into(),
+        },
     ];
 
     let mut body = vec![
@@ -110,16 +123,34 @@ pub fn module(cfg: &Config, names: &Names) -> Module {
     body.push(swire("start_acc", aw, start));
     body.push(Item::Blank);
 
-    body.push(comment("Multiples 1..P of the current increment."));
-    body.push(net("inc", p * mw));
-    body.push(Item::Instance {
-        module: names.bfpi.clone(),
-        name: "u_bfpi".into(),
-        params: vec![],
-        conns: vec![("di".into(), "cur_di".into()), ("inc".into(), "inc".into())],
-    });
-    body.push(swire("inc_p", mw, format!("inc[{} +: {mw}]", (p - 1) * mw)));
-    body.push(swire("step", aw, sext("inc_p", mw, aw)));
+    if arch == BfpiArch::Tree {
+        body.push(comment("Doubling tree: lane j + 2^k = lane j + (dI << k)."));
+        body.push(swire("cur_di_ext", aw, sext("cur_di", dw, aw)));
+        body.push(swire("tv0", aw, "cur_acc"));
+        for i in 1..p {
+            let k = 31 - i.leading_zeros();
+            let j = i - (1 << k);
+            let term = if k == 0 { "cur_di_ext".to_string() } else { format!("(cur_di_ext << {k})") };
+            body.push(swire(&format!("tv{i}"), aw, format!("tv{j} + {term}")));
+        }
+        body.push(bus("tree", p * aw));
+        for i in 0..p {
+            body.push(assign(format!("tree[{} +: {aw}]", i * aw), format!("tv{i}")));
+        }
+        let step = if log2p == 0 { "cur_di_ext".to_string() } else { format!("cur_di_ext << {log2p}") };
+        body.push(swire("step", aw, step));
+    } else {
+        body.push(comment("Multiples 1..P of the current increment."));
+        body.push(net("inc", p * mw));
+        body.push(Item::Instance {
+            module: names.bfpi.clone(),
+            name: "u_bfpi".into(),
+            params: vec![],
+            conns: vec![("di".into(), "cur_di".into()), ("inc".into(), "inc".into())],
+        });
+        body.push(swire("inc_p", mw, format!("inc[{} +: {mw}]", (p - 1) * mw)));
+        body.push(swire("step", aw, sext("inc_p", mw, aw)));
+    }
     body.push(Item::Blank);
 
     body.push(comment("Lanes: add, round (the half is in the accumulator), clamp to 0..255, mask."));
@@ -133,13 +164,17 @@ pub fn module(cfg: &Config, names: &Names) -> Module {
         comment("The fraction bits of v only carry into the sum; the pixel is its integer part."),
         comment("verilator lint_off UNUSEDSIGNAL"),
         Item::Wire { name: "v".into(), width: aw, signed: true, value: None },
-        Item::IfGenerate {
-            cond: "i == 0".into(),
-            then: ("base".into(), vec![assign("v", "cur_acc")]),
-            els: (
-                "offset".into(),
-                vec![swire("d", mw, format!("inc[(i-1)*{mw} +: {mw}]")), assign("v", format!("cur_acc + {}", sext("d", mw, aw)))],
-            ),
+        if arch == BfpiArch::Tree {
+            assign("v", format!("tree[i*{aw} +: {aw}]"))
+        } else {
+            Item::IfGenerate {
+                cond: "i == 0".into(),
+                then: ("base".into(), vec![assign("v", "cur_acc")]),
+                els: (
+                    "offset".into(),
+                    vec![swire("d", mw, format!("inc[(i-1)*{mw} +: {mw}]")), assign("v", format!("cur_acc + {}", sext("d", mw, aw)))],
+                ),
+            }
         },
         swire("q", qw, format!("v[{}:{f}]", aw - 1)),
         comment("verilator lint_on UNUSEDSIGNAL"),

@@ -33,15 +33,16 @@ fn verilator_lint_and_icarus_are_clean() {
     for (cfg, prefix) in configs() {
         let dir = std::env::temp_dir().join(format!("hdl-gen-lint-{}-{}-{}", std::process::id(), cfg.p, cfg.align));
         let _ = std::fs::remove_dir_all(&dir);
-        let files = generate(&Options { cfg, prefix: prefix.into() });
+        let files = generate(&Options { cfg, prefix: prefix.into(), ..Default::default() });
         output::write_all(&dir, &files).unwrap();
         let sources: Vec<String> =
             files.iter().filter(|f| f.name.ends_with(".v")).map(|f| dir.join(&f.name).display().to_string()).collect();
-        let top = hdl_gen::Names::new(prefix, &cfg).segment;
-        let mut lint = vec!["--lint-only".to_string(), "-Wall".into(), "--top-module".into(), top];
-        lint.extend(sources.iter().cloned());
-        let text = run("verilator", &lint);
-        assert!(!text.contains("%Warning"), "{cfg:?}: {text}");
+        for top in [hdl_gen::Names::new(prefix, &cfg).segment, hdl_gen::specular::SpecNames::new(prefix).unit] {
+            let mut lint = vec!["--lint-only".to_string(), "-Wall".into(), "--top-module".into(), top];
+            lint.extend(sources.iter().cloned());
+            let text = run("verilator", &lint);
+            assert!(!text.contains("%Warning"), "{cfg:?}: {text}");
+        }
         let mut ivl = vec!["-g2005".to_string(), "-Wall".into(), "-o".into(), dir.join("a.out").display().to_string()];
         ivl.extend(sources);
         let text = run("iverilog", &ivl);

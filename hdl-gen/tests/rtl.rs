@@ -6,7 +6,7 @@ use hdl_gen::{generate, Options};
 #[test]
 fn committed_rtl_matches_the_generator() {
     let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../rtl");
-    let files = generate(&Options { cfg: golden::Config::default(), prefix: String::new() });
+    let files = generate(&Options::default());
     let mut on_disk: Vec<String> = std::fs::read_dir(&dir)
         .expect("rtl/ exists")
         .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())

@@ -91,3 +91,37 @@ struct BfpiOut {
         m->eval();                                                                            \
         segshade_copy(out->inc, m->inc, BYTES);                                               \
     }
+
+struct SpecIn {
+    uint32_t in_c, in_n, in_theta0, in_dtheta, in_len;  // thetas: two's complement bits
+    uint8_t rst, in_valid, out_ready;
+};
+
+struct SpecOut {
+    uint16_t out_spec;
+    uint8_t in_ready, out_valid, out_last, out_err;
+};
+
+#define SEGSHADE_SPECULAR_SHIM(CLASS, SYM)                                                   \
+    extern "C" void* SYM##_new(uint64_t seed) { return new SegshadeModel<CLASS>(seed); }      \
+    extern "C" void SYM##_free(void* h) { delete static_cast<SegshadeModel<CLASS>*>(h); }     \
+    extern "C" void SYM##_step(void* h, const SpecIn* in, SpecOut* out) {                     \
+        CLASS* m = static_cast<SegshadeModel<CLASS>*>(h)->top;                                \
+        m->clk = 0;                                                                           \
+        m->rst = in->rst;                                                                     \
+        m->in_valid = in->in_valid;                                                           \
+        m->out_ready = in->out_ready;                                                         \
+        m->in_c = in->in_c;                                                                   \
+        m->in_n = in->in_n;                                                                   \
+        m->in_theta0 = in->in_theta0;                                                         \
+        m->in_dtheta = in->in_dtheta;                                                         \
+        m->in_len = in->in_len;                                                               \
+        m->eval();                                                                            \
+        out->in_ready = m->in_ready;                                                          \
+        out->out_valid = m->out_valid;                                                        \
+        out->out_last = m->out_last;                                                          \
+        out->out_err = m->out_err;                                                            \
+        out->out_spec = m->out_spec;                                                          \
+        m->clk = 1;                                                                           \
+        m->eval();                                                                            \
+    }

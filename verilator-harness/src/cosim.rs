@@ -77,7 +77,7 @@ pub struct Report {
 const KEEP_MISMATCHES: usize = 20;
 
 impl Report {
-    fn mismatch(&mut self, m: Mismatch) {
+    pub fn mismatch(&mut self, m: Mismatch) {
         self.mismatch_count += 1;
         if let Some(t) = m.triangle {
             self.failed.insert(t);

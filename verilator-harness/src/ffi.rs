@@ -76,6 +76,32 @@ impl BfpiOut {
     }
 }
 
+/// Inputs of `specular_unit` for one clock.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default)]
+pub struct SpecIn {
+    pub in_c: u32,
+    pub in_n: u32,
+    /// Two's complement bits of the signed Q3.28 ports.
+    pub in_theta0: u32,
+    pub in_dtheta: u32,
+    pub in_len: u32,
+    pub rst: u8,
+    pub in_valid: u8,
+    pub out_ready: u8,
+}
+
+/// Outputs of `specular_unit`, sampled just before the rising edge.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default)]
+pub struct SpecOut {
+    pub out_spec: u16,
+    pub in_ready: u8,
+    pub out_valid: u8,
+    pub out_last: u8,
+    pub out_err: u8,
+}
+
 /// A linked model: its configuration and its three symbols.
 pub struct ModelInfo<I: 'static, O: 'static> {
     /// `seg_p8_span`, `bfpi_p8`, ...: also the Verilator class suffix.

@@ -2,10 +2,12 @@
 //!
 //! `build.rs` verilates and links the models; [`ffi`] wraps them; [`stimulus`] makes random
 //! and directed triangles; [`cosim`] streams their spans through a model with random valid
-//! gaps and backpressure and checks every segment and the final frames.
+//! gaps and backpressure and checks every segment and the final frames; [`specular`] does the
+//! same for the specular unit, pixel by pixel.
 
 pub mod cosim;
 pub mod ffi;
+pub mod specular;
 pub mod stimulus;
 
 /// The seed of a random test: `COSIM_SEED` when set (to replay a failure), else a fresh one.

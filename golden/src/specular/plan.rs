@@ -377,10 +377,10 @@ impl SpecularPlan {
         self.mag_bits + self.nk_mant_bits
     }
 
-    /// Clock edges from the edge that loads `theta_j` into the accumulator (for j = 0, the
-    /// input transfer) to the edge that loads pixel j's `out_spec`.
+    /// A span transferred in clock t has its first pixel valid in clock t + latency: one clock
+    /// per register stage (the same convention as the segment shader's).
     pub fn latency(&self) -> u32 {
-        self.stages().len() as u32 - 1
+        self.stages().len() as u32
     }
 
     /// The register stages, in order. Stage 0 is the accumulator; a stall (out_ready low with
@@ -544,7 +544,7 @@ mod tests {
         assert_eq!(p.prod_bits(), 24 + p.nk_mant_bits);
         assert_eq!(p.nk_width(), 2 + p.nk_mant_bits);
         let nw = p.nk_mant_bits;
-        assert_eq!(p.latency(), 4);
+        assert_eq!(p.latency(), 5);
         assert_eq!(p.stages().len(), 5);
         for (t, tb) in p.tables.iter().enumerate() {
             assert!(tb.end_arg() < std::f64::consts::FRAC_PI_2);

@@ -1,5 +1,6 @@
 //! `cosim`: streams random triangles through one verilated segment shader and checks every
 //! segment and frame against the golden model. Ends with `N passed, M failed` (triangles).
+//! With `--specular`, the same for the specular unit, pixel by pixel (spans).
 
 use clap::Parser;
 use golden::setup::Screen;
@@ -9,7 +10,9 @@ use rand::SeedableRng;
 use std::process::ExitCode;
 use std::time::Instant;
 use verilator_harness::cosim::{Report, SegmentCosim, Traffic};
-use verilator_harness::ffi::{segment_model, SEGMENT_MODELS};
+use golden::specular::SpecularUnit;
+use verilator_harness::ffi::{segment_model, SEGMENT_MODELS, SPECULAR_MODELS};
+use verilator_harness::specular::{random_span, SpecularCosim};
 use verilator_harness::stimulus::random_triangle;
 
 #[derive(Parser)]
@@ -38,10 +41,20 @@ struct Args {
     /// Triangles painted into one frame between frame checks.
     #[arg(long, default_value_t = 64, value_parser = clap::value_parser!(u64).range(1..))]
     batch: u64,
+    /// Run the specular unit instead: random spans set up from random normals and
+    /// half-vectors, every pixel checked; `N passed, M failed` then counts spans.
+    #[arg(long)]
+    specular: bool,
+    /// With --specular: pixels to stream.
+    #[arg(long, default_value_t = 1_000_000, requires = "specular")]
+    pixels: u64,
 }
 
 fn main() -> ExitCode {
     let args = Args::parse();
+    if args.specular {
+        return specular(&args);
+    }
     let align: Align = args.align.parse().expect("clap checked it");
     let Some(info) = segment_model(args.p, align) else {
         let built: Vec<&str> = SEGMENT_MODELS.iter().map(|m| m.tag).collect();
@@ -88,9 +101,44 @@ fn main() -> ExitCode {
         report.cycles as f64 / secs
     );
     println!("{} passed, {} failed", report.passed_count(), report.failed_count());
+    exit_code(&report)
+}
+
+fn exit_code(report: &Report) -> ExitCode {
     if report.ok() {
         ExitCode::SUCCESS
     } else {
         ExitCode::from(1)
     }
+}
+
+fn specular(args: &Args) -> ExitCode {
+    let Some(info) = SPECULAR_MODELS.first() else {
+        eprintln!("error: --specular: this build has no specular unit");
+        return ExitCode::from(2);
+    };
+    let seed = args.seed.unwrap_or_else(|| verilator_harness::seed("cosim --specular"));
+    let traffic = if args.traffic == "full" { Traffic::FULL } else { Traffic::RANDOM };
+    println!("model {} ({}), seed {seed}, traffic {}", info.tag, info.top, args.traffic);
+    let mut rng = StdRng::seed_from_u64(seed);
+    let mut sim = SpecularCosim::new(info, SpecularUnit::default(), seed, traffic);
+    let mut report = Report::default();
+    let start = Instant::now();
+    while report.pixels < args.pixels {
+        let spans: Vec<_> = (0..256).map(|_| random_span(&mut rng, info.cfg.max_len())).collect();
+        sim.stream(&spans, &mut report);
+    }
+    let secs = start.elapsed().as_secs_f64();
+    for m in &report.mismatches {
+        println!("MISMATCH (seed {seed}) {m}");
+    }
+    println!("spans:      {}", report.spans);
+    println!("pixels:     {} compared", report.pixels);
+    println!("mismatches: {}", report.mismatch_count);
+    println!("cycles:     {}", report.cycles);
+    println!("cycles per pixel: {:.3} (latency {} clocks)", report.cycles as f64 / report.pixels.max(1) as f64, info.latency);
+    println!("wall: {secs:.2} s, {:.0} pixels/s, {:.0} clocks/s", report.pixels as f64 / secs, report.cycles as f64 / secs);
+    let failed = report.failed_count();
+    println!("{} passed, {failed} failed", report.spans as usize - report.failed.len().min(report.spans as usize));
+    exit_code(&report)
 }

@@ -1,0 +1,166 @@
+//! `hdl-gen synth-wrapper`: a harness that puts a generated module between registers for FPGA
+//! area and timing measurements (scripts/synth).
+//!
+//! Every input of the block is driven by a flip-flop and every output lands in a flip-flop, so
+//! the place-and-route Fmax is the block's own register-to-register speed, not a pad delay. The
+//! wide buses would not fit the package's pins (an HX8K in ct256 has 206 I/Os, and P = 16
+//! already needs more), so the harness talks to the outside through three pins:
+//!
+//! - the input registers form one shift chain fed from `si` (flip-flops only, no logic);
+//! - the output registers are folded by a pipelined XOR tree, four bits per LUT and a register
+//!   after every level, into `so`, so no output bit can be optimized away and every wrapper path
+//!   is one LUT long.
+//!
+//! The ports come from the module's entry in `manifest.json`, so any module `generate` lists is
+//! covered, whatever it is.
+
+use crate::verilog::{bit, reg, set, Dir, Item, Module, Port, Stmt};
+
+/// One port of the wrapped block, as the manifest lists it.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct BlockPort {
+    pub name: String,
+    pub dir: Dir,
+    pub width: u32,
+}
+
+/// The ports of `module` in a `manifest.json` text.
+pub fn ports_from_manifest(manifest: &str, module: &str) -> Result<Vec<BlockPort>, String> {
+    let m: serde_json::Value = serde_json::from_str(manifest).map_err(|e| format!("manifest.json: {e}"))?;
+    let modules = m["modules"].as_array().ok_or("manifest.json has no modules list")?;
+    let entry = modules.iter().find(|e| e["name"] == module).ok_or_else(|| {
+        let names: Vec<&str> = modules.iter().filter_map(|e| e["name"].as_str()).collect();
+        format!("manifest.json lists no module '{module}' (it lists {})", names.join(", "))
+    })?;
+    let ports = entry["ports"].as_array().ok_or_else(|| format!("module '{module}' has no ports list"))?;
+    ports
+        .iter()
+        .map(|p| {
+            let name = p["name"].as_str().ok_or("a port has no name")?.to_string();
+            let dir = match p["direction"].as_str() {
+                Some("input") => Dir::Input,
+                Some("output") => Dir::Output,
+                other => return Err(format!("port {name}: direction {other:?} is not input or output")),
+            };
+            let width = p["width"].as_u64().filter(|&w| (1..=1 << 20).contains(&w)).ok_or(format!("port {name}: bad width"))? as u32;
+            Ok(BlockPort { name, dir, width })
+        })
+        .collect()
+}
+
+/// The harness module `<block>_synth` around `block`, which must have an input `clk`.
+pub fn module(block: &str, ports: &[BlockPort]) -> Result<Module, String> {
+    if !ports.iter().any(|p| p.name == "clk" && p.dir == Dir::Input && p.width == 1) {
+        return Err(format!("module '{block}' has no one-bit input clk"));
+    }
+    let ins: Vec<&BlockPort> = ports.iter().filter(|p| p.dir == Dir::Input && p.name != "clk").collect();
+    let outs: Vec<&BlockPort> = ports.iter().filter(|p| p.dir == Dir::Output).collect();
+    let n_in: u32 = ins.iter().map(|p| p.width).sum();
+    let n_out: u32 = outs.iter().map(|p| p.width).sum();
+    if n_in == 0 || n_out == 0 {
+        return Err(format!("module '{block}' needs at least one input besides clk and one output"));
+    }
+
+    let mut body = vec![Item::Comment("Input registers: one shift chain from si.".into()), reg("in_q", n_in)];
+    let shift_in = if n_in == 1 { "si".to_string() } else { format!("{{in_q[{}:0], si}}", n_in - 2) };
+    body.push(Item::Always(vec![set("in_q", shift_in)]));
+    body.push(Item::Blank);
+
+    let mut conns = vec![("clk".to_string(), "clk".to_string())];
+    let mut off = 0;
+    for p in &ins {
+        let sel = if n_in == 1 {
+            "in_q".to_string()
+        } else if p.width == 1 {
+            format!("in_q[{off}]")
+        } else {
+            format!("in_q[{off} +: {}]", p.width)
+        };
+        conns.push((p.name.clone(), sel));
+        off += p.width;
+    }
+    let mut outs_concat = Vec::new();
+    for p in &outs {
+        body.push(Item::Wire { name: format!("o_{}", p.name), width: p.width, signed: false, value: None });
+        conns.push((p.name.clone(), format!("o_{}", p.name)));
+        outs_concat.push(format!("o_{}", p.name));
+    }
+    body.push(Item::Instance { module: block.to_string(), name: "u_block".into(), params: vec![], conns });
+    body.push(Item::Blank);
+
+    body.push(Item::Comment("Output registers.".into()));
+    body.push(reg("out_q", n_out));
+    let all = if outs_concat.len() == 1 { outs_concat[0].clone() } else { format!("{{{}}}", outs_concat.join(", ")) };
+    body.push(Item::Always(vec![set("out_q", all)]));
+    body.push(Item::Blank);
+
+    body.push(Item::Comment("Pipelined XOR fold of the output registers into so, four bits per level and LUT.".into()));
+    let (mut name, mut width) = ("out_q".to_string(), n_out);
+    let mut level = 0;
+    while width > 1 {
+        level += 1;
+        let next = width.div_ceil(4);
+        let next_name = format!("fold{level}");
+        body.push(reg(&next_name, next));
+        let mut stmts = Vec::new();
+        for b in 0..next {
+            let lo = 4 * b;
+            let n = (width - lo).min(4);
+            let rhs = if n == 1 { bit(&name, width, lo) } else { format!("^{name}[{lo} +: {n}]") };
+            stmts.push(Stmt::Set(bit(&next_name, next, b), rhs));
+        }
+        body.push(Item::Always(stmts));
+        (name, width) = (next_name, next);
+    }
+    body.push(Item::Assign("so".into(), name));
+
+    Ok(Module {
+        name: format!("{block}_synth"),
+        header: vec![
+            format!("{block}_synth — synthesis harness: {block} between registers, for area and timing reports."),
+            "Generated by segshade hdl-gen synth-wrapper; do not edit.".into(),
+            String::new(),
+            format!("{n_in} input bits arrive through a shift chain from si; {n_out} output bits are registered and"),
+            "folded by a pipelined XOR tree into so. Every path outside the block is at most one LUT long.".into(),
+            format!("Clocks from si to the block input MSB: {n_in}; output register to so: {}.", level + 1),
+        ],
+        params: vec![],
+        ports: vec![
+            Port::input("clk", 1, "", "rising edge"),
+            Port::input("si", 1, "", "serial input into the input registers"),
+            Port::output("so", 1, "", "XOR of every output register, pipelined"),
+        ],
+        body,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn port(name: &str, dir: Dir, width: u32) -> BlockPort {
+        BlockPort { name: name.into(), dir, width }
+    }
+
+    #[test]
+    fn wraps_every_port() {
+        let ports = [
+            port("clk", Dir::Input, 1),
+            port("rst", Dir::Input, 1),
+            port("a", Dir::Input, 5),
+            port("y", Dir::Output, 9),
+            port("z", Dir::Output, 1),
+        ];
+        let text = module("blk", &ports).unwrap().render();
+        assert!(text.contains("module blk_synth ("), "{text}");
+        assert!(text.contains(".rst(in_q[0])") && text.contains(".a(in_q[1 +: 5])"), "{text}");
+        assert!(text.contains("out_q <= {o_y, o_z};"), "{text}");
+        // 10 output bits: 3, then 1.
+        assert!(text.contains("fold1[2] <= ^out_q[8 +: 2];") && text.contains("fold2 <= ^fold1[0 +: 3];"), "{text}");
+    }
+
+    #[test]
+    fn needs_a_clock() {
+        assert!(module("blk", &[port("a", Dir::Input, 2), port("y", Dir::Output, 2)]).is_err());
+    }
+}
