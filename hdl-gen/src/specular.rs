@@ -53,6 +53,17 @@ pub fn ports(cfg: &Config) -> Vec<Port> {
     ]
 }
 
+/// A ROM read that moves with the pipeline: enabled by `adv`, image named by `file_param`.
+fn rom_read(module: &str, name: &str, file_param: &str, addr: &str, data: &str) -> Item {
+    let conn = |port: &str, sig: &str| (port.to_string(), sig.to_string());
+    Item::Instance {
+        module: module.into(),
+        name: name.into(),
+        params: vec![conn("INIT_FILE", file_param)],
+        conns: vec![conn("clk", "clk"), conn("en", "adv"), conn("addr", addr), conn("data", data)],
+    }
+}
+
 /// The ROM modules and the unit, in file order.
 pub fn modules(cfg: &Config, unit: &SpecularUnit, names: &SpecNames) -> Vec<Module> {
     vec![
@@ -152,17 +163,7 @@ fn module(cfg: &Config, unit: &SpecularUnit, names: &SpecNames) -> Module {
         reg("c1", C_BITS),
         reg("last1", 1),
         Item::Bus { name: "nk1".into(), width: g.nk_width },
-        Item::Instance {
-            module: names.nk.clone(),
-            name: "u_nk".into(),
-            params: vec![("INIT_FILE".into(), "NK_FILE".into())],
-            conns: vec![
-                ("clk".into(), "clk".into()),
-                ("en".into(), adv.into()),
-                ("addr".into(), "n0".into()),
-                ("data".into(), "nk1".into()),
-            ],
-        },
+        rom_read(&names.nk, "u_nk", "NK_FILE", "n0", "nk1"),
         Item::Blank,
         comment("Stage 2: the argument multiplier; M = 0 marks an invalid n."),
         wire("m1", mw, format!("nk1[{}:0]", mw - 1)),
@@ -210,17 +211,7 @@ fn module(cfg: &Config, unit: &SpecularUnit, names: &SpecNames) -> Module {
         reg("c3", C_BITS),
         reg("last3", 1),
         Item::Bus { name: "w3".into(), width: w },
-        Item::Instance {
-            module: names.brdf.clone(),
-            name: "u_brdf".into(),
-            params: vec![("INIT_FILE".into(), "BRDF_FILE".into())],
-            conns: vec![
-                ("clk".into(), "clk".into()),
-                ("en".into(), adv.into()),
-                ("addr".into(), "addr2".into()),
-                ("data".into(), "w3".into()),
-            ],
-        },
+        rom_read(&names.brdf, "u_brdf", "BRDF_FILE", "addr2", "w3"),
         Item::Blank,
         comment(format!("Stage 4: out = C * (w + 1) / 2^{w}, rounded half up; never above C.")),
         comment("verilator lint_off UNUSEDSIGNAL"),
