@@ -6,6 +6,7 @@ pub mod bfpi;
 pub mod format;
 pub mod raster;
 pub mod rom;
+pub mod schemes;
 pub mod segment;
 pub mod setup;
 pub mod specular;

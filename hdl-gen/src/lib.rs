@@ -4,9 +4,11 @@
 pub mod bfpi;
 pub mod manifest;
 pub mod output;
+pub mod report;
 pub mod rom;
 pub mod segment;
 pub mod specular;
+pub mod testbench;
 pub mod verilog;
 pub mod wrapper;
 

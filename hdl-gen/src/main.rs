@@ -71,6 +71,54 @@ enum Command {
         #[arg(long)]
         out: PathBuf,
     },
+    /// Write a self-checking Verilog-2005 testbench of the segment shader and of the specular
+    /// unit, with vectors from the golden model, beside the generated RTL (runs in Icarus).
+    Testbench {
+        /// Segment width: pixels per clock, a power of two in 1..256.
+        #[arg(long, default_value_t = golden::format::DEFAULT_P, value_parser = parse_p)]
+        p: u32,
+        /// Fraction bits F of the intensity format UQ8.F (4..20).
+        #[arg(long = "frac", default_value_t = golden::format::DEFAULT_FRAC, value_parser = clap::value_parser!(u32).range(4..=20))]
+        frac: u32,
+        /// Screen-x bits XW (4..16).
+        #[arg(long = "xbits", default_value_t = golden::format::DEFAULT_XBITS, value_parser = clap::value_parser!(u32).range(4..=16))]
+        xbits: u32,
+        /// Segmentation: span (the seed's) or screen (segments on multiples of P).
+        #[arg(long, default_value = "span", value_parser = ["span", "screen"])]
+        align: String,
+        /// String prepended to every module name.
+        #[arg(long, default_value = "", value_parser = parse_prefix)]
+        prefix: String,
+        #[command(flatten)]
+        brdf: BrdfArgs,
+        /// Spans per block (1..1000000).
+        #[arg(long, default_value_t = 1000, value_parser = clap::value_parser!(u32).range(1..=hdl_gen::testbench::MAX_VECTORS as i64))]
+        vectors: u32,
+        /// Seed of the vectors and of the bench's traffic pattern.
+        #[arg(long, default_value_t = 1)]
+        seed: u64,
+        /// Output folder (created if missing).
+        #[arg(long)]
+        out: PathBuf,
+    },
+    /// Measure the generated hardware against its references.
+    Report {
+        #[command(subcommand)]
+        report: Report,
+    },
+}
+
+#[derive(Subcommand)]
+enum Report {
+    /// The specular unit's max relative error inside the epicentre per n range (SPEC §4):
+    /// its approximation, the patent's and the cos^2 prototype's, and the RTL's total error.
+    Accuracy {
+        #[command(flatten)]
+        brdf: BrdfArgs,
+        /// Also draw the error against n into this PNG file.
+        #[arg(long)]
+        png: Option<PathBuf>,
+    },
 }
 
 /// The specular unit's table set, shared by every command that builds the unit.
@@ -129,8 +177,18 @@ fn parse_prefix(s: &str) -> Result<String, String> {
     Ok(s.to_string())
 }
 
+/// The command line, every subcommand reading a negative number as a value (which its flag's
+/// range then rejects by name) rather than as an unknown flag.
+fn parse_cli() -> Cli {
+    use clap::{CommandFactory, FromArgMatches};
+    fn negatives(c: clap::Command) -> clap::Command {
+        c.allow_negative_numbers(true).mut_subcommands(negatives)
+    }
+    Cli::from_arg_matches(&negatives(Cli::command()).get_matches()).unwrap_or_else(|e| e.exit())
+}
+
 fn main() -> ExitCode {
-    let cli = Cli::parse();
+    let cli = parse_cli();
     let result = match cli.command {
         Command::Generate { p, frac, xbits, align, prefix, bfpi_arch, brdf, out } => {
             let align: Align = align.parse().expect("clap checked the alignment");
@@ -163,6 +221,25 @@ fn main() -> ExitCode {
             .and_then(|ports| hdl_gen::wrapper::module(&module, &ports))
             .and_then(|m| output::write_one(&out, m.render().as_bytes()))
             .map(|()| eprintln!("wrote {}", out.display())),
+        Command::Testbench { p, frac, xbits, align, prefix, brdf, vectors, seed, out } => {
+            let align: Align = align.parse().expect("clap checked the alignment");
+            Config::new(p, frac, xbits, align)
+                .and_then(|cfg| Ok(Options { cfg, prefix, brdf: brdf.plan()?, ..Options::default() }))
+                .and_then(|opts| hdl_gen::testbench::testbench(&opts, vectors, seed))
+                .and_then(|files| output::write_all(&out, &files))
+                .map(|()| eprintln!("wrote {}", out.display()))
+        }
+        Command::Report { report: Report::Accuracy { brdf, png } } => brdf.plan().and_then(|plan| {
+            let unit = Options { brdf: plan, ..Options::default() }.specular_unit();
+            let report = hdl_gen::report::AccuracyReport::measure(&unit);
+            // The file first: a failed write then leaves no table behind either.
+            if let Some(path) = &png {
+                output::write_one(path, &report.png()?)?;
+                eprintln!("wrote {}", path.display());
+            }
+            print!("{}", report.table());
+            Ok(())
+        }),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -47,13 +47,21 @@ impl Port {
     }
 }
 
-/// Statements inside a clocked always block.
+/// Statements inside a clocked always block (and, for testbenches, an `initial` block).
 #[derive(Clone, Debug)]
 pub enum Stmt {
     /// Non-blocking assignment.
     Set(String, String),
     If(String, Vec<Stmt>, Vec<Stmt>),
     Comment(String),
+    /// Testbench only: blocking assignment `lhs = rhs;`.
+    Blocking(String, String),
+    /// Testbench only: a system task call such as `$display("...", x)`, printed with its `;`.
+    Call(String),
+    /// Testbench only: `#n;`.
+    Delay(u32),
+    /// Testbench only: `forever begin ... end`.
+    Forever(Vec<Stmt>),
 }
 
 pub fn set(lhs: impl Into<String>, rhs: impl Into<String>) -> Stmt {
@@ -83,6 +91,8 @@ pub enum Item {
     ReadMemH { file: String, mem: String },
     /// `reg [w-1:0] name [0:depth-1];`
     Memory { name: String, width: u32, depth: u32 },
+    /// Testbench only (SPEC §3 allows no `initial` in the modules): `initial begin ... end`.
+    Initial(Vec<Stmt>),
 }
 
 pub fn wire(name: &str, width: u32, value: impl Into<String>) -> Item {
@@ -310,6 +320,12 @@ fn render_items(o: &mut String, items: &[Item], level: usize) {
             Item::Memory { name, width, depth } => {
                 writeln!(o, "reg {}{name} [0:{}];", range(*width), depth - 1).unwrap()
             }
+            Item::Initial(stmts) => {
+                o.push_str("initial begin\n");
+                render_stmts(o, stmts, level + 1);
+                indent(o, level);
+                o.push_str("end\n");
+            }
         }
     }
 }
@@ -320,6 +336,15 @@ fn render_stmts(o: &mut String, stmts: &[Stmt], level: usize) {
         match s {
             Stmt::Set(l, r) => writeln!(o, "{l} <= {r};").unwrap(),
             Stmt::Comment(c) => writeln!(o, "// {c}").unwrap(),
+            Stmt::Blocking(l, r) => writeln!(o, "{l} = {r};").unwrap(),
+            Stmt::Call(c) => writeln!(o, "{c};").unwrap(),
+            Stmt::Delay(n) => writeln!(o, "#{n};").unwrap(),
+            Stmt::Forever(body) => {
+                o.push_str("forever begin\n");
+                render_stmts(o, body, level + 1);
+                indent(o, level);
+                o.push_str("end\n");
+            }
             Stmt::If(cond, then, els) => {
                 writeln!(o, "if ({cond}) begin").unwrap();
                 render_stmts(o, then, level + 1);

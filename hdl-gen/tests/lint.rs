@@ -1,9 +1,14 @@
 //! Generated Verilog is clean under `verilator --lint-only -Wall` and compiles in Icarus
-//! (`iverilog -g2005`), for a spread of configurations. A missing tool fails the test with
-//! the command that installs it: a lint that did not run must not pass.
+//! (`iverilog -g2005`), for a spread of configurations and every increment form. Every `.v`
+//! file that `generate` writes is linted as the top module, whatever modules it holds, and so
+//! is the synthesis harness around every module the manifest lists. A missing tool fails the
+//! test with the command that installs it: a lint that did not run must not pass.
+//!
+//! The full sweep (every P, both alignments, every form, plus Yosys) is `scripts/lint-all`.
 
 use golden::{Align, Config};
-use hdl_gen::{generate, output, Options};
+use hdl_gen::{generate, output, wrapper, BfpiArch, Options};
+use std::path::Path;
 use std::process::Command;
 
 fn run(tool: &str, args: &[String]) -> String {
@@ -15,38 +20,71 @@ fn run(tool: &str, args: &[String]) -> String {
     text
 }
 
-fn configs() -> Vec<(Config, &'static str)> {
+fn configs() -> Vec<(Config, &'static str, BfpiArch)> {
     let mut v = Vec::new();
     for p in [1, 2, 4, 8, 16, 64, 256] {
         for align in Align::ALL {
-            v.push((Config { p, align, ..Config::default() }, ""));
+            v.push((Config { p, align, ..Config::default() }, "", BfpiArch::ShiftAdd));
         }
     }
-    v.push((Config::new(16, 4, 4, Align::Screen).unwrap(), "edge_"));
-    v.push((Config::new(2, 20, 16, Align::Screen).unwrap(), ""));
-    v.push((Config::new(128, 7, 9, Align::Span).unwrap(), "x_"));
+    v.push((Config::new(16, 4, 4, Align::Screen).unwrap(), "edge_", BfpiArch::ShiftAdd));
+    v.push((Config::new(2, 20, 16, Align::Screen).unwrap(), "", BfpiArch::ShiftAdd));
+    v.push((Config::new(128, 7, 9, Align::Span).unwrap(), "x_", BfpiArch::ShiftAdd));
+    for arch in [BfpiArch::Naive, BfpiArch::Tree] {
+        for (p, align) in [(1, Align::Span), (2, Align::Screen), (8, Align::Span), (64, Align::Screen), (256, Align::Span)] {
+            v.push((Config { p, align, ..Config::default() }, "", arch));
+        }
+        v.push((Config::new(16, 4, 4, Align::Screen).unwrap(), "edge_", arch));
+    }
     v
+}
+
+fn lint(sources: &[String], top: &str) {
+    let mut args = vec!["--lint-only".to_string(), "-Wall".into(), "--top-module".into(), top.into()];
+    args.extend(sources.iter().cloned());
+    let text = run("verilator", &args);
+    assert!(!text.contains("%Warning"), "{top}: {text}");
+}
+
+fn module_names(manifest: &str) -> Vec<String> {
+    let m: serde_json::Value = serde_json::from_str(manifest).unwrap();
+    m["modules"].as_array().unwrap().iter().map(|e| e["name"].as_str().unwrap().to_string()).collect()
 }
 
 #[test]
 fn verilator_lint_and_icarus_are_clean() {
-    for (cfg, prefix) in configs() {
-        let dir = std::env::temp_dir().join(format!("hdl-gen-lint-{}-{}-{}", std::process::id(), cfg.p, cfg.align));
+    for (k, (cfg, prefix, arch)) in configs().into_iter().enumerate() {
+        let what = format!("{cfg:?}, prefix '{prefix}', --bfpi-arch {arch}");
+        let dir = std::env::temp_dir().join(format!("hdl-gen-lint-{}-{k}", std::process::id()));
         let _ = std::fs::remove_dir_all(&dir);
-        let files = generate(&Options { cfg, prefix: prefix.into(), ..Default::default() });
+        let files = generate(&Options { cfg, prefix: prefix.into(), bfpi_arch: arch, ..Default::default() });
         output::write_all(&dir, &files).unwrap();
-        let sources: Vec<String> =
-            files.iter().filter(|f| f.name.ends_with(".v")).map(|f| dir.join(&f.name).display().to_string()).collect();
-        for top in [hdl_gen::Names::new(prefix, &cfg).segment, hdl_gen::specular::SpecNames::new(prefix).unit] {
-            let mut lint = vec!["--lint-only".to_string(), "-Wall".into(), "--top-module".into(), top];
-            lint.extend(sources.iter().cloned());
-            let text = run("verilator", &lint);
-            assert!(!text.contains("%Warning"), "{cfg:?}: {text}");
+        let path = |name: &str| dir.join(name).display().to_string();
+        let sources: Vec<String> = files.iter().filter(|f| f.name.ends_with(".v")).map(|f| path(&f.name)).collect();
+        assert!(sources.len() >= 2, "{what}: {sources:?}");
+        // One module per file (SPEC §3), so the file stem is the module to lint as top.
+        for f in files.iter().filter(|f| f.name.ends_with(".v")) {
+            lint(&sources, f.name.trim_end_matches(".v"));
         }
-        let mut ivl = vec!["-g2005".to_string(), "-Wall".into(), "-o".into(), dir.join("a.out").display().to_string()];
-        ivl.extend(sources);
+        let manifest = &files.iter().find(|f| f.name == "manifest.json").unwrap().contents;
+        let mut with_wrappers = sources.clone();
+        for module in module_names(manifest) {
+            assert!(Path::new(&path(&format!("{module}.v"))).exists(), "{what}: manifest lists {module} but no {module}.v");
+            let ports = wrapper::ports_from_manifest(manifest, &module).unwrap();
+            if ports.iter().any(|p| p.name == "clk") {
+                let w = wrapper::module(&module, &ports).unwrap();
+                let file = path(&format!("{}.v", w.name));
+                std::fs::write(&file, w.render()).unwrap();
+                let mut srcs = sources.clone();
+                srcs.push(file.clone());
+                lint(&srcs, &w.name);
+                with_wrappers.push(file);
+            }
+        }
+        let mut ivl = vec!["-g2005".to_string(), "-Wall".into(), "-o".into(), path("a.out")];
+        ivl.extend(with_wrappers);
         let text = run("iverilog", &ivl);
-        assert!(text.trim().is_empty(), "{cfg:?}: iverilog says:\n{text}");
+        assert!(text.trim().is_empty(), "{what}: iverilog says:\n{text}");
         let _ = std::fs::remove_dir_all(&dir);
     }
 }

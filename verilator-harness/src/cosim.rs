@@ -33,6 +33,87 @@ impl Traffic {
     pub const RANDOM: Traffic = Traffic { valid: 0.7, ready: 0.7 };
 }
 
+/// Stress on top of [`Traffic`], off by default: `rst` at random clocks, long stretches of
+/// `out_ready` low, long `in_valid` gaps between spans. With a reset, the spans accepted and not
+/// yet fully out are *cut* (their remaining output is dropped from the scoreboard) and a span
+/// being offered is offered again afterwards; in a clock with `rst` high nothing transfers.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Stress {
+    /// Probability per clock of asserting `rst` (for 1..=3 clocks).
+    pub reset: f64,
+    /// Probability per clock that `out_ready` drops for 1..=`stall_max` clocks.
+    pub stall: f64,
+    pub stall_max: u32,
+    /// Probability after each input transfer of an `in_valid` gap of 1..=`gap_max` clocks.
+    pub gap: f64,
+    pub gap_max: u32,
+}
+
+impl Stress {
+    pub const NONE: Stress = Stress { reset: 0.0, stall: 0.0, stall_max: 0, gap: 0.0, gap_max: 0 };
+    /// Long backpressure bursts and input gaps, no reset.
+    pub const BURSTS: Stress = Stress { reset: 0.0, stall: 0.01, stall_max: 300, gap: 0.05, gap_max: 200 };
+    /// Everything at once: resets about every 500 clocks, bursts and gaps.
+    pub const HARSH: Stress = Stress { reset: 0.002, ..Stress::BURSTS };
+}
+
+/// The per-clock decisions of the driver and the sink under [`Traffic`] and [`Stress`]. Without
+/// stress it draws exactly what the plain random driver drew, so old seeds replay unchanged.
+#[derive(Clone, Debug)]
+pub(crate) struct Pacer {
+    traffic: Traffic,
+    stress: Stress,
+    rst_left: u32,
+    stall_left: u32,
+    gap_left: u32,
+}
+
+impl Pacer {
+    pub(crate) fn new(traffic: Traffic, stress: Stress) -> Pacer {
+        Pacer { traffic, stress, rst_left: 0, stall_left: 0, gap_left: 0 }
+    }
+
+    /// Whether `rst` is high this clock.
+    pub(crate) fn reset(&mut self, rng: &mut StdRng) -> bool {
+        if self.rst_left == 0 && self.stress.reset > 0.0 && rng.gen_bool(self.stress.reset) {
+            self.rst_left = rng.gen_range(1..=3);
+        }
+        if self.rst_left > 0 {
+            self.rst_left -= 1;
+            return true;
+        }
+        false
+    }
+
+    /// Whether a pending span starts being offered this clock.
+    pub(crate) fn offer(&mut self, rng: &mut StdRng) -> bool {
+        if self.gap_left > 0 {
+            self.gap_left -= 1;
+            return false;
+        }
+        self.traffic.valid >= 1.0 || rng.gen_bool(self.traffic.valid)
+    }
+
+    /// `out_ready` this clock.
+    pub(crate) fn ready(&mut self, rng: &mut StdRng) -> bool {
+        if self.stall_left == 0 && self.stress.stall > 0.0 && rng.gen_bool(self.stress.stall) {
+            self.stall_left = rng.gen_range(1..=self.stress.stall_max.max(1));
+        }
+        if self.stall_left > 0 {
+            self.stall_left -= 1;
+            return false;
+        }
+        self.traffic.ready >= 1.0 || rng.gen_bool(self.traffic.ready)
+    }
+
+    /// A span was transferred: maybe a gap before the next one is offered.
+    pub(crate) fn accepted(&mut self, rng: &mut StdRng) {
+        if self.stress.gap > 0.0 && rng.gen_bool(self.stress.gap) {
+            self.gap_left = rng.gen_range(1..=self.stress.gap_max.max(1));
+        }
+    }
+}
+
 /// A span with where it came from, for failure messages.
 #[derive(Clone, Copy, Debug)]
 pub struct Stim {
@@ -72,6 +153,9 @@ pub struct Report {
     pub mismatches: Vec<Mismatch>,
     /// Worst |pixel - exact plane| over all frames compared with the f64 reference.
     pub max_error: f64,
+    /// Resets injected by [`Stress`], and the accepted spans they cut short.
+    pub resets: u64,
+    pub cut_spans: u64,
 }
 
 const KEEP_MISMATCHES: usize = 20;
@@ -128,6 +212,7 @@ pub struct SegmentCosim {
     cfg: Config,
     rng: StdRng,
     traffic: Traffic,
+    stress: Stress,
     input: SegIn,
     output: SegOut,
 }
@@ -146,11 +231,17 @@ impl SegmentCosim {
             cfg: info.cfg,
             rng: StdRng::seed_from_u64(seed),
             traffic,
+            stress: Stress::NONE,
             input: SegIn::default(),
             output: SegOut::default(),
         };
         c.reset();
         c
+    }
+
+    /// Adds [`Stress`] to the traffic of every following [`SegmentCosim::stream`].
+    pub fn set_stress(&mut self, stress: Stress) {
+        self.stress = stress;
     }
 
     pub fn info(&self) -> &'static ModelInfo<SegIn, SegOut> {
@@ -174,14 +265,34 @@ impl SegmentCosim {
     }
 
     /// Streams `stims` through the model, checking every segment against golden; `paint` gets
-    /// each checked segment that left the model, with its span.
-    pub fn stream(&mut self, stims: &[Stim], report: &mut Report, mut paint: impl FnMut(&Stim, &SegOut)) {
+    /// each checked segment that left the model, with its span. Panics, before the model sees
+    /// anything, on a span its ports cannot take (see [`SegmentCosim::try_stream`]).
+    pub fn stream(&mut self, stims: &[Stim], report: &mut Report, paint: impl FnMut(&Stim, &SegOut)) {
+        if let Err(e) = self.try_stream(stims, report, paint) {
+            panic!("{}: {e}", self.info.tag);
+        }
+    }
+
+    /// [`SegmentCosim::stream`], or an error naming the first span the RTL cannot take
+    /// (`golden::Span::check`: `x0 + len` beyond 2^XW, `len` above 2^XW, `I0` or `dI` wider than
+    /// their ports). Nothing is streamed then.
+    ///
+    /// Besides the scoreboard, a protocol monitor checks SPEC §3's valid/ready rules on the
+    /// output: a segment offered and not taken stays offered, unchanged, in the next clock; in
+    /// the first clock after a reset `out_valid` is low.
+    pub fn try_stream(&mut self, stims: &[Stim], report: &mut Report, mut paint: impl FnMut(&Stim, &SegOut)) -> Result<(), String> {
         let cfg = self.cfg;
+        for (k, s) in stims.iter().enumerate() {
+            s.span.check(&cfg).map_err(|e| format!("span {k} (triangle {}, y = {}) rejected: {e}", s.triangle, s.y))?;
+        }
+        let mut pacer = Pacer::new(self.traffic, self.stress);
         let mut expected: VecDeque<(usize, Segment)> = VecDeque::new();
         let mut next = 0;
         let mut offering = false;
         let mut idle = 0u64;
         let mut drain = 0;
+        let mut in_reset = false;
+        let mut held: Option<SegOut> = None;
         loop {
             if next == stims.len() && expected.is_empty() {
                 // Everything came out; a few more clocks must bring nothing.
@@ -190,16 +301,49 @@ impl SegmentCosim {
                 }
                 drain += 1;
             }
+            if pacer.reset(&mut self.rng) {
+                // Nothing transfers in a reset clock: the spans in flight are cut, the one
+                // being offered stays offered.
+                if !in_reset {
+                    report.resets += 1;
+                    let mut cut: Vec<usize> = expected.iter().map(|e| e.0).collect();
+                    cut.dedup();
+                    report.cut_spans += cut.len() as u64;
+                    expected.clear();
+                }
+                in_reset = true;
+                held = None;
+                self.input.rst = 1;
+                self.input.in_valid = offering as u8;
+                self.input.out_ready = pacer.ready(&mut self.rng) as u8;
+                self.rtl.step_into(&self.input, &mut self.output);
+                self.input.rst = 0;
+                report.cycles += 1;
+                idle = 0;
+                continue;
+            }
             if !offering && next < stims.len() {
-                offering = self.traffic.valid >= 1.0 || self.rng.gen_bool(self.traffic.valid);
+                offering = pacer.offer(&mut self.rng);
                 if offering {
                     self.drive(&stims[next].span);
                 }
             }
             self.input.in_valid = offering as u8;
-            self.input.out_ready = (self.traffic.ready >= 1.0 || self.rng.gen_bool(self.traffic.ready)) as u8;
+            self.input.out_ready = pacer.ready(&mut self.rng) as u8;
             self.rtl.step_into(&self.input, &mut self.output);
             report.cycles += 1;
+            if std::mem::take(&mut in_reset) && self.output.out_valid != 0 {
+                report.mismatch(Mismatch {
+                    triangle: None,
+                    context: format!("clock {}", report.cycles),
+                    what: "out_valid high in the first clock after a reset".into(),
+                });
+            }
+            if let Some(h) = held.take() {
+                if let Some(what) = changed_while_stalled(&h, &self.output, cfg.p) {
+                    report.mismatch(Mismatch { triangle: None, context: format!("clock {}", report.cycles), what });
+                }
+            }
             let mut progress = false;
             if self.output.out_valid == 1 && self.input.out_ready == 1 {
                 progress = true;
@@ -214,6 +358,8 @@ impl SegmentCosim {
                         what: format!("segment at x = {} with no span outstanding", self.output.out_x),
                     }),
                 }
+            } else if self.output.out_valid == 1 {
+                held = Some(self.output);
             }
             if offering && self.output.in_ready == 1 {
                 progress = true;
@@ -222,6 +368,7 @@ impl SegmentCosim {
                 report.spans += 1;
                 next += 1;
                 offering = false;
+                pacer.accepted(&mut self.rng);
             }
             idle = if progress { 0 } else { idle + 1 };
             if idle > STALL_LIMIT {
@@ -235,9 +382,10 @@ impl SegmentCosim {
                     what: format!("no transfer for {STALL_LIMIT} clocks; {} segments still expected", expected.len()),
                 });
                 self.reset();
-                return;
+                return Ok(());
             }
         }
+        Ok(())
     }
 
     fn check(&self, stim: &Stim, seg: &Segment, report: &mut Report) {
@@ -337,6 +485,21 @@ impl SegmentCosim {
             });
         }
     }
+}
+
+/// What changed in a segment that was offered and not taken in the previous clock, if anything
+/// (masked lanes are don't-care).
+fn changed_while_stalled(before: &SegOut, now: &SegOut, p: u32) -> Option<String> {
+    if now.out_valid != 1 {
+        return Some(format!("out_valid dropped before the segment at x = {} was taken", before.out_x));
+    }
+    let lanes_differ = (0..p).any(|i| {
+        now.lane_enabled(i) != before.lane_enabled(i) || (now.lane_enabled(i) && now.pix[i as usize] != before.pix[i as usize])
+    });
+    if now.out_x != before.out_x || now.out_last != before.out_last || lanes_differ {
+        return Some(format!("segment at x = {} changed while waiting for out_ready (now x = {})", before.out_x, now.out_x));
+    }
+    None
 }
 
 fn describe(s: &Stim) -> String {

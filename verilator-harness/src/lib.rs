@@ -3,10 +3,11 @@
 //! `build.rs` verilates and links the models; [`ffi`] wraps them; [`stimulus`] makes random
 //! and directed triangles; [`cosim`] streams their spans through a model with random valid
 //! gaps and backpressure and checks every segment and the final frames; [`specular`] does the
-//! same for the specular unit, pixel by pixel.
+//! same for the specular unit, pixel by pixel; [`render`] draws whole scenes through them.
 
 pub mod cosim;
 pub mod ffi;
+pub mod render;
 pub mod specular;
 pub mod stimulus;
 

@@ -2,7 +2,7 @@
 //! against golden, within SPEC §4 of the f64 approximation `C cos^k(sqrt(n/k) delta)`, and,
 //! along each span, never brighter where |theta| is larger.
 
-use crate::cosim::{Mismatch, Report, Traffic};
+use crate::cosim::{Mismatch, Pacer, Report, Stress, Traffic};
 use crate::ffi::{to_port, ModelInfo, Rtl, SpecIn, SpecOut};
 use golden::specular::reference::{approx, epicentre};
 use golden::specular::setup::{norm, normalize, setup_span, SpanEnds, Vec3};
@@ -20,6 +20,7 @@ pub struct SpecularCosim {
     unit: SpecularUnit,
     rng: StdRng,
     traffic: Traffic,
+    stress: Stress,
     input: SpecIn,
     output: SpecOut,
 }
@@ -35,6 +36,7 @@ impl SpecularCosim {
             unit,
             rng: StdRng::seed_from_u64(seed),
             traffic,
+            stress: Stress::NONE,
             input: SpecIn::default(),
             output: SpecOut::default(),
         };
@@ -50,12 +52,60 @@ impl SpecularCosim {
         self.info
     }
 
-    /// Streams `spans` (counted in `report.spans`; `report.failed` holds span indices).
+    /// Adds [`Stress`] to the traffic of every following [`SpecularCosim::stream`].
+    pub fn set_stress(&mut self, stress: Stress) {
+        self.stress = stress;
+    }
+
+    /// Streams `spans` (counted in `report.spans`; `report.failed` holds span indices). Panics,
+    /// before the model sees anything, on a span its ports cannot take
+    /// (see [`SpecularCosim::try_stream`]).
     pub fn stream(&mut self, spans: &[SpecularSpan], report: &mut Report) {
+        if let Err(e) = self.try_stream(spans, report) {
+            panic!("{}: {e}", self.info.tag);
+        }
+    }
+
+    /// [`SpecularCosim::stream`], or an error naming the first span the ports cannot carry:
+    /// `len` beyond the `in_len` port (XW + 1 bits) or `n` beyond the 10-bit `in_n` port. An n
+    /// the port carries but outside 1..1000 is valid input (its pixels have `out_err = 1`).
+    /// With [`Stress`] resets, a span cut by a reset owes no more pixels; a protocol monitor
+    /// checks that a pixel offered and not taken stays, unchanged, and that `out_valid` is low
+    /// in the first clock after a reset.
+    pub fn try_stream(&mut self, spans: &[SpecularSpan], report: &mut Report) -> Result<(), String> {
+        self.try_stream_with(spans, report, |_, _, _| {})
+    }
+
+    /// [`SpecularCosim::stream`], and `pixel` gets each checked output pixel that left the
+    /// unit: its span's index, its pixel index `j` in the span and the outputs.
+    pub fn stream_with(&mut self, spans: &[SpecularSpan], report: &mut Report, pixel: impl FnMut(usize, u32, &SpecOut)) {
+        if let Err(e) = self.try_stream_with(spans, report, pixel) {
+            panic!("{}: {e}", self.info.tag);
+        }
+    }
+
+    /// [`SpecularCosim::try_stream`] with [`SpecularCosim::stream_with`]'s `pixel` callback.
+    pub fn try_stream_with(
+        &mut self,
+        spans: &[SpecularSpan],
+        report: &mut Report,
+        mut pixel: impl FnMut(usize, u32, &SpecOut),
+    ) -> Result<(), String> {
+        let len_max = (1u32 << (self.info.cfg.xbits + 1)) - 1;
+        for (k, s) in spans.iter().enumerate() {
+            if s.len > len_max {
+                return Err(format!("span {k} rejected: len = {} does not fit the {}-bit in_len port", s.len, self.info.cfg.xbits + 1));
+            }
+            if s.n as u32 >= 1 << golden::specular::N_BITS {
+                return Err(format!("span {k} rejected: n = {} does not fit the {}-bit in_n port", s.n, golden::specular::N_BITS));
+            }
+        }
+        let mut pacer = Pacer::new(self.traffic, self.stress);
         // (span, pixel j) of every pixel owed, in order.
         let mut expected: VecDeque<(usize, u32)> = VecDeque::new();
         let mut along: Vec<(u32, u16)> = Vec::new();
         let (mut next, mut offering, mut idle, mut drain) = (0, false, 0u64, 0);
+        let (mut in_reset, mut held): (bool, Option<SpecOut>) = (false, None);
         loop {
             if next == spans.len() && expected.is_empty() {
                 if drain == crate::cosim::DRAIN_CLOCKS {
@@ -63,8 +113,28 @@ impl SpecularCosim {
                 }
                 drain += 1;
             }
+            if pacer.reset(&mut self.rng) {
+                if !in_reset {
+                    report.resets += 1;
+                    let mut cut: Vec<usize> = expected.iter().map(|e| e.0).collect();
+                    cut.dedup();
+                    report.cut_spans += cut.len() as u64;
+                    expected.clear();
+                    along.clear();
+                }
+                in_reset = true;
+                held = None;
+                self.input.rst = 1;
+                self.input.in_valid = offering as u8;
+                self.input.out_ready = pacer.ready(&mut self.rng) as u8;
+                self.rtl.step_into(&self.input, &mut self.output);
+                self.input.rst = 0;
+                report.cycles += 1;
+                idle = 0;
+                continue;
+            }
             if !offering && next < spans.len() {
-                offering = self.traffic.valid >= 1.0 || self.rng.gen_bool(self.traffic.valid);
+                offering = pacer.offer(&mut self.rng);
                 if offering {
                     let s = &spans[next];
                     self.input.in_c = s.c as u32;
@@ -75,15 +145,33 @@ impl SpecularCosim {
                 }
             }
             self.input.in_valid = offering as u8;
-            self.input.out_ready = (self.traffic.ready >= 1.0 || self.rng.gen_bool(self.traffic.ready)) as u8;
+            self.input.out_ready = pacer.ready(&mut self.rng) as u8;
             self.rtl.step_into(&self.input, &mut self.output);
             report.cycles += 1;
+            if std::mem::take(&mut in_reset) && self.output.out_valid != 0 {
+                report.mismatch(Mismatch {
+                    triangle: None,
+                    context: format!("clock {}", report.cycles),
+                    what: "out_valid high in the first clock after a reset".into(),
+                });
+            }
+            if let Some(h) = held.take() {
+                let o = &self.output;
+                if o.out_valid != 1 || (o.out_spec, o.out_last, o.out_err) != (h.out_spec, h.out_last, h.out_err) {
+                    report.mismatch(Mismatch {
+                        triangle: None,
+                        context: format!("clock {}", report.cycles),
+                        what: format!("pixel {h:?} dropped or changed while waiting for out_ready: now {o:?}"),
+                    });
+                }
+            }
             let mut progress = false;
             if self.output.out_valid == 1 && self.input.out_ready == 1 {
                 progress = true;
                 match expected.pop_front() {
                     Some((k, j)) => {
                         self.check(k, &spans[k], j, report, &mut along);
+                        pixel(k, j, &self.output);
                         if j + 1 == spans[k].len {
                             check_monotone(k, &mut along, report);
                         }
@@ -94,6 +182,8 @@ impl SpecularCosim {
                         what: "pixel with no span outstanding".into(),
                     }),
                 }
+            } else if self.output.out_valid == 1 {
+                held = Some(self.output);
             }
             if offering && self.output.in_ready == 1 {
                 progress = true;
@@ -101,6 +191,7 @@ impl SpecularCosim {
                 report.spans += 1;
                 next += 1;
                 offering = false;
+                pacer.accepted(&mut self.rng);
             }
             idle = if progress { 0 } else { idle + 1 };
             if idle > STALL_LIMIT {
@@ -109,9 +200,10 @@ impl SpecularCosim {
                     context: "stream".into(),
                     what: format!("no transfer for {STALL_LIMIT} clocks; {} pixels still expected", expected.len()),
                 });
-                return;
+                return Ok(());
             }
         }
+        Ok(())
     }
 
     fn check(&self, k: usize, s: &SpecularSpan, j: u32, report: &mut Report, along: &mut Vec<(u32, u16)>) {

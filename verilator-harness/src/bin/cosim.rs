@@ -16,7 +16,7 @@ use verilator_harness::specular::{random_span, SpecularCosim};
 use verilator_harness::stimulus::random_triangle;
 
 #[derive(Parser)]
-#[command(about = "Co-simulate the generated segment shader against the golden model")]
+#[command(about = "Co-simulate the generated segment shader against the golden model", allow_negative_numbers = true)]
 struct Args {
     /// Segment width of the model to run.
     #[arg(long, default_value_t = 8)]

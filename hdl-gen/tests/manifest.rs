@@ -1,0 +1,155 @@
+//! `manifest.json` against what it describes: every module it lists is a file that `generate`
+//! wrote, holding that module with exactly those ports (name, direction, width, signedness,
+//! order), read back from the Verilog text; every file it names exists; and every field it
+//! has is documented in docs/manifest.md.
+
+use golden::{Align, Config};
+use hdl_gen::{generate, BfpiArch, GeneratedFile, Options};
+use serde_json::Value;
+use std::collections::BTreeSet;
+
+fn configs() -> Vec<Options> {
+    let mut v = Vec::new();
+    for (p, align) in [(1, Align::Span), (8, Align::Screen), (8, Align::Span), (256, Align::Screen)] {
+        for bfpi_arch in BfpiArch::ALL {
+            v.push(Options { cfg: Config { p, align, ..Config::default() }, bfpi_arch, ..Default::default() });
+        }
+    }
+    v.push(Options { cfg: Config::new(16, 4, 4, Align::Screen).unwrap(), prefix: "acme_".into(), ..Default::default() });
+    v.push(Options { cfg: Config::new(2, 20, 16, Align::Span).unwrap(), ..Default::default() });
+    v
+}
+
+#[derive(Debug, PartialEq, Eq)]
+struct PortDecl {
+    name: String,
+    direction: String,
+    width: u32,
+    signed: bool,
+}
+
+/// The ports of `module` as its ANSI header in `text` declares them.
+fn verilog_ports(text: &str, module: &str) -> Vec<PortDecl> {
+    let mut lines = text.lines().skip_while(|l| {
+        let mut t = l.split_whitespace();
+        !(t.next() == Some("module") && t.next().map(|n| n.trim_end_matches(['(', '#'])) == Some(module))
+    });
+    assert!(lines.next().is_some(), "no `module {module}` in its file");
+    let mut ports = Vec::new();
+    for line in lines {
+        let code = line.split("//").next().unwrap().trim().trim_end_matches(',').trim();
+        if code == ");" {
+            return ports;
+        }
+        let tokens: Vec<&str> = code.split_whitespace().collect();
+        let direction = match tokens.first() {
+            Some(&d @ ("input" | "output" | "inout")) => d.to_string(),
+            _ => continue,
+        };
+        let mut rest = &tokens[1..];
+        if let Some(&("wire" | "reg")) = rest.first() {
+            rest = &rest[1..];
+        }
+        let signed = rest.first() == Some(&"signed");
+        if signed {
+            rest = &rest[1..];
+        }
+        let width = match rest.first() {
+            Some(r) if r.starts_with('[') => {
+                let (hi, lo) = r.trim_matches(['[', ']']).split_once(':').unwrap_or_else(|| panic!("range {r}"));
+                rest = &rest[1..];
+                hi.parse::<u32>().unwrap() - lo.parse::<u32>().unwrap() + 1
+            }
+            _ => 1,
+        };
+        assert_eq!(rest.len(), 1, "{module}: cannot read port line `{line}`");
+        ports.push(PortDecl { name: rest[0].to_string(), direction, width, signed });
+    }
+    panic!("{module}: header has no closing `);`")
+}
+
+fn manifest_of(files: &[GeneratedFile]) -> Value {
+    serde_json::from_str(&files.iter().find(|f| f.name == "manifest.json").expect("manifest.json written").contents).unwrap()
+}
+
+/// Every string under a key named `file`, anywhere in the manifest.
+fn named_files(v: &Value, out: &mut Vec<String>) {
+    match v {
+        Value::Object(m) => {
+            for (k, x) in m {
+                match (k.as_str(), x) {
+                    ("file", Value::String(s)) => out.push(s.clone()),
+                    _ => named_files(x, out),
+                }
+            }
+        }
+        Value::Array(a) => a.iter().for_each(|x| named_files(x, out)),
+        _ => {}
+    }
+}
+
+#[test]
+fn every_listed_port_exists_in_the_verilog_with_that_width() {
+    for opts in configs() {
+        let what = format!("{:?}, prefix '{}', --bfpi-arch {}", opts.cfg, opts.prefix, opts.bfpi_arch);
+        let files = generate(&opts);
+        let m = manifest_of(&files);
+        let modules = m["modules"].as_array().expect("modules list");
+        let mut listed = BTreeSet::new();
+        for entry in modules {
+            let name = entry["name"].as_str().unwrap();
+            let file = entry["file"].as_str().unwrap();
+            listed.insert(file.to_string());
+            let text = &files.iter().find(|f| f.name == file).unwrap_or_else(|| panic!("{what}: {file} not written")).contents;
+            let declared = verilog_ports(text, name);
+            let in_manifest: Vec<PortDecl> = entry["ports"]
+                .as_array()
+                .unwrap()
+                .iter()
+                .map(|p| PortDecl {
+                    name: p["name"].as_str().unwrap().into(),
+                    direction: p["direction"].as_str().unwrap().into(),
+                    width: p["width"].as_u64().unwrap() as u32,
+                    signed: p["signed"].as_bool().unwrap(),
+                })
+                .collect();
+            assert_eq!(in_manifest, declared, "{what}: manifest ports of {name} differ from {file}");
+        }
+        let written: BTreeSet<String> = files.iter().filter(|f| f.name.ends_with(".v")).map(|f| f.name.clone()).collect();
+        assert_eq!(listed, written, "{what}: the manifest lists other Verilog files than generate wrote");
+        let mut named = Vec::new();
+        named_files(&m, &mut named);
+        for f in named {
+            assert!(files.iter().any(|g| g.name == f), "{what}: manifest names {f}, which generate did not write");
+        }
+        let arch = m["parameters"]["bfpi_arch"].as_str().unwrap_or("shift-add");
+        assert_eq!(arch, opts.bfpi_arch.name(), "{what}");
+        assert_eq!(m["bfpi"].is_object(), opts.bfpi_arch == BfpiArch::ShiftAdd, "{what}: the bfpi graph is written for shift-add only");
+    }
+}
+
+fn key_paths(v: &Value, path: &str, out: &mut BTreeSet<String>) {
+    match v {
+        Value::Object(m) => {
+            for (k, x) in m {
+                let p = if path.is_empty() { k.clone() } else { format!("{path}.{k}") };
+                out.insert(p.clone());
+                key_paths(x, &p, out);
+            }
+        }
+        Value::Array(a) => a.iter().for_each(|x| key_paths(x, &format!("{path}[]"), out)),
+        _ => {}
+    }
+}
+
+#[test]
+fn every_manifest_field_is_documented() {
+    let doc_path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../docs/manifest.md");
+    let doc = std::fs::read_to_string(&doc_path).expect("docs/manifest.md exists");
+    let mut paths = BTreeSet::new();
+    for opts in configs() {
+        key_paths(&manifest_of(&generate(&opts)), "", &mut paths);
+    }
+    let missing: Vec<&String> = paths.iter().filter(|p| !doc.contains(&format!("`{p}`"))).collect();
+    assert!(missing.is_empty(), "docs/manifest.md does not document (as `path`) these manifest fields: {missing:?}");
+}

@@ -1,0 +1,234 @@
+//! `render`: draws a scene (`--scene sphere|torus`) or a triangle file (`--triangles FILE`)
+//! through the verilated RTL, writes it as a PNG, renders the same input with the golden model
+//! and exits non-zero when the two images differ in any pixel.
+//!
+//! Exit status: 0 the RTL image equals golden's; 1 it does not (or a co-simulation check
+//! failed), the images are written anyway; 2 bad arguments or input (one `error: ...` message,
+//! nothing written).
+
+use clap::{ArgGroup, Parser};
+use golden::setup::Screen;
+use golden::Align;
+use image::codecs::png::PngEncoder;
+use image::{ExtendedColorType, ImageEncoder};
+use std::io::{IsTerminal, Write};
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+use std::time::Instant;
+use verilator_harness::ffi::{segment_model, SEGMENT_MODELS, SPECULAR_MODELS};
+use verilator_harness::render::{busy_cycles, difference_image, run, scene_job, triangles_job, Job, SceneKind};
+
+#[derive(Parser)]
+#[command(about = "Render a scene or a triangle file through the generated RTL to PNG, checked against golden")]
+#[command(group(ArgGroup::new("input").required(true).args(["scene", "triangles"])))]
+struct Args {
+    /// A built-in scene: a lit RGB object, Gouraud diffuse through one segment shader per
+    /// channel plus the specular unit's highlight.
+    #[arg(long, value_parser = ["sphere", "torus"])]
+    scene: Option<String>,
+    /// A triangle file (SPEC §5: `x0 y0 i0 x1 y1 i1 x2 y2 i2` per line, `#` comments): 8-bit
+    /// grayscale, background 0, later triangles over earlier ones, diffuse only.
+    #[arg(long, value_name = "FILE")]
+    triangles: Option<PathBuf>,
+    /// Segment width of the shader model.
+    #[arg(long, default_value_t = 8)]
+    p: u32,
+    /// Segmentation of the shader model.
+    #[arg(long, default_value = "span", value_parser = ["span", "screen"])]
+    align: String,
+    #[arg(long, default_value_t = 640, value_parser = clap::value_parser!(u32).range(1..=65536))]
+    width: u32,
+    #[arg(long, default_value_t = 480, value_parser = clap::value_parser!(u32).range(1..=65536))]
+    height: u32,
+    /// Blinn–Phong exponent n of the scene's highlight.
+    #[arg(long, default_value_t = 40, value_parser = clap::value_parser!(u16).range(1..=1000), conflicts_with = "triangles")]
+    shininess: u16,
+    /// The RTL image. Golden's goes next to it as `<stem>.golden.png` (stem: the name without
+    /// `.png`), the difference image, with --diff, as `<stem>.diff.png`.
+    #[arg(long, value_name = "FILE.png")]
+    out: PathBuf,
+    /// Also write the difference image: matching pixels dim gray, differing ones red.
+    #[arg(long)]
+    diff: bool,
+    /// No progress line.
+    #[arg(long)]
+    quiet: bool,
+}
+
+fn fail(msg: impl std::fmt::Display) -> ExitCode {
+    eprintln!("error: {msg}");
+    ExitCode::from(2)
+}
+
+/// `<stem><suffix>` next to `out`, the stem being `out` without a final `.png`.
+fn sibling(out: &Path, suffix: &str) -> PathBuf {
+    let s = out.as_os_str().to_string_lossy();
+    let stem = s.strip_suffix(".png").unwrap_or(&s);
+    PathBuf::from(format!("{stem}{suffix}"))
+}
+
+fn main() -> ExitCode {
+    let args = Args::parse();
+    let start = Instant::now();
+    let align: Align = args.align.parse().expect("clap checked it");
+    let Some(info) = segment_model(args.p, align) else {
+        let built: Vec<&str> = SEGMENT_MODELS.iter().map(|m| m.tag).collect();
+        return fail(format!("--p {} --align {align}: no such model in this build (built: {})", args.p, built.join(", ")));
+    };
+    let screen = Screen { width: args.width, height: args.height };
+    if let Err(e) = screen.check_for(&info.cfg) {
+        return fail(format!("--width/--height: {e}"));
+    }
+    let dir = match args.out.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
+        _ => PathBuf::from("."),
+    };
+    if !dir.is_dir() {
+        return fail(format!("--out {}: folder {} does not exist", args.out.display(), dir.display()));
+    }
+    if args.out.is_dir() {
+        return fail(format!("--out {}: is a folder", args.out.display()));
+    }
+    let golden_path = sibling(&args.out, ".golden.png");
+    let diff_path = sibling(&args.out, ".diff.png");
+
+    let job = match (&args.scene, &args.triangles) {
+        (Some(scene), _) => {
+            if SPECULAR_MODELS.is_empty() {
+                return fail("--scene: this build has no specular unit");
+            }
+            let kind: SceneKind = scene.parse().expect("clap checked it");
+            match scene_job(kind, args.shininess, &info.cfg, &screen) {
+                Ok(j) => j,
+                Err(e) => return fail(format!("--scene {scene}: {e}")),
+            }
+        }
+        (None, Some(file)) => {
+            let text = match std::fs::read(file) {
+                Ok(bytes) => match String::from_utf8(bytes) {
+                    Ok(t) => t,
+                    Err(_) => return fail(format!("{}: not UTF-8 text", file.display())),
+                },
+                Err(e) => return fail(format!("{}: {e}", file.display())),
+            };
+            match triangles_job(&text, &info.cfg, &screen) {
+                Ok(j) => j,
+                Err(e) => return fail(format!("{}: {e}", file.display())),
+            }
+        }
+        (None, None) => unreachable!("clap requires one"),
+    };
+
+    let show = !args.quiet && std::io::stderr().is_terminal();
+    let mut shown = false;
+    let mut last = start;
+    let outcome = run(&job, info, SPECULAR_MODELS.first(), |f| {
+        // Only renders that take a while get a progress line, redrawn at most 10 times a second.
+        let now = Instant::now();
+        if show && (now - start).as_secs_f64() > 0.5 && ((now - last).as_secs_f64() >= 0.1 || f >= 1.0) {
+            shown = true;
+            last = now;
+            let bar = (f * 40.0) as usize;
+            eprint!("\rrendering [{}{}] {:5.1}%", "#".repeat(bar), " ".repeat(40 - bar.min(40)), 100.0 * f);
+            let _ = std::io::stderr().flush();
+        }
+    });
+    if shown {
+        eprintln!();
+    }
+
+    let channels = job.channels();
+    let color = if channels == 3 { ExtendedColorType::Rgb8 } else { ExtendedColorType::L8 };
+    let mut files = vec![
+        (args.out.clone(), png(&outcome.rtl, &screen, color)),
+        (golden_path.clone(), png(&outcome.golden, &screen, color)),
+    ];
+    if args.diff {
+        let d = difference_image(&outcome.rtl, &outcome.golden, channels);
+        files.push((diff_path.clone(), png(&d, &screen, ExtendedColorType::Rgb8)));
+    }
+    if let Err(e) = write_all(&files) {
+        return fail(e);
+    }
+    let secs = start.elapsed().as_secs_f64();
+
+    let differing = outcome.differing_pixels(channels);
+    summary(&args, &job, &outcome, info.tag, secs);
+    for (path, _) in &files {
+        println!("wrote       {}", path.display());
+    }
+    for r in outcome.segment.iter().chain(&outcome.specular) {
+        for m in &r.mismatches {
+            println!("MISMATCH {m}");
+        }
+    }
+    if differing == 0 && outcome.cosim_ok() {
+        println!("RTL image matches golden in every pixel");
+        ExitCode::SUCCESS
+    } else {
+        println!("RTL image differs from golden in {differing} pixels");
+        ExitCode::from(1)
+    }
+}
+
+fn summary(args: &Args, job: &Job, o: &verilator_harness::render::Outcome, tag: &str, secs: f64) {
+    let what = match (&args.scene, &args.triangles) {
+        (Some(s), _) => format!("scene {s}"),
+        (_, Some(f)) => format!("triangles {}", f.display()),
+        _ => String::new(),
+    };
+    println!("render {what}, {}x{}, model {tag} x {} channel(s)", job.screen.width, job.screen.height, job.channels());
+    if job.drawn == job.triangles {
+        println!("triangles:  {}", job.triangles);
+    } else {
+        println!("triangles:  {} ({} after back-face culling)", job.triangles, job.drawn);
+    }
+    let seg = &o.segment[0];
+    let cycles = busy_cycles(seg);
+    println!("spans:      {}", job.spans());
+    println!("segments:   {} per channel", seg.segments);
+    println!("pixels:     {} shaded per channel, {} visible", seg.pixels, job.visible_pixels());
+    println!("RTL clocks: {cycles} (segment shader, each channel's instance)");
+    println!("pixels per clock: {:.3}", seg.pixels as f64 / cycles.max(1) as f64);
+    if let Some(s) = &o.specular {
+        println!("specular unit: {} pixels in {} clocks (one pixel per clock)", s.pixels, busy_cycles(s));
+    }
+    println!("wall time:  {secs:.2} s");
+}
+
+fn png(buf: &[u8], screen: &Screen, color: ExtendedColorType) -> Vec<u8> {
+    let mut out = Vec::new();
+    PngEncoder::new(&mut out).write_image(buf, screen.width, screen.height, color).expect("in-memory PNG encoding");
+    out
+}
+
+/// Writes every file under a temporary name first, then renames them all: either every file is
+/// complete or (on an error) none is touched.
+fn write_all(files: &[(PathBuf, Vec<u8>)]) -> Result<(), String> {
+    let tmp: Vec<PathBuf> = files
+        .iter()
+        .map(|(p, _)| {
+            let mut t = p.as_os_str().to_owned();
+            t.push(format!(".tmp{}", std::process::id()));
+            PathBuf::from(t)
+        })
+        .collect();
+    let cleanup = |n: usize| {
+        for t in &tmp[..n] {
+            let _ = std::fs::remove_file(t);
+        }
+    };
+    for (k, ((path, bytes), t)) in files.iter().zip(&tmp).enumerate() {
+        if let Err(e) = std::fs::write(t, bytes) {
+            cleanup(k + 1);
+            return Err(format!("{}: {e}", path.display()));
+        }
+    }
+    for (k, ((path, _), t)) in files.iter().zip(&tmp).enumerate() {
+        if let Err(e) = std::fs::rename(t, path) {
+            cleanup(files.len());
+            return Err(format!("{}: {e} ({k} of {} files already written)", path.display(), files.len()));
+        }
+    }
+    Ok(())
+}

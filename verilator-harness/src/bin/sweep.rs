@@ -1,0 +1,239 @@
+//! `sweep`: pixels per clock of the segment shader for every p built, in both alignments,
+//! measured in RTL clocks by co-simulation at full rate, next to the cycle models of the seeds'
+//! other parallel schemes (`golden::schemes`), on one workload of random triangles in three size
+//! classes. Prints a Markdown table (or writes it with --out).
+//!
+//! Every segment is checked against golden as usual; the RTL clock count of every run must also
+//! equal the analytical one (`Σ segments + latency`). Either failing gives exit status 1.
+
+use clap::Parser;
+use golden::schemes::{workload_count, Scheme, FILL};
+use golden::setup::{Screen, Triangle, Vertex};
+use golden::Align;
+use rand::rngs::StdRng;
+use rand::{Rng, SeedableRng};
+use std::fmt::Write as _;
+use std::io::{IsTerminal, Write as _};
+use std::path::PathBuf;
+use std::process::ExitCode;
+use std::time::Instant;
+use verilator_harness::cosim::{Report, SegmentCosim, Stim, Traffic};
+use verilator_harness::ffi::SEGMENT_MODELS;
+use verilator_harness::render::busy_cycles;
+
+#[derive(Parser)]
+#[command(about = "Pixels per clock of the segment shader (RTL) and the seeds' other parallel schemes (models)")]
+struct Args {
+    /// Random triangles per size class.
+    #[arg(long, default_value_t = 10_000, value_parser = clap::value_parser!(u64).range(1..=1_000_000))]
+    triangles: u64,
+    /// Seed of the workload.
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+    #[arg(long, default_value_t = 640, value_parser = clap::value_parser!(u32).range(64..=4096))]
+    width: u32,
+    #[arg(long, default_value_t = 480, value_parser = clap::value_parser!(u32).range(64..=65536))]
+    height: u32,
+    /// Write the table here (atomically) instead of to standard output.
+    #[arg(long, value_name = "FILE.md")]
+    out: Option<PathBuf>,
+}
+
+/// The size classes: target area in pixels.
+const CLASSES: [f64; 3] = [10.0, 100.0, 1000.0];
+
+/// A random triangle of about `area` pixels (log-uniform within ±20%), entirely on the screen,
+/// vertices on the 1/128-pixel grid (so the midline split tiles it exactly), random intensities.
+/// The shape: three points uniform in a disk, scaled to the area; very thin ones (under 5% of
+/// the disk's largest triangle) are drawn again, so the class is not dominated by slivers.
+fn sized_triangle(rng: &mut StdRng, screen: &Screen, area: f64) -> Triangle {
+    let target = area * rng.gen_range(0.8f64.ln()..1.25f64.ln()).exp();
+    loop {
+        let mut p = [[0.0f64; 2]; 3];
+        for q in &mut p {
+            loop {
+                let (x, y) = (rng.gen_range(-1.0..1.0), rng.gen_range(-1.0..1.0));
+                if x * x + y * y <= 1.0 {
+                    *q = [x, y];
+                    break;
+                }
+            }
+        }
+        let a = ((p[1][0] - p[0][0]) * (p[2][1] - p[0][1]) - (p[1][1] - p[0][1]) * (p[2][0] - p[0][0])).abs() / 2.0;
+        if a < 0.05 * 1.299 {
+            continue;
+        }
+        let s = (target / a).sqrt();
+        let xs = p.map(|q| q[0] * s);
+        let ys = p.map(|q| q[1] * s);
+        let (x0, x1) = (xs.iter().cloned().fold(f64::INFINITY, f64::min), xs.iter().cloned().fold(f64::NEG_INFINITY, f64::max));
+        let (y0, y1) = (ys.iter().cloned().fold(f64::INFINITY, f64::min), ys.iter().cloned().fold(f64::NEG_INFINITY, f64::max));
+        let (w, h) = (screen.width as f64, screen.height as f64);
+        if x1 - x0 > w - 2.0 || y1 - y0 > h - 2.0 {
+            continue;
+        }
+        let dx = rng.gen_range(1.0 - x0..w - 1.0 - x1);
+        let dy = rng.gen_range(1.0 - y0..h - 1.0 - y1);
+        let grid = |c: f64| (c * 128.0).round() / 128.0;
+        let v = [0, 1, 2].map(|k| Vertex { x: grid(xs[k] + dx), y: grid(ys[k] + dy), i: rng.gen_range(0.0..=255.0) });
+        return Triangle { v };
+    }
+}
+
+struct Cell {
+    ppc: f64,
+    width: u32,
+}
+
+impl Cell {
+    fn show(&self, bold: bool) -> String {
+        let b = if bold { "**" } else { "" };
+        format!("{b}{:.2}{b} ({:.0}%)", self.ppc, 100.0 * self.ppc / self.width as f64)
+    }
+}
+
+fn main() -> ExitCode {
+    let args = Args::parse();
+    let start = Instant::now();
+    let screen = Screen { width: args.width, height: args.height };
+    let mut models: Vec<_> = SEGMENT_MODELS.iter().filter(|m| screen.check_for(&m.cfg).is_ok()).collect();
+    models.sort_by_key(|m| (m.cfg.p, m.cfg.align == Align::Screen));
+    if models.is_empty() {
+        eprintln!("error: no segment shader model in this build fits a {}x{} screen", screen.width, screen.height);
+        return ExitCode::from(2);
+    }
+    let cfg = models[0].cfg;
+    let mut rng = StdRng::seed_from_u64(args.seed);
+    let workloads: Vec<Vec<Triangle>> =
+        CLASSES.iter().map(|&a| (0..args.triangles).map(|_| sized_triangle(&mut rng, &screen, a)).collect()).collect();
+    let show = std::io::stderr().is_terminal();
+    let mut failures = Vec::new();
+
+    // Baselines: cycle models.
+    let mut rows: Vec<(String, &str, Vec<Cell>)> = Vec::new();
+    let mut stats = Vec::new();
+    for scheme in Scheme::BASELINES {
+        let mut cells = Vec::new();
+        for tris in &workloads {
+            let c = workload_count(scheme, &cfg, &screen, tris).expect("the workload fits the screen");
+            cells.push(Cell { ppc: c.pixels_per_clock(), width: scheme.width() });
+            if scheme == Scheme::Classical {
+                stats.push(c);
+            }
+        }
+        rows.push((scheme.to_string(), "model", cells));
+    }
+
+    // The segment shader: RTL clocks.
+    let mut rtl: Vec<(u32, Align, Vec<f64>)> = Vec::new();
+    let runs = models.len() * workloads.len();
+    for (n, info) in models.iter().enumerate() {
+        let (p, align) = (info.cfg.p, info.cfg.align);
+        let mut cells = Vec::new();
+        let mut ppcs = Vec::new();
+        for (k, tris) in workloads.iter().enumerate() {
+            if show {
+                eprint!("\rsweep: {} on class {} ({}/{runs})   ", info.tag, k, n * workloads.len() + k + 1);
+                let _ = std::io::stderr().flush();
+            }
+            let mut stims = Vec::new();
+            for (t, tri) in tris.iter().enumerate() {
+                golden::setup::triangle_spans(&info.cfg, &screen, tri, |y, span| stims.push(Stim { triangle: t, y, span }))
+                    .expect("the workload fits the screen");
+            }
+            let mut sim = SegmentCosim::new(info, args.seed, Traffic::FULL);
+            let mut report = Report { triangles: tris.len(), ..Report::default() };
+            sim.stream(&stims, &mut report, |_, _| {});
+            let cycles = busy_cycles(&report);
+            let model = workload_count(Scheme::Segment { p, align }, &info.cfg, &screen, tris).expect("fits");
+            let want = model.clocks + info.latency as u64;
+            if !report.ok() {
+                failures.push(format!("{}: class {k}: {} mismatches, first: {}", info.tag, report.mismatch_count, report.mismatches[0]));
+            }
+            if cycles != want || report.pixels != model.pixels || FILL != info.latency as u64 {
+                failures.push(format!("{}: class {k}: {cycles} RTL clocks, the model says {want}", info.tag));
+            }
+            let ppc = report.pixels as f64 / cycles.max(1) as f64;
+            cells.push(Cell { ppc, width: p });
+            ppcs.push(ppc);
+        }
+        rows.push((format!("segment shader p = {p}, {align}"), "RTL", cells));
+        rtl.push((p, align, ppcs));
+    }
+    if show {
+        eprintln!();
+    }
+
+    // Best p per class and alignment: the smallest p within 10% of the widest model's rate.
+    let best = |align: Align, k: usize| -> Option<u32> {
+        let of = rtl.iter().filter(|r| r.1 == align);
+        let top = of.clone().map(|r| r.2[k]).fold(0.0, f64::max);
+        of.filter(|r| r.2[k] >= 0.9 * top).map(|r| r.0).min()
+    };
+    let mut md = String::new();
+    let cmd = format!(
+        "cargo run --release -p verilator-harness --bin sweep -- --triangles {} --seed {}{}",
+        args.triangles,
+        args.seed,
+        if (args.width, args.height) == (640, 480) { String::new() } else { format!(" --width {} --height {}", args.width, args.height) }
+    );
+    let _ = writeln!(md, "Regenerate with `{cmd}`.\n");
+    let _ = writeln!(
+        md,
+        "Workload: {} random triangles per size class on a {}x{} screen (seed {}); random shapes, area \
+         within ±20% of the class, entirely on screen. Every segment shader is co-simulated at full rate \
+         (both ends always ready) with every segment checked against golden; its clocks run from the \
+         first span offered to the last segment out{}. The other schemes are cycle models \
+         (`golden::schemes`, same assumptions: no per-span overhead, the same {}-clock fill).\n",
+        args.triangles,
+        screen.width,
+        screen.height,
+        args.seed,
+        if failures.is_empty() {
+            format!(" and equal Σ segments + {FILL} (pipeline fill) in every cell")
+        } else {
+            " (THIS RUN FAILED ITS CHECKS: see the FAIL lines)".to_string()
+        },
+        FILL
+    );
+    let _ = writeln!(md, "| | ~10 px | ~100 px | ~1000 px |\n|---|---:|---:|---:|");
+    let row = |f: &dyn Fn(&golden::schemes::Count) -> String| stats.iter().map(f).collect::<Vec<_>>().join(" | ");
+    let _ = writeln!(md, "| pixels per triangle (mean) | {} |", row(&|c| format!("{:.1}", c.pixels as f64 / c.triangles as f64)));
+    let _ = writeln!(md, "| span length (mean pixels) | {} |", row(&|c| format!("{:.2}", c.pixels as f64 / c.spans as f64)));
+    let _ = writeln!(md, "| spans per triangle (mean) | {} |\n", row(&|c| format!("{:.2}", c.spans as f64 / c.triangles as f64)));
+    let _ = writeln!(md, "Pixels per clock (in brackets: of the pixels the scheme could make per clock). **Bold**: the best p of each class and alignment.\n");
+    let _ = writeln!(md, "| scheme | clocks | ~10 px | ~100 px | ~1000 px |\n|---|---|---:|---:|---:|");
+    for (name, source, cells) in &rows {
+        let bold = |k: usize| {
+            rtl.iter().any(|r| *name == format!("segment shader p = {}, {}", r.0, r.1) && best(r.1, k) == Some(r.0))
+        };
+        let c: Vec<String> = cells.iter().enumerate().map(|(k, c)| c.show(bold(k))).collect();
+        let _ = writeln!(md, "| {name} | {source} | {} |", c.join(" | "));
+    }
+    let _ = writeln!(md, "\nBest p: the smallest p within 10% of the pixels per clock of the widest model (p = {}), per alignment:\n", rtl.iter().map(|r| r.0).max().unwrap_or(0));
+    for (k, class) in ["~10 px", "~100 px", "~1000 px"].iter().enumerate() {
+        let show = |a| best(a, k).map_or("-".to_string(), |p| p.to_string());
+        let _ = writeln!(md, "- {class}: p = {} span-aligned, p = {} screen-aligned", show(Align::Span), show(Align::Screen));
+    }
+
+    match &args.out {
+        Some(path) => {
+            let tmp = PathBuf::from(format!("{}.tmp{}", path.display(), std::process::id()));
+            if let Err(e) = std::fs::write(&tmp, &md).and_then(|_| std::fs::rename(&tmp, path)) {
+                let _ = std::fs::remove_file(&tmp);
+                eprintln!("error: --out {}: {e}", path.display());
+                return ExitCode::from(2);
+            }
+        }
+        None => print!("{md}"),
+    }
+    eprintln!("sweep: {} models x {} classes in {:.1} s", models.len(), workloads.len(), start.elapsed().as_secs_f64());
+    for f in &failures {
+        eprintln!("FAIL {f}");
+    }
+    if failures.is_empty() {
+        ExitCode::SUCCESS
+    } else {
+        ExitCode::from(1)
+    }
+}

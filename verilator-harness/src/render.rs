@@ -1,0 +1,631 @@
+//! Scenes through the RTL: tessellation, lighting, hidden surfaces, co-simulation of every span
+//! and image assembly, with the golden model's image made by the same host logic.
+//!
+//! A render is a [`Job`]: the spans of every triangle, per colour channel, in stream order; the
+//! specular span of each (scenes only); and the visibility of every pixel, decided on the host
+//! before any shading ([`Job::owner`]). [`run`] streams the spans through one segment shader per
+//! channel and one specular unit, all at full rate ([`Traffic::FULL`]), and keeps each output
+//! pixel whose triangle owns it. The golden image applies the same ownership to golden's pixels,
+//! so the two images agree pixel for pixel exactly when the RTL agrees with golden.
+//!
+//! Hidden surfaces. Scenes: back-face culling (the meshes are closed) and a host z-buffer over
+//! every remaining triangle, in f64, on `1/z` interpolated linearly in screen space (exact for a
+//! perspective projection). The z-buffer is resolved before shading, as a depth pre-pass: each
+//! pixel records the nearest triangle (the first in stream order on a tie), and only that
+//! triangle's pixel is kept when the shaded segments come back. Triangle files: no depth; later
+//! triangles are drawn over earlier ones, so a pixel belongs to the last triangle covering it.
+
+use crate::cosim::{Report, SegmentCosim, Stim, Traffic, DRAIN_CLOCKS};
+use crate::ffi::{ModelInfo, SegIn, SegOut, SpecIn, SpecOut};
+use crate::specular::SpecularCosim;
+use golden::setup::{parse_triangles, triangle_spans, Screen, Triangle, Vertex};
+use golden::specular::setup::{cross, dot, normalize, setup_span, SpanEnds, Vec3};
+use golden::specular::{SpecularSpan, SpecularUnit, C_FRAC};
+use golden::Config;
+use std::f64::consts::{PI, TAU};
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::time::Duration;
+
+/// `owner` of a pixel no triangle covers.
+pub const BACKGROUND: u32 = u32::MAX;
+
+/// A triangle mesh. Faces are wound counter-clockwise seen from outside; `normals` are the
+/// smooth vertex normals (unit).
+#[derive(Clone, Debug, Default)]
+pub struct Mesh {
+    pub positions: Vec<Vec3>,
+    pub normals: Vec<Vec3>,
+    pub faces: Vec<[u32; 3]>,
+}
+
+impl Mesh {
+    /// Adds face `[a, b, c]`, flipped if needed so its winding agrees with its vertex normals.
+    fn face(&mut self, f: [u32; 3]) {
+        let p = f.map(|k| self.positions[k as usize]);
+        let n = cross(sub(p[1], p[0]), sub(p[2], p[0]));
+        let avg = add(add(self.normals[f[0] as usize], self.normals[f[1] as usize]), self.normals[f[2] as usize]);
+        self.faces.push(if dot(n, avg) >= 0.0 { f } else { [f[0], f[2], f[1]] });
+    }
+
+    fn vertex(&mut self, p: Vec3, n: Vec3) -> u32 {
+        self.positions.push(p);
+        self.normals.push(normalize(n).unwrap_or([0.0, 0.0, 1.0]));
+        (self.positions.len() - 1) as u32
+    }
+}
+
+/// A unit sphere: `stacks` rings of latitude, `slices` of longitude; fans at the poles, so no
+/// face is degenerate. `2 * slices * (stacks - 1)` triangles.
+pub fn sphere(stacks: u32, slices: u32) -> Mesh {
+    let mut m = Mesh::default();
+    let north = m.vertex([0.0, 1.0, 0.0], [0.0, 1.0, 0.0]);
+    for i in 1..stacks {
+        let phi = PI * i as f64 / stacks as f64;
+        for j in 0..slices {
+            let th = TAU * j as f64 / slices as f64;
+            let p = [phi.sin() * th.cos(), phi.cos(), -phi.sin() * th.sin()];
+            m.vertex(p, p);
+        }
+    }
+    let south = m.vertex([0.0, -1.0, 0.0], [0.0, -1.0, 0.0]);
+    let ring = |i: u32, j: u32| 1 + (i - 1) * slices + j % slices;
+    for j in 0..slices {
+        m.face([north, ring(1, j), ring(1, j + 1)]);
+        m.face([south, ring(stacks - 1, j + 1), ring(stacks - 1, j)]);
+    }
+    for i in 1..stacks - 1 {
+        for j in 0..slices {
+            let (a, b, c, d) = (ring(i, j), ring(i, j + 1), ring(i + 1, j + 1), ring(i + 1, j));
+            m.face([a, d, c]);
+            m.face([a, c, b]);
+        }
+    }
+    m
+}
+
+/// A torus around the y axis: tube centre radius `big`, tube radius `small`; `2 * around *
+/// tube` triangles.
+pub fn torus(around: u32, tube: u32, big: f64, small: f64) -> Mesh {
+    let mut m = Mesh::default();
+    for i in 0..around {
+        let u = TAU * i as f64 / around as f64;
+        for j in 0..tube {
+            let v = TAU * j as f64 / tube as f64;
+            let n = [v.cos() * u.cos(), v.sin(), v.cos() * u.sin()];
+            let p = [(big + small * v.cos()) * u.cos(), small * v.sin(), (big + small * v.cos()) * u.sin()];
+            m.vertex(p, n);
+        }
+    }
+    let at = |i: u32, j: u32| (i % around) * tube + j % tube;
+    for i in 0..around {
+        for j in 0..tube {
+            let (a, b, c, d) = (at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j + 1));
+            m.face([a, b, c]);
+            m.face([a, c, d]);
+        }
+    }
+    m
+}
+
+fn sub(a: Vec3, b: Vec3) -> Vec3 {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+fn add(a: Vec3, b: Vec3) -> Vec3 {
+    [a[0] + b[0], a[1] + b[1], a[2] + b[2]]
+}
+fn scale(a: Vec3, s: f64) -> Vec3 {
+    [a[0] * s, a[1] * s, a[2] * s]
+}
+/// Rotation about x by `ax`, then about y by `ay`.
+fn rotate_xy(p: Vec3, ax: f64, ay: f64) -> Vec3 {
+    let (s, c) = ax.sin_cos();
+    let p = [p[0], c * p[1] - s * p[2], s * p[1] + c * p[2]];
+    let (s, c) = ay.sin_cos();
+    [c * p[0] + s * p[2], p[1], -s * p[0] + c * p[2]]
+}
+
+/// The built-in scenes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SceneKind {
+    Sphere,
+    Torus,
+}
+
+impl std::str::FromStr for SceneKind {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s {
+            "sphere" => Ok(SceneKind::Sphere),
+            "torus" => Ok(SceneKind::Torus),
+            _ => Err(format!("unknown scene '{s}' (expected 'sphere' or 'torus')")),
+        }
+    }
+}
+
+/// Lighting and camera of a scene; everything in world units, the object centred at the origin.
+#[derive(Clone, Debug)]
+pub struct Lighting {
+    pub eye: Vec3,
+    pub light: Vec3,
+    /// Object colour per channel (0..1).
+    pub colour: [f64; 3],
+    pub ambient: f64,
+    pub diffuse: f64,
+    /// `Il * ks`: the highlight's peak, in 8-bit levels, added to every channel (white).
+    pub specular: f64,
+    /// Blinn–Phong exponent n, 1..=1000.
+    pub shininess: u16,
+}
+
+/// The mesh and lighting of a scene (shininess as given).
+pub fn scene(kind: SceneKind, shininess: u16) -> (Mesh, Lighting, f64) {
+    let eye = [0.0, 0.0, 4.5];
+    let light = [-4.0, 4.5, 6.0];
+    match kind {
+        SceneKind::Sphere => {
+            let l = Lighting {
+                eye,
+                light,
+                colour: [0.92, 0.32, 0.22],
+                ambient: 0.07,
+                diffuse: 0.93,
+                specular: 235.0,
+                shininess,
+            };
+            // 64 x 96: 12,096 triangles, about half of them facing the camera.
+            (sphere(64, 96), l, 1.0)
+        }
+        SceneKind::Torus => {
+            let mut m = torus(128, 48, 1.0, 0.42);
+            // Tilted toward the camera so the hole shows and the near side hides the far one.
+            for p in m.positions.iter_mut() {
+                *p = rotate_xy(*p, 0.5, 0.35);
+            }
+            for n in m.normals.iter_mut() {
+                *n = rotate_xy(*n, 0.5, 0.35);
+            }
+            let l = Lighting {
+                eye,
+                light,
+                colour: [0.24, 0.58, 0.95],
+                ambient: 0.07,
+                diffuse: 0.93,
+                specular: 235.0,
+                shininess,
+            };
+            (m, l, 1.42)
+        }
+    }
+}
+
+/// Everything a render streams, and who owns every pixel.
+#[derive(Clone, Debug)]
+pub struct Job {
+    pub screen: Screen,
+    /// Per colour channel (1 or 3), the spans in stream order. Every channel has the same
+    /// spans (same triangles, rows, x and length), only the intensities differ.
+    pub stims: Vec<Vec<Stim>>,
+    /// The specular span of each stim (same order), or empty: diffuse only.
+    pub specular: Vec<SpecularSpan>,
+    /// Per pixel (row-major), the triangle whose pixel is visible, or [`BACKGROUND`].
+    pub owner: Vec<u32>,
+    /// Triangles in the input (tessellated or read).
+    pub triangles: usize,
+    /// Triangles streamed (after back-face culling).
+    pub drawn: usize,
+}
+
+impl Job {
+    pub fn channels(&self) -> usize {
+        self.stims.len()
+    }
+    pub fn spans(&self) -> usize {
+        self.stims.first().map_or(0, Vec::len)
+    }
+    /// Pixels the shader makes per channel (covered by some streamed span).
+    pub fn shaded_pixels(&self) -> u64 {
+        self.stims.first().map_or(0, |s| s.iter().map(|s| s.span.len as u64).sum())
+    }
+    pub fn visible_pixels(&self) -> u64 {
+        self.owner.iter().filter(|&&o| o != BACKGROUND).count() as u64
+    }
+}
+
+/// The job of a scene: tessellate, light the vertices, cull back faces, set up the spans of
+/// every channel and the specular span of each, resolve the z-buffer.
+pub fn scene_job(kind: SceneKind, shininess: u16, cfg: &Config, screen: &Screen) -> Result<Job, String> {
+    let (mesh, light, radius) = scene(kind, shininess);
+    let (w, h) = (screen.width as f64, screen.height as f64);
+    let d = light.eye[2];
+    // Focal length in pixels: the object's bounding sphere fills 84% of the shorter side.
+    let focal = 0.42 * w.min(h) * (d * d - radius * radius).sqrt() / radius;
+    // Screen position and 1/depth of every vertex (the camera looks down -z from `eye`).
+    let proj: Vec<(f64, f64, f64)> = mesh
+        .positions
+        .iter()
+        .map(|p| {
+            let depth = d - p[2];
+            (w / 2.0 + focal * p[0] / depth, h / 2.0 - focal * p[1] / depth, 1.0 / depth)
+        })
+        .collect();
+    // Per-vertex diffuse intensity of each channel (Gouraud: lit at the vertices only).
+    let lit: Vec<[f64; 3]> = mesh
+        .positions
+        .iter()
+        .zip(&mesh.normals)
+        .map(|(p, n)| {
+            let l = normalize(sub(light.light, *p)).unwrap_or([0.0, 0.0, 1.0]);
+            let k = light.ambient + light.diffuse * dot(*n, l).max(0.0);
+            light.colour.map(|c| (255.0 * c * k).clamp(0.0, 255.0))
+        })
+        .collect();
+
+    let npix = (screen.width * screen.height) as usize;
+    let mut job = Job {
+        screen: *screen,
+        stims: vec![Vec::new(); 3],
+        specular: Vec::new(),
+        owner: vec![BACKGROUND; npix],
+        triangles: mesh.faces.len(),
+        drawn: 0,
+    };
+    let mut zbuf = vec![f64::NEG_INFINITY; npix];
+    for f in &mesh.faces {
+        let p = f.map(|k| mesh.positions[k as usize]);
+        let normal = cross(sub(p[1], p[0]), sub(p[2], p[0]));
+        if dot(normal, sub(light.eye, p[0])) <= 0.0 {
+            continue; // back face
+        }
+        let tri = job.drawn as u32;
+        job.drawn += 1;
+        let v = f.map(|k| proj[k as usize]);
+        let first = job.stims[0].len();
+        for (c, stims) in job.stims.iter_mut().enumerate() {
+            let t = Triangle { v: [0, 1, 2].map(|k| Vertex { x: v[k].0, y: v[k].1, i: lit[f[k] as usize][c] }) };
+            triangle_spans(cfg, screen, &t, |y, span| stims.push(Stim { triangle: tri as usize, y, span }))?;
+        }
+        let interp = Interp::new(v);
+        for s in &job.stims[0][first..] {
+            // Depth pre-pass: nearest wins, the first drawn on a tie.
+            let py = s.y as f64 + 0.5;
+            for x in s.span.x0..s.span.x0 + s.span.len {
+                let idx = (s.y * screen.width + x) as usize;
+                let z = interp.inv_depth(x as f64 + 0.5, py);
+                if z > zbuf[idx] {
+                    zbuf[idx] = z;
+                    job.owner[idx] = tri;
+                }
+            }
+            // Specular set-up of the span: N and H at its first and last pixel.
+            let end = |x: u32| {
+                let mu = interp.weights(x as f64 + 0.5, py);
+                let blend = |a: &dyn Fn(usize) -> Vec3| {
+                    add(add(scale(a(0), mu[0]), scale(a(1), mu[1])), scale(a(2), mu[2]))
+                };
+                let n = blend(&|k| mesh.normals[f[k] as usize]);
+                let pos = blend(&|k| mesh.positions[f[k] as usize]);
+                let l = normalize(sub(light.light, pos)).unwrap_or([0.0, 0.0, 1.0]);
+                let e = normalize(sub(light.eye, pos)).unwrap_or([0.0, 0.0, 1.0]);
+                (n, add(l, e))
+            };
+            let (n1, h1) = end(s.span.x0);
+            let (n2, h2) = end(s.span.x0 + s.span.len - 1);
+            let ends = SpanEnds { n1, h1, n2, h2 };
+            job.specular.push(setup_span(&ends, light.specular, 1.0, light.shininess, s.span.len - 1).port);
+        }
+    }
+    for c in 1..3 {
+        debug_assert!(job.stims[c].iter().zip(&job.stims[0]).all(|(a, b)| (a.y, a.span.x0, a.span.len) == (b.y, b.span.x0, b.span.len)));
+    }
+    Ok(job)
+}
+
+/// Screen-space interpolation over a projected triangle: 1/depth (affine in screen space) and
+/// perspective-correct barycentric weights.
+struct Interp {
+    v: [(f64, f64, f64); 3],
+    area: f64,
+}
+
+impl Interp {
+    fn new(v: [(f64, f64, f64); 3]) -> Interp {
+        let area = (v[1].0 - v[0].0) * (v[2].1 - v[0].1) - (v[1].1 - v[0].1) * (v[2].0 - v[0].0);
+        Interp { v, area }
+    }
+
+    /// Screen-space barycentric weights of (x, y); equal weights for a degenerate triangle.
+    fn screen_weights(&self, x: f64, y: f64) -> [f64; 3] {
+        if self.area.abs() < 1e-12 {
+            return [1.0 / 3.0; 3];
+        }
+        let v = &self.v;
+        let e = |a: usize, b: usize| ((v[b].0 - v[a].0) * (y - v[a].1) - (v[b].1 - v[a].1) * (x - v[a].0)) / self.area;
+        [e(1, 2), e(2, 0), e(0, 1)]
+    }
+
+    fn inv_depth(&self, x: f64, y: f64) -> f64 {
+        let l = self.screen_weights(x, y);
+        l[0] * self.v[0].2 + l[1] * self.v[1].2 + l[2] * self.v[2].2
+    }
+
+    /// Perspective-correct weights: the barycentric weights of the surface point seen at (x, y).
+    fn weights(&self, x: f64, y: f64) -> [f64; 3] {
+        let l = self.screen_weights(x, y).map(|l| l.max(0.0));
+        let w = [l[0] * self.v[0].2, l[1] * self.v[1].2, l[2] * self.v[2].2];
+        let s = w[0] + w[1] + w[2];
+        if s > 0.0 {
+            w.map(|w| w / s)
+        } else {
+            [1.0 / 3.0; 3]
+        }
+    }
+}
+
+/// The job of a triangle file (SPEC §5's text format): one grayscale channel, triangles drawn in
+/// file order, later over earlier. Errors name the line (`line N: ...`) or the triangle.
+pub fn triangles_job(text: &str, cfg: &Config, screen: &Screen) -> Result<Job, String> {
+    let tris = parse_triangles(text).map_err(|e| e.to_string())?;
+    triangles_job_of(&tris, cfg, screen)
+}
+
+/// As [`triangles_job`], for triangles already parsed.
+pub fn triangles_job_of(tris: &[Triangle], cfg: &Config, screen: &Screen) -> Result<Job, String> {
+    screen.check_for(cfg)?;
+    let mut job = Job {
+        screen: *screen,
+        stims: vec![Vec::new()],
+        specular: Vec::new(),
+        owner: vec![BACKGROUND; (screen.width * screen.height) as usize],
+        triangles: tris.len(),
+        drawn: tris.len(),
+    };
+    for (k, t) in tris.iter().enumerate() {
+        let stims = &mut job.stims[0];
+        let owner = &mut job.owner;
+        triangle_spans(cfg, screen, t, |y, span| {
+            for x in span.x0..span.x0 + span.len {
+                owner[(y * screen.width + x) as usize] = k as u32;
+            }
+            stims.push(Stim { triangle: k, y, span });
+        })
+        .map_err(|e| format!("triangle {}: {e}", k + 1))?;
+    }
+    Ok(job)
+}
+
+/// What a render produced.
+#[derive(Debug)]
+pub struct Outcome {
+    /// Channels interleaved per pixel (1 or 3 bytes), row-major.
+    pub rtl: Vec<u8>,
+    pub golden: Vec<u8>,
+    /// Per pixel, how many enabled output lanes of the (first) segment shader wrote it.
+    pub coverage: Vec<u16>,
+    /// One report per channel's segment shader.
+    pub segment: Vec<Report>,
+    pub specular: Option<Report>,
+}
+
+impl Outcome {
+    /// Pixels where the RTL image differs from golden's.
+    pub fn differing_pixels(&self, channels: usize) -> u64 {
+        self.rtl.chunks(channels).zip(self.golden.chunks(channels)).filter(|(a, b)| a != b).count() as u64
+    }
+    /// Every co-simulation check passed.
+    pub fn cosim_ok(&self) -> bool {
+        self.segment.iter().all(Report::ok) && self.specular.as_ref().map_or(true, Report::ok)
+    }
+}
+
+/// Clocks from the first span offered to the last output, without the co-simulation's quiet
+/// clocks after it ([`DRAIN_CLOCKS`]).
+pub fn busy_cycles(r: &Report) -> u64 {
+    r.cycles.saturating_sub(DRAIN_CLOCKS)
+}
+
+/// The highlight of a specular output pixel (UQ8.8) in 8-bit levels, rounded.
+pub fn spec_level(spec: u16) -> u32 {
+    (spec as u32 + (1 << (C_FRAC - 1))) >> C_FRAC
+}
+
+/// Streams `job` through one `seg` model per channel and, when the job has specular spans, the
+/// `spec` model, all at full rate on their own threads; builds the RTL and golden images.
+/// `progress` is called now and then on the calling thread with the fraction done.
+pub fn run(
+    job: &Job,
+    seg: &'static ModelInfo<SegIn, SegOut>,
+    spec: Option<&'static ModelInfo<SpecIn, SpecOut>>,
+    mut progress: impl FnMut(f64),
+) -> Outcome {
+    let screen = job.screen;
+    let (width, npix) = (screen.width, (screen.width * screen.height) as usize);
+    let channels = job.channels();
+    let p = seg.cfg.p;
+    let with_spec = !job.specular.is_empty() && spec.is_some();
+    let total = (job.shaded_pixels() * (channels as u64 + with_spec as u64)).max(1);
+    let done = AtomicU64::new(0);
+    let owner = &job.owner;
+    const SEED: u64 = 1;
+
+    let (diffuse, coverage, segment, spec_out) = std::thread::scope(|s| {
+        let seg_threads: Vec<_> = job
+            .stims
+            .iter()
+            .enumerate()
+            .map(|(c, stims)| {
+                let done = &done;
+                s.spawn(move || {
+                    let mut img = vec![0u8; npix];
+                    let mut cov = if c == 0 { vec![0u16; npix] } else { Vec::new() };
+                    let mut sim = SegmentCosim::new(seg, SEED + c as u64, Traffic::FULL);
+                    let mut report = Report { triangles: job.drawn, ..Report::default() };
+                    sim.stream(stims, &mut report, |stim, out| {
+                        let mut n = 0;
+                        for i in (0..p).filter(|&i| out.lane_enabled(i)) {
+                            let x = out.out_x + i;
+                            if x >= width {
+                                continue;
+                            }
+                            let idx = (stim.y * width + x) as usize;
+                            n += 1;
+                            if c == 0 {
+                                cov[idx] = cov[idx].saturating_add(1);
+                            }
+                            if owner[idx] == stim.triangle as u32 {
+                                img[idx] = out.pix[i as usize];
+                            }
+                        }
+                        done.fetch_add(n, Ordering::Relaxed);
+                    });
+                    (img, cov, report)
+                })
+            })
+            .collect();
+        let spec_thread = spec.filter(|_| with_spec).map(|info| {
+            let done = &done;
+            s.spawn(move || {
+                let mut out = vec![0u16; npix];
+                let mut sim = SpecularCosim::new(info, SpecularUnit::default(), SEED, Traffic::FULL);
+                let mut report = Report { triangles: job.drawn, ..Report::default() };
+                let stims = &job.stims[0];
+                sim.stream_with(&job.specular, &mut report, |k, j, o| {
+                    let st = &stims[k];
+                    let idx = (st.y * width + st.span.x0 + j) as usize;
+                    if owner[idx] == st.triangle as u32 {
+                        out[idx] = o.out_spec;
+                    }
+                    done.fetch_add(1, Ordering::Relaxed);
+                });
+                (out, report)
+            })
+        });
+        while !(seg_threads.iter().all(|t| t.is_finished()) && spec_thread.as_ref().map_or(true, |t| t.is_finished())) {
+            progress(done.load(Ordering::Relaxed) as f64 / total as f64);
+            std::thread::sleep(Duration::from_millis(10));
+        }
+        progress(1.0);
+        let mut diffuse = Vec::new();
+        let mut coverage = Vec::new();
+        let mut reports = Vec::new();
+        for (c, t) in seg_threads.into_iter().enumerate() {
+            let (img, cov, report) = t.join().expect("segment co-simulation thread panicked");
+            if c == 0 {
+                coverage = cov;
+            }
+            diffuse.push(img);
+            reports.push(report);
+        }
+        let spec_out = spec_thread.map(|t| t.join().expect("specular co-simulation thread panicked"));
+        (diffuse, coverage, reports, spec_out)
+    });
+
+    // Golden: the same spans, the same ownership, golden's pixels.
+    let frac = seg.cfg.frac;
+    let mut gold_diffuse = vec![vec![0u8; npix]; channels];
+    for (c, stims) in job.stims.iter().enumerate() {
+        for st in stims {
+            for j in 0..st.span.len {
+                let idx = (st.y * width + st.span.x0 + j) as usize;
+                if owner[idx] == st.triangle as u32 {
+                    gold_diffuse[c][idx] = st.span.pixel(j, frac);
+                }
+            }
+        }
+    }
+    let gold_spec = with_spec.then(|| {
+        let unit = SpecularUnit::default();
+        let mut out = vec![0u16; npix];
+        for (st, sp) in job.stims[0].iter().zip(&job.specular) {
+            for (j, px) in unit.span(sp).enumerate() {
+                let idx = (st.y * width + st.span.x0 + j as u32) as usize;
+                if owner[idx] == st.triangle as u32 {
+                    out[idx] = px.spec;
+                }
+            }
+        }
+        out
+    });
+    let (spec_img, spec_report) = match spec_out {
+        Some((img, r)) => (Some(img), Some(r)),
+        None => (None, None),
+    };
+    Outcome {
+        rtl: compose(&diffuse, spec_img.as_deref(), owner),
+        golden: compose(&gold_diffuse, gold_spec.as_deref(), owner),
+        coverage,
+        segment,
+        specular: spec_report,
+    }
+}
+
+/// Diffuse channels plus the white highlight, saturated; background 0.
+fn compose(diffuse: &[Vec<u8>], spec: Option<&[u16]>, owner: &[u32]) -> Vec<u8> {
+    let channels = diffuse.len();
+    let mut img = vec![0u8; owner.len() * channels];
+    for (idx, &o) in owner.iter().enumerate() {
+        if o == BACKGROUND {
+            continue;
+        }
+        let hi = spec.map_or(0, |s| spec_level(s[idx]));
+        for c in 0..channels {
+            img[idx * channels + c] = (diffuse[c][idx] as u32 + hi).min(255) as u8;
+        }
+    }
+    img
+}
+
+/// A difference image (RGB): matching pixels as a dim gray copy of golden, differing pixels
+/// bright red (brighter the larger the difference).
+pub fn difference_image(rtl: &[u8], golden: &[u8], channels: usize) -> Vec<u8> {
+    let mut out = Vec::with_capacity(rtl.len() / channels * 3);
+    for (a, b) in rtl.chunks(channels).zip(golden.chunks(channels)) {
+        let diff = a.iter().zip(b).map(|(x, y)| x.abs_diff(*y)).max().unwrap_or(0);
+        if diff == 0 {
+            let g = (b.iter().map(|&v| v as u32).sum::<u32>() / channels as u32 / 4) as u8;
+            out.extend([g, g, g]);
+        } else {
+            out.extend([(128 + diff as u32 / 2).min(255) as u8, 0, 0]);
+        }
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn difference_image_marks_differing_pixels_red() {
+        let golden = [100u8, 100, 100, 40, 40, 40];
+        let rtl = [100u8, 100, 100, 40, 41, 40];
+        assert_eq!(difference_image(&rtl, &golden, 3), vec![25, 25, 25, 128, 0, 0]);
+        assert_eq!(difference_image(&[0, 255], &[0, 0], 1), vec![0, 0, 0, 255, 0, 0]);
+        assert_eq!(spec_level(0), 0);
+        assert_eq!(spec_level(127), 0);
+        assert_eq!(spec_level(128), 1);
+        assert_eq!(spec_level(u16::MAX), 256);
+    }
+
+    #[test]
+    fn meshes_are_closed_and_outward() {
+        for (m, want) in [(sphere(8, 12), 2 * 12 * 7), (torus(16, 8, 1.0, 0.4), 2 * 16 * 8)] {
+            assert_eq!(m.faces.len(), want);
+            // Closed: every directed edge has its reverse.
+            let mut edges = std::collections::HashSet::new();
+            for f in &m.faces {
+                for k in 0..3 {
+                    assert!(edges.insert((f[k], f[(k + 1) % 3])), "edge used twice in one direction");
+                }
+            }
+            for &(a, b) in &edges {
+                assert!(edges.contains(&(b, a)), "open edge");
+            }
+            // Outward: the face normal agrees with the vertex normals.
+            for f in &m.faces {
+                let p = f.map(|k| m.positions[k as usize]);
+                let n = cross(sub(p[1], p[0]), sub(p[2], p[0]));
+                assert!(f.iter().all(|&k| dot(n, m.normals[k as usize]) > 0.0));
+            }
+        }
+    }
+}
