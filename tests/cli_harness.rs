@@ -1,6 +1,7 @@
 //! The harness's command-line tools with bad input: every flag with a missing, out-of-range or
 //! wrongly typed value gets one clear message naming the flag, exit status 2, and no output.
 
+use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
 fn run(bin: &str, args: &[&str]) -> Output {
@@ -19,6 +20,21 @@ fn assert_rejected(bin: &str, args: &[&str], needle: &str) {
 }
 
 const COSIM: &str = env!("CARGO_BIN_EXE_cosim");
+const RENDER: &str = env!("CARGO_BIN_EXE_render");
+const SWEEP: &str = env!("CARGO_BIN_EXE_sweep");
+
+fn scratch(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("cli-harness-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+fn listing(dir: &Path) -> Vec<String> {
+    let mut v: Vec<String> = std::fs::read_dir(dir).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).collect();
+    v.sort();
+    v
+}
 
 #[test]
 fn cosim_rejects_every_bad_flag() {
@@ -66,4 +82,86 @@ fn cosim_runs_a_few_triangles() {
     let text = String::from_utf8_lossy(&out.stdout);
     assert!(out.status.success(), "{text}{}", String::from_utf8_lossy(&out.stderr));
     assert!(text.trim_end().ends_with("5 passed, 0 failed"), "{text}");
+}
+
+/// `render`: every flag, and triangle files that are missing, not files, not text, malformed
+/// (the message names the line) or hold NaN, infinity or coordinates beyond the set-up's
+/// limits. Nothing is written in any case.
+#[test]
+fn render_rejects_every_bad_flag_and_input_file() {
+    let dir = scratch("render");
+    let good = dir.join("good.txt");
+    std::fs::write(&good, "# one triangle\n0 0 0 10 0 128 0 10 255\n").unwrap();
+    let bad_file = |name: &str, body: &[u8]| {
+        let p = dir.join(name);
+        std::fs::write(&p, body).unwrap();
+        p.to_str().unwrap().to_string()
+    };
+    let short = bad_file("short.txt", b"0 0 0 10 0 128 0 10 255\n\n0 0 0 1 2\n");
+    let nan = bad_file("nan.txt", b"# c\n0 0 0 10 0 128 0 10 255\n0 0 0 nan 0 128 0 10 255\n");
+    let inf = bad_file("inf.txt", b"0 0 0 10 0 128 0 10 inf\n");
+    let far = bad_file("far.txt", b"0 0 0 10 0 128 0 10 255\n0 0 0 10 0 128 0 10 255\n0 0 0 1e6 0 128 0 10 255\n");
+    let bright = bad_file("bright.txt", b"0 0 0 10 0 300 0 10 255\n");
+    let word = bad_file("word.txt", b"0 0 zero 10 0 128 0 10 255\n");
+    let binary = bad_file("binary.txt", &[0xff, 0xfe, 0x00, 0x41]);
+    let missing = dir.join("missing.txt");
+    let (g, d) = (good.to_str().unwrap(), dir.to_str().unwrap());
+    let out = dir.join("out.png");
+    let o = out.to_str().unwrap();
+    let no_folder = dir.join("no/such/out.png");
+    let cases: Vec<(Vec<&str>, String)> = vec![
+        (vec!["--out", o], "--scene".into()),
+        (vec!["--scene", "sphere"], "--out".into()),
+        (vec!["--scene", "cube", "--out", o], "--scene".into()),
+        (vec!["--scene", "sphere", "--triangles", g, "--out", o], "--triangles".into()),
+        (vec!["--triangles", g, "--out", o, "--p", "3"], "--p 3".into()),
+        (vec!["--triangles", g, "--out", o, "--p", "x"], "--p".into()),
+        (vec!["--triangles", g, "--out", o, "--align", "middle"], "--align".into()),
+        (vec!["--triangles", g, "--out", o, "--width", "0"], "--width".into()),
+        (vec!["--triangles", g, "--out", o, "--width", "9000"], "--width".into()),
+        (vec!["--triangles", g, "--out", o, "--height", "70000"], "--height".into()),
+        (vec!["--scene", "torus", "--out", o, "--shininess", "0"], "--shininess".into()),
+        (vec!["--scene", "torus", "--out", o, "--shininess", "1001"], "--shininess".into()),
+        (vec!["--triangles", g, "--out", o, "--shininess", "5"], "--shininess".into()),
+        (vec!["--triangles", g, "--out", no_folder.to_str().unwrap()], "--out".into()),
+        (vec!["--triangles", g, "--out", d], "--out".into()),
+        (vec!["--triangles", missing.to_str().unwrap(), "--out", o], missing.display().to_string()),
+        (vec!["--triangles", d, "--out", o], d.to_string()),
+        (vec!["--triangles", &binary, "--out", o], "UTF-8".into()),
+        (vec!["--triangles", &short, "--out", o], "line 3".into()),
+        (vec!["--triangles", &nan, "--out", o], "line 3".into()),
+        (vec!["--triangles", &inf, "--out", o], "line 1".into()),
+        (vec!["--triangles", &far, "--out", o], "line 3".into()),
+        (vec!["--triangles", &bright, "--out", o], "line 1".into()),
+        (vec!["--triangles", &word, "--out", o], "line 1".into()),
+        (vec!["--triangles", g, "--out", o, "--bogus"], "--bogus".into()),
+    ];
+    let before = listing(&dir);
+    for (args, needle) in &cases {
+        assert_rejected(RENDER, args, needle);
+        assert_eq!(listing(&dir), before, "{args:?} wrote or removed files");
+    }
+}
+
+#[test]
+fn sweep_rejects_every_bad_flag() {
+    let dir = scratch("sweep");
+    let missing = dir.join("no/such/table.md");
+    let cases: Vec<(Vec<&str>, &str)> = vec![
+        (vec!["--triangles", "0"], "--triangles"),
+        (vec!["--triangles", "1000001"], "--triangles"),
+        (vec!["--triangles", "some"], "--triangles"),
+        (vec!["--seed", "x"], "--seed"),
+        (vec!["--width", "63"], "--width"),
+        (vec!["--width", "4097"], "--width"),
+        (vec!["--height", "63"], "--height"),
+        (vec!["--height", "tall"], "--height"),
+        (vec!["--out"], "--out"),
+        (vec!["--triangles", "1", "--out", missing.to_str().unwrap()], "no/such"),
+        (vec!["--bogus"], "--bogus"),
+    ];
+    for (args, needle) in &cases {
+        assert_rejected(SWEEP, args, needle);
+    }
+    assert!(listing(&dir).is_empty());
 }

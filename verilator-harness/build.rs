@@ -2,12 +2,22 @@
 //! verilate it, read the file list from the generated `*_classes.mk`, compile with cc at -O2
 //! and link statically. A model whose inputs (RTL, shim, Verilator version) are unchanged since
 //! the last build is neither re-verilated nor recompiled.
+//!
+//! Each model is compiled as one translation unit (its class files and its shim), as
+//! Verilator's own makefile compiles `V*__ALL.cpp`: the evaluation functions inline into each
+//! other and into the shim's `step`, which is what a native testbench gets. Models are built on
+//! as many threads as cargo gives jobs, and each records its build time in
+//! `OUT_DIR/obj/<tag>/build.time` (read by the `bench` binary).
 
 use golden::{Align, Config};
 use std::fmt::Write as _;
 use std::fs;
 use std::path::{Path, PathBuf};
 use std::process::Command;
+use std::time::Instant;
+
+/// How a model is compiled; part of every model's key, so a change here rebuilds the models.
+const LAYOUT: &str = "one translation unit per model: class files, then the shim; -O2 -fPIE";
 
 /// The segment widths built by default, each in both alignments; each p's BFPI is built too.
 const BUILT_P: [u32; 7] = [1, 2, 4, 8, 16, 32, 64];
@@ -45,10 +55,7 @@ fn main() {
         None => generated_models(),
     };
     let verilator = Verilator::find();
-    let mut globals = Vec::new();
-    for m in &models {
-        globals = build_model(&verilator, &out, m);
-    }
+    let globals = build_models(&verilator, &out, &models);
     build_runtime(&verilator, &out, &globals);
     println!("cargo:rustc-link-search=native={}", out.display());
     for m in &models {
@@ -176,10 +183,16 @@ impl Verilator {
 }
 
 /// The compiler set-up Verilator's own makefile uses, at -O2 whatever the cargo profile.
+/// Position-independent for an executable (`-fPIE`, as g++ builds a native testbench), not for
+/// a shared library (`-fPIC`): the models only ever link into executables, and under `-fPIC`
+/// every global function may be interposed, so GCC would not inline the model's evaluation
+/// functions into each other.
 fn cc_build(v: &Verilator) -> cc::Build {
     let mut b = cc::Build::new();
     b.cpp(true)
         .opt_level(2)
+        .pic(false)
+        .flag("-fPIE")
         .debug(false)
         .warnings(false)
         .cargo_metadata(false)
@@ -195,6 +208,25 @@ fn cc_build(v: &Verilator) -> cc::Build {
     b
 }
 
+/// Builds every model, as many at once as cargo allows jobs (each model is one verilator run and
+/// one compiler run). Returns the runtime files their makefiles ask for.
+fn build_models(v: &Verilator, out: &Path, models: &[Model]) -> Vec<String> {
+    let jobs = std::env::var("NUM_JOBS").ok().and_then(|j| j.parse().ok()).unwrap_or(1usize).clamp(1, models.len().max(1));
+    let next = std::sync::atomic::AtomicUsize::new(0);
+    let globals = std::sync::Mutex::new(Vec::new());
+    std::thread::scope(|s| {
+        for _ in 0..jobs {
+            s.spawn(|| loop {
+                let k = next.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+                let Some(m) = models.get(k) else { break };
+                let g = build_model(v, out, m);
+                *globals.lock().unwrap() = g;
+            });
+        }
+    });
+    globals.into_inner().unwrap()
+}
+
 /// Verilates and compiles one model unless its key (everything the result depends on) is the
 /// one recorded by the last build. Returns the runtime files its makefile asks for.
 fn build_model(v: &Verilator, out: &Path, m: &Model) -> Vec<String> {
@@ -202,7 +234,7 @@ fn build_model(v: &Verilator, out: &Path, m: &Model) -> Vec<String> {
     let rtl = out.join("rtl").join(&m.tag);
     let class = format!("V{}", m.tag);
     let shim = shim_cpp(m, &class);
-    let mut key = format!("{}\n{}\n{}\n{}\n", v.version, m.top, include_str!("csrc/shim.h"), shim);
+    let mut key = format!("{}\n{LAYOUT}\n{}\n{}\n{}\n", v.version, m.top, include_str!("csrc/shim.h"), shim);
     for (name, text) in &m.sources {
         write!(key, "== {name}\n{text}").unwrap();
     }
@@ -210,6 +242,7 @@ fn build_model(v: &Verilator, out: &Path, m: &Model) -> Vec<String> {
     let classes_mk = obj.join(format!("{class}_classes.mk"));
     let lib = out.join(format!("lib{}.a", m.tag));
     let fresh = fs::read_to_string(&key_file).map_or(false, |k| k == key) && lib.exists() && classes_mk.exists();
+    let start = Instant::now();
     if !fresh {
         let _ = fs::remove_dir_all(&obj);
         let _ = fs::remove_dir_all(&rtl);
@@ -244,15 +277,21 @@ fn build_model(v: &Verilator, out: &Path, m: &Model) -> Vec<String> {
     }
     let mk = Classes::read(&classes_mk);
     if !fresh {
-        let shim_path = obj.join("shim.cpp");
-        fs::write(&shim_path, &shim).unwrap();
-        let mut b = cc_build(v);
-        b.include(&obj).include(Path::new(env!("CARGO_MANIFEST_DIR")).join("csrc")).out_dir(&obj).file(&shim_path);
+        let verilated = start.elapsed().as_secs_f64();
+        // The model's classes and the shim in one translation unit (see the module comment).
+        let mut all = String::from("// Generated by build.rs: the model and its shim, one translation unit.\n");
         for c in &mk.model {
-            b.file(obj.join(format!("{c}.cpp")));
+            writeln!(all, "#include \"{c}.cpp\"").unwrap();
         }
+        all.push_str(&shim);
+        let all_path = obj.join(format!("{class}__all.cpp"));
+        fs::write(&all_path, &all).unwrap();
+        let mut b = cc_build(v);
+        b.include(&obj).include(Path::new(env!("CARGO_MANIFEST_DIR")).join("csrc")).out_dir(&obj).file(&all_path);
         b.compile(&m.tag);
         fs::rename(obj.join(format!("lib{}.a", m.tag)), &lib).unwrap();
+        let total = start.elapsed().as_secs_f64();
+        fs::write(obj.join("build.time"), format!("verilate {verilated:.3}\ncompile {:.3}\ntotal {total:.3}\n", total - verilated)).unwrap();
         fs::write(&key_file, &key).unwrap();
     }
     mk.global
@@ -262,12 +301,13 @@ fn build_model(v: &Verilator, out: &Path, m: &Model) -> Vec<String> {
 /// compiled once for every model.
 fn build_runtime(v: &Verilator, out: &Path, globals: &[String]) {
     let obj = out.join("obj").join("runtime");
-    let key = format!("{}\n{}\n", v.version, globals.join(" "));
+    let key = format!("{}\n{LAYOUT}\n{}\n", v.version, globals.join(" "));
     let lib = out.join("libverilated_rt.a");
     if fs::read_to_string(obj.join("build.key")).map_or(false, |k| k == key) && lib.exists() {
         return;
     }
     fs::create_dir_all(&obj).unwrap();
+    let start = Instant::now();
     let mut b = cc_build(v);
     b.out_dir(&obj);
     for g in globals {
@@ -275,6 +315,7 @@ fn build_runtime(v: &Verilator, out: &Path, globals: &[String]) {
     }
     b.compile("verilated_rt");
     fs::rename(obj.join("libverilated_rt.a"), &lib).unwrap();
+    fs::write(obj.join("build.time"), format!("compile {:.3}\ntotal {:.3}\n", start.elapsed().as_secs_f64(), start.elapsed().as_secs_f64())).unwrap();
     fs::write(obj.join("build.key"), key).unwrap();
 }
 

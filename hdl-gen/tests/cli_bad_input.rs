@@ -168,3 +168,20 @@ fn testbench_bad_flags() {
     assert_rejected(&["testbench", "--vectors", "5", "--out", file.to_str().unwrap()], file.to_str().unwrap(), &dir);
     assert_eq!(std::fs::read(&file).unwrap(), b"keep");
 }
+
+#[test]
+fn report_bad_flags() {
+    let dir = scratch("report");
+    std::fs::create_dir_all(&dir).unwrap();
+    let cases: &[(&[&str], &str)] = &[
+        (&["report", "precision"], "precision"),
+        (&["report", "accuracy", "--png"], "--png"),
+        (&["report", "accuracy", "--brdf-k"], "--brdf-k"),
+        (&["report", "accuracy", "--brdf-k", "auto", "--max-rel-error", "0%"], "--max-rel-error"),
+        (&["report", "accuracy", "--max-rel-error"], "--max-rel-error"),
+    ];
+    for (args, needle) in cases {
+        assert_rejected(args, needle, &dir);
+    }
+    assert!(files_under(&dir).is_empty());
+}

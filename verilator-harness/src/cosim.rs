@@ -12,26 +12,12 @@ use golden::raster::{compare, reference_triangle, Frame, RefFrame};
 use golden::segment::{segments, Segment};
 use golden::setup::{triangle_spans, Screen, Triangle};
 use golden::{Config, Span};
-use rand::rngs::StdRng;
-use rand::{Rng, SeedableRng};
+use crate::traffic::TrafficGen;
+use rand::Rng;
 use std::collections::{BTreeSet, VecDeque};
 use std::fmt;
 
-/// How often the driver offers a span and the sink takes a segment.
-#[derive(Clone, Copy, Debug)]
-pub struct Traffic {
-    /// Probability per clock that a pending span starts being offered.
-    pub valid: f64,
-    /// Probability per clock that `out_ready` is high.
-    pub ready: f64,
-}
-
-impl Traffic {
-    /// Both ends always willing: measures the shader's own throughput.
-    pub const FULL: Traffic = Traffic { valid: 1.0, ready: 1.0 };
-    /// Random gaps and backpressure.
-    pub const RANDOM: Traffic = Traffic { valid: 0.7, ready: 0.7 };
-}
+pub use crate::traffic::Traffic;
 
 /// Stress on top of [`Traffic`], off by default: `rst` at random clocks, long stretches of
 /// `out_ready` low, long `in_valid` gaps between spans. With a reset, the spans accepted and not
@@ -57,11 +43,11 @@ impl Stress {
     pub const HARSH: Stress = Stress { reset: 0.002, ..Stress::BURSTS };
 }
 
-/// The per-clock decisions of the driver and the sink under [`Traffic`] and [`Stress`]. Without
-/// stress it draws exactly what the plain random driver drew, so old seeds replay unchanged.
+/// The per-clock decisions of the driver and the sink under [`Traffic`] and [`Stress`]: the
+/// generator's two draws of the clock ([`TrafficGen::clock`]), then the stress draws. Without
+/// stress it is exactly the plain traffic of the native and cocotb benches.
 #[derive(Clone, Debug)]
 pub(crate) struct Pacer {
-    traffic: Traffic,
     stress: Stress,
     rst_left: u32,
     stall_left: u32,
@@ -69,12 +55,13 @@ pub(crate) struct Pacer {
 }
 
 impl Pacer {
-    pub(crate) fn new(traffic: Traffic, stress: Stress) -> Pacer {
-        Pacer { traffic, stress, rst_left: 0, stall_left: 0, gap_left: 0 }
+    pub(crate) fn new(stress: Stress) -> Pacer {
+        Pacer { stress, rst_left: 0, stall_left: 0, gap_left: 0 }
     }
 
     /// Whether `rst` is high this clock.
-    pub(crate) fn reset(&mut self, rng: &mut StdRng) -> bool {
+    #[inline]
+    pub(crate) fn reset(&mut self, rng: &mut TrafficGen) -> bool {
         if self.rst_left == 0 && self.stress.reset > 0.0 && rng.gen_bool(self.stress.reset) {
             self.rst_left = rng.gen_range(1..=3);
         }
@@ -86,16 +73,18 @@ impl Pacer {
     }
 
     /// Whether a pending span starts being offered this clock.
-    pub(crate) fn offer(&mut self, rng: &mut StdRng) -> bool {
+    #[inline]
+    pub(crate) fn offer(&mut self, rng: &mut TrafficGen) -> bool {
         if self.gap_left > 0 {
             self.gap_left -= 1;
             return false;
         }
-        self.traffic.valid >= 1.0 || rng.gen_bool(self.traffic.valid)
+        rng.offer()
     }
 
     /// `out_ready` this clock.
-    pub(crate) fn ready(&mut self, rng: &mut StdRng) -> bool {
+    #[inline]
+    pub(crate) fn ready(&mut self, rng: &mut TrafficGen) -> bool {
         if self.stall_left == 0 && self.stress.stall > 0.0 && rng.gen_bool(self.stress.stall) {
             self.stall_left = rng.gen_range(1..=self.stress.stall_max.max(1));
         }
@@ -103,11 +92,12 @@ impl Pacer {
             self.stall_left -= 1;
             return false;
         }
-        self.traffic.ready >= 1.0 || rng.gen_bool(self.traffic.ready)
+        rng.ready()
     }
 
     /// A span was transferred: maybe a gap before the next one is offered.
-    pub(crate) fn accepted(&mut self, rng: &mut StdRng) {
+    #[inline]
+    pub(crate) fn accepted(&mut self, rng: &mut TrafficGen) {
         if self.stress.gap > 0.0 && rng.gen_bool(self.stress.gap) {
             self.gap_left = rng.gen_range(1..=self.stress.gap_max.max(1));
         }
@@ -210,11 +200,14 @@ pub struct SegmentCosim {
     info: &'static ModelInfo<SegIn, SegOut>,
     rtl: Rtl<SegIn, SegOut>,
     cfg: Config,
-    rng: StdRng,
-    traffic: Traffic,
+    rng: TrafficGen,
     stress: Stress,
     input: SegIn,
     output: SegOut,
+    /// Spare golden rows (see [`golden_row`]).
+    rows: Vec<Frame>,
+    /// The segment offered and not taken in the previous clock (its lanes below P).
+    held: SegOut,
 }
 
 /// Clocks run after the last expected segment, in which the model must stay quiet.
@@ -229,11 +222,12 @@ impl SegmentCosim {
             info,
             rtl: Rtl::new(info, seed),
             cfg: info.cfg,
-            rng: StdRng::seed_from_u64(seed),
-            traffic,
+            rng: TrafficGen::new(traffic, seed),
             stress: Stress::NONE,
             input: SegIn::default(),
             output: SegOut::default(),
+            rows: Vec::new(),
+            held: SegOut::default(),
         };
         c.reset();
         c
@@ -285,14 +279,16 @@ impl SegmentCosim {
         for (k, s) in stims.iter().enumerate() {
             s.span.check(&cfg).map_err(|e| format!("span {k} (triangle {}, y = {}) rejected: {e}", s.triangle, s.y))?;
         }
-        let mut pacer = Pacer::new(self.traffic, self.stress);
-        let mut expected: VecDeque<(usize, Segment)> = VecDeque::new();
+        let mut pacer = Pacer::new(self.stress);
+        // Every accepted span with segments still owed, oldest first: its index, its golden
+        // segments (made by golden as they are compared), how many are left and its golden row.
+        let mut expected = VecDeque::new();
         let mut next = 0;
         let mut offering = false;
         let mut idle = 0u64;
         let mut drain = 0;
         let mut in_reset = false;
-        let mut held: Option<SegOut> = None;
+        let mut held = false;
         loop {
             if next == stims.len() && expected.is_empty() {
                 // Everything came out; a few more clocks must bring nothing.
@@ -301,18 +297,17 @@ impl SegmentCosim {
                 }
                 drain += 1;
             }
+            self.rng.clock();
             if pacer.reset(&mut self.rng) {
                 // Nothing transfers in a reset clock: the spans in flight are cut, the one
                 // being offered stays offered.
                 if !in_reset {
                     report.resets += 1;
-                    let mut cut: Vec<usize> = expected.iter().map(|e| e.0).collect();
-                    cut.dedup();
-                    report.cut_spans += cut.len() as u64;
-                    expected.clear();
+                    report.cut_spans += expected.len() as u64;
+                    self.rows.extend(expected.drain(..).map(|(_, _, _, row)| row));
                 }
                 in_reset = true;
-                held = None;
+                held = false;
                 self.input.rst = 1;
                 self.input.in_valid = offering as u8;
                 self.input.out_ready = pacer.ready(&mut self.rng) as u8;
@@ -339,32 +334,49 @@ impl SegmentCosim {
                     what: "out_valid high in the first clock after a reset".into(),
                 });
             }
-            if let Some(h) = held.take() {
-                if let Some(what) = changed_while_stalled(&h, &self.output, cfg.p) {
+            if std::mem::take(&mut held) {
+                if let Some(what) = changed_while_stalled(&self.held, &self.output, cfg.p) {
                     report.mismatch(Mismatch { triangle: None, context: format!("clock {}", report.cycles), what });
                 }
             }
             let mut progress = false;
             if self.output.out_valid == 1 && self.input.out_ready == 1 {
                 progress = true;
-                match expected.pop_front() {
-                    Some((k, seg)) => {
-                        self.check(&stims[k], &seg, report);
+                match expected.front_mut() {
+                    Some((k, segs, left, row)) => {
+                        let k: usize = *k;
+                        let seg: Segment = Iterator::next(segs).expect("segments owed");
+                        *left -= 1;
+                        let all_out = *left == 0;
+                        self.check(&stims[k], &seg, row.pixels(), report);
                         paint(&stims[k], &self.output);
+                        if all_out {
+                            let (_, _, _, row) = expected.pop_front().expect("front");
+                            self.rows.push(row);
+                        }
                     }
-                    None => report.mismatch(Mismatch {
-                        triangle: None,
-                        context: format!("clock {}", report.cycles),
-                        what: format!("segment at x = {} with no span outstanding", self.output.out_x),
-                    }),
+                    None => {
+                        // Output nobody asked for is no progress: a model that streams garbage
+                        // while refusing input is declared hung, not followed forever.
+                        progress = false;
+                        report.mismatch(Mismatch {
+                            triangle: None,
+                            context: format!("clock {}", report.cycles),
+                            what: format!("segment at x = {} with no span outstanding", self.output.out_x),
+                        });
+                    }
                 }
             } else if self.output.out_valid == 1 {
-                held = Some(self.output);
+                held = true;
+                keep_offered(&mut self.held, &self.output, cfg.p);
             }
             if offering && self.output.in_ready == 1 {
                 progress = true;
                 let stim = &stims[next];
-                expected.extend(segments(&cfg, &stim.span).map(|s| (next, s)));
+                let owed = cfg.segment_count(stim.span.x0, stim.span.len);
+                if owed > 0 {
+                    expected.push_back((next, segments(&cfg, &stim.span), owed, golden_row(&mut self.rows, &cfg, &stim.span)));
+                }
                 report.spans += 1;
                 next += 1;
                 offering = false;
@@ -373,13 +385,16 @@ impl SegmentCosim {
             idle = if progress { 0 } else { idle + 1 };
             if idle > STALL_LIMIT {
                 let context = match expected.front() {
-                    Some((k, _)) => describe(&stims[*k]),
+                    Some((k, _, _, _)) => describe(&stims[*k]),
                     None => "idle".into(),
                 };
                 report.mismatch(Mismatch {
-                    triangle: expected.front().map(|(k, _)| stims[*k].triangle),
+                    triangle: expected.front().map(|(k, _, _, _)| stims[*k].triangle),
                     context,
-                    what: format!("no transfer for {STALL_LIMIT} clocks; {} segments still expected", expected.len()),
+                    what: format!(
+                        "no transfer for {STALL_LIMIT} clocks; {} segments still expected",
+                        expected.iter().map(|(_, _, left, _)| *left as u64).sum::<u64>()
+                    ),
                 });
                 self.reset();
                 return Ok(());
@@ -388,7 +403,22 @@ impl SegmentCosim {
         Ok(())
     }
 
-    fn check(&self, stim: &Stim, seg: &Segment, report: &mut Report) {
+    /// Checks one segment against golden; `row` is its span's golden row (see [`golden_row`]).
+    #[inline]
+    fn check(&self, stim: &Stim, seg: &Segment, row: &[u8], report: &mut Report) {
+        match agrees(&self.output, &stim.span, seg, row, self.cfg.p) {
+            Some(pixels) => {
+                report.segments += 1;
+                report.pixels += pixels;
+            }
+            None => self.check_lanes(stim, seg, report),
+        }
+    }
+
+    /// The segment lane by lane against golden, saying what disagrees.
+    #[cold]
+    #[inline(never)]
+    fn check_lanes(&self, stim: &Stim, seg: &Segment, report: &mut Report) {
         let out = &self.output;
         let mut problems = Vec::new();
         if out.out_x != seg.x {
@@ -487,14 +517,107 @@ impl SegmentCosim {
     }
 }
 
+/// For 8 lane-enable bits, the word selecting those lanes' bytes.
+static BYTE_MASK: [u64; 256] = {
+    let mut t = [0u64; 256];
+    let mut m = 0;
+    while m < 256 {
+        let mut b = 0;
+        while b < 8 {
+            if m >> b & 1 == 1 {
+                t[m] |= 0xff << (8 * b);
+            }
+            b += 1;
+        }
+        m += 1;
+    }
+    t
+};
+
+/// Keeps what [`changed_while_stalled`] compares of a segment offered and not taken: its flags,
+/// x and the lanes below `p` (not the whole 300-byte struct, every stalled clock).
+#[inline]
+fn keep_offered(held: &mut SegOut, out: &SegOut, p: u32) {
+    held.out_valid = out.out_valid;
+    held.out_last = out.out_last;
+    held.out_x = out.out_x;
+    // Whole 8-byte words (lanes past P are never compared).
+    for w in 0..p.div_ceil(8) as usize {
+        held.pix[8 * w..8 * w + 8].copy_from_slice(&out.pix[8 * w..8 * w + 8]);
+    }
+    for w in 0..p.div_ceil(64) as usize {
+        held.mask[8 * w..8 * w + 8].copy_from_slice(&out.mask[8 * w..8 * w + 8]);
+    }
+}
+
+/// Golden's pixels of a span as one frame row, indexed by x: written by golden
+/// (`Frame::write_span`, SPEC §2's pixel rule) once, when the span is accepted, so the
+/// scoreboard compares lanes with memory instead of deriving every pixel again. Rows are reused
+/// (`spare`); they are P pixels wider than the screen, so a segment at the last x stays inside.
+fn golden_row(spare: &mut Vec<Frame>, cfg: &Config, span: &Span) -> Frame {
+    let mut row = spare.pop().unwrap_or_else(|| Frame::new(cfg.max_len() + cfg.p, 1));
+    row.write_span(0, span, cfg.frac);
+    row
+}
+
+/// [`SegmentCosim::check`]'s verdict on the way every segment should go: the number of
+/// in-span lanes when x, last, the mask and every in-span pixel agree with golden, `None` at
+/// the first disagreement, which `check` then describes lane by lane.
+///
+/// Golden enables lanes `[lo, hi)`, lane i carrying span pixel `j = x + i - x0` (SPEC §3: lane
+/// i is the pixel at screen x `out_x + i`). Golden's `Segment::lane_pixel` is affine in the
+/// lane, so the range is confirmed by asking golden at both ends and just outside them; then
+/// the mask is compared a byte at a time and the pixels eight lanes at a time with the span's
+/// golden `row` from `out_x` on, masked lanes ignored.
+#[inline]
+fn agrees(out: &SegOut, span: &Span, seg: &Segment, row: &[u8], p: u32) -> Option<u64> {
+    if out.out_x != seg.x || (out.out_last == 1) != seg.last {
+        return None;
+    }
+    let lo = span.x0.saturating_sub(seg.x).min(p);
+    let hi = (span.x0 + span.len).saturating_sub(seg.x).min(p);
+    if lo >= hi {
+        return None;
+    }
+    let j_lo = seg.x + lo - span.x0;
+    if seg.lane_pixel(lo) != Some(j_lo)
+        || seg.lane_pixel(hi - 1) != Some(j_lo + (hi - 1 - lo))
+        || (lo > 0 && seg.lane_pixel(lo - 1).is_some())
+        || (hi < p && seg.lane_pixel(hi).is_some())
+    {
+        return None;
+    }
+    let row = row.get(seg.x as usize..(seg.x + p) as usize)?;
+    // Lanes [lo, hi) of the 8 from `base` as a byte of enable bits.
+    let lanes_on = |base: u32| ((1u16 << (hi.clamp(base, base + 8) - base)) - (1u16 << (lo.clamp(base, base + 8) - base))) as u8;
+    if p < 8 {
+        let (on, n) = (lanes_on(0), p as usize);
+        let word = |b: &[u8]| b[..n].iter().rev().fold(0u64, |w, &x| w << 8 | x as u64);
+        return (out.mask[0] & ((1u16 << p) - 1) as u8 == on && (word(&out.pix) ^ word(row)) & BYTE_MASK[on as usize] == 0)
+            .then_some((hi - lo) as u64);
+    }
+    for c in 0..(p / 8) as usize {
+        let on = lanes_on(8 * c as u32);
+        let word = |b: &[u8]| u64::from_le_bytes(b[8 * c..8 * c + 8].try_into().expect("8 lanes"));
+        if out.mask[c] != on || (word(&out.pix) ^ word(row)) & BYTE_MASK[on as usize] != 0 {
+            return None;
+        }
+    }
+    Some((hi - lo) as u64)
+}
+
 /// What changed in a segment that was offered and not taken in the previous clock, if anything
 /// (masked lanes are don't-care).
+#[inline]
 fn changed_while_stalled(before: &SegOut, now: &SegOut, p: u32) -> Option<String> {
     if now.out_valid != 1 {
         return Some(format!("out_valid dropped before the segment at x = {} was taken", before.out_x));
     }
-    let lanes_differ = (0..p).any(|i| {
-        now.lane_enabled(i) != before.lane_enabled(i) || (now.lane_enabled(i) && now.pix[i as usize] != before.pix[i as usize])
+    let lanes_differ = (0..p.div_ceil(8) as usize).any(|b| {
+        let lanes = if p >= 8 * (b as u32 + 1) { 0xff } else { (1u8 << (p % 8)) - 1 };
+        let on = now.mask[b] & lanes;
+        let word = |o: &SegOut| u64::from_le_bytes(o.pix[8 * b..8 * b + 8].try_into().expect("8 bytes"));
+        on != before.mask[b] & lanes || (word(now) ^ word(before)) & BYTE_MASK[on as usize] != 0
     });
     if now.out_x != before.out_x || now.out_last != before.out_last || lanes_differ {
         return Some(format!("segment at x = {} changed while waiting for out_ready (now x = {})", before.out_x, now.out_x));

@@ -3,13 +3,16 @@
 //! `build.rs` verilates and links the models; [`ffi`] wraps them; [`stimulus`] makes random
 //! and directed triangles; [`cosim`] streams their spans through a model with random valid
 //! gaps and backpressure and checks every segment and the final frames; [`specular`] does the
-//! same for the specular unit, pixel by pixel; [`render`] draws whole scenes through them.
+//! same for the specular unit, pixel by pixel; [`render`] draws whole scenes through them;
+//! [`traffic`] makes the driver's and the sink's per-clock decisions (shared, bit for bit,
+//! with the native and cocotb benches of `scripts/bench-cosim`).
 
 pub mod cosim;
 pub mod ffi;
 pub mod render;
 pub mod specular;
 pub mod stimulus;
+pub mod traffic;
 
 /// The seed of a random test: `COSIM_SEED` when set (to replay a failure), else a fresh one.
 /// Printed either way, so every failure can be replayed.

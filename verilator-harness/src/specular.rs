@@ -3,26 +3,41 @@
 //! along each span, never brighter where |theta| is larger.
 
 use crate::cosim::{Mismatch, Pacer, Report, Stress, Traffic};
+use crate::traffic::TrafficGen;
 use crate::ffi::{to_port, ModelInfo, Rtl, SpecIn, SpecOut};
-use golden::specular::reference::{approx, epicentre};
+use golden::specular::reference::{approx, cos_k, epicentre};
 use golden::specular::setup::{norm, normalize, setup_span, SpanEnds, Vec3};
 use golden::specular::{
     n_valid, theta_at, SpecularSpan, SpecularUnit, ABS_TOL, C_FRAC, INSIDE_REL, N_MAX, OUTSIDE_REL, THETA_FRAC,
 };
-use rand::rngs::StdRng;
-use rand::{Rng, SeedableRng};
+use rand::Rng;
 use std::collections::VecDeque;
+use std::f64::consts::FRAC_PI_2;
 
 /// The specular unit under test, its golden twin and the driver's random source.
 pub struct SpecularCosim {
     rtl: Rtl<SpecIn, SpecOut>,
     info: &'static ModelInfo<SpecIn, SpecOut>,
     unit: SpecularUnit,
-    rng: StdRng,
-    traffic: Traffic,
+    rng: TrafficGen,
     stress: Stress,
     input: SpecIn,
     output: SpecOut,
+    /// What the accuracy check needs of the last n seen, computed once per n, not per pixel.
+    shine: Shine,
+    /// `cos^k` tables for the accuracy check's shortcut, one per k met so far.
+    cos_k: Vec<CosK>,
+}
+
+/// What SPEC §4's check needs of a span's n.
+#[derive(Clone, Copy)]
+struct Shine {
+    n: u16,
+    /// k(n) when n is valid (1..1000), with `sqrt(n/k)` as golden's `approx` computes it and
+    /// the index of its table in `SpecularCosim::cos_k`.
+    k: Option<(u32, f64, usize)>,
+    /// The epicentre of n.
+    edge: f64,
 }
 
 const STALL_LIMIT: u64 = 10_000;
@@ -34,11 +49,12 @@ impl SpecularCosim {
             rtl: Rtl::new(info, seed),
             info,
             unit,
-            rng: StdRng::seed_from_u64(seed),
-            traffic,
+            rng: TrafficGen::new(traffic, seed),
             stress: Stress::NONE,
             input: SpecIn::default(),
             output: SpecOut::default(),
+            shine: Shine { n: u16::MAX, k: None, edge: 0.0 },
+            cos_k: Vec::new(),
         };
         c.input.rst = 1;
         for _ in 0..2 {
@@ -100,8 +116,8 @@ impl SpecularCosim {
                 return Err(format!("span {k} rejected: n = {} does not fit the {}-bit in_n port", s.n, golden::specular::N_BITS));
             }
         }
-        let mut pacer = Pacer::new(self.traffic, self.stress);
-        // (span, pixel j) of every pixel owed, in order.
+        let mut pacer = Pacer::new(self.stress);
+        // Every accepted span with pixels still owed, oldest first: (span, next pixel j).
         let mut expected: VecDeque<(usize, u32)> = VecDeque::new();
         let mut along: Vec<(u32, u16)> = Vec::new();
         let (mut next, mut offering, mut idle, mut drain) = (0, false, 0u64, 0);
@@ -113,12 +129,11 @@ impl SpecularCosim {
                 }
                 drain += 1;
             }
+            self.rng.clock();
             if pacer.reset(&mut self.rng) {
                 if !in_reset {
                     report.resets += 1;
-                    let mut cut: Vec<usize> = expected.iter().map(|e| e.0).collect();
-                    cut.dedup();
-                    report.cut_spans += cut.len() as u64;
+                    report.cut_spans += expected.len() as u64;
                     expected.clear();
                     along.clear();
                 }
@@ -168,26 +183,38 @@ impl SpecularCosim {
             let mut progress = false;
             if self.output.out_valid == 1 && self.input.out_ready == 1 {
                 progress = true;
-                match expected.pop_front() {
+                match expected.front_mut() {
                     Some((k, j)) => {
-                        self.check(k, &spans[k], j, report, &mut along);
-                        pixel(k, j, &self.output);
-                        if j + 1 == spans[k].len {
+                        let (k, j0) = (*k, *j);
+                        *j += 1;
+                        if j0 + 1 == spans[k].len {
+                            expected.pop_front();
+                        }
+                        self.check(k, &spans[k], j0, report, &mut along);
+                        pixel(k, j0, &self.output);
+                        if j0 + 1 == spans[k].len {
                             check_monotone(k, &mut along, report);
                         }
                     }
-                    None => report.mismatch(Mismatch {
-                        triangle: None,
-                        context: format!("clock {}", report.cycles),
-                        what: "pixel with no span outstanding".into(),
-                    }),
+                    None => {
+                        // Output nobody asked for is no progress: a model that streams garbage
+                        // while refusing input is declared hung, not followed forever.
+                        progress = false;
+                        report.mismatch(Mismatch {
+                            triangle: None,
+                            context: format!("clock {}", report.cycles),
+                            what: "pixel with no span outstanding".into(),
+                        });
+                    }
                 }
             } else if self.output.out_valid == 1 {
                 held = Some(self.output);
             }
             if offering && self.output.in_ready == 1 {
                 progress = true;
-                expected.extend((0..spans[next].len).map(|j| (next, j)));
+                if spans[next].len > 0 {
+                    expected.push_back((next, 0));
+                }
                 report.spans += 1;
                 next += 1;
                 offering = false;
@@ -198,7 +225,10 @@ impl SpecularCosim {
                 report.mismatch(Mismatch {
                     triangle: expected.front().map(|e| e.0),
                     context: "stream".into(),
-                    what: format!("no transfer for {STALL_LIMIT} clocks; {} pixels still expected", expected.len()),
+                    what: format!(
+                        "no transfer for {STALL_LIMIT} clocks; {} pixels still expected",
+                        expected.iter().map(|&(k, j)| (spans[k].len - j) as u64).sum::<u64>()
+                    ),
                 });
                 return Ok(());
             }
@@ -206,7 +236,59 @@ impl SpecularCosim {
         Ok(())
     }
 
-    fn check(&self, k: usize, s: &SpecularSpan, j: u32, report: &mut Report, along: &mut Vec<(u32, u16)>) {
+    /// Checks pixel `j` of span `k` (bit-exact, SPEC §4) and keeps it for the span's
+    /// monotonicity check.
+    #[inline]
+    fn check(&mut self, k: usize, s: &SpecularSpan, j: u32, report: &mut Report, along: &mut Vec<(u32, u16)>) {
+        if self.shine.n != s.n {
+            self.shine = self.shine_of(s.n);
+        }
+        let out = &self.output;
+        let (spec, err) = self.unit.pixel(s.c, s.n, s.theta0, s.dtheta, j);
+        let exact = (out.out_spec, out.out_err == 1, out.out_last == 1) == (spec, err, j + 1 == s.len);
+        let theta = theta_at(s.theta0, s.dtheta, j);
+        let accurate = match self.shine.k {
+            None => true,
+            Some((k_n, a, table)) => {
+                let scale = (1u32 << C_FRAC) as f64;
+                let (c, got) = (s.c as f64 / scale, out.out_spec as f64 / scale);
+                let delta = theta.unsigned_abs() as f64 / (1u64 << THETA_FRAC) as f64;
+                let inside = delta <= self.shine.edge;
+                self.cos_k[table].surely_within(a * delta, c, got, inside) || {
+                    let want = approx(c, s.n as u32, k_n, delta);
+                    let tol = if inside { INSIDE_REL * want } else { OUTSIDE_REL * c } + ABS_TOL;
+                    (got - want).abs() <= tol
+                }
+            }
+        };
+        along.push((theta.unsigned_abs(), out.out_spec));
+        report.pixels += 1;
+        if !(exact && accurate) {
+            self.describe_pixel(k, s, j, report);
+        }
+    }
+
+    /// What SPEC §4's check needs of `n` (see [`Shine`]).
+    #[cold]
+    fn shine_of(&mut self, n: u16) -> Shine {
+        let k = self.unit.plan().decoder.k_of(n as u32).filter(|_| n_valid(n as u32)).map(|k_n| {
+            let table = match self.cos_k.iter().position(|t| t.k == k_n) {
+                Some(t) => t,
+                None => {
+                    self.cos_k.push(CosK::new(k_n));
+                    self.cos_k.len() - 1
+                }
+            };
+            // As golden's `approx` computes it, so `a * delta` is the argument it evaluates.
+            (k_n, (n as f64 / k_n as f64).sqrt(), table)
+        });
+        Shine { n, k, edge: epicentre(n as u32) }
+    }
+
+    /// Reports what is wrong with pixel `j` of span `k`: `check`'s tests again, with words.
+    #[cold]
+    #[inline(never)]
+    fn describe_pixel(&self, k: usize, s: &SpecularSpan, j: u32, report: &mut Report) {
         let out = &self.output;
         let (spec, err) = self.unit.pixel(s.c, s.n, s.theta0, s.dtheta, j);
         let last = j + 1 == s.len;
@@ -218,20 +300,18 @@ impl SpecularCosim {
             ));
         }
         let theta = theta_at(s.theta0, s.dtheta, j);
-        if let Some(k_n) = self.unit.plan().decoder.k_of(s.n as u32).filter(|_| n_valid(s.n as u32)) {
+        if let Some((k_n, _, _)) = self.shine.k {
             let scale = (1u32 << C_FRAC) as f64;
             let (c, got) = (s.c as f64 / scale, out.out_spec as f64 / scale);
             let delta = theta.unsigned_abs() as f64 / (1u64 << THETA_FRAC) as f64;
             let want = approx(c, s.n as u32, k_n, delta);
-            let inside = delta <= epicentre(s.n as u32);
+            let inside = delta <= self.shine.edge;
             let tol = if inside { INSIDE_REL * want } else { OUTSIDE_REL * c } + ABS_TOL;
             if (got - want).abs() > tol {
                 let place = if inside { "inside" } else { "outside" };
                 problems.push(format!("{got:.5} is {:.5} from approx {want:.5} {place} the epicentre (bound {tol:.5})", (got - want).abs()));
             }
         }
-        along.push((theta.unsigned_abs(), out.out_spec));
-        report.pixels += 1;
         if !problems.is_empty() {
             report.mismatch(Mismatch {
                 triangle: Some(k),
@@ -242,8 +322,63 @@ impl SpecularCosim {
     }
 }
 
+/// A shortcut for SPEC §4's bound that never changes its verdict: `cos^k` tabulated on
+/// [0, pi/2] (golden's `cos_k` at every grid point) and interpolated linearly, with the
+/// interpolation's error bound `h^2 k^2 / 8` (|d²/dx² cos^k x| <= k^2). When every value
+/// `C cos^k(x)` could take passes the bound, with a margin far above rounding, the pixel
+/// passes; otherwise golden's `approx` is evaluated and decides, exactly as without the table.
+struct CosK {
+    k: u32,
+    inv_h: f64,
+    err: f64,
+    t: Vec<f64>,
+}
+
+/// Grid steps of the [`CosK`] table of `k` over [0, pi/2]: enough that the interpolation error
+/// stays below 1/1000 for C up to 256, a fraction of SPEC §4's smallest bound (2/256), and no
+/// more, so the tables stay in cache.
+fn cos_k_steps(k: u32) -> usize {
+    (512 * k as usize).next_power_of_two().min(1 << 14)
+}
+
+impl CosK {
+    fn new(k: u32) -> CosK {
+        let h = FRAC_PI_2 / cos_k_steps(k) as f64;
+        let t = (0..=cos_k_steps(k)).map(|i| cos_k(k, i as f64 * h)).collect();
+        // Interpolation, plus slack for rounding in the table and in the interpolation.
+        let err = h * h * (k as f64 * k as f64) / 8.0 + 1e-12;
+        CosK { k, inv_h: 1.0 / h, err, t }
+    }
+
+    /// Whether `got` is surely within SPEC §4's bound of `c cos^k(x)` (`x >= 0`).
+    #[inline]
+    fn surely_within(&self, x: f64, c: f64, got: f64, inside: bool) -> bool {
+        if !(x < FRAC_PI_2) {
+            return false;
+        }
+        let u = x * self.inv_h;
+        let i = (u as usize).min(self.t.len() - 2);
+        let f = (u - i as f64).clamp(0.0, 1.0);
+        let est = self.t[i] + (self.t[i + 1] - self.t[i]) * f;
+        // Every value the exact approximation can take lies in [lo, hi]; the bound must hold
+        // at both ends (it is linear in the value), with margin `m`.
+        let (lo, hi) = (c * (est - self.err), c * (est + self.err));
+        let m = 1e-9 * (1.0 + c);
+        if inside {
+            got >= hi - (INSIDE_REL * hi + ABS_TOL) + m && got <= lo + (INSIDE_REL * lo + ABS_TOL) - m
+        } else {
+            let tol = OUTSIDE_REL * c + ABS_TOL;
+            got >= hi - tol + m && got <= lo + tol - m
+        }
+    }
+}
+
 /// Along a span the output never grows as |theta| grows.
 fn check_monotone(k: usize, along: &mut Vec<(u32, u16)>, report: &mut Report) {
+    if monotone(along) {
+        along.clear();
+        return;
+    }
     along.sort_unstable();
     if let Some(w) = along.windows(2).find(|w| w[1].1 > w[0].1) {
         report.mismatch(Mismatch {
@@ -253,6 +388,39 @@ fn check_monotone(k: usize, along: &mut Vec<(u32, u16)>, report: &mut Report) {
         });
     }
     along.clear();
+}
+
+/// Whether the output is a non-increasing function of |theta| over `along` ((|theta|, out) in
+/// pixel order): exactly when `check_monotone`'s sorted scan finds nothing. Without sorting when
+/// |theta| falls and then rises along the span, as a linear theta does: the two runs are merged
+/// by |theta| and consecutive pairs compared (`a < b` must give out(a) >= out(b), `a == b` equal
+/// outputs; consecutive pairs suffice by transitivity). Anything else (a wrapped theta) is
+/// left to the sort: `false` means "not shown monotone here".
+fn monotone(along: &[(u32, u16)]) -> bool {
+    let split = along.windows(2).position(|w| w[1].0 > w[0].0).map_or(along.len(), |p| p + 1);
+    let (falling, rising) = along.split_at(split);
+    if rising.windows(2).any(|w| w[1].0 < w[0].0) {
+        return false;
+    }
+    let ok = |a: (u32, u16), b: (u32, u16)| if a.0 == b.0 { a.1 == b.1 } else { a.1 >= b.1 };
+    let (mut f, mut r) = (falling.iter().rev().peekable(), rising.iter().peekable());
+    let mut prev: Option<(u32, u16)> = None;
+    loop {
+        let next = match (f.peek(), r.peek()) {
+            (Some(&&a), Some(&&b)) if a.0 <= b.0 => f.next().copied(),
+            (Some(_), Some(_)) => r.next().copied(),
+            (Some(_), None) => f.next().copied(),
+            (None, Some(_)) => r.next().copied(),
+            (None, None) => return true,
+        };
+        let cur = next.expect("peeked");
+        if let Some(p) = prev {
+            if !ok(p, cur) {
+                return false;
+            }
+        }
+        prev = Some(cur);
+    }
 }
 
 /// The shininess of a random span: all four default k ranges, their boundaries, and invalid n.
@@ -300,4 +468,75 @@ pub fn random_span(rng: &mut impl Rng, max_len: u32) -> SpecularSpan {
     let l = rng.gen_range(0..max_len.min(400));
     let il_ks = rng.gen_range(0.5..300.0);
     setup_span(&ends, il_ks, 1.0, n, l).port
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{monotone, CosK};
+    use golden::specular::reference::cos_k;
+    use golden::specular::{ABS_TOL, INSIDE_REL, OUTSIDE_REL};
+    use rand::rngs::StdRng;
+    use rand::{Rng, SeedableRng};
+    use std::f64::consts::FRAC_PI_2;
+
+    /// The sorted scan `check_monotone` falls back to.
+    fn sorted_ok(along: &[(u32, u16)]) -> bool {
+        let mut v = along.to_vec();
+        v.sort_unstable();
+        !v.windows(2).any(|w| w[1].1 > w[0].1)
+    }
+
+    /// `monotone` never passes what the sorted scan fails, and decides every span whose |theta|
+    /// falls and then rises (a linear theta) the way the sorted scan does.
+    #[test]
+    fn monotone_agrees_with_the_sorted_scan() {
+        let mut rng = StdRng::seed_from_u64(7);
+        for case in 0..20_000 {
+            let len = rng.gen_range(0..40);
+            let theta0: i64 = rng.gen_range(-60..60);
+            let dtheta: i64 = if case % 7 == 0 { 0 } else { rng.gen_range(-9..9) };
+            let mut along: Vec<(u32, u16)> =
+                (0..len).map(|j| ((theta0 + j * dtheta).unsigned_abs() as u32, 0)).collect();
+            for a in along.iter_mut() {
+                a.1 = (1000 - a.0.min(1000)) as u16 / rng.gen_range(1..3);
+            }
+            if case % 3 == 0 && len > 0 {
+                let k = rng.gen_range(0..len as usize);
+                along[k].1 = along[k].1.wrapping_add(rng.gen_range(0..3));
+            }
+            if case % 11 == 0 {
+                along.iter_mut().for_each(|a| a.0 = rng.gen_range(0..20));
+            }
+            let (fast, slow) = (monotone(&along), sorted_ok(&along));
+            assert!(!fast || slow, "monotone passed what the sorted scan fails: {along:?}");
+            let split = along.windows(2).position(|w| w[1].0 > w[0].0).map_or(along.len(), |p| p + 1);
+            if !along[split..].windows(2).any(|w| w[1].0 < w[0].0) {
+                assert_eq!(fast, slow, "{along:?}");
+            }
+        }
+    }
+
+    /// The table's interval always holds golden's `C cos^k(x)`, and the shortcut never passes a
+    /// pixel the exact check fails.
+    #[test]
+    fn cos_k_shortcut_is_sound() {
+        let mut rng = StdRng::seed_from_u64(11);
+        for k in [1, 2, 3, 4, 16, 64] {
+            let table = CosK::new(k);
+            for _ in 0..100_000 {
+                let x = rng.gen_range(0.0..FRAC_PI_2);
+                let c = rng.gen_range(0.0..256.0);
+                let want = c * cos_k(k, x);
+                let inside = rng.gen_bool(0.5);
+                let tol = if inside { INSIDE_REL * want } else { OUTSIDE_REL * c } + ABS_TOL;
+                // Outputs around both edges of the bound, and inside it.
+                let got = want + tol * rng.gen_range(-1.02..1.02);
+                if table.surely_within(x, c, got, inside) {
+                    assert!((got - want).abs() <= tol, "k {k} x {x} c {c}: {got} vs {want} (bound {tol})");
+                }
+                let near = want + tol * rng.gen_range(-0.5..0.5);
+                assert!(table.surely_within(x, c, near, inside) || k == 64, "k {k} x {x} c {c}: no shortcut for {near}");
+            }
+        }
+    }
 }
