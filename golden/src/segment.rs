@@ -40,23 +40,27 @@ impl Segment {
 
 /// The segments of `span` in output order.
 pub fn segments(cfg: &Config, span: &Span) -> impl Iterator<Item = Segment> {
+    let (cfg, span) = (*cfg, *span);
+    (0..cfg.segment_count(span.x0, span.len)).map(move |s| segment(&cfg, &span, s))
+}
+
+/// Segment `s` of `span` (`s` below `cfg.segment_count`).
+pub fn segment(cfg: &Config, span: &Span, s: u32) -> Segment {
     let p = cfg.p;
     let lead = match cfg.align {
         Align::Span => 0,
         Align::Screen => span.x0 % p,
     };
     let count = cfg.segment_count(span.x0, span.len);
-    let x_mask = cfg.max_len() - 1;
-    let (x0, len) = (span.x0, span.len);
-    (0..count).map(move |s| Segment {
+    Segment {
         index: s,
         // out_x is XW bits wide; a span that fits the screen never wraps it.
-        x: (x0 - lead + s * p) & x_mask,
+        x: (span.x0 - lead + s * p) & (cfg.max_len() - 1),
         last: s + 1 == count,
         first_j: s as i64 * p as i64 - lead as i64,
-        len,
+        len: span.len,
         p,
-    })
+    }
 }
 
 #[cfg(test)]

@@ -1,108 +1,24 @@
 //! Streams spans through a segment-shader model and checks everything that comes out.
 //!
-//! Driver: offers spans in order, raising `in_valid` after random gaps and holding it (and the
-//! data) until the span is taken, as SPEC §3 requires of a source. Backpressure: `out_ready`
-//! random every clock. Monitor and scoreboard: every accepted span queues its golden segments;
-//! every segment that leaves the model must be the next one queued, with the same x, mask,
-//! last flag and in-span pixels. The segments are also painted into a frame that must equal
-//! golden's frame exactly and the f64 reference within SPEC §5's bounds.
+//! Driver ([`crate::driver`]): offers spans in order, raising `in_valid` after random gaps and
+//! holding it (and the data) until the span is taken, as SPEC §3 requires of a source, with
+//! `out_ready` random every clock. Scoreboard: every segment that leaves the model must be the
+//! next one owed by the oldest span in flight, with the same x, mask, last flag and in-span
+//! pixels as golden's. The segments are also painted into a frame that must equal golden's
+//! frame exactly and the f64 reference within SPEC §5's bounds.
 
+use crate::driver::{Check, Driver, Unit};
 use crate::ffi::{to_port, ModelInfo, Rtl, SegIn, SegOut};
+use crate::traffic::TrafficGen;
 use golden::raster::{compare, reference_triangle, Frame, RefFrame};
-use golden::segment::{segments, Segment};
+use golden::segment::{segment, Segment};
 use golden::setup::{triangle_spans, Screen, Triangle};
 use golden::{Config, Span};
-use crate::traffic::TrafficGen;
-use rand::Rng;
-use std::collections::{BTreeSet, VecDeque};
+use std::collections::BTreeSet;
 use std::fmt;
 
+pub use crate::driver::{Stress, DRAIN_CLOCKS};
 pub use crate::traffic::Traffic;
-
-/// Stress on top of [`Traffic`], off by default: `rst` at random clocks, long stretches of
-/// `out_ready` low, long `in_valid` gaps between spans. With a reset, the spans accepted and not
-/// yet fully out are *cut* (their remaining output is dropped from the scoreboard) and a span
-/// being offered is offered again afterwards; in a clock with `rst` high nothing transfers.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct Stress {
-    /// Probability per clock of asserting `rst` (for 1..=3 clocks).
-    pub reset: f64,
-    /// Probability per clock that `out_ready` drops for 1..=`stall_max` clocks.
-    pub stall: f64,
-    pub stall_max: u32,
-    /// Probability after each input transfer of an `in_valid` gap of 1..=`gap_max` clocks.
-    pub gap: f64,
-    pub gap_max: u32,
-}
-
-impl Stress {
-    pub const NONE: Stress = Stress { reset: 0.0, stall: 0.0, stall_max: 0, gap: 0.0, gap_max: 0 };
-    /// Long backpressure bursts and input gaps, no reset.
-    pub const BURSTS: Stress = Stress { reset: 0.0, stall: 0.01, stall_max: 300, gap: 0.05, gap_max: 200 };
-    /// Everything at once: resets about every 500 clocks, bursts and gaps.
-    pub const HARSH: Stress = Stress { reset: 0.002, ..Stress::BURSTS };
-}
-
-/// The per-clock decisions of the driver and the sink under [`Traffic`] and [`Stress`]: the
-/// generator's two draws of the clock ([`TrafficGen::clock`]), then the stress draws. Without
-/// stress it is exactly the plain traffic of the native and cocotb benches.
-#[derive(Clone, Debug)]
-pub(crate) struct Pacer {
-    stress: Stress,
-    rst_left: u32,
-    stall_left: u32,
-    gap_left: u32,
-}
-
-impl Pacer {
-    pub(crate) fn new(stress: Stress) -> Pacer {
-        Pacer { stress, rst_left: 0, stall_left: 0, gap_left: 0 }
-    }
-
-    /// Whether `rst` is high this clock.
-    #[inline]
-    pub(crate) fn reset(&mut self, rng: &mut TrafficGen) -> bool {
-        if self.rst_left == 0 && self.stress.reset > 0.0 && rng.gen_bool(self.stress.reset) {
-            self.rst_left = rng.gen_range(1..=3);
-        }
-        if self.rst_left > 0 {
-            self.rst_left -= 1;
-            return true;
-        }
-        false
-    }
-
-    /// Whether a pending span starts being offered this clock.
-    #[inline]
-    pub(crate) fn offer(&mut self, rng: &mut TrafficGen) -> bool {
-        if self.gap_left > 0 {
-            self.gap_left -= 1;
-            return false;
-        }
-        rng.offer()
-    }
-
-    /// `out_ready` this clock.
-    #[inline]
-    pub(crate) fn ready(&mut self, rng: &mut TrafficGen) -> bool {
-        if self.stall_left == 0 && self.stress.stall > 0.0 && rng.gen_bool(self.stress.stall) {
-            self.stall_left = rng.gen_range(1..=self.stress.stall_max.max(1));
-        }
-        if self.stall_left > 0 {
-            self.stall_left -= 1;
-            return false;
-        }
-        rng.ready()
-    }
-
-    /// A span was transferred: maybe a gap before the next one is offered.
-    #[inline]
-    pub(crate) fn accepted(&mut self, rng: &mut TrafficGen) {
-        if self.stress.gap > 0.0 && rng.gen_bool(self.stress.gap) {
-            self.gap_left = rng.gen_range(1..=self.stress.gap_max.max(1));
-        }
-    }
-}
 
 /// A span with where it came from, for failure messages.
 #[derive(Clone, Copy, Debug)]
@@ -129,7 +45,7 @@ impl fmt::Display for Mismatch {
     }
 }
 
-/// Counts of one run; `merge` adds runs up.
+/// Counts of one run; [`Report::absorb`] adds another run's.
 #[derive(Clone, Debug, Default)]
 pub struct Report {
     pub triangles: usize,
@@ -151,6 +67,22 @@ pub struct Report {
 const KEEP_MISMATCHES: usize = 20;
 
 impl Report {
+    /// Adds `other`'s counts and mismatches to this report's (its mismatches after these).
+    pub fn absorb(&mut self, other: Report) {
+        self.triangles += other.triangles;
+        self.spans += other.spans;
+        self.segments += other.segments;
+        self.pixels += other.pixels;
+        self.cycles += other.cycles;
+        self.failed.extend(other.failed);
+        self.mismatch_count += other.mismatch_count;
+        let room = KEEP_MISMATCHES.saturating_sub(self.mismatches.len());
+        self.mismatches.extend(other.mismatches.into_iter().take(room));
+        self.max_error = self.max_error.max(other.max_error);
+        self.resets += other.resets;
+        self.cut_spans += other.cut_spans;
+    }
+
     pub fn mismatch(&mut self, m: Mismatch) {
         self.mismatch_count += 1;
         if let Some(t) = m.triangle {
@@ -195,73 +127,198 @@ pub fn assert_clean(what: &str, seed: u64, report: &Report) {
     panic!("{msg}");
 }
 
-/// A segment-shader model under test with its driver's random source.
-pub struct SegmentCosim {
-    info: &'static ModelInfo<SegIn, SegOut>,
-    rtl: Rtl<SegIn, SegOut>,
-    cfg: Config,
-    rng: TrafficGen,
-    stress: Stress,
-    input: SegIn,
-    output: SegOut,
-    /// Spare golden rows (see [`golden_row`]).
-    rows: Vec<Frame>,
-    /// The segment offered and not taken in the previous clock (its lanes below P).
-    held: SegOut,
+/// A segment offered by the model, as the checker sees it: `out_x`, `out_last` and the lane
+/// buses below P (lane i's pixel in `pix[i]`, its enable in bit i % 8 of `mask[i / 8]`).
+#[derive(Clone, Copy, Debug)]
+pub struct SegView<'a> {
+    pub out_x: u32,
+    pub out_last: bool,
+    pub pix: &'a [u8],
+    pub mask: &'a [u8],
 }
 
-/// Clocks run after the last expected segment, in which the model must stay quiet.
-pub const DRAIN_CLOCKS: u64 = 3;
+impl SegView<'_> {
+    pub fn lane_enabled(&self, i: u32) -> bool {
+        self.mask[(i / 8) as usize] >> (i % 8) & 1 == 1
+    }
+}
 
-/// Clocks without any transfer after which the model is declared hung.
-const STALL_LIMIT: u64 = 10_000;
+/// The driver's view of a segment shader. An output's record is `out_x | out_last << 31`
+/// (4 bytes), the mask bytes below P, then the pixels, padded to whole 8-byte words so the
+/// checker compares them a word at a time.
+struct SegUnit {
+    cfg: Config,
+    /// Bytes of the mask, and of the padded pixels.
+    mask_bytes: usize,
+    pix_bytes: usize,
+}
+
+impl SegUnit {
+    fn new(cfg: Config) -> SegUnit {
+        SegUnit { cfg, mask_bytes: cfg.p.div_ceil(8) as usize, pix_bytes: cfg.p.next_multiple_of(8) as usize }
+    }
+
+    fn view<'a>(&self, rec: &'a [u8]) -> SegView<'a> {
+        let head = u32::from_le_bytes(rec[..4].try_into().expect("4 bytes"));
+        let (mask, pix) = rec[4..].split_at(self.mask_bytes);
+        SegView { out_x: head & !(1 << 31), out_last: head >> 31 == 1, pix, mask }
+    }
+}
+
+impl Unit for SegUnit {
+    type In = SegIn;
+    type Out = SegOut;
+    type Span = Stim;
+
+    fn record_bytes(&self) -> usize {
+        4 + self.mask_bytes + self.pix_bytes
+    }
+
+    #[inline]
+    fn load(&self, input: &mut SegIn, stim: &Stim) {
+        input.in_x = stim.span.x0;
+        input.in_len = stim.span.len;
+        input.in_i0 = stim.span.i0;
+        input.in_di = to_port(stim.span.di as i64, self.cfg.dw());
+    }
+
+    #[inline]
+    fn owed(&self, stim: &Stim) -> u32 {
+        self.cfg.segment_count(stim.span.x0, stim.span.len)
+    }
+
+    #[inline]
+    fn record(&self, out: &SegOut, rec: &mut [u8]) {
+        rec[..4].copy_from_slice(&(out.out_x | (out.out_last as u32) << 31).to_le_bytes());
+        let (mask, pix) = rec[4..].split_at_mut(self.mask_bytes);
+        mask.copy_from_slice(&out.mask[..self.mask_bytes]);
+        pix.copy_from_slice(&out.pix[..self.pix_bytes]);
+    }
+
+    fn changed(&self, before: &[u8], now: &[u8]) -> Option<String> {
+        let (b, n) = (self.view(before), self.view(now));
+        let p = self.cfg.p;
+        let lanes_differ = (0..self.mask_bytes).any(|w| {
+            let lanes = if p >= 8 * (w as u32 + 1) { 0xff } else { (1u8 << (p % 8)) - 1 };
+            let on = n.mask[w] & lanes;
+            let word = |v: &SegView| u64::from_le_bytes(v.pix[8 * w..8 * w + 8].try_into().expect("8 bytes"));
+            on != b.mask[w] & lanes || (word(&n) ^ word(&b)) & BYTE_MASK[on as usize] != 0
+        });
+        (n.out_x != b.out_x || n.out_last != b.out_last || lanes_differ)
+            .then(|| format!("segment at x = {} changed while waiting for out_ready (now x = {})", b.out_x, n.out_x))
+    }
+
+    fn blame(&self, _k: usize, stim: &Stim) -> (Option<usize>, String) {
+        (Some(stim.triangle), describe(stim))
+    }
+}
+
+/// The scoreboard of a segment shader, on the checking thread: every segment against golden,
+/// then to `paint`.
+struct SegCheck<'a, F> {
+    unit: &'a SegUnit,
+    stims: &'a [Stim],
+    /// The span whose golden row `row` holds (see [`golden_row`]).
+    row_of: Option<usize>,
+    row: &'a mut Frame,
+    paint: F,
+}
+
+impl<F: FnMut(&Stim, &SegView) + Send> Check for SegCheck<'_, F> {
+    #[inline]
+    fn check(&mut self, k: usize, j: u32, rec: &[u8], report: &mut Report) {
+        let (cfg, stim) = (&self.unit.cfg, &self.stims[k]);
+        if self.row_of != Some(k) {
+            self.row.write_span(0, &stim.span, cfg.frac);
+            self.row_of = Some(k);
+        }
+        let out = self.unit.view(rec);
+        let seg = segment(cfg, &stim.span, j);
+        match agrees(&out, &stim.span, &seg, self.row.pixels(), cfg.p) {
+            Some(pixels) => {
+                report.segments += 1;
+                report.pixels += pixels;
+            }
+            None => check_lanes(cfg, stim, &seg, &out, report),
+        }
+        (self.paint)(stim, &out);
+    }
+}
+
+/// The segment lane by lane against golden, saying what disagrees.
+#[cold]
+#[inline(never)]
+fn check_lanes(cfg: &Config, stim: &Stim, seg: &Segment, out: &SegView, report: &mut Report) {
+    let mut problems = Vec::new();
+    if out.out_x != seg.x {
+        problems.push(format!("out_x expected {}, got {}", seg.x, out.out_x));
+    }
+    if out.out_last != seg.last {
+        problems.push(format!("out_last expected {}, got {}", seg.last as u8, out.out_last as u8));
+    }
+    let mut pixels = 0;
+    for i in 0..cfg.p {
+        match seg.lane_pixel(i) {
+            Some(j) => {
+                pixels += 1;
+                if !out.lane_enabled(i) {
+                    problems.push(format!("lane {i} (pixel {j}) masked off"));
+                } else {
+                    let want = stim.span.pixel(j, cfg.frac);
+                    if out.pix[i as usize] != want {
+                        problems.push(format!("lane {i} (pixel {j}): expected {want}, got {}", out.pix[i as usize]));
+                    }
+                }
+            }
+            None if out.lane_enabled(i) => problems.push(format!("lane {i} enabled outside the span")),
+            None => {}
+        }
+    }
+    report.segments += 1;
+    report.pixels += pixels;
+    if !problems.is_empty() {
+        report.mismatch(Mismatch {
+            triangle: Some(stim.triangle),
+            context: format!("{}, segment {}", describe(stim), seg.index),
+            what: problems.join("; "),
+        });
+    }
+}
+
+/// A segment-shader model under test with its driver.
+pub struct SegmentCosim {
+    info: &'static ModelInfo<SegIn, SegOut>,
+    unit: SegUnit,
+    driver: Driver<SegUnit>,
+    /// Golden's row of the span being checked (see [`golden_row`]), kept between streams.
+    row: Frame,
+}
 
 impl SegmentCosim {
     pub fn new(info: &'static ModelInfo<SegIn, SegOut>, seed: u64, traffic: Traffic) -> SegmentCosim {
-        let mut c = SegmentCosim {
+        let cfg = info.cfg;
+        SegmentCosim {
             info,
-            rtl: Rtl::new(info, seed),
-            cfg: info.cfg,
-            rng: TrafficGen::new(traffic, seed),
-            stress: Stress::NONE,
-            input: SegIn::default(),
-            output: SegOut::default(),
-            rows: Vec::new(),
-            held: SegOut::default(),
-        };
-        c.reset();
-        c
+            unit: SegUnit::new(cfg),
+            driver: Driver::new(Rtl::new(info, seed), TrafficGen::new(traffic, seed)),
+            row: golden_row(&cfg),
+        }
     }
 
     /// Adds [`Stress`] to the traffic of every following [`SegmentCosim::stream`].
     pub fn set_stress(&mut self, stress: Stress) {
-        self.stress = stress;
+        self.driver.stress = stress;
     }
 
     pub fn info(&self) -> &'static ModelInfo<SegIn, SegOut> {
         self.info
     }
 
-    /// Two clocks of reset with the inputs idle.
-    pub fn reset(&mut self) {
-        self.input = SegIn { rst: 1, ..SegIn::default() };
-        for _ in 0..2 {
-            self.rtl.step_into(&self.input, &mut self.output);
-        }
-        self.input.rst = 0;
-    }
-
-    fn drive(&mut self, span: &Span) {
-        self.input.in_x = span.x0;
-        self.input.in_len = span.len;
-        self.input.in_i0 = span.i0;
-        self.input.in_di = to_port(span.di as i64, self.cfg.dw());
-    }
-
     /// Streams `stims` through the model, checking every segment against golden; `paint` gets
-    /// each checked segment that left the model, with its span. Panics, before the model sees
-    /// anything, on a span its ports cannot take (see [`SegmentCosim::try_stream`]).
-    pub fn stream(&mut self, stims: &[Stim], report: &mut Report, paint: impl FnMut(&Stim, &SegOut)) {
+    /// each checked segment that left the model, with its span, in order (on the checking
+    /// thread). Panics, before the model sees anything, on a span its ports cannot take (see
+    /// [`SegmentCosim::try_stream`]).
+    pub fn stream(&mut self, stims: &[Stim], report: &mut Report, paint: impl FnMut(&Stim, &SegView) + Send) {
         if let Err(e) = self.try_stream(stims, report, paint) {
             panic!("{}: {e}", self.info.tag);
         }
@@ -274,192 +331,20 @@ impl SegmentCosim {
     /// Besides the scoreboard, a protocol monitor checks SPEC §3's valid/ready rules on the
     /// output: a segment offered and not taken stays offered, unchanged, in the next clock; in
     /// the first clock after a reset `out_valid` is low.
-    pub fn try_stream(&mut self, stims: &[Stim], report: &mut Report, mut paint: impl FnMut(&Stim, &SegOut)) -> Result<(), String> {
-        let cfg = self.cfg;
+    pub fn try_stream(&mut self, stims: &[Stim], report: &mut Report, paint: impl FnMut(&Stim, &SegView) + Send) -> Result<(), String> {
+        let cfg = self.unit.cfg;
         for (k, s) in stims.iter().enumerate() {
             s.span.check(&cfg).map_err(|e| format!("span {k} (triangle {}, y = {}) rejected: {e}", s.triangle, s.y))?;
         }
-        let mut pacer = Pacer::new(self.stress);
-        // Every accepted span with segments still owed, oldest first: its index, its golden
-        // segments (made by golden as they are compared), how many are left and its golden row.
-        let mut expected = VecDeque::new();
-        let mut next = 0;
-        let mut offering = false;
-        let mut idle = 0u64;
-        let mut drain = 0;
-        let mut in_reset = false;
-        let mut held = false;
-        loop {
-            if next == stims.len() && expected.is_empty() {
-                // Everything came out; a few more clocks must bring nothing.
-                if drain == DRAIN_CLOCKS {
-                    break;
-                }
-                drain += 1;
-            }
-            self.rng.clock();
-            if pacer.reset(&mut self.rng) {
-                // Nothing transfers in a reset clock: the spans in flight are cut, the one
-                // being offered stays offered.
-                if !in_reset {
-                    report.resets += 1;
-                    report.cut_spans += expected.len() as u64;
-                    self.rows.extend(expected.drain(..).map(|(_, _, _, row)| row));
-                }
-                in_reset = true;
-                held = false;
-                self.input.rst = 1;
-                self.input.in_valid = offering as u8;
-                self.input.out_ready = pacer.ready(&mut self.rng) as u8;
-                self.rtl.step_into(&self.input, &mut self.output);
-                self.input.rst = 0;
-                report.cycles += 1;
-                idle = 0;
-                continue;
-            }
-            if !offering && next < stims.len() {
-                offering = pacer.offer(&mut self.rng);
-                if offering {
-                    self.drive(&stims[next].span);
-                }
-            }
-            self.input.in_valid = offering as u8;
-            self.input.out_ready = pacer.ready(&mut self.rng) as u8;
-            self.rtl.step_into(&self.input, &mut self.output);
-            report.cycles += 1;
-            if std::mem::take(&mut in_reset) && self.output.out_valid != 0 {
-                report.mismatch(Mismatch {
-                    triangle: None,
-                    context: format!("clock {}", report.cycles),
-                    what: "out_valid high in the first clock after a reset".into(),
-                });
-            }
-            if std::mem::take(&mut held) {
-                if let Some(what) = changed_while_stalled(&self.held, &self.output, cfg.p) {
-                    report.mismatch(Mismatch { triangle: None, context: format!("clock {}", report.cycles), what });
-                }
-            }
-            let mut progress = false;
-            if self.output.out_valid == 1 && self.input.out_ready == 1 {
-                progress = true;
-                match expected.front_mut() {
-                    Some((k, segs, left, row)) => {
-                        let k: usize = *k;
-                        let seg: Segment = Iterator::next(segs).expect("segments owed");
-                        *left -= 1;
-                        let all_out = *left == 0;
-                        self.check(&stims[k], &seg, row.pixels(), report);
-                        paint(&stims[k], &self.output);
-                        if all_out {
-                            let (_, _, _, row) = expected.pop_front().expect("front");
-                            self.rows.push(row);
-                        }
-                    }
-                    None => {
-                        // Output nobody asked for is no progress: a model that streams garbage
-                        // while refusing input is declared hung, not followed forever.
-                        progress = false;
-                        report.mismatch(Mismatch {
-                            triangle: None,
-                            context: format!("clock {}", report.cycles),
-                            what: format!("segment at x = {} with no span outstanding", self.output.out_x),
-                        });
-                    }
-                }
-            } else if self.output.out_valid == 1 {
-                held = true;
-                keep_offered(&mut self.held, &self.output, cfg.p);
-            }
-            if offering && self.output.in_ready == 1 {
-                progress = true;
-                let stim = &stims[next];
-                let owed = cfg.segment_count(stim.span.x0, stim.span.len);
-                if owed > 0 {
-                    expected.push_back((next, segments(&cfg, &stim.span), owed, golden_row(&mut self.rows, &cfg, &stim.span)));
-                }
-                report.spans += 1;
-                next += 1;
-                offering = false;
-                pacer.accepted(&mut self.rng);
-            }
-            idle = if progress { 0 } else { idle + 1 };
-            if idle > STALL_LIMIT {
-                let context = match expected.front() {
-                    Some((k, _, _, _)) => describe(&stims[*k]),
-                    None => "idle".into(),
-                };
-                report.mismatch(Mismatch {
-                    triangle: expected.front().map(|(k, _, _, _)| stims[*k].triangle),
-                    context,
-                    what: format!(
-                        "no transfer for {STALL_LIMIT} clocks; {} segments still expected",
-                        expected.iter().map(|(_, _, left, _)| *left as u64).sum::<u64>()
-                    ),
-                });
-                self.reset();
-                return Ok(());
-            }
-        }
+        let check = SegCheck { unit: &self.unit, stims, row_of: None, row: &mut self.row, paint };
+        self.driver.stream(&self.unit, stims, report, check);
         Ok(())
-    }
-
-    /// Checks one segment against golden; `row` is its span's golden row (see [`golden_row`]).
-    #[inline]
-    fn check(&self, stim: &Stim, seg: &Segment, row: &[u8], report: &mut Report) {
-        match agrees(&self.output, &stim.span, seg, row, self.cfg.p) {
-            Some(pixels) => {
-                report.segments += 1;
-                report.pixels += pixels;
-            }
-            None => self.check_lanes(stim, seg, report),
-        }
-    }
-
-    /// The segment lane by lane against golden, saying what disagrees.
-    #[cold]
-    #[inline(never)]
-    fn check_lanes(&self, stim: &Stim, seg: &Segment, report: &mut Report) {
-        let out = &self.output;
-        let mut problems = Vec::new();
-        if out.out_x != seg.x {
-            problems.push(format!("out_x expected {}, got {}", seg.x, out.out_x));
-        }
-        if (out.out_last == 1) != seg.last {
-            problems.push(format!("out_last expected {}, got {}", seg.last as u8, out.out_last));
-        }
-        let mut pixels = 0;
-        for i in 0..self.cfg.p {
-            match seg.lane_pixel(i) {
-                Some(j) => {
-                    pixels += 1;
-                    if !out.lane_enabled(i) {
-                        problems.push(format!("lane {i} (pixel {j}) masked off"));
-                    } else {
-                        let want = stim.span.pixel(j, self.cfg.frac);
-                        if out.pix[i as usize] != want {
-                            problems.push(format!("lane {i} (pixel {j}): expected {want}, got {}", out.pix[i as usize]));
-                        }
-                    }
-                }
-                None if out.lane_enabled(i) => problems.push(format!("lane {i} enabled outside the span")),
-                None => {}
-            }
-        }
-        report.segments += 1;
-        report.pixels += pixels;
-        if !problems.is_empty() {
-            report.mismatch(Mismatch {
-                triangle: Some(stim.triangle),
-                context: format!("{}, segment {}", describe(stim), seg.index),
-                what: problems.join("; "),
-            });
-        }
     }
 
     /// Sets up `triangles` (numbered from `first`), streams their spans, paints the segments and
     /// compares the frame with golden's and with the f64 reference.
     pub fn run_triangles(&mut self, screen: &Screen, triangles: &[Triangle], first: usize, report: &mut Report) {
-        let cfg = self.cfg;
+        let cfg = self.unit.cfg;
         let mut stims = Vec::new();
         for (k, t) in triangles.iter().enumerate() {
             let triangle = first + k;
@@ -534,35 +419,18 @@ static BYTE_MASK: [u64; 256] = {
     t
 };
 
-/// Keeps what [`changed_while_stalled`] compares of a segment offered and not taken: its flags,
-/// x and the lanes below `p` (not the whole 300-byte struct, every stalled clock).
-#[inline]
-fn keep_offered(held: &mut SegOut, out: &SegOut, p: u32) {
-    held.out_valid = out.out_valid;
-    held.out_last = out.out_last;
-    held.out_x = out.out_x;
-    // Whole 8-byte words (lanes past P are never compared).
-    for w in 0..p.div_ceil(8) as usize {
-        held.pix[8 * w..8 * w + 8].copy_from_slice(&out.pix[8 * w..8 * w + 8]);
-    }
-    for w in 0..p.div_ceil(64) as usize {
-        held.mask[8 * w..8 * w + 8].copy_from_slice(&out.mask[8 * w..8 * w + 8]);
-    }
+/// The row golden's pixels of a span are written into (`Frame::write_span`, SPEC §2's pixel
+/// rule), once per span, so the scoreboard compares lanes with memory instead of deriving every
+/// pixel again. Only the span's own pixels are written; the rest is stale, and it lies in
+/// masked lanes, which are don't-care. P pixels wider than the screen, so a segment at the
+/// last x stays inside.
+fn golden_row(cfg: &Config) -> Frame {
+    Frame::new(cfg.max_len() + cfg.p, 1)
 }
 
-/// Golden's pixels of a span as one frame row, indexed by x: written by golden
-/// (`Frame::write_span`, SPEC §2's pixel rule) once, when the span is accepted, so the
-/// scoreboard compares lanes with memory instead of deriving every pixel again. Rows are reused
-/// (`spare`); they are P pixels wider than the screen, so a segment at the last x stays inside.
-fn golden_row(spare: &mut Vec<Frame>, cfg: &Config, span: &Span) -> Frame {
-    let mut row = spare.pop().unwrap_or_else(|| Frame::new(cfg.max_len() + cfg.p, 1));
-    row.write_span(0, span, cfg.frac);
-    row
-}
-
-/// [`SegmentCosim::check`]'s verdict on the way every segment should go: the number of
+/// The scoreboard's verdict on the way every segment should go: the number of
 /// in-span lanes when x, last, the mask and every in-span pixel agree with golden, `None` at
-/// the first disagreement, which `check` then describes lane by lane.
+/// the first disagreement, which [`check_lanes`] then describes lane by lane.
 ///
 /// Golden enables lanes `[lo, hi)`, lane i carrying span pixel `j = x + i - x0` (SPEC §3: lane
 /// i is the pixel at screen x `out_x + i`). Golden's `Segment::lane_pixel` is affine in the
@@ -570,8 +438,8 @@ fn golden_row(spare: &mut Vec<Frame>, cfg: &Config, span: &Span) -> Frame {
 /// the mask is compared a byte at a time and the pixels eight lanes at a time with the span's
 /// golden `row` from `out_x` on, masked lanes ignored.
 #[inline]
-fn agrees(out: &SegOut, span: &Span, seg: &Segment, row: &[u8], p: u32) -> Option<u64> {
-    if out.out_x != seg.x || (out.out_last == 1) != seg.last {
+fn agrees(out: &SegView, span: &Span, seg: &Segment, row: &[u8], p: u32) -> Option<u64> {
+    if out.out_x != seg.x || out.out_last != seg.last {
         return None;
     }
     let lo = span.x0.saturating_sub(seg.x).min(p);
@@ -604,25 +472,6 @@ fn agrees(out: &SegOut, span: &Span, seg: &Segment, row: &[u8], p: u32) -> Optio
         }
     }
     Some((hi - lo) as u64)
-}
-
-/// What changed in a segment that was offered and not taken in the previous clock, if anything
-/// (masked lanes are don't-care).
-#[inline]
-fn changed_while_stalled(before: &SegOut, now: &SegOut, p: u32) -> Option<String> {
-    if now.out_valid != 1 {
-        return Some(format!("out_valid dropped before the segment at x = {} was taken", before.out_x));
-    }
-    let lanes_differ = (0..p.div_ceil(8) as usize).any(|b| {
-        let lanes = if p >= 8 * (b as u32 + 1) { 0xff } else { (1u8 << (p % 8)) - 1 };
-        let on = now.mask[b] & lanes;
-        let word = |o: &SegOut| u64::from_le_bytes(o.pix[8 * b..8 * b + 8].try_into().expect("8 bytes"));
-        on != before.mask[b] & lanes || (word(now) ^ word(before)) & BYTE_MASK[on as usize] != 0
-    });
-    if now.out_x != before.out_x || now.out_last != before.out_last || lanes_differ {
-        return Some(format!("segment at x = {} changed while waiting for out_ready (now x = {})", before.out_x, now.out_x));
-    }
-    None
 }
 
 fn describe(s: &Stim) -> String {

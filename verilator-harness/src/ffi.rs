@@ -2,6 +2,7 @@
 //! free); `step` takes every input of one clock in one struct and returns every output in
 //! another, so a clock costs one FFI call whatever the port count.
 
+use crate::driver::{Control, Handshake};
 use golden::{Align, Config};
 use std::ffi::c_void;
 
@@ -101,6 +102,30 @@ pub struct SpecOut {
     pub out_last: u8,
     pub out_err: u8,
 }
+
+/// The control inputs and handshake outputs both streaming units share.
+macro_rules! streaming_ports {
+    ($in:ty, $out:ty) => {
+        impl Control for $in {
+            #[inline(always)]
+            fn set_control(&mut self, rst: bool, in_valid: bool, out_ready: bool) {
+                (self.rst, self.in_valid, self.out_ready) = (rst as u8, in_valid as u8, out_ready as u8);
+            }
+        }
+        impl Handshake for $out {
+            #[inline(always)]
+            fn in_ready(&self) -> bool {
+                self.in_ready == 1
+            }
+            #[inline(always)]
+            fn out_valid(&self) -> bool {
+                self.out_valid == 1
+            }
+        }
+    };
+}
+streaming_ports!(SegIn, SegOut);
+streaming_ports!(SpecIn, SpecOut);
 
 /// A linked model: its configuration and its three symbols.
 pub struct ModelInfo<I: 'static, O: 'static> {

@@ -1,13 +1,15 @@
 //! Co-simulation of segshade's generated RTL against the golden model, through Verilator.
 //!
 //! `build.rs` verilates and links the models; [`ffi`] wraps them; [`stimulus`] makes random
-//! and directed triangles; [`cosim`] streams their spans through a model with random valid
-//! gaps and backpressure and checks every segment and the final frames; [`specular`] does the
-//! same for the specular unit, pixel by pixel; [`render`] draws whole scenes through them;
+//! and directed triangles; [`driver`] is the clock loop every unit shares (random valid gaps
+//! and backpressure, the protocol monitor, the scoreboard on a second thread); [`cosim`]
+//! checks every segment of a segment shader and the final frames; [`specular`] does the same
+//! for the specular unit, pixel by pixel; [`render`] draws whole scenes through them;
 //! [`traffic`] makes the driver's and the sink's per-clock decisions (shared, bit for bit,
 //! with the native and cocotb benches of `scripts/bench-cosim`).
 
 pub mod cosim;
+pub mod driver;
 pub mod ffi;
 pub mod render;
 pub mod specular;

@@ -2,31 +2,86 @@
 //! against golden, within SPEC §4 of the f64 approximation `C cos^k(sqrt(n/k) delta)`, and,
 //! along each span, never brighter where |theta| is larger.
 
-use crate::cosim::{Mismatch, Pacer, Report, Stress, Traffic};
-use crate::traffic::TrafficGen;
+use crate::cosim::{Mismatch, Report, Stress, Traffic};
+use crate::driver::{Check, Driver, Unit};
 use crate::ffi::{to_port, ModelInfo, Rtl, SpecIn, SpecOut};
+use crate::traffic::TrafficGen;
 use golden::specular::reference::{approx, cos_k, epicentre};
 use golden::specular::setup::{norm, normalize, setup_span, SpanEnds, Vec3};
 use golden::specular::{
     n_valid, theta_at, SpecularSpan, SpecularUnit, ABS_TOL, C_FRAC, INSIDE_REL, N_MAX, OUTSIDE_REL, THETA_FRAC,
 };
 use rand::Rng;
-use std::collections::VecDeque;
 use std::f64::consts::FRAC_PI_2;
 
-/// The specular unit under test, its golden twin and the driver's random source.
+/// The specular unit under test: its driver and the checker's golden twin and caches.
 pub struct SpecularCosim {
-    rtl: Rtl<SpecIn, SpecOut>,
     info: &'static ModelInfo<SpecIn, SpecOut>,
+    driver: Driver<SpecPorts>,
+    judge: Judge,
+}
+
+/// The driver's view of the specular unit. An output's record is `out_spec` (2 bytes),
+/// `out_err`, `out_last`.
+struct SpecPorts;
+
+impl Unit for SpecPorts {
+    type In = SpecIn;
+    type Out = SpecOut;
+    type Span = SpecularSpan;
+
+    fn record_bytes(&self) -> usize {
+        4
+    }
+
+    #[inline]
+    fn load(&self, input: &mut SpecIn, s: &SpecularSpan) {
+        input.in_c = s.c as u32;
+        input.in_n = s.n as u32;
+        input.in_theta0 = to_port(s.theta0 as i64, 32);
+        input.in_dtheta = to_port(s.dtheta as i64, 32);
+        input.in_len = s.len;
+    }
+
+    #[inline]
+    fn owed(&self, s: &SpecularSpan) -> u32 {
+        s.len
+    }
+
+    #[inline]
+    fn record(&self, out: &SpecOut, rec: &mut [u8]) {
+        rec[..2].copy_from_slice(&out.out_spec.to_le_bytes());
+        rec[2] = out.out_err;
+        rec[3] = out.out_last;
+    }
+
+    fn changed(&self, before: &[u8], now: &[u8]) -> Option<String> {
+        (before != now).then(|| format!("pixel {:?} changed while waiting for out_ready: now {:?}", pixel_of(before), pixel_of(now)))
+    }
+
+    fn blame(&self, k: usize, s: &SpecularSpan) -> (Option<usize>, String) {
+        (Some(k), describe(k, s))
+    }
+}
+
+/// The outputs a record holds.
+fn pixel_of(rec: &[u8]) -> SpecOut {
+    SpecOut { out_spec: u16::from_le_bytes([rec[0], rec[1]]), out_err: rec[2], out_last: rec[3], out_valid: 1, in_ready: 0 }
+}
+
+fn describe(k: usize, s: &SpecularSpan) -> String {
+    format!("span {k} (c {} n {} theta0 {} dtheta {} len {})", s.c, s.n, s.theta0, s.dtheta, s.len)
+}
+
+/// The checker's golden model and what it keeps between pixels and runs.
+struct Judge {
     unit: SpecularUnit,
-    rng: TrafficGen,
-    stress: Stress,
-    input: SpecIn,
-    output: SpecOut,
     /// What the accuracy check needs of the last n seen, computed once per n, not per pixel.
     shine: Shine,
     /// `cos^k` tables for the accuracy check's shortcut, one per k met so far.
     cos_k: Vec<CosK>,
+    /// The current span's (|theta|, output) pairs so far, for the monotonicity check.
+    along: Vec<(u32, u16)>,
 }
 
 /// What SPEC §4's check needs of a span's n.
@@ -34,34 +89,20 @@ pub struct SpecularCosim {
 struct Shine {
     n: u16,
     /// k(n) when n is valid (1..1000), with `sqrt(n/k)` as golden's `approx` computes it and
-    /// the index of its table in `SpecularCosim::cos_k`.
+    /// the index of its table in `Judge::cos_k`.
     k: Option<(u32, f64, usize)>,
     /// The epicentre of n.
     edge: f64,
 }
 
-const STALL_LIMIT: u64 = 10_000;
-
 impl SpecularCosim {
     /// `unit` must be the configuration the model was generated from.
     pub fn new(info: &'static ModelInfo<SpecIn, SpecOut>, unit: SpecularUnit, seed: u64, traffic: Traffic) -> Self {
-        let mut c = SpecularCosim {
-            rtl: Rtl::new(info, seed),
+        SpecularCosim {
             info,
-            unit,
-            rng: TrafficGen::new(traffic, seed),
-            stress: Stress::NONE,
-            input: SpecIn::default(),
-            output: SpecOut::default(),
-            shine: Shine { n: u16::MAX, k: None, edge: 0.0 },
-            cos_k: Vec::new(),
-        };
-        c.input.rst = 1;
-        for _ in 0..2 {
-            c.rtl.step_into(&c.input, &mut c.output);
+            driver: Driver::new(Rtl::new(info, seed), TrafficGen::new(traffic, seed)),
+            judge: Judge { unit, shine: Shine { n: u16::MAX, k: None, edge: 0.0 }, cos_k: Vec::new(), along: Vec::new() },
         }
-        c.input.rst = 0;
-        c
     }
 
     pub fn info(&self) -> &'static ModelInfo<SpecIn, SpecOut> {
@@ -70,16 +111,14 @@ impl SpecularCosim {
 
     /// Adds [`Stress`] to the traffic of every following [`SpecularCosim::stream`].
     pub fn set_stress(&mut self, stress: Stress) {
-        self.stress = stress;
+        self.driver.stress = stress;
     }
 
     /// Streams `spans` (counted in `report.spans`; `report.failed` holds span indices). Panics,
     /// before the model sees anything, on a span its ports cannot take
     /// (see [`SpecularCosim::try_stream`]).
     pub fn stream(&mut self, spans: &[SpecularSpan], report: &mut Report) {
-        if let Err(e) = self.try_stream(spans, report) {
-            panic!("{}: {e}", self.info.tag);
-        }
+        self.stream_with(spans, report, |_, _, _| {})
     }
 
     /// [`SpecularCosim::stream`], or an error naming the first span the ports cannot carry:
@@ -93,8 +132,9 @@ impl SpecularCosim {
     }
 
     /// [`SpecularCosim::stream`], and `pixel` gets each checked output pixel that left the
-    /// unit: its span's index, its pixel index `j` in the span and the outputs.
-    pub fn stream_with(&mut self, spans: &[SpecularSpan], report: &mut Report, pixel: impl FnMut(usize, u32, &SpecOut)) {
+    /// unit, in order (on the checking thread): its span's index, its pixel index `j` in the
+    /// span and the outputs.
+    pub fn stream_with(&mut self, spans: &[SpecularSpan], report: &mut Report, pixel: impl FnMut(usize, u32, &SpecOut) + Send) {
         if let Err(e) = self.try_stream_with(spans, report, pixel) {
             panic!("{}: {e}", self.info.tag);
         }
@@ -105,7 +145,7 @@ impl SpecularCosim {
         &mut self,
         spans: &[SpecularSpan],
         report: &mut Report,
-        mut pixel: impl FnMut(usize, u32, &SpecOut),
+        pixel: impl FnMut(usize, u32, &SpecOut) + Send,
     ) -> Result<(), String> {
         let len_max = (1u32 << (self.info.cfg.xbits + 1)) - 1;
         for (k, s) in spans.iter().enumerate() {
@@ -116,134 +156,47 @@ impl SpecularCosim {
                 return Err(format!("span {k} rejected: n = {} does not fit the {}-bit in_n port", s.n, golden::specular::N_BITS));
             }
         }
-        let mut pacer = Pacer::new(self.stress);
-        // Every accepted span with pixels still owed, oldest first: (span, next pixel j).
-        let mut expected: VecDeque<(usize, u32)> = VecDeque::new();
-        let mut along: Vec<(u32, u16)> = Vec::new();
-        let (mut next, mut offering, mut idle, mut drain) = (0, false, 0u64, 0);
-        let (mut in_reset, mut held): (bool, Option<SpecOut>) = (false, None);
-        loop {
-            if next == spans.len() && expected.is_empty() {
-                if drain == crate::cosim::DRAIN_CLOCKS {
-                    break;
-                }
-                drain += 1;
-            }
-            self.rng.clock();
-            if pacer.reset(&mut self.rng) {
-                if !in_reset {
-                    report.resets += 1;
-                    report.cut_spans += expected.len() as u64;
-                    expected.clear();
-                    along.clear();
-                }
-                in_reset = true;
-                held = None;
-                self.input.rst = 1;
-                self.input.in_valid = offering as u8;
-                self.input.out_ready = pacer.ready(&mut self.rng) as u8;
-                self.rtl.step_into(&self.input, &mut self.output);
-                self.input.rst = 0;
-                report.cycles += 1;
-                idle = 0;
-                continue;
-            }
-            if !offering && next < spans.len() {
-                offering = pacer.offer(&mut self.rng);
-                if offering {
-                    let s = &spans[next];
-                    self.input.in_c = s.c as u32;
-                    self.input.in_n = s.n as u32;
-                    self.input.in_theta0 = to_port(s.theta0 as i64, 32);
-                    self.input.in_dtheta = to_port(s.dtheta as i64, 32);
-                    self.input.in_len = s.len;
-                }
-            }
-            self.input.in_valid = offering as u8;
-            self.input.out_ready = pacer.ready(&mut self.rng) as u8;
-            self.rtl.step_into(&self.input, &mut self.output);
-            report.cycles += 1;
-            if std::mem::take(&mut in_reset) && self.output.out_valid != 0 {
-                report.mismatch(Mismatch {
-                    triangle: None,
-                    context: format!("clock {}", report.cycles),
-                    what: "out_valid high in the first clock after a reset".into(),
-                });
-            }
-            if let Some(h) = held.take() {
-                let o = &self.output;
-                if o.out_valid != 1 || (o.out_spec, o.out_last, o.out_err) != (h.out_spec, h.out_last, h.out_err) {
-                    report.mismatch(Mismatch {
-                        triangle: None,
-                        context: format!("clock {}", report.cycles),
-                        what: format!("pixel {h:?} dropped or changed while waiting for out_ready: now {o:?}"),
-                    });
-                }
-            }
-            let mut progress = false;
-            if self.output.out_valid == 1 && self.input.out_ready == 1 {
-                progress = true;
-                match expected.front_mut() {
-                    Some((k, j)) => {
-                        let (k, j0) = (*k, *j);
-                        *j += 1;
-                        if j0 + 1 == spans[k].len {
-                            expected.pop_front();
-                        }
-                        self.check(k, &spans[k], j0, report, &mut along);
-                        pixel(k, j0, &self.output);
-                        if j0 + 1 == spans[k].len {
-                            check_monotone(k, &mut along, report);
-                        }
-                    }
-                    None => {
-                        // Output nobody asked for is no progress: a model that streams garbage
-                        // while refusing input is declared hung, not followed forever.
-                        progress = false;
-                        report.mismatch(Mismatch {
-                            triangle: None,
-                            context: format!("clock {}", report.cycles),
-                            what: "pixel with no span outstanding".into(),
-                        });
-                    }
-                }
-            } else if self.output.out_valid == 1 {
-                held = Some(self.output);
-            }
-            if offering && self.output.in_ready == 1 {
-                progress = true;
-                if spans[next].len > 0 {
-                    expected.push_back((next, 0));
-                }
-                report.spans += 1;
-                next += 1;
-                offering = false;
-                pacer.accepted(&mut self.rng);
-            }
-            idle = if progress { 0 } else { idle + 1 };
-            if idle > STALL_LIMIT {
-                report.mismatch(Mismatch {
-                    triangle: expected.front().map(|e| e.0),
-                    context: "stream".into(),
-                    what: format!(
-                        "no transfer for {STALL_LIMIT} clocks; {} pixels still expected",
-                        expected.iter().map(|&(k, j)| (spans[k].len - j) as u64).sum::<u64>()
-                    ),
-                });
-                return Ok(());
-            }
-        }
+        self.judge.along.clear();
+        let check = SpecCheck { judge: &mut self.judge, spans, current: None, pixel };
+        self.driver.stream(&SpecPorts, spans, report, check);
         Ok(())
     }
+}
 
+/// The scoreboard of the specular unit, on the checking thread.
+struct SpecCheck<'a, F> {
+    judge: &'a mut Judge,
+    spans: &'a [SpecularSpan],
+    /// The span whose pixels `judge.along` holds.
+    current: Option<usize>,
+    pixel: F,
+}
+
+impl<F: FnMut(usize, u32, &SpecOut) + Send> Check for SpecCheck<'_, F> {
+    #[inline]
+    fn check(&mut self, k: usize, j: u32, rec: &[u8], report: &mut Report) {
+        if self.current != Some(k) {
+            // A span cut short by a reset is not judged for monotonicity.
+            self.judge.along.clear();
+            self.current = Some(k);
+        }
+        let (s, out) = (&self.spans[k], pixel_of(rec));
+        self.judge.check(k, s, j, &out, report);
+        (self.pixel)(k, j, &out);
+        if j + 1 == s.len {
+            check_monotone(k, &mut self.judge.along, report);
+        }
+    }
+}
+
+impl Judge {
     /// Checks pixel `j` of span `k` (bit-exact, SPEC §4) and keeps it for the span's
     /// monotonicity check.
     #[inline]
-    fn check(&mut self, k: usize, s: &SpecularSpan, j: u32, report: &mut Report, along: &mut Vec<(u32, u16)>) {
+    fn check(&mut self, k: usize, s: &SpecularSpan, j: u32, out: &SpecOut, report: &mut Report) {
         if self.shine.n != s.n {
             self.shine = self.shine_of(s.n);
         }
-        let out = &self.output;
         let (spec, err) = self.unit.pixel(s.c, s.n, s.theta0, s.dtheta, j);
         let exact = (out.out_spec, out.out_err == 1, out.out_last == 1) == (spec, err, j + 1 == s.len);
         let theta = theta_at(s.theta0, s.dtheta, j);
@@ -261,10 +214,10 @@ impl SpecularCosim {
                 }
             }
         };
-        along.push((theta.unsigned_abs(), out.out_spec));
+        self.along.push((theta.unsigned_abs(), out.out_spec));
         report.pixels += 1;
         if !(exact && accurate) {
-            self.describe_pixel(k, s, j, report);
+            self.describe_pixel(k, s, j, out, report);
         }
     }
 
@@ -288,8 +241,7 @@ impl SpecularCosim {
     /// Reports what is wrong with pixel `j` of span `k`: `check`'s tests again, with words.
     #[cold]
     #[inline(never)]
-    fn describe_pixel(&self, k: usize, s: &SpecularSpan, j: u32, report: &mut Report) {
-        let out = &self.output;
+    fn describe_pixel(&self, k: usize, s: &SpecularSpan, j: u32, out: &SpecOut, report: &mut Report) {
         let (spec, err) = self.unit.pixel(s.c, s.n, s.theta0, s.dtheta, j);
         let last = j + 1 == s.len;
         let mut problems = Vec::new();
@@ -315,7 +267,7 @@ impl SpecularCosim {
         if !problems.is_empty() {
             report.mismatch(Mismatch {
                 triangle: Some(k),
-                context: format!("span {k} (c {} n {} theta0 {} dtheta {} len {}), pixel {j}", s.c, s.n, s.theta0, s.dtheta, s.len),
+                context: format!("{}, pixel {j}", describe(k, s)),
                 what: problems.join("; "),
             });
         }

@@ -1,0 +1,348 @@
+//! The clock loop every streaming unit shares (SPEC §3's valid/ready on both sides), with its
+//! scoreboard on a second thread.
+//!
+//! The driving thread does only what must happen clock by clock: draw the traffic, put a span
+//! on the ports and hold it until taken, step the model, watch the protocol (an output offered
+//! and not taken stays, unchanged; `out_valid` is low right after a reset), count what each
+//! accepted span still owes, and copy every output transfer into a compact record. Records go
+//! in batches over a bounded channel to the checking thread, which compares each with golden
+//! (the expensive part: golden's segments and rows, the f64 references). On two cores the
+//! model then runs about as fast as it would in a bare C++ loop; the order of checks, and
+//! therefore every report, is the same as in one thread.
+
+use crate::cosim::{Mismatch, Report};
+use crate::ffi::Rtl;
+use crate::traffic::TrafficGen;
+use rand::Rng;
+use std::collections::VecDeque;
+use std::sync::mpsc::{sync_channel, Receiver};
+
+/// Stress on top of [`crate::traffic::Traffic`], off by default: `rst` at random clocks, long
+/// stretches of `out_ready` low, long `in_valid` gaps between spans. With a reset, the spans
+/// accepted and not yet fully out are *cut* (their remaining output is dropped from the
+/// scoreboard) and a span being offered is offered again afterwards; in a clock with `rst`
+/// high nothing transfers.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Stress {
+    /// Probability per clock of asserting `rst` (for 1..=3 clocks).
+    pub reset: f64,
+    /// Probability per clock that `out_ready` drops for 1..=`stall_max` clocks.
+    pub stall: f64,
+    pub stall_max: u32,
+    /// Probability after each input transfer of an `in_valid` gap of 1..=`gap_max` clocks.
+    pub gap: f64,
+    pub gap_max: u32,
+}
+
+impl Stress {
+    pub const NONE: Stress = Stress { reset: 0.0, stall: 0.0, stall_max: 0, gap: 0.0, gap_max: 0 };
+    /// Long backpressure bursts and input gaps, no reset.
+    pub const BURSTS: Stress = Stress { reset: 0.0, stall: 0.01, stall_max: 300, gap: 0.05, gap_max: 200 };
+    /// Everything at once: resets about every 500 clocks, bursts and gaps.
+    pub const HARSH: Stress = Stress { reset: 0.002, ..Stress::BURSTS };
+}
+
+/// The per-clock decisions of the driver and the sink under `Traffic` and [`Stress`]: the
+/// generator's two draws of the clock ([`TrafficGen::clock`]), then the stress draws. Without
+/// stress it is exactly the plain traffic of the native and cocotb benches.
+struct Pacer {
+    stress: Stress,
+    rst_left: u32,
+    stall_left: u32,
+    gap_left: u32,
+}
+
+impl Pacer {
+    fn new(stress: Stress) -> Pacer {
+        Pacer { stress, rst_left: 0, stall_left: 0, gap_left: 0 }
+    }
+
+    /// Whether `rst` is high this clock.
+    #[inline]
+    fn reset(&mut self, rng: &mut TrafficGen) -> bool {
+        if self.rst_left == 0 && self.stress.reset > 0.0 && rng.gen_bool(self.stress.reset) {
+            self.rst_left = rng.gen_range(1..=3);
+        }
+        if self.rst_left > 0 {
+            self.rst_left -= 1;
+            return true;
+        }
+        false
+    }
+
+    /// Whether a pending span starts being offered this clock.
+    #[inline]
+    fn offer(&mut self, rng: &mut TrafficGen) -> bool {
+        if self.gap_left > 0 {
+            self.gap_left -= 1;
+            return false;
+        }
+        rng.offer()
+    }
+
+    /// `out_ready` this clock.
+    #[inline]
+    fn ready(&mut self, rng: &mut TrafficGen) -> bool {
+        if self.stall_left == 0 && self.stress.stall > 0.0 && rng.gen_bool(self.stress.stall) {
+            self.stall_left = rng.gen_range(1..=self.stress.stall_max.max(1));
+        }
+        if self.stall_left > 0 {
+            self.stall_left -= 1;
+            return false;
+        }
+        rng.ready()
+    }
+
+    /// A span was transferred: maybe a gap before the next one is offered.
+    #[inline]
+    fn accepted(&mut self, rng: &mut TrafficGen) {
+        if self.stress.gap > 0.0 && rng.gen_bool(self.stress.gap) {
+            self.gap_left = rng.gen_range(1..=self.stress.gap_max.max(1));
+        }
+    }
+}
+
+/// The control inputs of a streaming unit.
+pub trait Control: Copy + Default + 'static {
+    fn set_control(&mut self, rst: bool, in_valid: bool, out_ready: bool);
+}
+
+/// The handshake outputs of a streaming unit.
+pub trait Handshake: Copy + Default + 'static {
+    fn in_ready(&self) -> bool;
+    fn out_valid(&self) -> bool;
+}
+
+/// What the driving thread knows of a unit: how a span goes onto its ports, how many outputs
+/// it owes, and the compact record of an output that the checker reads.
+pub(crate) trait Unit: Sync {
+    type In: Control;
+    type Out: Handshake;
+    type Span: Sync;
+    /// Bytes of one output's record.
+    fn record_bytes(&self) -> usize;
+    fn load(&self, input: &mut Self::In, span: &Self::Span);
+    /// Outputs (segments, pixels) the span yields.
+    fn owed(&self, span: &Self::Span) -> u32;
+    fn record(&self, out: &Self::Out, rec: &mut [u8]);
+    /// What differs between two records of an output offered in consecutive clocks and not
+    /// taken in the first (don't-care bits ignored), if anything.
+    fn changed(&self, before: &[u8], now: &[u8]) -> Option<String>;
+    /// The triangle (or span) to blame and a description, for a mismatch about span `k`.
+    fn blame(&self, k: usize, span: &Self::Span) -> (Option<usize>, String);
+}
+
+/// The checking thread's side: output `j` of span `k`, as [`Unit::record`] wrote it. Outputs
+/// come in transfer order; a span cut by a reset stops early, and the next record is of a
+/// later span.
+pub(crate) trait Check: Send {
+    fn check(&mut self, k: usize, j: u32, rec: &[u8], report: &mut Report);
+}
+
+/// Clocks run after the last expected output, in which the model must stay quiet.
+pub const DRAIN_CLOCKS: u64 = 3;
+
+/// Clocks without any transfer after which the model is declared hung.
+const STALL_LIMIT: u64 = 10_000;
+
+/// Outputs per batch sent to the checker, and batches in flight: enough to ride out the
+/// checker's uneven pace (a span's first segment costs more), little enough to stay in cache.
+const BATCH: usize = 1024;
+const IN_FLIGHT: usize = 4;
+
+/// A batch of output records: (span, output index) and the records back to back.
+struct Batch {
+    at: Vec<(u32, u32)>,
+    data: Vec<u8>,
+}
+
+/// A unit under test: the model, its traffic and its stress.
+pub(crate) struct Driver<U: Unit> {
+    rtl: Rtl<U::In, U::Out>,
+    rng: TrafficGen,
+    pub stress: Stress,
+    input: U::In,
+    output: U::Out,
+}
+
+impl<U: Unit> Driver<U> {
+    /// The model in reset for two clocks.
+    pub fn new(rtl: Rtl<U::In, U::Out>, rng: TrafficGen) -> Self {
+        let mut d = Driver { rtl, rng, stress: Stress::NONE, input: U::In::default(), output: U::Out::default() };
+        d.reset();
+        d
+    }
+
+    /// Two clocks of reset with the inputs idle.
+    pub fn reset(&mut self) {
+        self.input = U::In::default();
+        self.input.set_control(true, false, false);
+        for _ in 0..2 {
+            self.rtl.step_into(&self.input, &mut self.output);
+        }
+    }
+
+    /// Streams `spans` through the model, `check` judging every output on a second thread;
+    /// the driver's counts, protocol findings and the checker's verdicts all land in `report`.
+    pub fn stream(&mut self, unit: &U, spans: &[U::Span], report: &mut Report, mut check: impl Check) {
+        let (tx, rx) = sync_channel::<Batch>(IN_FLIGHT);
+        let mut checked = Report::default();
+        std::thread::scope(|s| {
+            let checker = s.spawn(|| {
+                consume(rx, unit.record_bytes(), &mut check, &mut checked);
+            });
+            self.drive(unit, spans, report, |batch| tx.send(batch).is_ok());
+            drop(tx);
+            if let Err(panic) = checker.join() {
+                std::panic::resume_unwind(panic);
+            }
+        });
+        report.absorb(checked);
+    }
+
+    /// The clock loop; `send` hands a full batch to the checker (false: the checker is gone,
+    /// having panicked; stop and let `stream` pass its panic on).
+    fn drive(&mut self, unit: &U, spans: &[U::Span], report: &mut Report, mut send: impl FnMut(Batch) -> bool) {
+        let rb = unit.record_bytes();
+        let new_batch = || Batch { at: Vec::with_capacity(BATCH), data: Vec::with_capacity(BATCH * rb) };
+        let mut batch = new_batch();
+        let mut pacer = Pacer::new(self.stress);
+        // Every accepted span with outputs still owed, oldest first: (span, next output).
+        let mut expected: VecDeque<(usize, u32)> = VecDeque::new();
+        let mut owed_front = 0;
+        let mut held = vec![0u8; rb];
+        let mut now = vec![0u8; rb];
+        let (mut next, mut offering, mut idle, mut drain) = (0, false, 0u64, 0);
+        let (mut in_reset, mut holding) = (false, false);
+        loop {
+            if next == spans.len() && expected.is_empty() {
+                // Everything came out; a few more clocks must bring nothing.
+                if drain == DRAIN_CLOCKS {
+                    break;
+                }
+                drain += 1;
+            }
+            self.rng.clock();
+            if pacer.reset(&mut self.rng) {
+                // Nothing transfers in a reset clock: the spans in flight are cut, the one
+                // being offered stays offered.
+                if !in_reset {
+                    report.resets += 1;
+                    report.cut_spans += expected.len() as u64;
+                    expected.clear();
+                }
+                in_reset = true;
+                holding = false;
+                let ready = pacer.ready(&mut self.rng);
+                self.input.set_control(true, offering, ready);
+                self.rtl.step_into(&self.input, &mut self.output);
+                report.cycles += 1;
+                idle = 0;
+                continue;
+            }
+            if !offering && next < spans.len() {
+                offering = pacer.offer(&mut self.rng);
+                if offering {
+                    unit.load(&mut self.input, &spans[next]);
+                }
+            }
+            let ready = pacer.ready(&mut self.rng);
+            self.input.set_control(false, offering, ready);
+            self.rtl.step_into(&self.input, &mut self.output);
+            report.cycles += 1;
+            let out = &self.output;
+            if std::mem::take(&mut in_reset) && out.out_valid() {
+                report.mismatch(Mismatch {
+                    triangle: None,
+                    context: format!("clock {}", report.cycles),
+                    what: "out_valid high in the first clock after a reset".into(),
+                });
+            }
+            let mut progress = false;
+            if out.out_valid() {
+                if std::mem::take(&mut holding) {
+                    unit.record(out, &mut now);
+                    if let Some(what) = unit.changed(&held, &now) {
+                        report.mismatch(Mismatch { triangle: None, context: format!("clock {}", report.cycles), what });
+                    }
+                }
+                if ready {
+                    match expected.front_mut() {
+                        Some((k, j)) => {
+                            progress = true;
+                            batch.at.push((*k as u32, *j));
+                            let at = batch.data.len();
+                            batch.data.resize(at + rb, 0);
+                            unit.record(out, &mut batch.data[at..]);
+                            *j += 1;
+                            if *j == owed_front {
+                                expected.pop_front();
+                                owed_front = expected.front().map_or(0, |&(k, _)| unit.owed(&spans[k]));
+                            }
+                            if batch.at.len() == BATCH && !send(std::mem::replace(&mut batch, new_batch())) {
+                                return;
+                            }
+                        }
+                        // Output nobody asked for is no progress: a model that streams garbage
+                        // while refusing input is declared hung, not followed forever.
+                        None => report.mismatch(Mismatch {
+                            triangle: None,
+                            context: format!("clock {}", report.cycles),
+                            what: "output with no span outstanding".into(),
+                        }),
+                    }
+                } else {
+                    holding = true;
+                    unit.record(out, &mut held);
+                }
+            } else if std::mem::take(&mut holding) {
+                report.mismatch(Mismatch {
+                    triangle: None,
+                    context: format!("clock {}", report.cycles),
+                    what: "out_valid dropped before the output offered was taken".into(),
+                });
+            }
+            if offering && out.in_ready() {
+                progress = true;
+                let owed = unit.owed(&spans[next]);
+                if owed > 0 {
+                    if expected.is_empty() {
+                        owed_front = owed;
+                    }
+                    expected.push_back((next, 0));
+                }
+                report.spans += 1;
+                next += 1;
+                offering = false;
+                pacer.accepted(&mut self.rng);
+            }
+            idle = if progress { 0 } else { idle + 1 };
+            if idle > STALL_LIMIT {
+                let (triangle, context) = match expected.front() {
+                    Some(&(k, _)) => unit.blame(k, &spans[k]),
+                    None => (None, "idle".into()),
+                };
+                let left: u64 = expected.iter().map(|&(k, j)| (unit.owed(&spans[k]) - j) as u64).sum();
+                report.mismatch(Mismatch {
+                    triangle,
+                    context,
+                    what: format!("no transfer for {STALL_LIMIT} clocks; {left} outputs still expected"),
+                });
+                self.reset();
+                break;
+            }
+        }
+        if !batch.at.is_empty() {
+            send(batch);
+        }
+    }
+}
+
+/// The checking thread: every record of every batch, in order.
+fn consume(rx: Receiver<Batch>, rb: usize, check: &mut impl Check, report: &mut Report) {
+    for batch in rx {
+        for (&(k, j), rec) in batch.at.iter().zip(batch.data.chunks_exact(rb)) {
+            check.check(k as usize, j, rec, report);
+        }
+    }
+}
