@@ -19,21 +19,8 @@ struct Cli {
 enum Command {
     /// Write every module of one configuration, manifest.json and a FuseSoC core into a folder.
     Generate {
-        /// Segment width: pixels per clock, a power of two in 1..256.
-        #[arg(long, default_value_t = golden::format::DEFAULT_P, value_parser = parse_p)]
-        p: u32,
-        /// Fraction bits F of the intensity format UQ8.F (4..20).
-        #[arg(long = "frac", default_value_t = golden::format::DEFAULT_FRAC, value_parser = clap::value_parser!(u32).range(4..=20))]
-        frac: u32,
-        /// Screen-x bits XW (4..16).
-        #[arg(long = "xbits", default_value_t = golden::format::DEFAULT_XBITS, value_parser = clap::value_parser!(u32).range(4..=16))]
-        xbits: u32,
-        /// Segmentation: span (the seed's) or screen (segments on multiples of P).
-        #[arg(long, default_value = "span", value_parser = ["span", "screen"])]
-        align: String,
-        /// String prepended to every module name.
-        #[arg(long, default_value = "", value_parser = parse_prefix)]
-        prefix: String,
+        #[command(flatten)]
+        config: ConfigArgs,
         /// Increments: shift-add (SPEC's BFPI), or the comparison forms naive (`*` by constants)
         /// and tree (doubling tree in the shader, no BFPI) used by scripts/synth.
         #[arg(long = "bfpi-arch", default_value = "shift-add", value_parser = ["shift-add", "naive", "tree"])]
@@ -74,21 +61,8 @@ enum Command {
     /// Write a self-checking Verilog-2005 testbench of the segment shader and of the specular
     /// unit, with vectors from the golden model, beside the generated RTL (runs in Icarus).
     Testbench {
-        /// Segment width: pixels per clock, a power of two in 1..256.
-        #[arg(long, default_value_t = golden::format::DEFAULT_P, value_parser = parse_p)]
-        p: u32,
-        /// Fraction bits F of the intensity format UQ8.F (4..20).
-        #[arg(long = "frac", default_value_t = golden::format::DEFAULT_FRAC, value_parser = clap::value_parser!(u32).range(4..=20))]
-        frac: u32,
-        /// Screen-x bits XW (4..16).
-        #[arg(long = "xbits", default_value_t = golden::format::DEFAULT_XBITS, value_parser = clap::value_parser!(u32).range(4..=16))]
-        xbits: u32,
-        /// Segmentation: span (the seed's) or screen (segments on multiples of P).
-        #[arg(long, default_value = "span", value_parser = ["span", "screen"])]
-        align: String,
-        /// String prepended to every module name.
-        #[arg(long, default_value = "", value_parser = parse_prefix)]
-        prefix: String,
+        #[command(flatten)]
+        config: ConfigArgs,
         #[command(flatten)]
         brdf: BrdfArgs,
         /// Spans per block (1..1000000).
@@ -119,6 +93,35 @@ enum Report {
         #[arg(long)]
         png: Option<PathBuf>,
     },
+}
+
+/// The configuration and module prefix, shared by `generate` and `testbench`.
+#[derive(Args)]
+struct ConfigArgs {
+    /// Segment width: pixels per clock, a power of two in 1..256.
+    #[arg(long, default_value_t = golden::format::DEFAULT_P, value_parser = parse_p)]
+    p: u32,
+    /// Fraction bits F of the intensity format UQ8.F (4..20).
+    #[arg(long = "frac", default_value_t = golden::format::DEFAULT_FRAC, value_parser = clap::value_parser!(u32).range(4..=20))]
+    frac: u32,
+    /// Screen-x bits XW (4..16).
+    #[arg(long = "xbits", default_value_t = golden::format::DEFAULT_XBITS, value_parser = clap::value_parser!(u32).range(4..=16))]
+    xbits: u32,
+    /// Segmentation: span (the seed's) or screen (segments on multiples of P).
+    #[arg(long, default_value = "span", value_parser = ["span", "screen"])]
+    align: String,
+    /// String prepended to every module name.
+    #[arg(long, default_value = "", value_parser = parse_prefix)]
+    prefix: String,
+}
+
+impl ConfigArgs {
+    /// Options for this configuration with the table set `brdf`; the rest default.
+    fn options(self, brdf: &BrdfArgs) -> Result<Options, String> {
+        let align: Align = self.align.parse().expect("clap checked the alignment");
+        let cfg = Config::new(self.p, self.frac, self.xbits, align)?;
+        Ok(Options { cfg, prefix: self.prefix, brdf: brdf.plan()?, ..Options::default() })
+    }
 }
 
 /// The specular unit's table set, shared by every command that builds the unit.
@@ -190,12 +193,11 @@ fn parse_cli() -> Cli {
 fn main() -> ExitCode {
     let cli = parse_cli();
     let result = match cli.command {
-        Command::Generate { p, frac, xbits, align, prefix, bfpi_arch, brdf, out } => {
-            let align: Align = align.parse().expect("clap checked the alignment");
+        Command::Generate { config, bfpi_arch, brdf, out } => {
             let bfpi_arch = bfpi_arch.parse().expect("clap checked the bfpi arch");
-            Config::new(p, frac, xbits, align)
-                .and_then(|cfg| Ok(Options { cfg, prefix, bfpi_arch, brdf: brdf.plan()? }))
-                .and_then(|opts| output::write_all(&out, &generate(&opts)))
+            config
+                .options(&brdf)
+                .and_then(|opts| output::write_all(&out, &generate(&Options { bfpi_arch, ..opts })))
                 .map(|()| eprintln!("wrote {}", out.display()))
         }
         Command::Rom { table, format, brdf, out } => brdf.plan().and_then(|plan| {
@@ -221,10 +223,9 @@ fn main() -> ExitCode {
             .and_then(|ports| hdl_gen::wrapper::module(&module, &ports))
             .and_then(|m| output::write_one(&out, m.render().as_bytes()))
             .map(|()| eprintln!("wrote {}", out.display())),
-        Command::Testbench { p, frac, xbits, align, prefix, brdf, vectors, seed, out } => {
-            let align: Align = align.parse().expect("clap checked the alignment");
-            Config::new(p, frac, xbits, align)
-                .and_then(|cfg| Ok(Options { cfg, prefix, brdf: brdf.plan()?, ..Options::default() }))
+        Command::Testbench { config, brdf, vectors, seed, out } => {
+            config
+                .options(&brdf)
                 .and_then(|opts| hdl_gen::testbench::testbench(&opts, vectors, seed))
                 .and_then(|files| output::write_all(&out, &files))
                 .map(|()| eprintln!("wrote {}", out.display()))
