@@ -158,6 +158,7 @@ impl SegUnit {
         SegUnit { cfg, mask_bytes: cfg.p.div_ceil(8) as usize, pix_bytes: cfg.p.next_multiple_of(8) as usize }
     }
 
+    #[inline(always)]
     fn view<'a>(&self, rec: &'a [u8]) -> SegView<'a> {
         let head = u32::from_le_bytes(rec[..4].try_into().expect("4 bytes"));
         let (mask, pix) = rec[4..].split_at(self.mask_bytes);
@@ -187,25 +188,37 @@ impl Unit for SegUnit {
         self.cfg.segment_count(stim.span.x0, stim.span.len)
     }
 
-    #[inline]
+    #[inline(always)]
     fn record(&self, out: &SegOut, rec: &mut [u8]) {
-        rec[..4].copy_from_slice(&(out.out_x | (out.out_last as u32) << 31).to_le_bytes());
-        let (mask, pix) = rec[4..].split_at_mut(self.mask_bytes);
-        mask.copy_from_slice(&out.mask[..self.mask_bytes]);
-        pix.copy_from_slice(&out.pix[..self.pix_bytes]);
+        let (head, rest) = rec.split_at_mut(4);
+        head.copy_from_slice(&(out.out_x | (out.out_last as u32) << 31).to_le_bytes());
+        let (mask, pix) = rest.split_at_mut(self.mask_bytes);
+        // Byte and word copies: the lengths are small and vary with P, and memcpy calls would
+        // cost more than the copies.
+        for (d, s) in mask.iter_mut().zip(&out.mask) {
+            *d = *s;
+        }
+        for (d, s) in pix.chunks_exact_mut(8).zip(out.pix.chunks_exact(8)) {
+            d.copy_from_slice(s);
+        }
     }
 
-    fn changed(&self, before: &[u8], now: &[u8]) -> Option<String> {
-        let (b, n) = (self.view(before), self.view(now));
+    #[inline(always)]
+    fn same(&self, held: &[u8], out: &SegOut) -> bool {
+        let held = self.view(held);
         let p = self.cfg.p;
-        let lanes_differ = (0..self.mask_bytes).any(|w| {
-            let lanes = if p >= 8 * (w as u32 + 1) { 0xff } else { (1u8 << (p % 8)) - 1 };
-            let on = n.mask[w] & lanes;
-            let word = |v: &SegView| u64::from_le_bytes(v.pix[8 * w..8 * w + 8].try_into().expect("8 bytes"));
-            on != b.mask[w] & lanes || (word(&n) ^ word(&b)) & BYTE_MASK[on as usize] != 0
-        });
-        (n.out_x != b.out_x || n.out_last != b.out_last || lanes_differ)
-            .then(|| format!("segment at x = {} changed while waiting for out_ready (now x = {})", b.out_x, n.out_x))
+        out.out_x == held.out_x
+            && (out.out_last == 1) == held.out_last
+            && (0..self.mask_bytes).all(|w| {
+                let lanes = if p >= 8 * (w as u32 + 1) { 0xff } else { (1u8 << (p % 8)) - 1 };
+                let on = out.mask[w] & lanes;
+                let word = |pix: &[u8]| u64::from_le_bytes(pix[8 * w..8 * w + 8].try_into().expect("8 bytes"));
+                on == held.mask[w] & lanes && (word(&out.pix) ^ word(held.pix)) & BYTE_MASK[on as usize] == 0
+            })
+    }
+
+    fn describe_change(&self, held: &[u8], out: &SegOut) -> String {
+        format!("segment at x = {} changed while waiting for out_ready (now x = {})", self.view(held).out_x, out.out_x)
     }
 
     fn blame(&self, _k: usize, stim: &Stim) -> (Option<usize>, String) {

@@ -15,7 +15,7 @@ use crate::ffi::Rtl;
 use crate::traffic::TrafficGen;
 use rand::Rng;
 use std::collections::VecDeque;
-use std::sync::mpsc::{sync_channel, Receiver};
+use std::sync::mpsc::{sync_channel, Receiver, SyncSender};
 
 /// Stress on top of [`crate::traffic::Traffic`], off by default: `rst` at random clocks, long
 /// stretches of `out_ready` low, long `in_valid` gaps between spans. With a reset, the spans
@@ -44,22 +44,26 @@ impl Stress {
 
 /// The per-clock decisions of the driver and the sink under `Traffic` and [`Stress`]: the
 /// generator's two draws of the clock ([`TrafficGen::clock`]), then the stress draws. Without
-/// stress it is exactly the plain traffic of the native and cocotb benches.
-struct Pacer {
+/// stress it is exactly the plain traffic of the native and cocotb benches, and with `ON`
+/// false (no stress) the stress draws are compiled out of the clock loop.
+struct Pacer<const ON: bool> {
     stress: Stress,
     rst_left: u32,
     stall_left: u32,
     gap_left: u32,
 }
 
-impl Pacer {
-    fn new(stress: Stress) -> Pacer {
+impl<const ON: bool> Pacer<ON> {
+    fn new(stress: Stress) -> Self {
         Pacer { stress, rst_left: 0, stall_left: 0, gap_left: 0 }
     }
 
     /// Whether `rst` is high this clock.
     #[inline]
     fn reset(&mut self, rng: &mut TrafficGen) -> bool {
+        if !ON {
+            return false;
+        }
         if self.rst_left == 0 && self.stress.reset > 0.0 && rng.gen_bool(self.stress.reset) {
             self.rst_left = rng.gen_range(1..=3);
         }
@@ -73,7 +77,7 @@ impl Pacer {
     /// Whether a pending span starts being offered this clock.
     #[inline]
     fn offer(&mut self, rng: &mut TrafficGen) -> bool {
-        if self.gap_left > 0 {
+        if ON && self.gap_left > 0 {
             self.gap_left -= 1;
             return false;
         }
@@ -83,6 +87,9 @@ impl Pacer {
     /// `out_ready` this clock.
     #[inline]
     fn ready(&mut self, rng: &mut TrafficGen) -> bool {
+        if !ON {
+            return rng.ready();
+        }
         if self.stall_left == 0 && self.stress.stall > 0.0 && rng.gen_bool(self.stress.stall) {
             self.stall_left = rng.gen_range(1..=self.stress.stall_max.max(1));
         }
@@ -96,7 +103,7 @@ impl Pacer {
     /// A span was transferred: maybe a gap before the next one is offered.
     #[inline]
     fn accepted(&mut self, rng: &mut TrafficGen) {
-        if self.stress.gap > 0.0 && rng.gen_bool(self.stress.gap) {
+        if ON && self.stress.gap > 0.0 && rng.gen_bool(self.stress.gap) {
             self.gap_left = rng.gen_range(1..=self.stress.gap_max.max(1));
         }
     }
@@ -124,10 +131,13 @@ pub(crate) trait Unit: Sync {
     fn load(&self, input: &mut Self::In, span: &Self::Span);
     /// Outputs (segments, pixels) the span yields.
     fn owed(&self, span: &Self::Span) -> u32;
+    /// Writes the record of `out` into `rec` (`record_bytes` long).
     fn record(&self, out: &Self::Out, rec: &mut [u8]);
-    /// What differs between two records of an output offered in consecutive clocks and not
-    /// taken in the first (don't-care bits ignored), if anything.
-    fn changed(&self, before: &[u8], now: &[u8]) -> Option<String>;
+    /// Whether `out` is the output recorded in `held`, offered in the clock before and not
+    /// taken (don't-care bits ignored).
+    fn same(&self, held: &[u8], out: &Self::Out) -> bool;
+    /// What differs when `out` is not [`Unit::same`] as `held`.
+    fn describe_change(&self, held: &[u8], out: &Self::Out) -> String;
     /// The triangle (or span) to blame and a description, for a mismatch about span `k`.
     fn blame(&self, k: usize, span: &Self::Span) -> (Option<usize>, String);
 }
@@ -145,18 +155,34 @@ pub const DRAIN_CLOCKS: u64 = 3;
 /// Clocks without any transfer after which the model is declared hung.
 const STALL_LIMIT: u64 = 10_000;
 
-/// Outputs per batch sent to the checker, and batches in flight: enough to ride out the
-/// checker's uneven pace (a span's first segment costs more), little enough to stay in cache.
-const BATCH: usize = 1024;
-const IN_FLIGHT: usize = 4;
+/// Bytes per batch of output records sent to the checker, and batches in flight. The checker
+/// is faster than the model, so it waits for every batch, and waking it costs the driver tens
+/// of microseconds on this kind of (virtual) machine: batches are large, a few thousand clocks
+/// to a few hundred thousand, and recycled, not allocated anew.
+const BATCH_BYTES: usize = 2 << 20;
+const IN_FLIGHT: usize = 3;
 
-/// A batch of output records: (span, output index) and the records back to back.
+/// A batch of output records: (span, output index) and the records back to back, room for
+/// [`Batch::records`] of them (`at.len()` are filled).
 struct Batch {
     at: Vec<(u32, u32)>,
     data: Vec<u8>,
 }
 
-/// A unit under test: the model, its traffic and its stress.
+impl Batch {
+    /// Records of `rb` bytes in a batch.
+    fn records(rb: usize) -> usize {
+        (BATCH_BYTES / (rb + std::mem::size_of::<(u32, u32)>())).max(1024)
+    }
+
+    fn new(rb: usize) -> Batch {
+        Batch { at: Vec::with_capacity(Batch::records(rb)), data: vec![0; Batch::records(rb) * rb] }
+    }
+}
+
+/// A unit under test: the model, its traffic and its stress. Written every clock, so aligned
+/// to whole cache lines: nothing the checking thread writes may sit beside it.
+#[repr(align(128))]
 pub(crate) struct Driver<U: Unit> {
     rtl: Rtl<U::In, U::Out>,
     rng: TrafficGen,
@@ -184,38 +210,51 @@ impl<U: Unit> Driver<U> {
 
     /// Streams `spans` through the model, `check` judging every output on a second thread;
     /// the driver's counts, protocol findings and the checker's verdicts all land in `report`.
-    pub fn stream(&mut self, unit: &U, spans: &[U::Span], report: &mut Report, mut check: impl Check) {
+    pub fn stream(&mut self, unit: &U, spans: &[U::Span], report: &mut Report, check: impl Check) {
         let (tx, rx) = sync_channel::<Batch>(IN_FLIGHT);
-        let mut checked = Report::default();
-        std::thread::scope(|s| {
-            let checker = s.spawn(|| {
-                consume(rx, unit.record_bytes(), &mut check, &mut checked);
-            });
-            self.drive(unit, spans, report, |batch| tx.send(batch).is_ok());
-            drop(tx);
-            if let Err(panic) = checker.join() {
-                std::panic::resume_unwind(panic);
+        // Checked batches come back empty, to be filled again.
+        let (back_tx, back_rx) = sync_channel::<Batch>(IN_FLIGHT + 2);
+        let checked = std::thread::scope(|s| {
+            // The checker's state (its checker, its report) lives on its own thread: written
+            // for every output, it must share no cache line with the driver's.
+            let checker = s.spawn(move || consume(rx, back_tx, unit.record_bytes(), check));
+            let (recycled, send) = (|| back_rx.try_recv().ok(), |batch| tx.send(batch).is_ok());
+            if self.stress == Stress::NONE {
+                self.drive(Pacer::<false>::new(self.stress), unit, spans, report, recycled, send);
+            } else {
+                self.drive(Pacer::<true>::new(self.stress), unit, spans, report, recycled, send);
             }
+            drop(tx);
+            checker.join().unwrap_or_else(|panic| std::panic::resume_unwind(panic))
         });
         report.absorb(checked);
     }
 
     /// The clock loop; `send` hands a full batch to the checker (false: the checker is gone,
-    /// having panicked; stop and let `stream` pass its panic on).
-    fn drive(&mut self, unit: &U, spans: &[U::Span], report: &mut Report, mut send: impl FnMut(Batch) -> bool) {
-        let rb = unit.record_bytes();
-        let new_batch = || Batch { at: Vec::with_capacity(BATCH), data: Vec::with_capacity(BATCH * rb) };
+    /// having panicked; stop and let `stream` pass its panic on), `recycled` returns an empty
+    /// batch the checker is done with, if there is one.
+    fn drive<const STRESSED: bool>(
+        &mut self,
+        mut pacer: Pacer<STRESSED>,
+        unit: &U,
+        spans: &[U::Span],
+        report: &mut Report,
+        mut recycled: impl FnMut() -> Option<Batch>,
+        mut send: impl FnMut(Batch) -> bool,
+    ) {
+        let (rb, full) = (unit.record_bytes(), Batch::records(unit.record_bytes()));
+        let mut new_batch = || recycled().unwrap_or_else(|| Batch::new(rb));
         let mut batch = new_batch();
-        let mut pacer = Pacer::new(self.stress);
-        // Every accepted span with outputs still owed, oldest first: (span, next output).
-        let mut expected: VecDeque<(usize, u32)> = VecDeque::new();
-        let mut owed_front = 0;
-        let mut held = vec![0u8; rb];
-        let mut now = vec![0u8; rb];
+        // Every accepted span with outputs still owed, oldest first, as (span, next output,
+        // owed): the oldest in `front` (in registers: every output transfer updates it), the
+        // rest queued behind it.
+        let mut front: Option<(usize, u32, u32)> = None;
+        let mut behind: VecDeque<(usize, u32, u32)> = VecDeque::new();
+        let mut held = vec![0; rb];
         let (mut next, mut offering, mut idle, mut drain) = (0, false, 0u64, 0);
         let (mut in_reset, mut holding) = (false, false);
         loop {
-            if next == spans.len() && expected.is_empty() {
+            if next == spans.len() && front.is_none() {
                 // Everything came out; a few more clocks must bring nothing.
                 if drain == DRAIN_CLOCKS {
                     break;
@@ -228,8 +267,9 @@ impl<U: Unit> Driver<U> {
                 // being offered stays offered.
                 if !in_reset {
                     report.resets += 1;
-                    report.cut_spans += expected.len() as u64;
-                    expected.clear();
+                    report.cut_spans += front.is_some() as u64 + behind.len() as u64;
+                    front = None;
+                    behind.clear();
                 }
                 in_reset = true;
                 holding = false;
@@ -261,25 +301,23 @@ impl<U: Unit> Driver<U> {
             let mut progress = false;
             if out.out_valid() {
                 if std::mem::take(&mut holding) {
-                    unit.record(out, &mut now);
-                    if let Some(what) = unit.changed(&held, &now) {
+                    if !unit.same(&held, out) {
+                        let what = unit.describe_change(&held, out);
                         report.mismatch(Mismatch { triangle: None, context: format!("clock {}", report.cycles), what });
                     }
                 }
                 if ready {
-                    match expected.front_mut() {
-                        Some((k, j)) => {
+                    match &mut front {
+                        Some((k, j, owed)) => {
                             progress = true;
+                            let n = batch.at.len();
+                            unit.record(out, &mut batch.data[n * rb..(n + 1) * rb]);
                             batch.at.push((*k as u32, *j));
-                            let at = batch.data.len();
-                            batch.data.resize(at + rb, 0);
-                            unit.record(out, &mut batch.data[at..]);
                             *j += 1;
-                            if *j == owed_front {
-                                expected.pop_front();
-                                owed_front = expected.front().map_or(0, |&(k, _)| unit.owed(&spans[k]));
+                            if *j == *owed {
+                                front = behind.pop_front();
                             }
-                            if batch.at.len() == BATCH && !send(std::mem::replace(&mut batch, new_batch())) {
+                            if batch.at.len() == full && !send(std::mem::replace(&mut batch, new_batch())) {
                                 return;
                             }
                         }
@@ -306,10 +344,11 @@ impl<U: Unit> Driver<U> {
                 progress = true;
                 let owed = unit.owed(&spans[next]);
                 if owed > 0 {
-                    if expected.is_empty() {
-                        owed_front = owed;
+                    if front.is_none() {
+                        front = Some((next, 0, owed));
+                    } else {
+                        behind.push_back((next, 0, owed));
                     }
-                    expected.push_back((next, 0));
                 }
                 report.spans += 1;
                 next += 1;
@@ -318,11 +357,11 @@ impl<U: Unit> Driver<U> {
             }
             idle = if progress { 0 } else { idle + 1 };
             if idle > STALL_LIMIT {
-                let (triangle, context) = match expected.front() {
-                    Some(&(k, _)) => unit.blame(k, &spans[k]),
+                let (triangle, context) = match front {
+                    Some((k, _, _)) => unit.blame(k, &spans[k]),
                     None => (None, "idle".into()),
                 };
-                let left: u64 = expected.iter().map(|&(k, j)| (unit.owed(&spans[k]) - j) as u64).sum();
+                let left: u64 = front.iter().chain(&behind).map(|&(_, j, owed)| (owed - j) as u64).sum();
                 report.mismatch(Mismatch {
                     triangle,
                     context,
@@ -338,11 +377,16 @@ impl<U: Unit> Driver<U> {
     }
 }
 
-/// The checking thread: every record of every batch, in order.
-fn consume(rx: Receiver<Batch>, rb: usize, check: &mut impl Check, report: &mut Report) {
-    for batch in rx {
+/// The checking thread: every record of every batch, in order; each batch then goes back.
+fn consume(rx: Receiver<Batch>, back: SyncSender<Batch>, rb: usize, mut check: impl Check) -> Report {
+    let mut report = Report::default();
+    for mut batch in rx {
         for (&(k, j), rec) in batch.at.iter().zip(batch.data.chunks_exact(rb)) {
-            check.check(k as usize, j, rec, report);
+            check.check(k as usize, j, rec, &mut report);
         }
+        batch.at.clear();
+        // The driver may have finished, or hold enough spares already: then it is dropped.
+        let _ = back.try_send(batch);
     }
+    report
 }

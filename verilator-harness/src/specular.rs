@@ -21,8 +21,7 @@ pub struct SpecularCosim {
     judge: Judge,
 }
 
-/// The driver's view of the specular unit. An output's record is `out_spec` (2 bytes),
-/// `out_err`, `out_last`.
+/// The driver's view of the specular unit. An output's record is [`record_word`].
 struct SpecPorts;
 
 impl Unit for SpecPorts {
@@ -48,20 +47,29 @@ impl Unit for SpecPorts {
         s.len
     }
 
-    #[inline]
+    #[inline(always)]
     fn record(&self, out: &SpecOut, rec: &mut [u8]) {
-        rec[..2].copy_from_slice(&out.out_spec.to_le_bytes());
-        rec[2] = out.out_err;
-        rec[3] = out.out_last;
+        rec[..4].copy_from_slice(&record_word(out).to_le_bytes());
     }
 
-    fn changed(&self, before: &[u8], now: &[u8]) -> Option<String> {
-        (before != now).then(|| format!("pixel {:?} changed while waiting for out_ready: now {:?}", pixel_of(before), pixel_of(now)))
+    #[inline(always)]
+    fn same(&self, held: &[u8], out: &SpecOut) -> bool {
+        u32::from_le_bytes(held[..4].try_into().expect("4 bytes")) == record_word(out)
+    }
+
+    fn describe_change(&self, held: &[u8], out: &SpecOut) -> String {
+        format!("pixel {:?} changed while waiting for out_ready: now {out:?}", pixel_of(held))
     }
 
     fn blame(&self, k: usize, s: &SpecularSpan) -> (Option<usize>, String) {
         (Some(k), describe(k, s))
     }
+}
+
+/// A pixel's record as one word: `out_spec`, `out_err` << 16, `out_last` << 24.
+#[inline(always)]
+fn record_word(out: &SpecOut) -> u32 {
+    out.out_spec as u32 | (out.out_err as u32) << 16 | (out.out_last as u32) << 24
 }
 
 /// The outputs a record holds.
