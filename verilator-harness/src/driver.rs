@@ -47,6 +47,9 @@ impl Stress {
 /// stress it is exactly the plain traffic of the native and cocotb benches, and with `ON`
 /// false (no stress) the stress draws are compiled out of the clock loop.
 struct Pacer<const ON: bool> {
+    /// The unit's traffic, moved here for the clock loop: behind the driver, whose ports every
+    /// call into the model may touch, it would be stored and reloaded around each call.
+    rng: TrafficGen,
     stress: Stress,
     rst_left: u32,
     stall_left: u32,
@@ -54,18 +57,24 @@ struct Pacer<const ON: bool> {
 }
 
 impl<const ON: bool> Pacer<ON> {
-    fn new(stress: Stress) -> Self {
-        Pacer { stress, rst_left: 0, stall_left: 0, gap_left: 0 }
+    fn new(stress: Stress, rng: TrafficGen) -> Self {
+        Pacer { rng, stress, rst_left: 0, stall_left: 0, gap_left: 0 }
+    }
+
+    /// Draws this clock's traffic.
+    #[inline]
+    fn clock(&mut self) {
+        self.rng.clock();
     }
 
     /// Whether `rst` is high this clock.
     #[inline]
-    fn reset(&mut self, rng: &mut TrafficGen) -> bool {
+    fn reset(&mut self) -> bool {
         if !ON {
             return false;
         }
-        if self.rst_left == 0 && self.stress.reset > 0.0 && rng.gen_bool(self.stress.reset) {
-            self.rst_left = rng.gen_range(1..=3);
+        if self.rst_left == 0 && self.stress.reset > 0.0 && self.rng.gen_bool(self.stress.reset) {
+            self.rst_left = self.rng.gen_range(1..=3);
         }
         if self.rst_left > 0 {
             self.rst_left -= 1;
@@ -76,35 +85,35 @@ impl<const ON: bool> Pacer<ON> {
 
     /// Whether a pending span starts being offered this clock.
     #[inline]
-    fn offer(&mut self, rng: &mut TrafficGen) -> bool {
+    fn offer(&mut self) -> bool {
         if ON && self.gap_left > 0 {
             self.gap_left -= 1;
             return false;
         }
-        rng.offer()
+        self.rng.offer()
     }
 
     /// `out_ready` this clock.
     #[inline]
-    fn ready(&mut self, rng: &mut TrafficGen) -> bool {
+    fn ready(&mut self) -> bool {
         if !ON {
-            return rng.ready();
+            return self.rng.ready();
         }
-        if self.stall_left == 0 && self.stress.stall > 0.0 && rng.gen_bool(self.stress.stall) {
-            self.stall_left = rng.gen_range(1..=self.stress.stall_max.max(1));
+        if self.stall_left == 0 && self.stress.stall > 0.0 && self.rng.gen_bool(self.stress.stall) {
+            self.stall_left = self.rng.gen_range(1..=self.stress.stall_max.max(1));
         }
         if self.stall_left > 0 {
             self.stall_left -= 1;
             return false;
         }
-        rng.ready()
+        self.rng.ready()
     }
 
     /// A span was transferred: maybe a gap before the next one is offered.
     #[inline]
-    fn accepted(&mut self, rng: &mut TrafficGen) {
-        if ON && self.stress.gap > 0.0 && rng.gen_bool(self.stress.gap) {
-            self.gap_left = rng.gen_range(1..=self.stress.gap_max.max(1));
+    fn accepted(&mut self) {
+        if ON && self.stress.gap > 0.0 && self.rng.gen_bool(self.stress.gap) {
+            self.gap_left = self.rng.gen_range(1..=self.stress.gap_max.max(1));
         }
     }
 }
@@ -220,9 +229,9 @@ impl<U: Unit> Driver<U> {
             let checker = s.spawn(move || consume(rx, back_tx, unit.record_bytes(), check));
             let (recycled, send) = (|| back_rx.try_recv().ok(), |batch| tx.send(batch).is_ok());
             if self.stress == Stress::NONE {
-                self.drive(Pacer::<false>::new(self.stress), unit, spans, report, recycled, send);
+                self.drive(Pacer::<false>::new(self.stress, self.rng.clone()), unit, spans, report, recycled, send);
             } else {
-                self.drive(Pacer::<true>::new(self.stress), unit, spans, report, recycled, send);
+                self.drive(Pacer::<true>::new(self.stress, self.rng.clone()), unit, spans, report, recycled, send);
             }
             drop(tx);
             checker.join().unwrap_or_else(|panic| std::panic::resume_unwind(panic))
@@ -261,8 +270,8 @@ impl<U: Unit> Driver<U> {
                 }
                 drain += 1;
             }
-            self.rng.clock();
-            if pacer.reset(&mut self.rng) {
+            pacer.clock();
+            if pacer.reset() {
                 // Nothing transfers in a reset clock: the spans in flight are cut, the one
                 // being offered stays offered.
                 if !in_reset {
@@ -273,7 +282,7 @@ impl<U: Unit> Driver<U> {
                 }
                 in_reset = true;
                 holding = false;
-                let ready = pacer.ready(&mut self.rng);
+                let ready = pacer.ready();
                 self.input.set_control(true, offering, ready);
                 self.rtl.step_into(&self.input, &mut self.output);
                 report.cycles += 1;
@@ -281,12 +290,12 @@ impl<U: Unit> Driver<U> {
                 continue;
             }
             if !offering && next < spans.len() {
-                offering = pacer.offer(&mut self.rng);
+                offering = pacer.offer();
                 if offering {
                     unit.load(&mut self.input, &spans[next]);
                 }
             }
-            let ready = pacer.ready(&mut self.rng);
+            let ready = pacer.ready();
             self.input.set_control(false, offering, ready);
             self.rtl.step_into(&self.input, &mut self.output);
             report.cycles += 1;
@@ -353,7 +362,7 @@ impl<U: Unit> Driver<U> {
                 report.spans += 1;
                 next += 1;
                 offering = false;
-                pacer.accepted(&mut self.rng);
+                pacer.accepted();
             }
             idle = if progress { 0 } else { idle + 1 };
             if idle > STALL_LIMIT {
@@ -371,6 +380,8 @@ impl<U: Unit> Driver<U> {
                 break;
             }
         }
+        // The next stream goes on with the traffic where this one left it.
+        self.rng = pacer.rng;
         if !batch.at.is_empty() {
             send(batch);
         }
