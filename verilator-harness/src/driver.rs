@@ -121,6 +121,8 @@ impl<const ON: bool> Pacer<ON> {
 /// The control inputs of a streaming unit.
 pub trait Control: Copy + Default + 'static {
     fn set_control(&mut self, rst: bool, in_valid: bool, out_ready: bool);
+    /// Whether the next step may leave the data ports as the last one wrote them.
+    fn keep_data(&mut self, keep: bool);
 }
 
 /// The handshake outputs of a streaming unit.
@@ -293,11 +295,15 @@ impl<U: Unit> Driver<U> {
                 offering = pacer.offer();
                 if offering {
                     unit.load(&mut self.input, &spans[next]);
+                    self.input.keep_data(false);
                 }
             }
             let ready = pacer.ready();
             self.input.set_control(false, offering, ready);
             self.rtl.step_into(&self.input, &mut self.output);
+            // The ports now hold this span's data: until the next span, the shim need not
+            // write them again.
+            self.input.keep_data(true);
             report.cycles += 1;
             let out = &self.output;
             if std::mem::take(&mut in_reset) && out.out_valid() {

@@ -18,6 +18,9 @@ pub struct SegIn {
     pub rst: u8,
     pub in_valid: u8,
     pub out_ready: u8,
+    /// 1: the data ports still hold what the last step wrote, so the shim leaves them alone
+    /// (the driver's clocks between spans); 0 (the default): write them.
+    pub keep: u8,
 }
 
 /// Outputs of `segment_shader_p<P>`, sampled just before the rising edge.
@@ -90,6 +93,9 @@ pub struct SpecIn {
     pub rst: u8,
     pub in_valid: u8,
     pub out_ready: u8,
+    /// 1: the data ports still hold what the last step wrote, so the shim leaves them alone
+    /// (the driver's clocks between spans); 0 (the default): write them.
+    pub keep: u8,
 }
 
 /// Outputs of `specular_unit`, sampled just before the rising edge.
@@ -110,6 +116,10 @@ macro_rules! streaming_ports {
             #[inline(always)]
             fn set_control(&mut self, rst: bool, in_valid: bool, out_ready: bool) {
                 (self.rst, self.in_valid, self.out_ready) = (rst as u8, in_valid as u8, out_ready as u8);
+            }
+            #[inline(always)]
+            fn keep_data(&mut self, keep: bool) {
+                self.keep = keep as u8;
             }
         }
         impl Handshake for $out {
