@@ -241,7 +241,7 @@ fn build_model(v: &Verilator, out: &Path, m: &Model) -> Vec<String> {
     let key_file = obj.join("build.key");
     let classes_mk = obj.join(format!("{class}_classes.mk"));
     let lib = out.join(format!("lib{}.a", m.tag));
-    let fresh = fs::read_to_string(&key_file).map_or(false, |k| k == key) && lib.exists() && classes_mk.exists();
+    let fresh = fs::read_to_string(&key_file).is_ok_and(|k| k == key) && lib.exists() && classes_mk.exists();
     let start = Instant::now();
     if !fresh {
         let _ = fs::remove_dir_all(&obj);
@@ -303,7 +303,7 @@ fn build_runtime(v: &Verilator, out: &Path, globals: &[String]) {
     let obj = out.join("obj").join("runtime");
     let key = format!("{}\n{LAYOUT}\n{}\n", v.version, globals.join(" "));
     let lib = out.join("libverilated_rt.a");
-    if fs::read_to_string(obj.join("build.key")).map_or(false, |k| k == key) && lib.exists() {
+    if fs::read_to_string(obj.join("build.key")).is_ok_and(|k| k == key) && lib.exists() {
         return;
     }
     fs::create_dir_all(&obj).unwrap();

@@ -148,7 +148,7 @@ fn best_adder(c: u32, built: &[u32], depth: &[Option<u32>], shift_max: u32, leve
                     }
                     let adder = Adder { value: c as u32, a: x, a_shift: xs, op, b: y, b_shift: ys, depth: level };
                     let key = (da + db, s, (op == Op::Sub) as u32);
-                    if best.as_ref().map_or(true, |(k0, k1, k2, _)| key < (*k0, *k1, *k2)) {
+                    if best.as_ref().is_none_or(|(k0, k1, k2, _)| key < (*k0, *k1, *k2)) {
                         best = Some((key.0, key.1, key.2, adder));
                     }
                 }

@@ -178,7 +178,7 @@ pub fn module_with(cfg: &Config, names: &Names, arch: BfpiArch) -> Module {
         },
         swire("q", qw, format!("v[{}:{f}]", aw - 1)),
         comment("verilator lint_on UNUSEDSIGNAL"),
-        assign(format!("pix[i*8 +: 8]"), format!("q[{}] ? 8'd0 : (|q[{}:8]) ? 8'd255 : q[7:0]", qw - 1, qw - 2)),
+        assign("pix[i*8 +: 8]".to_string(), format!("q[{}] ? 8'd0 : (|q[{}:8]) ? 8'd255 : q[7:0]", qw - 1, qw - 2)),
     ];
     if screen {
         lane.push(assign("mask[i]", "(LANE < cur_rem) && lead_mask[i]"));

@@ -207,7 +207,7 @@ impl Word {
     }
     fn hex(&self) -> String {
         let pad = (4 - self.bits.len() % 4) % 4;
-        let bits: Vec<bool> = std::iter::repeat(false).take(pad).chain(self.bits.iter().copied()).collect();
+        let bits: Vec<bool> = std::iter::repeat_n(false, pad).chain(self.bits.iter().copied()).collect();
         bits.chunks(4)
             .map(|c| {
                 let d = c.iter().fold(0u32, |a, &b| a << 1 | b as u32);
@@ -321,7 +321,7 @@ fn bench_module(b: &BenchSpec) -> Module {
     let finish = |passed_msg: bool| -> Vec<Stmt> {
         let mut v = vec![
             if_("failed > N_SPANS", vec![blocking("failed", "N_SPANS")], vec![]),
-            call(format!("$display(\"%0d passed, %0d failed\", N_SPANS - failed, failed)")),
+            call("$display(\"%0d passed, %0d failed\", N_SPANS - failed, failed)".to_string()),
         ];
         if passed_msg {
             v.push(if_("failed != 0", vec![call(format!("$fatal(1, \"{}: FAILED\")", b.name))], vec![call("$finish")]));

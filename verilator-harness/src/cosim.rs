@@ -474,13 +474,13 @@ fn agrees(out: &SegView, span: &Span, seg: &Segment, row: &[u8], p: u32) -> Opti
     if p < 8 {
         let (on, n) = (lanes_on(0), p as usize);
         let word = |b: &[u8]| b[..n].iter().rev().fold(0u64, |w, &x| w << 8 | x as u64);
-        return (out.mask[0] & ((1u16 << p) - 1) as u8 == on && (word(&out.pix) ^ word(row)) & BYTE_MASK[on as usize] == 0)
+        return (out.mask[0] & ((1u16 << p) - 1) as u8 == on && (word(out.pix) ^ word(row)) & BYTE_MASK[on as usize] == 0)
             .then_some((hi - lo) as u64);
     }
     for c in 0..(p / 8) as usize {
         let on = lanes_on(8 * c as u32);
         let word = |b: &[u8]| u64::from_le_bytes(b[8 * c..8 * c + 8].try_into().expect("8 lanes"));
-        if out.mask[c] != on || (word(&out.pix) ^ word(row)) & BYTE_MASK[on as usize] != 0 {
+        if out.mask[c] != on || (word(out.pix) ^ word(row)) & BYTE_MASK[on as usize] != 0 {
             return None;
         }
     }

@@ -315,11 +315,9 @@ impl<U: Unit> Driver<U> {
             }
             let mut progress = false;
             if out.out_valid() {
-                if std::mem::take(&mut holding) {
-                    if !unit.same(&held, out) {
-                        let what = unit.describe_change(&held, out);
-                        report.mismatch(Mismatch { triangle: None, context: format!("clock {}", report.cycles), what });
-                    }
+                if std::mem::take(&mut holding) && !unit.same(&held, out) {
+                    let what = unit.describe_change(&held, out);
+                    report.mismatch(Mismatch { triangle: None, context: format!("clock {}", report.cycles), what });
                 }
                 if ready {
                     match &mut front {

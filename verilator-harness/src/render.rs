@@ -413,7 +413,7 @@ impl Outcome {
     }
     /// Every co-simulation check passed.
     pub fn cosim_ok(&self) -> bool {
-        self.segment.iter().all(Report::ok) && self.specular.as_ref().map_or(true, Report::ok)
+        self.segment.iter().all(Report::ok) && self.specular.as_ref().is_none_or(Report::ok)
     }
 }
 
@@ -499,7 +499,7 @@ pub fn run(
                 (out, report)
             })
         });
-        while !(seg_threads.iter().all(|t| t.is_finished()) && spec_thread.as_ref().map_or(true, |t| t.is_finished())) {
+        while !(seg_threads.iter().all(|t| t.is_finished()) && spec_thread.as_ref().is_none_or(|t| t.is_finished())) {
             progress(done.load(Ordering::Relaxed) as f64 / total as f64);
             std::thread::sleep(Duration::from_millis(10));
         }

@@ -102,7 +102,7 @@ pub fn best_reachable(max_tables: usize) -> (f64, Vec<u32>) {
             for a in 1..b {
                 if let Some((e, chain)) = &best[c - 1][a] {
                     let e = e.max(tb.gap(a, b).0);
-                    if cand.as_ref().map_or(true, |(ce, _)| e < *ce) {
+                    if cand.as_ref().is_none_or(|(ce, _)| e < *ce) {
                         let mut ch = chain.clone();
                         ch.push(b as u32);
                         cand = Some((e, ch));
@@ -176,7 +176,7 @@ pub fn auto_plan(max_err: f64) -> Result<SpecularPlan, String> {
                     let extra = if a == 1 && tb.owner(2, 1, b) == 1 { one_extra } else { Some(0) };
                     let (Some(lb), Some(extra)) = (len(b, xb), extra) else { continue };
                     let total = entries + lb + extra;
-                    if cand.as_ref().map_or(true, |c| total < c.0) {
+                    if cand.as_ref().is_none_or(|c| total < c.0) {
                         let mut ch = chain.clone();
                         ch.push(b as u32);
                         cand = Some((total, ch));
@@ -192,7 +192,7 @@ pub fn auto_plan(max_err: f64) -> Result<SpecularPlan, String> {
                 let extra = if chain.len() == 1 && b == 1 { one_extra } else { Some(0) };
                 let Some(extra) = extra else { continue };
                 let bits = (entries + extra) * w as u64 + nk_bits;
-                if winner.as_ref().map_or(true, |win| bits < win.0) {
+                if winner.as_ref().is_none_or(|win| bits < win.0) {
                     winner = Some((bits, w, chain.clone()));
                 }
             }

@@ -241,7 +241,7 @@ impl SpecularPlan {
             }
             let x: Vec<f64> = shape.iter().map(|s| s.0).collect();
             match SpecularPlan::fit(&decoder, &x, w, nw, &lens) {
-                Ok(p) if best.as_ref().map_or(true, |b| p.rom_bits() < b.rom_bits()) => best = Some(p),
+                Ok(p) if best.as_ref().is_none_or(|b| p.rom_bits() < b.rom_bits()) => best = Some(p),
                 Ok(_) => {}
                 Err(e) => last_err = e,
             }
