@@ -1,30 +1,8 @@
 //! The `hdl-gen` command line: deterministic output, and one clear error with exit status 2
 //! and nothing written for every bad argument.
 
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
-
-fn hdl_gen(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_hdl-gen")).args(args).output().expect("running hdl-gen")
-}
-
-fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("hdl-gen-cli-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    dir
-}
-
-fn listing(dir: &Path) -> Vec<(String, Vec<u8>)> {
-    let mut files: Vec<_> = std::fs::read_dir(dir)
-        .unwrap()
-        .map(|e| {
-            let e = e.unwrap();
-            (e.file_name().to_string_lossy().into_owned(), std::fs::read(e.path()).unwrap())
-        })
-        .collect();
-    files.sort();
-    files
-}
+mod common;
+use common::{hdl_gen, scratch, listing};
 
 #[test]
 fn same_command_same_bytes() {

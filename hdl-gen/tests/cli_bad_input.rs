@@ -2,18 +2,9 @@
 //! wrong type, unwritable path, unreadable or malformed input): one message naming the flag or
 //! the file, exit status 2, nothing written.
 
+mod common;
+use common::{hdl_gen, scratch};
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
-
-fn hdl_gen(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_hdl-gen")).args(args).output().expect("running hdl-gen")
-}
-
-fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("hdl-gen-bad-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    dir
-}
 
 /// Every file under `dir`, recursively (none if it does not exist).
 fn files_under(dir: &Path) -> Vec<PathBuf> {

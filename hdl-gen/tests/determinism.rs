@@ -9,7 +9,9 @@
 //! After an intended change to the generated files, refresh the fingerprints with
 //! `SEGSHADE_BLESS=1 cargo test -p hdl-gen --test determinism` and commit the file.
 
-use std::path::{Path, PathBuf};
+mod common;
+use common::{scratch_dir as scratch, listing};
+use std::path::Path;
 use std::process::Command;
 
 const CONFIGS: &[&str] = &[
@@ -21,13 +23,6 @@ const CONFIGS: &[&str] = &[
     "--p 16 --align screen --bfpi-arch tree",
 ];
 
-fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("hdl-gen-det-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
-
 /// Runs `hdl-gen generate ARGS --out out` in `cwd` with exactly `env`.
 fn generate(args: &str, cwd: &Path, out: &Path, env: &[(&str, &str)]) {
     let mut cmd = Command::new(env!("CARGO_BIN_EXE_hdl-gen"));
@@ -35,19 +30,6 @@ fn generate(args: &str, cwd: &Path, out: &Path, env: &[(&str, &str)]) {
     cmd.envs(env.iter().copied());
     let o = cmd.output().expect("running hdl-gen");
     assert!(o.status.success(), "hdl-gen generate {args}: {}", String::from_utf8_lossy(&o.stderr));
-}
-
-/// Every file of a folder, sorted by name.
-fn listing(dir: &Path) -> Vec<(String, Vec<u8>)> {
-    let mut files: Vec<_> = std::fs::read_dir(dir)
-        .unwrap()
-        .map(|e| {
-            let e = e.unwrap();
-            (e.file_name().to_string_lossy().into_owned(), std::fs::read(e.path()).unwrap())
-        })
-        .collect();
-    files.sort();
-    files
 }
 
 /// FNV-1a (64 bit) over every file's name, length and bytes: a fingerprint, not a signature.

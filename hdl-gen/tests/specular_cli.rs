@@ -2,22 +2,11 @@
 //! `--brdf-k` and `--max-rel-error` refused with one message and exit status 2, and
 //! `report accuracy` with SPEC's figures and its PNG.
 
+mod common;
+use common::{hdl_gen, scratch_dir as scratch};
 use golden::rom::{Rom, RomFormat};
 use golden::specular::{best_reachable, SpecularPlan, SpecularUnit, MAX_AUTO_TABLES};
 use std::path::PathBuf;
-use std::process::{Command, Output};
-
-fn hdl_gen(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_hdl-gen")).args(args).output().expect("running hdl-gen")
-}
-
-/// An empty folder of this test's own.
-fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("hdl-gen-specular-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
 
 fn entries(dir: &PathBuf) -> Vec<String> {
     let mut names: Vec<String> = std::fs::read_dir(dir)

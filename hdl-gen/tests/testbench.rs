@@ -2,14 +2,10 @@
 //! and fail (non-zero exit, `M failed` with M > 0) when the RTL is broken. A missing Icarus
 //! fails the test with the command that installs it: a bench that did not run must not pass.
 
-use std::path::{Path, PathBuf};
+mod common;
+use common::{scratch};
+use std::path::Path;
 use std::process::Command;
-
-fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("hdl-gen-tb-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    dir
-}
 
 fn testbench(dir: &Path, args: &[&str]) {
     let mut full = vec!["testbench", "--out", dir.to_str().unwrap()];
