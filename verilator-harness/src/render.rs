@@ -159,21 +159,20 @@ pub struct Lighting {
 
 /// The mesh and lighting of a scene (shininess as given).
 pub fn scene(kind: SceneKind, shininess: u16) -> (Mesh, Lighting, f64) {
-    let eye = [0.0, 0.0, 4.5];
-    let light = [-4.0, 4.5, 6.0];
+    // Both scenes: the same camera, light and material, in their own colour.
+    let lighting = |colour| Lighting {
+        eye: [0.0, 0.0, 4.5],
+        light: [-4.0, 4.5, 6.0],
+        colour,
+        ambient: 0.07,
+        diffuse: 0.93,
+        specular: 235.0,
+        shininess,
+    };
     match kind {
         SceneKind::Sphere => {
-            let l = Lighting {
-                eye,
-                light,
-                colour: [0.92, 0.32, 0.22],
-                ambient: 0.07,
-                diffuse: 0.93,
-                specular: 235.0,
-                shininess,
-            };
             // 64 x 96: 12,096 triangles, about half of them facing the camera.
-            (sphere(64, 96), l, 1.0)
+            (sphere(64, 96), lighting([0.92, 0.32, 0.22]), 1.0)
         }
         SceneKind::Torus => {
             let mut m = torus(128, 48, 1.0, 0.42);
@@ -184,16 +183,7 @@ pub fn scene(kind: SceneKind, shininess: u16) -> (Mesh, Lighting, f64) {
             for n in m.normals.iter_mut() {
                 *n = rotate_xy(*n, 0.5, 0.35);
             }
-            let l = Lighting {
-                eye,
-                light,
-                colour: [0.24, 0.58, 0.95],
-                ambient: 0.07,
-                diffuse: 0.93,
-                specular: 235.0,
-                shininess,
-            };
-            (m, l, 1.42)
+            (m, lighting([0.24, 0.58, 0.95]), 1.42)
         }
     }
 }

@@ -194,6 +194,15 @@ fn with_ext(prefix: &std::path::Path, ext: &str) -> PathBuf {
     PathBuf::from(s)
 }
 
+/// PREFIX.stim and PREFIX.expect, each begun with its header.
+fn create_pair(out: &std::path::Path, header: &Header) -> (BufWriter<File>, BufWriter<File>) {
+    let mut sf = create(with_ext(out, ".stim"));
+    let mut ef = create(with_ext(out, ".expect"));
+    sf.write_all(&header.bytes()).unwrap();
+    ef.write_all(&expect_header(header.design, header.rec, header.outputs)).unwrap();
+    (sf, ef)
+}
+
 fn stim_record(ports: [u32; 5], outputs: u32, triangle: u32, y: u32) -> [u8; 32] {
     let mut r = [0u8; 32];
     for (k, w) in ports.iter().chain(&[outputs, triangle, y]).enumerate() {
@@ -245,10 +254,7 @@ fn gen_segment(p: u32, count: usize, seed: u64, traffic: Traffic, out: &std::pat
         rec,
         dw: cfg.dw(),
     };
-    let mut sf = create(with_ext(out, ".stim"));
-    let mut ef = create(with_ext(out, ".expect"));
-    sf.write_all(&header.bytes()).unwrap();
-    ef.write_all(&expect_header(0, rec, outputs)).unwrap();
+    let (mut sf, mut ef) = create_pair(out, &header);
     let mut r = vec![0u8; rec as usize];
     let mut pixels = 0u64;
     for s in &stims {
@@ -297,10 +303,7 @@ fn gen_specular(count: usize, seed: u64, traffic: Traffic, out: &std::path::Path
         rec: 4,
         dw: 32,
     };
-    let mut sf = create(with_ext(out, ".stim"));
-    let mut ef = create(with_ext(out, ".expect"));
-    sf.write_all(&header.bytes()).unwrap();
-    ef.write_all(&expect_header(1, 4, outputs)).unwrap();
+    let (mut sf, mut ef) = create_pair(out, &header);
     for (k, s) in spans.iter().enumerate() {
         let ports = [s.c as u32, s.n as u32, to_port(s.theta0 as i64, 32), to_port(s.dtheta as i64, 32), s.len];
         sf.write_all(&stim_record(ports, s.len, k as u32, 0)).unwrap();
