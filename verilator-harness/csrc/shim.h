@@ -48,32 +48,48 @@ template <class M> struct SegshadeModel {
     }
 };
 
-// Inputs are applied with the clock low and the outputs sampled there: they are the values
-// the rising edge sees, so a transfer happens in this call iff valid && ready in the result.
-#define SEGSHADE_SEGMENT_SHIM(CLASS, SYM, P)                                                 \
+// A model's constructor and destructor as C symbols.
+#define SEGSHADE_LIFETIME(CLASS, SYM)                                                        \
     extern "C" void* SYM##_new(uint64_t seed) { return new SegshadeModel<CLASS>(seed); }      \
-    extern "C" void SYM##_free(void* h) { delete static_cast<SegshadeModel<CLASS>*>(h); }     \
+    extern "C" void SYM##_free(void* h) { delete static_cast<SegshadeModel<CLASS>*>(h); }
+
+// One clock of a streaming unit (both share SPEC §3's control ports). Inputs are applied with
+// the clock low and the outputs sampled there: they are the values the rising edge sees, so a
+// transfer happens in this call iff valid && ready in the result. `data` writes the data ports
+// (skipped while `keep` says they still hold the last span), `sample` reads the data outputs.
+template <class M, class In, class Out, class Data, class Sample>
+static inline void segshade_clock(M* m, const In* in, Out* out, Data data, Sample sample) {
+    m->clk = 0;
+    m->rst = in->rst;
+    m->in_valid = in->in_valid;
+    m->out_ready = in->out_ready;
+    if (!in->keep) data();
+    m->eval();
+    out->in_ready = m->in_ready;
+    out->out_valid = m->out_valid;
+    out->out_last = m->out_last;
+    sample();
+    m->clk = 1;
+    m->eval();
+}
+
+#define SEGSHADE_SEGMENT_SHIM(CLASS, SYM, P)                                                 \
+    SEGSHADE_LIFETIME(CLASS, SYM)                                                             \
     extern "C" void SYM##_step(void* h, const SegIn* in, SegOut* out) {                       \
         CLASS* m = static_cast<SegshadeModel<CLASS>*>(h)->top;                                \
-        m->clk = 0;                                                                           \
-        m->rst = in->rst;                                                                     \
-        m->in_valid = in->in_valid;                                                           \
-        m->out_ready = in->out_ready;                                                         \
-        if (!in->keep) {                                                                      \
-            m->in_x = in->in_x;                                                               \
-            m->in_len = in->in_len;                                                           \
-            m->in_i0 = in->in_i0;                                                             \
-            m->in_di = in->in_di;                                                             \
-        }                                                                                     \
-        m->eval();                                                                            \
-        out->in_ready = m->in_ready;                                                          \
-        out->out_valid = m->out_valid;                                                        \
-        out->out_last = m->out_last;                                                          \
-        out->out_x = m->out_x;                                                                \
-        segshade_copy(out->pix, m->out_pix, P);                                               \
-        segshade_copy(out->mask, m->out_mask, (P + 7) / 8);                                   \
-        m->clk = 1;                                                                           \
-        m->eval();                                                                            \
+        segshade_clock(                                                                       \
+            m, in, out,                                                                       \
+            [&] {                                                                             \
+                m->in_x = in->in_x;                                                           \
+                m->in_len = in->in_len;                                                       \
+                m->in_i0 = in->in_i0;                                                         \
+                m->in_di = in->in_di;                                                         \
+            },                                                                                \
+            [&] {                                                                             \
+                out->out_x = m->out_x;                                                        \
+                segshade_copy(out->pix, m->out_pix, P);                                       \
+                segshade_copy(out->mask, m->out_mask, (P + 7) / 8);                           \
+            });                                                                               \
     }
 
 struct BfpiIn {
@@ -86,8 +102,7 @@ struct BfpiOut {
 
 // The BFPI is combinational: one evaluation per call, no clock.
 #define SEGSHADE_BFPI_SHIM(CLASS, SYM, BYTES)                                                \
-    extern "C" void* SYM##_new(uint64_t seed) { return new SegshadeModel<CLASS>(seed); }      \
-    extern "C" void SYM##_free(void* h) { delete static_cast<SegshadeModel<CLASS>*>(h); }     \
+    SEGSHADE_LIFETIME(CLASS, SYM)                                                             \
     extern "C" void SYM##_step(void* h, const BfpiIn* in, BfpiOut* out) {                     \
         CLASS* m = static_cast<SegshadeModel<CLASS>*>(h)->top;                                \
         m->di = in->di;                                                                       \
@@ -107,27 +122,20 @@ struct SpecOut {
 };
 
 #define SEGSHADE_SPECULAR_SHIM(CLASS, SYM)                                                   \
-    extern "C" void* SYM##_new(uint64_t seed) { return new SegshadeModel<CLASS>(seed); }      \
-    extern "C" void SYM##_free(void* h) { delete static_cast<SegshadeModel<CLASS>*>(h); }     \
+    SEGSHADE_LIFETIME(CLASS, SYM)                                                             \
     extern "C" void SYM##_step(void* h, const SpecIn* in, SpecOut* out) {                     \
         CLASS* m = static_cast<SegshadeModel<CLASS>*>(h)->top;                                \
-        m->clk = 0;                                                                           \
-        m->rst = in->rst;                                                                     \
-        m->in_valid = in->in_valid;                                                           \
-        m->out_ready = in->out_ready;                                                         \
-        if (!in->keep) {                                                                      \
-            m->in_c = in->in_c;                                                               \
-            m->in_n = in->in_n;                                                               \
-            m->in_theta0 = in->in_theta0;                                                     \
-            m->in_dtheta = in->in_dtheta;                                                     \
-            m->in_len = in->in_len;                                                           \
-        }                                                                                     \
-        m->eval();                                                                            \
-        out->in_ready = m->in_ready;                                                          \
-        out->out_valid = m->out_valid;                                                        \
-        out->out_last = m->out_last;                                                          \
-        out->out_err = m->out_err;                                                            \
-        out->out_spec = m->out_spec;                                                          \
-        m->clk = 1;                                                                           \
-        m->eval();                                                                            \
+        segshade_clock(                                                                       \
+            m, in, out,                                                                       \
+            [&] {                                                                             \
+                m->in_c = in->in_c;                                                           \
+                m->in_n = in->in_n;                                                           \
+                m->in_theta0 = in->in_theta0;                                                 \
+                m->in_dtheta = in->in_dtheta;                                                 \
+                m->in_len = in->in_len;                                                       \
+            },                                                                                \
+            [&] {                                                                             \
+                out->out_err = m->out_err;                                                    \
+                out->out_spec = m->out_spec;                                                  \
+            });                                                                               \
     }
