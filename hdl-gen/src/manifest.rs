@@ -5,7 +5,7 @@ use crate::verilog::{Dir, Module};
 use crate::specular::SpecNames;
 use crate::{segment, BfpiArch, Names, Options, VERSION};
 use golden::bfpi::{Adder, BfpiPlan};
-use golden::rom::{BRDF_HEX, NK_HEX};
+use golden::rom::{Rom, BRDF_HEX, NK_HEX};
 use golden::specular::{SpecularGeometry, SpecularUnit};
 use serde::Serialize;
 
@@ -40,6 +40,12 @@ struct RomEntry {
     depth: usize,
     width: u32,
     bits: u64,
+}
+
+impl RomEntry {
+    fn new(module: &str, file: &'static str, rom: &Rom) -> RomEntry {
+        RomEntry { module: module.to_string(), file, depth: rom.depth(), width: rom.width, bits: rom.bits() }
+    }
 }
 
 #[derive(Serialize)]
@@ -163,20 +169,8 @@ pub fn render(opts: &Options, names: &Names, modules: &[Module], unit: &Specular
         }),
         specular: Specular {
             module: spec.unit.clone(),
-            brdf_rom: RomEntry {
-                module: spec.brdf.clone(),
-                file: BRDF_HEX,
-                depth: unit.brdf_rom().depth(),
-                width: unit.brdf_rom().width,
-                bits: unit.brdf_rom().bits(),
-            },
-            nk_rom: RomEntry {
-                module: spec.nk.clone(),
-                file: NK_HEX,
-                depth: unit.nk_rom().depth(),
-                width: unit.nk_rom().width,
-                bits: unit.nk_rom().bits(),
-            },
+            brdf_rom: RomEntry::new(&spec.brdf, BRDF_HEX, unit.brdf_rom()),
+            nk_rom: RomEntry::new(&spec.nk, NK_HEX, unit.nk_rom()),
             geometry: unit.plan().geometry(),
         },
     };
