@@ -4,6 +4,7 @@
 
 pub mod bfpi;
 pub mod format;
+pub mod frontend;
 pub mod raster;
 pub mod rom;
 pub mod schemes;

@@ -210,7 +210,14 @@ pub struct Snapped {
 impl Snapped {
     /// The triangle must pass [`Triangle::check`]; otherwise the exactness bounds do not hold.
     pub fn new(tri: &Triangle) -> Snapped {
-        let mut v = tri.v.map(|v| (snap(v.y), snap(v.x), v.i));
+        Snapped::from_fixed(tri.v.map(|v| snap(v.x)), tri.v.map(|v| snap(v.y)), tri.v.map(|v| v.i))
+    }
+
+    /// The same canonical form from coordinates already snapped to sub-pixel units (the
+    /// hardware front-end's ports). Coverage stays exact in `i64` for any coordinates within
+    /// 2^25 sub-pixel units, the widest guard band a configuration can have.
+    pub fn from_fixed(x: [i64; 3], y: [i64; 3], i: [f64; 3]) -> Snapped {
+        let mut v = [0, 1, 2].map(|k| (y[k], x[k], i[k]));
         v.sort_by_key(|&(y, x, _)| (y, x));
         let area2 = (v[1].1 - v[0].1) * (v[2].0 - v[0].0) - (v[1].0 - v[0].0) * (v[2].1 - v[0].1);
         if area2 < 0 {

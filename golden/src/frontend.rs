@@ -1,0 +1,666 @@
+//! The triangle front-end in hardware (SPEC §6): triangles in, one span per covered scanline out.
+//! This is the bit-exact definition of what the generated `tri_setup` / `edge_walker` RTL
+//! computes, and the plan (every width) the generator prints.
+//!
+//! # Coverage: an integer edge walker
+//!
+//! A triangle arrives as three vertices on the 1/256-pixel grid (signed, within a guard band of
+//! one screen on every side) with UQ8.F intensities. Set-up orients the edges so the interior is
+//! where every edge function `e(p) = dx (py - ya) - dy (px - xa)` is positive, exactly as
+//! `setup::Snapped` does, and then, per edge with `dy != 0`, sets up a DDA on
+//!
+//! `g(r) = floor((e(128, 256 r + 128) - t) / D)`, `D = 256 |dy|`, `t = 0` on a top-left edge, else 1,
+//!
+//! which is the last covered column for a right edge (`dy > 0`: `hi = g`) and minus the first
+//! covered column for a left edge (`dy < 0`: `lo = -g`). From row to row the numerator grows by
+//! `256 dx = Qs D + 256 Rs` (`Qs, Rs = divmod(dx, |dy|)`), so the walker adds `Qs` and `256 Rs` and
+//! carries once: one add per edge per row, no division, exactly the bound `setup::Snapped`
+//! solves for with one division per row.
+//!
+//! Each edge takes part only in the rows whose centres lie within its own y extent
+//! `[yt, yb]` (its *active* rows). Outside them the other two edges imply its constraint: a row
+//! strictly above `yt` cuts the wedge at the opposite vertex inside the triangle, where the
+//! edge's function is positive, hence at least 1 on the integer grid. Keeping to active rows is
+//! what keeps every value small: an active edge's bound lies within one pixel of the edge's own
+//! x extent, so `g` fits `GW = XW + 3` signed bits, and an edge active on two rows has
+//! `|dy| >= 256`, so `|Qs| <= |dx| / 256 + 1` fits too. A horizontal edge is never active: it
+//! only decides whether a centre exactly on it is covered, which for a bottom edge (the only
+//! kind that excludes) removes the last row when `ymax` lies on a centre.
+//!
+//! # Intensity: one division for dI, one reciprocal for every scanline's I0
+//!
+//! With vertex intensities `I_k` (integers, 2^-F units) the plane through the snapped vertices is
+//! `I(p) = I_0 + (Nx (px - x0) + Ny (py - y0)) / A` (A twice the area, oriented positive).
+//!
+//! - `dI = round(256 Nx / A)` (half away from zero), saturated to DW bits: one sequential
+//!   division per triangle. Saturation never touches a span of two or more pixels: two
+//!   neighbouring covered centres have plane values in [0, 255], so then `|dI/dx| <= 255`.
+//! - `I0 = round(S / A)` for the span's first pixel, `S(c, r) = I_0 A + Nx (256c + 128 - x0) +
+//!   Ny (256r + 128 - y0)`, exactly (correctly rounded), with no division per scanline: set-up
+//!   computes one reciprocal `Rn = floor(2^K / (2 An))` of the normalised `An = A << s`
+//!   (`s` leading zeros of A in AW bits, `K = IW + 2 + AW`); per row the walker forms
+//!   `S2n = ((2S + A) << s) mod 2^K` from two running sums and one multiply by the column, and
+//!   `q~ = (S2n Rn) >> K` is the quotient or one below it; one multiply by `2An` and a compare
+//!   correct it. Everything is modular: the values that leave the unit are small, and the sums
+//!   only need to be right modulo 2^K.
+//!
+//! # Accuracy
+//!
+//! `I0` is the plane rounded to nearest (error <= 2^-(F+1)) and so is `dI` (per pixel), so
+//! `V_j = I0 + j dI` is within `(j + 1) 2^-(F+1) <= W 2^-(F+1)` of the plane over a span, and the
+//! 8-bit pixel within `1/2 + W 2^-(F+1)` of it. That is at most 1 — SPEC §6's bound — for every
+//! screen with `W <= 2^F`, which [`FrontEnd::new`] requires. The plane is the one through the
+//! UQ8.F intensities the hardware receives; real-valued vertex intensities add at most
+//! `2^-(F+1)` more when they are rounded onto the port.
+
+use crate::format::{Config, Span};
+use crate::setup::{is_top_left, snap, Screen, Snapped, Triangle, SUBPIXEL};
+use serde::{Deserialize, Serialize};
+use std::fmt;
+
+const HALF: i64 = SUBPIXEL / 2;
+
+/// Why a front-end configuration is refused.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum FrontEndError {
+    /// The screen is wider than the `in_x` / `in_len` ports of the configuration.
+    Width { width: u32, max: u32 },
+    /// The F-bit `dI` cannot keep every pixel within 1 of the plane on so wide a screen.
+    Accuracy { width: u32, frac: u32 },
+    /// Height outside 1..=65536.
+    Height { height: u32 },
+}
+
+impl fmt::Display for FrontEndError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match *self {
+            FrontEndError::Width { width, max } => {
+                write!(f, "screen width {width} is outside 1..={max} (2^XW of the configuration)")
+            }
+            FrontEndError::Accuracy { width, frac } => write!(
+                f,
+                "screen width {width} exceeds 2^F = {}: with F = {frac} fraction bits a pixel could \
+                 end up more than 1 from the plane (bound 1/2 + W 2^-(F+1)); raise --frac",
+                1u64 << frac
+            ),
+            FrontEndError::Height { height } => write!(f, "screen height {height} is outside 1..=65536"),
+        }
+    }
+}
+
+impl std::error::Error for FrontEndError {}
+
+/// A front-end configuration: the shader's formats and the screen it draws on.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub struct FrontEnd {
+    pub cfg: Config,
+    pub screen: Screen,
+}
+
+/// Every width of the front-end, derived once from the configuration: the generator declares
+/// the RTL's registers with these and golden checks its values fit them.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub struct Widths {
+    /// Row index `out_y`: holds `height - 1`.
+    pub yw: u32,
+    /// Vertex x, signed Q(XW+2).8: the guard band [-W, 2W) and then some.
+    pub cx: u32,
+    /// Vertex y, signed Q(YW+2).8.
+    pub cy: u32,
+    /// |A|, twice the area in sub-pixel units squared, unsigned.
+    pub aw: u32,
+    /// Edge bound `g` and step `Qs`, signed.
+    pub gw: u32,
+    /// Edge divisor `D = 256 |dy|` and the DDA remainder, unsigned.
+    pub dw_edge: u32,
+    /// Modulus bits of the normalised intensity sums: `K = IW + 2 + AW`.
+    pub k: u32,
+    /// The reciprocal `Rn`.
+    pub rw: u32,
+    /// Leading-zero count `s` of A.
+    pub sw: u32,
+}
+
+/// A triangle as it stands on the front-end's ports: sub-pixel coordinates, UQ8.F intensities.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct FixedTriangle {
+    pub x: [i64; 3],
+    pub y: [i64; 3],
+    pub i: [u32; 3],
+}
+
+impl FixedTriangle {
+    /// Snaps a triangle onto the ports (coordinates to 1/256 pixel, intensities to nearest).
+    pub fn from_triangle(t: &Triangle, frac: u32) -> FixedTriangle {
+        let scale = (1u64 << frac) as f64;
+        let imax = ((256u64 << frac) - 1) as f64;
+        FixedTriangle {
+            x: t.v.map(|v| snap(v.x)),
+            y: t.v.map(|v| snap(v.y)),
+            i: t.v.map(|v| (v.i * scale).round().clamp(0.0, imax) as u32),
+        }
+    }
+
+    /// The exact real triangle these port values stand for.
+    pub fn to_triangle(&self, frac: u32) -> Triangle {
+        let scale = (1u64 << frac) as f64;
+        let s = SUBPIXEL as f64;
+        let mut t = Triangle { v: [crate::setup::Vertex { x: 0.0, y: 0.0, i: 0.0 }; 3] };
+        for k in 0..3 {
+            t.v[k] = crate::setup::Vertex { x: self.x[k] as f64 / s, y: self.y[k] as f64 / s, i: self.i[k] as f64 / scale };
+        }
+        t
+    }
+
+    /// `setup::Snapped` of the same triangle, for coverage comparisons.
+    pub fn snapped(&self, frac: u32) -> Snapped {
+        let scale = (1u64 << frac) as f64;
+        Snapped::from_fixed(self.x, self.y, self.i.map(|i| i as f64 / scale))
+    }
+}
+
+/// What the front-end does with a triangle.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Outcome {
+    /// A vertex lies outside the guard band: dropped, `err` raised.
+    Guard,
+    /// Zero area, or no pixel centre of the screen inside its bounding box: dropped by set-up.
+    Culled,
+    /// Walked; it may still cover no pixel (a sliver between centres).
+    Walked,
+}
+
+/// One edge's walker state.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct EdgeWalk {
+    /// `dy > 0` (gives `hi`), `dy < 0` (gives `lo`); horizontal edges are never active.
+    pub right: bool,
+    pub active: bool,
+    /// First and last active row (meaningful when `active`).
+    pub rs: u32,
+    pub re: u32,
+    /// Bound and remainder at the current row.
+    pub g: i64,
+    pub rem: i64,
+    /// `D = 256 |dy|`, and the per-row step `Qs`, `256 Rs`.
+    pub d: i64,
+    pub qs: i64,
+    pub rs256: i64,
+}
+
+impl EdgeWalk {
+    /// After row `r` was emitted: one DDA step, if the edge has started.
+    fn step(&mut self, r: u32) {
+        if self.active && r >= self.rs {
+            self.rem += self.rs256;
+            self.g += self.qs;
+            if self.rem >= self.d {
+                self.rem -= self.d;
+                self.g += 1;
+            }
+        }
+    }
+}
+
+/// Everything set-up hands the walker for one triangle.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct TriSetup {
+    pub first: u32,
+    pub last: u32,
+    pub edges: [EdgeWalk; 3],
+    pub di: i32,
+    /// `An = A << s`, `s`, and the reciprocal `Rn = floor(2^K / (2 An))`.
+    pub an: u128,
+    pub s: u32,
+    pub rn: u128,
+    /// Normalised running sums, modulo 2^K: `S(0, first) << s`, and the steps per row and
+    /// per column, `(256 Ny) << s` and `(256 Nx) << s`.
+    pub tn: u128,
+    pub dyn_: u128,
+    pub gxn: u128,
+    /// Exact plane data, for self-checks: `I_0 A`, `Nx`, `Ny`, `x0`, `y0`, `A`.
+    pub plane: Plane,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Plane {
+    pub i0a: i128,
+    pub nx: i128,
+    pub ny: i128,
+    pub x0: i64,
+    pub y0: i64,
+    pub a: i128,
+}
+
+impl Plane {
+    /// `S(c, r)`: A times the plane's value (2^-F units) at the centre of pixel (c, r).
+    pub fn s(&self, c: i64, r: i64) -> i128 {
+        self.i0a + self.nx * (256 * c + HALF - self.x0) as i128 + self.ny * (256 * r + HALF - self.y0) as i128
+    }
+    /// The plane's value at the centre of (c, r), in intensity levels.
+    pub fn value(&self, c: i64, r: i64, frac: u32) -> f64 {
+        self.s(c, r) as f64 / self.a as f64 / (1u64 << frac) as f64
+    }
+}
+
+fn bits(v: u128) -> u32 {
+    128 - v.leading_zeros()
+}
+
+fn floor_div(n: i64, d: i64) -> i64 {
+    n.div_euclid(d)
+}
+
+fn ceil_div(n: i64, d: i64) -> i64 {
+    -(-n).div_euclid(d)
+}
+
+fn mask(w: u32) -> u128 {
+    if w >= 128 {
+        u128::MAX
+    } else {
+        (1u128 << w) - 1
+    }
+}
+
+impl FrontEnd {
+    pub fn new(cfg: Config, screen: Screen) -> Result<FrontEnd, FrontEndError> {
+        if screen.width == 0 || screen.width > cfg.max_len() {
+            return Err(FrontEndError::Width { width: screen.width, max: cfg.max_len() });
+        }
+        if screen.width as u64 > 1u64 << cfg.frac {
+            return Err(FrontEndError::Accuracy { width: screen.width, frac: cfg.frac });
+        }
+        if screen.height == 0 || screen.height > 1 << 16 {
+            return Err(FrontEndError::Height { height: screen.height });
+        }
+        Ok(FrontEnd { cfg, screen })
+    }
+
+    pub fn widths(&self) -> Widths {
+        let yw = bits((self.screen.height - 1) as u128).max(1);
+        let cx = self.cfg.xbits + 10;
+        let cy = yw + 10;
+        let aw = cx + cy + 1;
+        let k = self.cfg.iw() + 2 + aw;
+        Widths { yw, cx, cy, aw, gw: self.cfg.xbits + 3, dw_edge: cy + 8, k, rw: self.cfg.iw() + 3, sw: bits(aw as u128) }
+    }
+
+    /// Whether every vertex lies in the guard band: `-W <= x < 2W`, `-H <= y < 2H` pixels.
+    pub fn in_guard_band(&self, t: &FixedTriangle) -> bool {
+        let (w, h) = (self.screen.width as i64 * SUBPIXEL, self.screen.height as i64 * SUBPIXEL);
+        (0..3).all(|k| (-w..2 * w).contains(&t.x[k]) && (-h..2 * h).contains(&t.y[k]))
+    }
+
+    /// Whether the triangle's port values fit the ports (any value the RTL can be given).
+    pub fn fits_ports(&self, t: &FixedTriangle) -> bool {
+        let w = self.widths();
+        let fits = |v: i64, bw: u32| v >= -(1i64 << (bw - 1)) && v < 1i64 << (bw - 1);
+        (0..3).all(|k| fits(t.x[k], w.cx) && fits(t.y[k], w.cy) && t.i[k] < 1 << self.cfg.iw())
+    }
+
+    /// Set-up of one triangle: the outcome, and for a walked triangle everything the walker needs.
+    pub fn setup(&self, t: &FixedTriangle) -> (Outcome, Option<TriSetup>) {
+        assert!(self.fits_ports(t), "triangle does not fit the ports: {t:?}");
+        if !self.in_guard_band(t) {
+            return (Outcome::Guard, None);
+        }
+        let wd = self.widths();
+        let (x, y) = (t.x, t.y);
+        let a = ((x[1] - x[0]) as i128) * ((y[2] - y[0]) as i128) - ((y[1] - y[0]) as i128) * ((x[2] - x[0]) as i128);
+        if a == 0 {
+            return (Outcome::Culled, None);
+        }
+        let o: i64 = if a > 0 { 1 } else { -1 };
+        let aabs = a.unsigned_abs();
+        debug_assert!(bits(aabs) <= wd.aw);
+        let (w, h) = (self.screen.width as i64, self.screen.height as i64);
+        let (ymin, ymax) = (*y.iter().min().unwrap(), *y.iter().max().unwrap());
+        let (xmin, xmax) = (*x.iter().min().unwrap(), *x.iter().max().unwrap());
+        let mut edges = [EdgeWalk { right: false, active: false, rs: 0, re: 0, g: 0, rem: 0, d: 1, qs: 0, rs256: 0 }; 3];
+        let mut kill = 0;
+        // (dx, dy) oriented, anchor a, the edge's y extent, top-left.
+        let mut dirs = [(0i64, 0i64, 0i64, 0i64, (0i64, 0i64), false); 3];
+        for (k, dir) in dirs.iter_mut().enumerate() {
+            let (ea, eb) = ((k + 1) % 3, (k + 2) % 3);
+            let (dx, dy) = (o * (x[eb] - x[ea]), o * (y[eb] - y[ea]));
+            let tl = is_top_left(dx, dy);
+            if dy == 0 && !tl {
+                kill = 1;
+            }
+            *dir = (dx, dy, x[ea], y[ea], (y[ea].min(y[eb]), y[ea].max(y[eb])), tl);
+        }
+        let first = ceil_div(ymin - HALF, SUBPIXEL).max(0);
+        let last = floor_div(ymax - HALF - kill, SUBPIXEL).min(h - 1);
+        let cfirst = ceil_div(xmin - HALF, SUBPIXEL);
+        let clast = floor_div(xmax - HALF, SUBPIXEL);
+        if first > last || cfirst > clast || cfirst > w - 1 || clast < 0 {
+            return (Outcome::Culled, None);
+        }
+        let b = 1i64 << (wd.gw - 1);
+        for (k, &(dx, dy, xa, ya, (yt, yb), tl)) in dirs.iter().enumerate() {
+            if dy == 0 {
+                continue;
+            }
+            let rs = ceil_div(yt - HALF, SUBPIXEL).max(first);
+            let re = floor_div(yb - HALF, SUBPIXEL).min(last);
+            let d = SUBPIXEL * dy.abs();
+            let t = if tl { 0 } else { 1 };
+            let e = &mut edges[k];
+            e.right = dy > 0;
+            e.d = d;
+            e.qs = floor_div(dx, dy.abs());
+            e.rs256 = SUBPIXEL * (dx - e.qs * dy.abs());
+            if rs > re {
+                continue;
+            }
+            e.active = true;
+            (e.rs, e.re) = (rs as u32, re as u32);
+            let n = dx * (SUBPIXEL * rs + HALF - ya) - dy * (HALF - xa) - t;
+            e.g = floor_div(n, d);
+            e.rem = n - e.g * d;
+            // The widths the RTL's dividers have (module documentation).
+            debug_assert!((-b..b).contains(&e.g), "edge bound {} outside GW = {} bits", e.g, wd.gw);
+            debug_assert!(re == rs || (-b..b).contains(&e.qs), "edge step {} outside GW bits", e.qs);
+            debug_assert!(bits(d as u128) <= wd.dw_edge);
+        }
+        // The plane, oriented like the edges.
+        let (i0, i1, i2) = (t.i[0] as i128, t.i[1] as i128, t.i[2] as i128);
+        let (dx1, dy1, dx2, dy2) = ((x[1] - x[0]) as i128, (y[1] - y[0]) as i128, (x[2] - x[0]) as i128, (y[2] - y[0]) as i128);
+        let nx = o as i128 * ((i1 - i0) * dy2 - (i2 - i0) * dy1);
+        let ny = o as i128 * ((i2 - i0) * dx1 - (i1 - i0) * dx2);
+        let plane = Plane { i0a: i0 * aabs as i128, nx, ny, x0: x[0], y0: y[0], a: aabs as i128 };
+        let di = self.di(256 * nx, aabs);
+        let s = wd.aw - bits(aabs);
+        let an = aabs << s;
+        let rn = (1u128 << wd.k) / (2 * an);
+        debug_assert!(bits(rn) <= wd.rw);
+        let km = mask(wd.k);
+        let norm = |v: i128| ((v as u128) << s) & km;
+        let setup = TriSetup {
+            first: first as u32,
+            last: last as u32,
+            edges,
+            di,
+            an,
+            s,
+            rn,
+            tn: norm(plane.s(0, first)),
+            dyn_: norm(256 * ny),
+            gxn: norm(256 * nx),
+            plane,
+        };
+        (Outcome::Walked, Some(setup))
+    }
+
+    /// `round(x / a)`, half away from zero, saturated to DW signed bits: the set-up's divider.
+    fn di(&self, x: i128, a: u128) -> i32 {
+        let iw = self.cfg.iw();
+        let x2 = 2 * x.unsigned_abs() + a;
+        let q = x2 / (2 * a);
+        if q >= 1 << iw {
+            return if x < 0 { -(1 << iw) } else { (1 << iw) - 1 };
+        }
+        if x < 0 {
+            -(q as i32)
+        } else {
+            q as i32
+        }
+    }
+
+    /// The walker's intensity for row `r`, first column `c`: `S2n = ((2S + A) << s) mod 2^K`
+    /// from the running sum `tn` of the row, then the reciprocal and one correction.
+    pub fn i0(&self, st: &TriSetup, tn: u128, c: u32) -> u32 {
+        let wd = self.widths();
+        let km = mask(wd.k);
+        let s2n = (2 * (tn + st.gxn * c as u128) + st.an) & km;
+        let qt = (s2n * st.rn) >> wd.k;
+        let c2 = s2n.wrapping_sub(qt * 2 * st.an) & mask(wd.aw + 2);
+        qt as u32 + (c2 >= 2 * st.an) as u32
+    }
+
+    /// Walks a set-up triangle: `out(y, span)` for every covered row, top to bottom.
+    pub fn walk(&self, st: &TriSetup, mut out: impl FnMut(u32, Span)) {
+        let wd = self.widths();
+        let km = mask(wd.k);
+        let mut edges = st.edges;
+        let mut tn = st.tn;
+        for r in st.first..=st.last {
+            let (mut lo, mut hi) = (0i64, self.screen.width as i64 - 1);
+            for e in &edges {
+                if e.active && (e.rs..=e.re).contains(&r) {
+                    if e.right {
+                        hi = hi.min(e.g);
+                    } else {
+                        lo = lo.max(-e.g);
+                    }
+                }
+            }
+            if lo <= hi {
+                let i0 = self.i0(st, tn, lo as u32);
+                debug_assert_eq!(
+                    i0 as i128,
+                    (2 * st.plane.s(lo, r as i64) + st.plane.a) / (2 * st.plane.a),
+                    "I0 of row {r} at column {lo}, {st:?}"
+                );
+                out(r, Span { x0: lo as u32, len: (hi - lo + 1) as u32, i0, di: st.di });
+            }
+            for e in &mut edges {
+                e.step(r);
+            }
+            tn = (tn + st.dyn_) & km;
+        }
+    }
+
+    /// Set-up and walk: the outcome, and `out(y, span)` for every span.
+    pub fn spans(&self, t: &FixedTriangle, out: impl FnMut(u32, Span)) -> Outcome {
+        let (outcome, st) = self.setup(t);
+        if let Some(st) = st {
+            self.walk(&st, out);
+        }
+        outcome
+    }
+
+    /// The spans as a list (tests, tools).
+    pub fn span_list(&self, t: &FixedTriangle) -> (Outcome, Vec<(u32, Span)>) {
+        let mut v = Vec::new();
+        let o = self.spans(t, |y, s| v.push((y, s)));
+        (o, v)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::setup::Vertex;
+    use crate::Align;
+
+    /// xorshift64*: a small, stable generator (the test's sequence never changes with a crate).
+    struct Rng(u64);
+    impl Rng {
+        fn next(&mut self) -> u64 {
+            self.0 ^= self.0 >> 12;
+            self.0 ^= self.0 << 25;
+            self.0 ^= self.0 >> 27;
+            self.0.wrapping_mul(0x2545_F491_4F6C_DD1D)
+        }
+        fn range(&mut self, lo: i64, hi: i64) -> i64 {
+            lo + (self.next() % (hi - lo) as u64) as i64
+        }
+    }
+
+    /// A random port-level triangle of one of several kinds: anywhere in the guard band, small,
+    /// slivers, vertices on centres, shared y (horizontal edges), at the band's edges.
+    fn random_tri(rng: &mut Rng, fe: &FrontEnd) -> FixedTriangle {
+        let (w, h) = (fe.screen.width as i64 * 256, fe.screen.height as i64 * 256);
+        let imax = (1i64 << fe.cfg.iw()) - 1;
+        let kind = rng.range(0, 6);
+        let mut x = [0i64; 3];
+        let mut y = [0i64; 3];
+        let (cx, cy) = (rng.range(-w / 4, w + w / 4), rng.range(-h / 4, h + h / 4));
+        for k in 0..3 {
+            let (px, py) = match kind {
+                0 => (rng.range(-w, 2 * w), rng.range(-h, 2 * h)),
+                1 => (cx + rng.range(-2000, 2000), cy + rng.range(-2000, 2000)),
+                2 => (cx + rng.range(-20_000, 20_000), cy + rng.range(-300, 300)),
+                3 => ((cx / 256) * 256 + 128 + 256 * rng.range(-20, 20), (cy / 256) * 256 + 128 + 256 * rng.range(-20, 20)),
+                4 => (rng.range(-w, 2 * w), if k == 2 { rng.range(-h, 2 * h) } else { cy }),
+                _ => (if rng.range(0, 2) == 0 { -w } else { 2 * w - 1 }, rng.range(-h, 2 * h)),
+            };
+            (x[k], y[k]) = (px, py);
+        }
+        if kind == 2 && rng.range(0, 2) == 0 {
+            // A tall sliver instead of a wide one.
+            (x, y) = (y.map(|v| cx + (v - cy) / 16), x.map(|v| cy + (v - cx)));
+        }
+        let x = x.map(|v| v.clamp(-w, 2 * w - 1));
+        let y = y.map(|v| v.clamp(-h, 2 * h - 1));
+        let i = [0, 1, 2].map(|_| rng.range(0, imax + 1) as u32);
+        FixedTriangle { x, y, i }
+    }
+
+    fn check_against_host(fe: &FrontEnd, n: usize, seed: u64) {
+        let mut rng = Rng(seed);
+        let mut walked = 0;
+        for _ in 0..n {
+            let t = random_tri(&mut rng, fe);
+            let (outcome, spans) = fe.span_list(&t);
+            assert_ne!(outcome, Outcome::Guard);
+            let mut host = Vec::new();
+            t.snapped(fe.cfg.frac).spans(&fe.cfg, &fe.screen, |y, s| host.push((y, s.x0, s.len)));
+            let ours: Vec<_> = spans.iter().map(|&(y, s)| (y, s.x0, s.len)).collect();
+            if ours != host {
+                let diff = ours.iter().zip(&host).position(|(a, b)| a != b).unwrap_or(ours.len().min(host.len()));
+                panic!("coverage differs for {t:?} at span {diff}: {:?} vs {:?} ({} vs {} spans)", ours.get(diff), host.get(diff), ours.len(), host.len());
+            }
+            walked += (outcome == Outcome::Walked) as usize;
+            // Every pixel within 1 of the exact plane through the port intensities.
+            let (_, st) = fe.setup(&t);
+            for (y, s) in &spans {
+                let st = st.as_ref().unwrap();
+                s.check(&fe.cfg).unwrap();
+                // The error grows with j, so the last pixel is the one that matters; a stride
+                // through the rest keeps the huge screens' triangles affordable.
+                for j in (0..s.len).step_by(1 + s.len as usize / 64).chain([s.len - 1]) {
+                    let exact = st.plane.value((s.x0 + j) as i64, *y as i64, fe.cfg.frac);
+                    let got = s.pixel(j, fe.cfg.frac) as f64;
+                    assert!((got - exact).abs() <= 1.0, "pixel {j} of row {y}: {got} vs {exact} for {t:?}");
+                }
+            }
+        }
+        assert!(walked > n / 4, "only {walked} of {n} triangles were walked");
+    }
+
+    #[test]
+    fn coverage_equals_the_host_set_up_at_640x480() {
+        let fe = FrontEnd::new(Config::default(), Screen::default()).unwrap();
+        check_against_host(&fe, 20_000, 1);
+    }
+
+    #[test]
+    fn coverage_and_accuracy_on_the_widest_screens() {
+        // The widest screen each configuration allows: 2^XW = 2^F = 4096 at the defaults, and
+        // a 65536-pixel screen with XW = 16, F = 16.
+        let fe = FrontEnd::new(Config::default(), Screen { width: 4096, height: 4096 }).unwrap();
+        check_against_host(&fe, 2_000, 2);
+        let wide = Config::new(8, 16, 16, Align::Span).unwrap();
+        let fe = FrontEnd::new(wide, Screen { width: 65536, height: 65536 }).unwrap();
+        check_against_host(&fe, 300, 3);
+        // Small screens: most triangles clip.
+        let fe = FrontEnd::new(Config::default(), Screen { width: 37, height: 23 }).unwrap();
+        check_against_host(&fe, 20_000, 4);
+    }
+
+    #[test]
+    fn a_span_across_the_widest_screen_stays_within_one() {
+        // Full-width spans with the steepest gradient that still fits: the bound is tight here.
+        let fe = FrontEnd::new(Config::default(), Screen { width: 4096, height: 64 }).unwrap();
+        let mut rng = Rng(9);
+        let mut worst = 0.0f64;
+        for _ in 0..2000 {
+            let (a, b) = (rng.range(0, 1 << 20) as u32, rng.range(0, 1 << 20) as u32);
+            let t = FixedTriangle { x: [-256, 4096 * 256, -256], y: [-256, -256, 64 * 256], i: [a, b, a] };
+            let (_, st) = fe.setup(&t);
+            let st = st.unwrap();
+            fe.walk(&st, |y, s| {
+                for j in (0..s.len).step_by(97).chain([s.len - 1]) {
+                    let exact = st.plane.value((s.x0 + j) as i64, y as i64, 12);
+                    worst = worst.max((s.pixel(j, 12) as f64 - exact).abs());
+                }
+            });
+        }
+        assert!(worst <= 1.0, "{worst}");
+        assert!(worst > 0.5, "the test should reach past the rounding alone: {worst}");
+    }
+
+    #[test]
+    fn guard_band_and_culling() {
+        let fe = FrontEnd::new(Config::default(), Screen::default()).unwrap();
+        let ok = FixedTriangle { x: [0, 2560, 0], y: [0, 0, 2560], i: [0, 0, 0] };
+        assert_eq!(fe.span_list(&ok).0, Outcome::Walked);
+        let outside = [(Some(-640 * 256 - 1), None), (Some(1280 * 256), None), (None, Some(-480 * 256 - 1)), (None, Some(960 * 256))];
+        for (k, (bx, by)) in outside.into_iter().enumerate() {
+            let mut t = ok;
+            if let Some(v) = bx {
+                t.x[k % 3] = v;
+            }
+            if let Some(v) = by {
+                t.y[k % 3] = v;
+            }
+            assert_eq!(fe.span_list(&t), (Outcome::Guard, vec![]), "{t:?}");
+        }
+        // The band's own edges are inside it.
+        let edge = FixedTriangle { x: [-640 * 256, 1280 * 256 - 1, 0], y: [-480 * 256, 0, 960 * 256 - 1], i: [0; 3] };
+        assert_eq!(fe.span_list(&edge).0, Outcome::Walked);
+        // Zero area, and entirely off each side: culled in set-up.
+        let flat = FixedTriangle { x: [0, 2560, 5120], y: [0, 2560, 5120], i: [0; 3] };
+        assert_eq!(fe.span_list(&flat).0, Outcome::Culled);
+        for (dx, dy) in [(-620, 0), (700, 0), (0, -470), (0, 500)] {
+            let t = FixedTriangle { x: ok.x.map(|v| v + dx * 256), y: ok.y.map(|v| v + dy * 256), i: [0; 3] };
+            assert_eq!(fe.span_list(&t).0, Outcome::Culled, "{dx} {dy}");
+        }
+    }
+
+    #[test]
+    fn di_is_rounded_once_per_triangle_and_saturates() {
+        let cfg = Config::default();
+        let fe = FrontEnd::new(cfg, Screen::default()).unwrap();
+        // dI/dx = 1 level per pixel exactly.
+        let t = FixedTriangle::from_triangle(
+            &Triangle { v: [Vertex { x: 10.0, y: 10.0, i: 0.0 }, Vertex { x: 110.0, y: 10.0, i: 100.0 }, Vertex { x: 10.0, y: 60.0, i: 255.0 }] },
+            12,
+        );
+        let (_, spans) = fe.span_list(&t);
+        assert!(spans.iter().all(|(_, s)| s.di == 1 << 12 && s.x0 == 10));
+        // 255 levels over 1/256 pixel saturates both ways.
+        let steep = FixedTriangle { x: [2688, 2689, 2688], y: [2560, 2560, 5120], i: [0, (1 << 20) - 1, 0] };
+        assert_eq!(fe.setup(&steep).1.unwrap().di, (1 << 20) - 1);
+        let steep = FixedTriangle { i: [(1 << 20) - 1, 0, (1 << 20) - 1], ..steep };
+        assert_eq!(fe.setup(&steep).1.unwrap().di, -(1 << 20));
+    }
+
+    #[test]
+    fn every_order_and_winding_gives_the_same_coverage() {
+        let fe = FrontEnd::new(Config::default(), Screen::default()).unwrap();
+        let mut rng = Rng(5);
+        for _ in 0..2000 {
+            let t = random_tri(&mut rng, &fe);
+            let want: Vec<_> = fe.span_list(&t).1.iter().map(|&(y, s)| (y, s.x0, s.len)).collect();
+            for p in [[0, 2, 1], [1, 0, 2], [1, 2, 0], [2, 0, 1], [2, 1, 0]] {
+                let u = FixedTriangle { x: p.map(|k| t.x[k]), y: p.map(|k| t.y[k]), i: p.map(|k| t.i[k]) };
+                let got: Vec<_> = fe.span_list(&u).1.iter().map(|&(y, s)| (y, s.x0, s.len)).collect();
+                assert_eq!(got, want);
+            }
+        }
+    }
+
+    #[test]
+    fn refuses_screens_it_cannot_shade_within_one() {
+        let cfg = Config::default();
+        assert!(FrontEnd::new(cfg, Screen { width: 4096, height: 1 }).is_ok());
+        let e = FrontEnd::new(Config::new(8, 8, 12, Align::Span).unwrap(), Screen { width: 257, height: 10 }).unwrap_err();
+        assert!(e.to_string().contains("2^F = 256"), "{e}");
+        assert!(FrontEnd::new(cfg, Screen { width: 4097, height: 1 }).is_err());
+        assert!(FrontEnd::new(cfg, Screen { width: 640, height: 0 }).is_err());
+    }
+}
