@@ -2,6 +2,7 @@
 //! manifest and FuseSoC core. The binary (`hdl-gen`) is a thin clap front end over this.
 
 pub mod bfpi;
+pub mod frontend;
 pub mod manifest;
 pub mod output;
 pub mod report;
@@ -23,6 +24,9 @@ pub struct Names {
     pub prefix: String,
     pub bfpi: String,
     pub segment: String,
+    /// SPEC §6's front-end (set-up and edge walker), and the chain of it with the shader.
+    pub frontend: String,
+    pub top: String,
 }
 
 impl Names {
@@ -31,6 +35,8 @@ impl Names {
             prefix: prefix.to_string(),
             bfpi: format!("{prefix}bfpi_p{}", cfg.p),
             segment: format!("{prefix}segment_shader_p{}", cfg.p),
+            frontend: format!("{prefix}tri_frontend"),
+            top: format!("{prefix}tri_shader_p{}", cfg.p),
         }
     }
 }
@@ -54,9 +60,22 @@ pub struct Options {
     pub bfpi_arch: BfpiArch,
     /// The specular unit's tables (`--brdf-k`); `None` is the patent's set and n ranges.
     pub brdf: Option<golden::specular::SpecularPlan>,
+    /// The front-end's screen (`--width`, `--height`); `None`: [`Options::default_screen`].
+    pub screen: Option<golden::setup::Screen>,
 }
 
 impl Options {
+    /// 640x480, narrowed to what the configuration can shade within 1 (2^XW and 2^F pixels).
+    pub fn default_screen(cfg: &Config) -> golden::setup::Screen {
+        let max = cfg.max_len().min(1 << cfg.frac.min(31));
+        golden::setup::Screen { width: 640.min(max), height: 480 }
+    }
+
+    /// The front-end these options describe.
+    pub fn frontend(&self) -> Result<golden::frontend::FrontEnd, golden::frontend::FrontEndError> {
+        golden::frontend::FrontEnd::new(self.cfg, self.screen.unwrap_or_else(|| Options::default_screen(&self.cfg)))
+    }
+
     /// The specular unit these options describe, with its ROM images.
     pub fn specular_unit(&self) -> golden::specular::SpecularUnit {
         match &self.brdf {
@@ -78,6 +97,11 @@ pub fn generate(opts: &Options) -> Vec<GeneratedFile> {
     let names = Names::new(&opts.prefix, &opts.cfg);
     let mut modules: Vec<verilog::Module> = bfpi::module_for(&opts.cfg, &names, opts.bfpi_arch).into_iter().collect();
     modules.push(segment::module_with(&opts.cfg, &names, opts.bfpi_arch));
+    // The CLI validates the screen; a library caller with a bad one gets no front-end.
+    if let Ok(fe) = opts.frontend() {
+        modules.push(frontend::module(&fe, &names));
+        modules.push(frontend::top_module(&fe, &names));
+    }
     let unit = opts.specular_unit();
     modules.extend(specular::modules(&opts.cfg, &unit, &specular::SpecNames::new(&opts.prefix)));
     let mut files: Vec<GeneratedFile> = modules

@@ -128,11 +128,17 @@ pub fn render(opts: &Options, names: &Names, modules: &[Module], unit: &Specular
     let cfg = &opts.cfg;
     let plan = BfpiPlan::new(cfg.p);
     let spec = SpecNames::new(&opts.prefix);
+    let fe = opts.frontend().ok();
+    let fe_latency = fe.as_ref().map_or(0, crate::frontend::latency);
     let entry = |m: &Module| {
         let (role, latency, throughput) = if m.name == names.bfpi {
             ("bfpi", 0, "combinational")
         } else if m.name == names.segment {
             ("segment_shader", segment::LATENCY, "one segment per clock")
+        } else if m.name == names.frontend {
+            ("frontend", fe_latency, "one span per clock; set-up per walked triangle as in frontend.setup_clocks")
+        } else if m.name == names.top {
+            ("triangle_shader", fe_latency + segment::LATENCY, "one segment per clock")
         } else if m.name == spec.unit {
             ("specular_unit", unit.plan().latency(), "one pixel per clock")
         } else {
