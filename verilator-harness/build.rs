@@ -9,6 +9,7 @@
 //! as many threads as cargo gives jobs, and each records its build time in
 //! `OUT_DIR/obj/<tag>/build.time` (read by the `bench` binary).
 
+use golden::setup::Screen;
 use golden::{Align, Config};
 use std::fmt::Write as _;
 use std::fs;
@@ -21,12 +22,18 @@ const LAYOUT: &str = "one translation unit per model: class files, then the shim
 
 /// The segment widths built by default, each in both alignments; each p's BFPI is built too.
 const BUILT_P: [u32; 7] = [1, 2, 4, 8, 16, 32, 64];
+/// The triangle-to-segment chains built by default (SPEC §6), on 640x480.
+const BUILT_TRI: [(u32, Align); 4] = [(1, Align::Span), (8, Align::Span), (8, Align::Screen), (64, Align::Screen)];
 
 #[derive(Clone, Copy, PartialEq)]
 enum Kind {
     Segment,
     Bfpi,
     Specular,
+    /// `tri_frontend`: triangles in, spans out.
+    Frontend,
+    /// `tri_shader_p<P>`: triangles in, segments with y out.
+    TriShader,
 }
 
 struct Model {
@@ -34,6 +41,8 @@ struct Model {
     tag: String,
     kind: Kind,
     cfg: Config,
+    /// The front-end's screen (front-end models; the default elsewhere).
+    screen: Screen,
     top: String,
     /// Clocks from input transfer to first output valid (0: combinational).
     latency: u32,
@@ -76,6 +85,7 @@ fn generated_models() -> Vec<Model> {
         tag: "spec".into(),
         kind: Kind::Specular,
         cfg: Config::default(),
+        screen: Screen::default(),
         top: spec_names.unit.clone(),
         latency: hdl_gen::Options::default().specular_unit().plan().latency(),
         sources: spec
@@ -93,10 +103,23 @@ fn generated_models() -> Vec<Model> {
             let names = hdl_gen::Names::new("", &cfg);
             if align == Align::Span {
                 let bfpi = sources.iter().filter(|(n, _)| *n == format!("{}.v", names.bfpi)).cloned().collect();
-                models.push(Model { tag: format!("bfpi_p{p}"), kind: Kind::Bfpi, cfg, top: names.bfpi.clone(), latency: 0, sources: bfpi });
+                models.push(Model { tag: format!("bfpi_p{p}"), kind: Kind::Bfpi, cfg, screen: Screen::default(), top: names.bfpi.clone(), latency: 0, sources: bfpi });
             }
             let latency = hdl_gen::segment::LATENCY;
-            models.push(Model { tag: format!("seg_p{p}_{align}"), kind: Kind::Segment, cfg, top: names.segment, latency, sources });
+            if BUILT_TRI.contains(&(p, align)) {
+                let opts = hdl_gen::Options { cfg, screen: Some(Screen::default()), ..Default::default() };
+                let fe = opts.frontend().expect("640x480 front-end");
+                let (fe_lat, top_lat) = (hdl_gen::frontend::latency(&fe), hdl_gen::frontend::latency(&fe) + latency);
+                if p == 8 && align == Align::Span {
+                    let src = sources.iter().filter(|(n, _)| *n == format!("{}.v", names.frontend)).cloned().collect();
+                    models.push(Model { tag: "fe".into(), kind: Kind::Frontend, cfg, screen: fe.screen, top: names.frontend.clone(), latency: fe_lat, sources: src });
+                }
+                let chain = [&names.bfpi, &names.segment, &names.frontend, &names.top].map(|n| format!("{n}.v"));
+                let src = sources.iter().filter(|(n, _)| chain.contains(n)).cloned().collect();
+                models.push(Model { tag: format!("tris_p{p}_{align}"), kind: Kind::TriShader, cfg, screen: fe.screen, top: names.top.clone(), latency: top_lat, sources: src });
+            }
+            let sources = sources.into_iter().filter(|(n, _)| *n == format!("{}.v", names.segment) || *n == format!("{}.v", names.bfpi)).collect();
+            models.push(Model { tag: format!("seg_p{p}_{align}"), kind: Kind::Segment, cfg, screen: Screen::default(), top: names.segment, latency, sources });
         }
     }
     models
@@ -131,11 +154,23 @@ fn models_from_dir(dir: &Path) -> Vec<Model> {
     if let Some(top) = top_of("bfpi") {
         let file = format!("{top}.v");
         let src = sources.iter().filter(|(n, _)| *n == file).cloned().collect();
-        models.push(Model { tag: format!("bfpi_p{}", cfg.p), kind: Kind::Bfpi, cfg, top, latency: 0, sources: src });
+        models.push(Model { tag: format!("bfpi_p{}", cfg.p), kind: Kind::Bfpi, cfg, screen: Screen::default(), top, latency: 0, sources: src });
     }
     if let Some(top) = top_of("segment_shader") {
         let latency = latency_of("segment_shader");
-        models.push(Model { tag: format!("seg_p{}_{}", cfg.p, cfg.align), kind: Kind::Segment, cfg, top, latency, sources });
+        models.push(Model { tag: format!("seg_p{}_{}", cfg.p, cfg.align), kind: Kind::Segment, cfg, screen: Screen::default(), top, latency, sources: sources.clone() });
+    }
+    if let (Some(fe_top), Some(tri_top)) = (top_of("frontend"), top_of("triangle_shader")) {
+        let sc = &m["frontend"]["screen"];
+        let dim = |k: &str| sc[k].as_u64().unwrap_or_else(|| fail(format!("manifest has no frontend.screen.{k}"))) as u32;
+        let screen = Screen { width: dim("width"), height: dim("height") };
+        let fe_src = files_of(&["frontend"]);
+        let mut all = sources.clone();
+        all.extend(fe_src.iter().cloned());
+        all.extend(files_of(&["triangle_shader"]));
+        models.push(Model { tag: "fe".into(), kind: Kind::Frontend, cfg, screen, top: fe_top, latency: latency_of("frontend"), sources: fe_src });
+        let tag = format!("tris_p{}_{}", cfg.p, cfg.align);
+        models.push(Model { tag, kind: Kind::TriShader, cfg, screen, top: tri_top, latency: latency_of("triangle_shader"), sources: all });
     }
     if let Some(top) = top_of("specular_unit") {
         let mut src = files_of(&["specular_unit", "rom"]);
@@ -144,7 +179,7 @@ fn models_from_dir(dir: &Path) -> Vec<Model> {
             src.push(read(file));
         }
         let latency = latency_of("specular_unit");
-        models.push(Model { tag: "spec".into(), kind: Kind::Specular, cfg, top, latency, sources: src });
+        models.push(Model { tag: "spec".into(), kind: Kind::Specular, cfg, screen: Screen::default(), top, latency, sources: src });
     }
     if models.is_empty() {
         fail("manifest lists no bfpi, segment_shader or specular_unit module".into());
@@ -355,6 +390,8 @@ fn shim_cpp(m: &Model, class: &str) -> String {
         Kind::Segment => format!("SEGSHADE_SEGMENT_SHIM({class}, {}, {})", m.tag, m.cfg.p),
         Kind::Bfpi => format!("SEGSHADE_BFPI_SHIM({class}, {}, {})", m.tag, (m.cfg.p * m.cfg.mw()).div_ceil(8)),
         Kind::Specular => format!("SEGSHADE_SPECULAR_SHIM({class}, {})", m.tag),
+        Kind::Frontend => format!("SEGSHADE_FRONTEND_SHIM({class}, {})", m.tag),
+        Kind::TriShader => format!("SEGSHADE_TRISHADER_SHIM({class}, {}, {})", m.tag, m.cfg.p),
     };
     format!("// Generated by build.rs.\n#include \"{class}.h\"\n#include \"shim.h\"\n{expand}\n")
 }
@@ -364,11 +401,15 @@ fn models_rs(models: &[Model]) -> String {
     let mut seg = String::new();
     let mut bfpi = String::new();
     let mut spec = String::new();
+    let mut fe = String::new();
+    let mut tris = String::new();
     for m in models {
         let (inp, outp, list) = match m.kind {
             Kind::Segment => ("SegIn", "SegOut", &mut seg),
             Kind::Bfpi => ("BfpiIn", "BfpiOut", &mut bfpi),
             Kind::Specular => ("SpecIn", "SpecOut", &mut spec),
+            Kind::Frontend => ("TriIn", "FeOut", &mut fe),
+            Kind::TriShader => ("TriIn", "TriSegOut", &mut tris),
         };
         let t = &m.tag;
         writeln!(
@@ -385,8 +426,8 @@ fn models_rs(models: &[Model]) -> String {
         writeln!(
             list,
             "    ModelInfo {{ tag: \"{t}\", top: \"{}\", latency: {}, cfg: Config {{ p: {}, frac: {}, xbits: {}, align: Align::{align} }}, \
-             new: {t}_new, free: {t}_free, step: {t}_step }},",
-            m.top, m.latency, c.p, c.frac, c.xbits
+             screen: golden::setup::Screen {{ width: {}, height: {} }}, new: {t}_new, free: {t}_free, step: {t}_step }},",
+            m.top, m.latency, c.p, c.frac, c.xbits, m.screen.width, m.screen.height
         )
         .unwrap();
     }
@@ -394,7 +435,9 @@ fn models_rs(models: &[Model]) -> String {
         s,
         "pub static SEGMENT_MODELS: &[ModelInfo<SegIn, SegOut>] = &[\n{seg}];\n\
          pub static BFPI_MODELS: &[ModelInfo<BfpiIn, BfpiOut>] = &[\n{bfpi}];\n\
-         pub static SPECULAR_MODELS: &[ModelInfo<SpecIn, SpecOut>] = &[\n{spec}];\n"
+         pub static SPECULAR_MODELS: &[ModelInfo<SpecIn, SpecOut>] = &[\n{spec}];\n\
+         pub static FRONTEND_MODELS: &[ModelInfo<TriIn, FeOut>] = &[\n{fe}];\n\
+         pub static TRISHADER_MODELS: &[ModelInfo<TriIn, TriSegOut>] = &[\n{tris}];\n"
     )
     .unwrap();
     s

@@ -139,3 +139,80 @@ struct SpecOut {
                 out->out_spec = m->out_spec;                                                  \
             });                                                                               \
     }
+
+// The triangle front-end (SPEC §6): three vertices in, spans out. Coordinates are two's
+// complement masked to the port width (Verilator requires the bits above it to be zero).
+struct TriIn {
+    uint32_t x[3], y[3], i[3];
+    uint8_t rst, in_valid, out_ready;
+    uint8_t keep;  // the data ports hold what the last call wrote: skip writing them
+};
+
+struct FeOut {
+    uint32_t out_x, out_len, out_i0, out_di;  // out_di: two's complement in DW bits
+    uint32_t out_y;
+    uint8_t in_ready, out_valid, err, pad;
+};
+
+#define SEGSHADE_TRI_PORTS(m, in)                                                            \
+    m->in_x0 = in->x[0];                                                                      \
+    m->in_y0 = in->y[0];                                                                      \
+    m->in_i0 = in->i[0];                                                                      \
+    m->in_x1 = in->x[1];                                                                      \
+    m->in_y1 = in->y[1];                                                                      \
+    m->in_i1 = in->i[1];                                                                      \
+    m->in_x2 = in->x[2];                                                                      \
+    m->in_y2 = in->y[2];                                                                      \
+    m->in_i2 = in->i[2];
+
+// The front-end has no out_last, so it has its own clock (same order as segshade_clock).
+#define SEGSHADE_FRONTEND_SHIM(CLASS, SYM)                                                   \
+    SEGSHADE_LIFETIME(CLASS, SYM)                                                             \
+    extern "C" void SYM##_step(void* h, const TriIn* in, FeOut* out) {                        \
+        CLASS* m = static_cast<SegshadeModel<CLASS>*>(h)->top;                                \
+        m->clk = 0;                                                                           \
+        m->rst = in->rst;                                                                     \
+        m->in_valid = in->in_valid;                                                           \
+        m->out_ready = in->out_ready;                                                         \
+        if (!in->keep) {                                                                      \
+            SEGSHADE_TRI_PORTS(m, in)                                                         \
+        }                                                                                     \
+        m->eval();                                                                            \
+        out->in_ready = m->in_ready;                                                          \
+        out->out_valid = m->out_valid;                                                        \
+        out->err = m->err;                                                                    \
+        out->out_x = m->out_x;                                                                \
+        out->out_len = m->out_len;                                                            \
+        out->out_i0 = m->out_i0;                                                              \
+        out->out_di = m->out_di;                                                              \
+        out->out_y = m->out_y;                                                                \
+        m->clk = 1;                                                                           \
+        m->eval();                                                                            \
+    }
+
+// tri_shader_p<P>: triangles in, segments with their y out.
+struct TriSegOut {
+    uint32_t out_x, out_y;
+    uint8_t in_ready, out_valid, out_last, err;
+    uint8_t pix[256];  // lane i in byte i
+    uint8_t mask[32];  // lane i in bit i % 8 of byte i / 8
+};
+
+#define SEGSHADE_TRISHADER_SHIM(CLASS, SYM, P)                                               \
+    SEGSHADE_LIFETIME(CLASS, SYM)                                                             \
+    extern "C" void SYM##_step(void* h, const TriIn* in, TriSegOut* out) {                    \
+        CLASS* m = static_cast<SegshadeModel<CLASS>*>(h)->top;                                \
+        segshade_clock(                                                                       \
+            m, in, out, [&] { SEGSHADE_TRI_PORTS(m, in) },                                    \
+            [&] {                                                                             \
+                out->err = m->err;                                                            \
+                out->out_x = m->out_x;                                                        \
+                out->out_y = m->out_y;                                                        \
+                segshade_copy(out->pix, m->out_pix, P);                                       \
+                segshade_copy(out->mask, m->out_mask, (P + 7) / 8);                           \
+            });                                                                               \
+    }
+
+static_assert(sizeof(TriIn) == 40, "TriIn layout is mirrored in ffi.rs");
+static_assert(sizeof(FeOut) == 24, "FeOut layout is mirrored in ffi.rs");
+static_assert(sizeof(TriSegOut) == 300, "TriSegOut layout is mirrored in ffi.rs");

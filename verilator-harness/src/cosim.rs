@@ -62,6 +62,8 @@ pub struct Report {
     /// Resets injected by [`Stress`], and the accepted spans they cut short.
     pub resets: u64,
     pub cut_spans: u64,
+    /// Side pulses the unit raised (the front-end's guard-band `err`).
+    pub pulses: u64,
 }
 
 const KEEP_MISMATCHES: usize = 20;
@@ -81,6 +83,7 @@ impl Report {
         self.max_error = self.max_error.max(other.max_error);
         self.resets += other.resets;
         self.cut_spans += other.cut_spans;
+        self.pulses += other.pulses;
     }
 
     pub fn mismatch(&mut self, m: Mismatch) {
@@ -261,7 +264,7 @@ impl<F: FnMut(&Stim, &SegView) + Send> Check for SegCheck<'_, F> {
 /// The segment lane by lane against golden, saying what disagrees.
 #[cold]
 #[inline(never)]
-fn check_lanes(cfg: &Config, stim: &Stim, seg: &Segment, out: &SegView, report: &mut Report) {
+pub(crate) fn check_lanes(cfg: &Config, stim: &Stim, seg: &Segment, out: &SegView, report: &mut Report) {
     let mut problems = Vec::new();
     if out.out_x != seg.x {
         problems.push(format!("out_x expected {}, got {}", seg.x, out.out_x));
@@ -437,7 +440,7 @@ static BYTE_MASK: [u64; 256] = {
 /// pixel again. Only the span's own pixels are written; the rest is stale, and it lies in
 /// masked lanes, which are don't-care. P pixels wider than the screen, so a segment at the
 /// last x stays inside.
-fn golden_row(cfg: &Config) -> Frame {
+pub(crate) fn golden_row(cfg: &Config) -> Frame {
     Frame::new(cfg.max_len() + cfg.p, 1)
 }
 
@@ -451,7 +454,7 @@ fn golden_row(cfg: &Config) -> Frame {
 /// the mask is compared a byte at a time and the pixels eight lanes at a time with the span's
 /// golden `row` from `out_x` on, masked lanes ignored.
 #[inline]
-fn agrees(out: &SegView, span: &Span, seg: &Segment, row: &[u8], p: u32) -> Option<u64> {
+pub(crate) fn agrees(out: &SegView, span: &Span, seg: &Segment, row: &[u8], p: u32) -> Option<u64> {
     if out.out_x != seg.x || out.out_last != seg.last {
         return None;
     }
@@ -487,7 +490,7 @@ fn agrees(out: &SegView, span: &Span, seg: &Segment, row: &[u8], p: u32) -> Opti
     Some((hi - lo) as u64)
 }
 
-fn describe(s: &Stim) -> String {
+pub(crate) fn describe(s: &Stim) -> String {
     format!(
         "span y = {} x0 = {} len = {} i0 = {} di = {}",
         s.y, s.span.x0, s.span.len, s.span.i0, s.span.di

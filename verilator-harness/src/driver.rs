@@ -149,6 +149,11 @@ pub(crate) trait Unit: Sync {
     fn same(&self, held: &[u8], out: &Self::Out) -> bool;
     /// What differs when `out` is not [`Unit::same`] as `held`.
     fn describe_change(&self, held: &[u8], out: &Self::Out) -> String;
+    /// A one-clock side pulse of the unit (the front-end's `err`), counted in `Report::pulses`.
+    #[inline(always)]
+    fn pulse(&self, _out: &Self::Out) -> bool {
+        false
+    }
     /// The triangle (or span) to blame and a description, for a mismatch about span `k`.
     fn blame(&self, k: usize, span: &Self::Span) -> (Option<usize>, String);
 }
@@ -306,6 +311,7 @@ impl<U: Unit> Driver<U> {
             self.input.keep_data(true);
             report.cycles += 1;
             let out = &self.output;
+            report.pulses += unit.pulse(out) as u64;
             if std::mem::take(&mut in_reset) && out.out_valid() {
                 report.mismatch(Mismatch {
                     triangle: None,

@@ -109,9 +109,65 @@ pub struct SpecOut {
     pub out_err: u8,
 }
 
-/// The control inputs and handshake outputs both streaming units share.
+/// Inputs of `tri_frontend` and `tri_shader_p<P>` for one clock: the three vertices, each
+/// value two's complement masked to its port's width.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default)]
+pub struct TriIn {
+    pub x: [u32; 3],
+    pub y: [u32; 3],
+    pub i: [u32; 3],
+    pub rst: u8,
+    pub in_valid: u8,
+    pub out_ready: u8,
+    pub keep: u8,
+}
+
+/// Outputs of `tri_frontend`: one span, and the guard-band error pulse.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default)]
+pub struct FeOut {
+    pub out_x: u32,
+    pub out_len: u32,
+    pub out_i0: u32,
+    /// Two's complement in DW bits.
+    pub out_di: u32,
+    pub out_y: u32,
+    pub in_ready: u8,
+    pub out_valid: u8,
+    pub err: u8,
+    pub pad: u8,
+}
+
+/// Outputs of `tri_shader_p<P>`: a segment with its scanline, and the error pulse.
+#[repr(C)]
+#[derive(Clone, Copy)]
+pub struct TriSegOut {
+    pub out_x: u32,
+    pub out_y: u32,
+    pub in_ready: u8,
+    pub out_valid: u8,
+    pub out_last: u8,
+    pub err: u8,
+    pub pix: [u8; 256],
+    pub mask: [u8; 32],
+}
+
+impl Default for TriSegOut {
+    fn default() -> Self {
+        TriSegOut { out_x: 0, out_y: 0, in_ready: 0, out_valid: 0, out_last: 0, err: 0, pix: [0; 256], mask: [0; 32] }
+    }
+}
+
+// The C++ side (csrc/shim.h) asserts the same sizes.
+const _: () = assert!(std::mem::size_of::<TriIn>() == 40);
+const _: () = assert!(std::mem::size_of::<FeOut>() == 24);
+const _: () = assert!(std::mem::size_of::<TriSegOut>() == 300);
+const _: () = assert!(std::mem::offset_of!(TriSegOut, pix) == 12);
+
+/// The control inputs and handshake outputs the streaming units share.
 macro_rules! streaming_ports {
-    ($in:ty, $out:ty) => {
+    ($in:ty, $($out:ty),+) => {
         impl Control for $in {
             #[inline(always)]
             fn set_control(&mut self, rst: bool, in_valid: bool, out_ready: bool) {
@@ -122,7 +178,7 @@ macro_rules! streaming_ports {
                 self.keep = keep as u8;
             }
         }
-        impl Handshake for $out {
+        $(impl Handshake for $out {
             #[inline(always)]
             fn in_ready(&self) -> bool {
                 self.in_ready == 1
@@ -131,11 +187,12 @@ macro_rules! streaming_ports {
             fn out_valid(&self) -> bool {
                 self.out_valid == 1
             }
-        }
+        })+
     };
 }
 streaming_ports!(SegIn, SegOut);
 streaming_ports!(SpecIn, SpecOut);
+streaming_ports!(TriIn, FeOut, TriSegOut);
 
 /// A linked model: its configuration and its three symbols.
 pub struct ModelInfo<I: 'static, O: 'static> {
@@ -146,6 +203,8 @@ pub struct ModelInfo<I: 'static, O: 'static> {
     /// Clocks from an input transfer to the first output valid, as the generator states it.
     pub latency: u32,
     pub cfg: Config,
+    /// The screen of a front-end model (`tri_frontend`, `tri_shader_p<P>`); 640x480 elsewhere.
+    pub screen: golden::setup::Screen,
     pub new: unsafe extern "C" fn(u64) -> *mut c_void,
     pub free: unsafe extern "C" fn(*mut c_void),
     pub step: unsafe extern "C" fn(*mut c_void, *const I, *mut O),

@@ -11,6 +11,7 @@
 pub mod cosim;
 pub mod driver;
 pub mod ffi;
+pub mod frontend;
 pub mod render;
 pub mod specular;
 pub mod stimulus;

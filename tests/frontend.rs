@@ -1,0 +1,102 @@
+//! The triangle front-end (SPEC §6) in RTL against golden: `tri_frontend` span by span, and
+//! `tri_shader_p<P>` segment by segment and frame by frame, with random gaps and backpressure.
+
+use golden::frontend::{FixedTriangle, FrontEnd, Outcome};
+use rand::rngs::StdRng;
+use rand::SeedableRng;
+use verilator_harness::cosim::{assert_clean, Stress, Traffic};
+use verilator_harness::ffi::{FRONTEND_MODELS, TRISHADER_MODELS};
+use verilator_harness::frontend::{mesh, random_triangles, run_chain, run_frontend, Expected};
+
+fn frontend(m: &verilator_harness::ffi::ModelInfo<impl Sized, impl Sized>) -> FrontEnd {
+    FrontEnd::new(m.cfg, m.screen).unwrap()
+}
+
+#[test]
+fn spans_equal_golden_for_every_kind_of_triangle() {
+    let seed = verilator_harness::seed("frontend spans");
+    assert!(!FRONTEND_MODELS.is_empty(), "this build has no tri_frontend model");
+    for m in FRONTEND_MODELS {
+        let fe = frontend(m);
+        let tris = random_triangles(&mut StdRng::seed_from_u64(seed), &fe, 3000);
+        let exp = Expected::new(fe, &tris);
+        // The stimulus reaches every outcome.
+        for o in [Outcome::Guard, Outcome::Culled, Outcome::Walked] {
+            assert!(exp.stims.iter().any(|s| s.outcome == o), "no {o:?} triangle");
+        }
+        let report = run_frontend(m, seed, Traffic::RANDOM, Stress::NONE, &tris);
+        eprintln!(
+            "{}: {} triangles, {} spans out, {} guard drops, {} clocks",
+            m.tag, report.triangles, report.segments, report.pulses, report.cycles
+        );
+        assert_clean(m.tag, seed, &report);
+        assert_eq!(report.segments, exp.spans.len() as u64);
+        assert_eq!(report.pulses, exp.guard_drops());
+    }
+}
+
+#[test]
+fn resets_in_the_middle_of_triangles_drop_them_cleanly() {
+    let seed = verilator_harness::seed("frontend resets");
+    for m in FRONTEND_MODELS {
+        let fe = frontend(m);
+        let tris = random_triangles(&mut StdRng::seed_from_u64(seed ^ 1), &fe, 1500);
+        let report = run_frontend(m, seed, Traffic::RANDOM, Stress::HARSH, &tris);
+        assert!(report.resets > 0, "the stress made no reset");
+        assert_clean(m.tag, seed, &report);
+    }
+}
+
+#[test]
+fn segments_and_frames_through_the_chain() {
+    let seed = verilator_harness::seed("tri_shader");
+    assert!(!TRISHADER_MODELS.is_empty(), "this build has no tri_shader model");
+    for m in TRISHADER_MODELS {
+        let fe = frontend(m);
+        let mut rng = StdRng::seed_from_u64(seed ^ m.cfg.p as u64);
+        // Few enough per frame that the frame comparison stays meaningful where they overlap:
+        // the last writer wins in both the RTL frame and golden's.
+        for round in 0..4 {
+            let tris = random_triangles(&mut rng, &fe, 150);
+            let run = run_chain(m, seed + round, Traffic::RANDOM, &tris);
+            assert_clean(m.tag, seed, &run.report);
+            assert!(run.report.max_error <= 1.0);
+        }
+    }
+}
+
+#[test]
+fn a_shared_edge_mesh_writes_every_covered_pixel_exactly_once() {
+    let seed = verilator_harness::seed("tri_shader mesh");
+    for m in TRISHADER_MODELS {
+        let fe = frontend(m);
+        let tris: Vec<FixedTriangle> = mesh(&mut StdRng::seed_from_u64(seed), &fe, 17, 11);
+        let run = run_chain(m, seed, Traffic::RANDOM, &tris);
+        assert_clean(m.tag, seed, &run.report);
+        // The mesh covers the screen [0, W) x [0, H) exactly: every pixel, once.
+        let (once, more, none) = run.writes.iter().fold((0, 0, 0), |(a, b, c), &n| match n {
+            1 => (a + 1, b, c),
+            0 => (a, b, c + 1),
+            _ => (a, b + 1, c),
+        });
+        assert_eq!((more, none), (0, 0), "{}: {once} pixels written once, {more} more than once, {none} never", m.tag);
+    }
+}
+
+#[test]
+fn the_scoreboard_catches_a_wrong_span() {
+    // Negative control: the same run against golden spans with one I0 off by one must fail.
+    let seed = verilator_harness::seed("frontend negative control");
+    let m = &FRONTEND_MODELS[0];
+    let fe = frontend(m);
+    let tris = random_triangles(&mut StdRng::seed_from_u64(seed), &fe, 200);
+    let mut bad = tris.clone();
+    // A vertex intensity changed by one LSB changes golden's spans but not the RTL's input.
+    let k = Expected::new(fe, &tris).stims.iter().position(|s| s.count > 0).unwrap();
+    bad[k].i[0] ^= 1 << 10;
+    let exp_bad = Expected::new(fe, &bad);
+    let exp_good = Expected::new(fe, &tris);
+    assert_ne!(exp_bad.spans, exp_good.spans, "the planted fault must change golden's answer");
+    let report = verilator_harness::frontend::run_frontend_against(m, seed, &tris, &exp_bad);
+    assert!(!report.ok(), "a wrong expectation went unnoticed");
+}
