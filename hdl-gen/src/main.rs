@@ -27,6 +27,13 @@ enum Command {
         bfpi_arch: String,
         #[command(flatten)]
         brdf: BrdfArgs,
+        /// Screen width of the triangle front-end (tri_frontend, tri_shader_p<P>), at most 2^XW
+        /// and 2^F pixels. Default: 640, or the widest the configuration allows when less.
+        #[arg(long, value_parser = clap::value_parser!(u32).range(1..=65536))]
+        width: Option<u32>,
+        /// Screen height of the triangle front-end (1..65536). Default: 480.
+        #[arg(long, value_parser = clap::value_parser!(u32).range(1..=65536))]
+        height: Option<u32>,
         /// Output folder (created if missing).
         #[arg(long)]
         out: PathBuf,
@@ -193,11 +200,18 @@ fn parse_cli() -> Cli {
 fn main() -> ExitCode {
     let cli = parse_cli();
     let result = match cli.command {
-        Command::Generate { config, bfpi_arch, brdf, out } => {
+        Command::Generate { config, bfpi_arch, brdf, width, height, out } => {
             let bfpi_arch = bfpi_arch.parse().expect("clap checked the bfpi arch");
             config
                 .options(&brdf)
-                .and_then(|opts| output::write_all(&out, &generate(&Options { bfpi_arch, ..opts })))
+                .and_then(|opts| {
+                    let default = Options::default_screen(&opts.cfg);
+                    let screen = golden::setup::Screen { width: width.unwrap_or(default.width), height: height.unwrap_or(default.height) };
+                    let opts = Options { bfpi_arch, screen: Some(screen), ..opts };
+                    opts.frontend().map_err(|e| format!("--width/--height: {e}"))?;
+                    Ok(opts)
+                })
+                .and_then(|opts| output::write_all(&out, &generate(&opts)))
                 .map(|()| eprintln!("wrote {}", out.display()))
         }
         Command::Rom { table, format, brdf, out } => brdf.plan().and_then(|plan| {

@@ -21,6 +21,26 @@ struct Manifest<'a> {
     #[serde(skip_serializing_if = "Option::is_none")]
     bfpi: Option<Bfpi>,
     specular: Specular,
+    /// SPEC §6's front-end; absent when the configuration cannot host the screen.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    frontend: Option<Frontend>,
+}
+
+/// The front-end's screen, guard band, widths and timing.
+#[derive(Serialize)]
+struct Frontend {
+    module: String,
+    top: String,
+    screen: golden::setup::Screen,
+    guard_band: String,
+    widths: golden::frontend::Widths,
+    /// Clocks from a triangle's transfer to its first span when the walker is idle.
+    latency: u32,
+    /// Set-up clocks per walked triangle (its rate limit) and per dropped triangle.
+    setup_clocks_walked: u32,
+    setup_clocks_dropped: u32,
+    /// Walker clocks per triangle: one per row from its first to its last covered row.
+    walker: &'static str,
 }
 
 /// The specular unit's configuration: k-set, n ranges, tables, ROM geometry, pipeline.
@@ -179,6 +199,23 @@ pub fn render(opts: &Options, names: &Names, modules: &[Module], unit: &Specular
             nk_rom: RomEntry::new(&spec.nk, NK_HEX, unit.nk_rom()),
             geometry: unit.plan().geometry(),
         },
+        frontend: fe.map(|fe| Frontend {
+            module: names.frontend.clone(),
+            top: names.top.clone(),
+            screen: fe.screen,
+            guard_band: format!(
+                "-{w} <= x < {}, -{h} <= y < {} pixels",
+                2 * fe.screen.width,
+                2 * fe.screen.height,
+                w = fe.screen.width,
+                h = fe.screen.height
+            ),
+            widths: fe.widths(),
+            latency: crate::frontend::latency(&fe),
+            setup_clocks_walked: crate::frontend::setup_clocks(&fe).0,
+            setup_clocks_dropped: crate::frontend::setup_clocks(&fe).1,
+            walker: "one clock per row from the first to the last row of the bounding box on screen",
+        }),
     };
     serde_json::to_string_pretty(&manifest).expect("manifest serializes") + "\n"
 }
