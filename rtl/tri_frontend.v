@@ -7,8 +7,9 @@
 // Coverage: exactly golden::setup's (top-left rule, pixel centres, clipped), by an integer DDA per edge.
 // Spans: (y, x0, m, I0, dI) in SPEC §2's formats; I0 correctly rounded, dI rounded once per triangle;
 // every pixel within 1/2 + W 2^-(F+1) <= 1 of the plane through the vertex intensities.
-// Set-up: CALC 1 clock, 23 divider clocks (8 restoring dividers in parallel), hand-off; dropped triangles take 2.
-// Latency: first span valid 28 clocks after the triangle's transfer when the walker is idle.
+// Set-up: CALC 1 clock, 12 divider clocks (8 restoring dividers in parallel, 2 quotient bit(s) a clock), hand-off;
+// 15 clocks per walked triangle, 2 per dropped one.
+// Latency: first span valid 17 clocks after the triangle's transfer when the walker is idle.
 // Walker: one row per clock (rows with no covered pixel make a bubble); the next triangle's set-up overlaps it.
 // Widths: |A| 42, edge bound 15 signed, edge divisor 27, intensity sums modulo 2^64, reciprocal 23.
 
@@ -211,22 +212,86 @@ module tri_frontend (
   reg [65:0] drn_p;
   reg [65:0] drn_d;
   reg [22:0] drn_q;
-  wire ei0_ge = ei0_p >= ei0_d;
-  wire ei0_on = div_cnt < 5'd15;
-  wire es0_ge = es0_p >= es0_d;
-  wire es0_on = div_cnt < 5'd15;
-  wire ei1_ge = ei1_p >= ei1_d;
-  wire ei1_on = div_cnt < 5'd15;
-  wire es1_ge = es1_p >= es1_d;
-  wire es1_on = div_cnt < 5'd15;
-  wire ei2_ge = ei2_p >= ei2_d;
-  wire ei2_on = div_cnt < 5'd15;
-  wire es2_ge = es2_p >= es2_d;
-  wire es2_on = div_cnt < 5'd15;
-  wire ddi_ge = ddi_p >= ddi_d;
-  wire ddi_on = div_cnt < 5'd20;
-  wire drn_ge = drn_p >= drn_d;
-  wire drn_on = div_cnt < 5'd23;
+  wire ei0_on0 = div_cnt < 5'd15;
+  wire ei0_ge0 = ei0_p >= ei0_d;
+  wire [41:0] ei0_p1 = (ei0_on0 && ei0_ge0) ? ei0_p - ei0_d : ei0_p;
+  wire [41:0] ei0_d1 = ei0_on0 ? ei0_d >> 1 : ei0_d;
+  wire [14:0] ei0_q1 = ei0_on0 ? {ei0_q[13:0], ei0_ge0} : ei0_q;
+  wire ei0_on1 = div_cnt >= 5'd1 && div_cnt - 5'd1 < 5'd15;
+  wire ei0_ge1 = ei0_p1 >= ei0_d1;
+  wire [41:0] ei0_p2 = (ei0_on1 && ei0_ge1) ? ei0_p1 - ei0_d1 : ei0_p1;
+  wire [41:0] ei0_d2 = ei0_on1 ? ei0_d1 >> 1 : ei0_d1;
+  wire [14:0] ei0_q2 = ei0_on1 ? {ei0_q1[13:0], ei0_ge1} : ei0_q1;
+  wire es0_on0 = div_cnt < 5'd15;
+  wire es0_ge0 = es0_p >= es0_d;
+  wire [33:0] es0_p1 = (es0_on0 && es0_ge0) ? es0_p - es0_d : es0_p;
+  wire [33:0] es0_d1 = es0_on0 ? es0_d >> 1 : es0_d;
+  wire [14:0] es0_q1 = es0_on0 ? {es0_q[13:0], es0_ge0} : es0_q;
+  wire es0_on1 = div_cnt >= 5'd1 && div_cnt - 5'd1 < 5'd15;
+  wire es0_ge1 = es0_p1 >= es0_d1;
+  wire [33:0] es0_p2 = (es0_on1 && es0_ge1) ? es0_p1 - es0_d1 : es0_p1;
+  wire [33:0] es0_d2 = es0_on1 ? es0_d1 >> 1 : es0_d1;
+  wire [14:0] es0_q2 = es0_on1 ? {es0_q1[13:0], es0_ge1} : es0_q1;
+  wire ei1_on0 = div_cnt < 5'd15;
+  wire ei1_ge0 = ei1_p >= ei1_d;
+  wire [41:0] ei1_p1 = (ei1_on0 && ei1_ge0) ? ei1_p - ei1_d : ei1_p;
+  wire [41:0] ei1_d1 = ei1_on0 ? ei1_d >> 1 : ei1_d;
+  wire [14:0] ei1_q1 = ei1_on0 ? {ei1_q[13:0], ei1_ge0} : ei1_q;
+  wire ei1_on1 = div_cnt >= 5'd1 && div_cnt - 5'd1 < 5'd15;
+  wire ei1_ge1 = ei1_p1 >= ei1_d1;
+  wire [41:0] ei1_p2 = (ei1_on1 && ei1_ge1) ? ei1_p1 - ei1_d1 : ei1_p1;
+  wire [41:0] ei1_d2 = ei1_on1 ? ei1_d1 >> 1 : ei1_d1;
+  wire [14:0] ei1_q2 = ei1_on1 ? {ei1_q1[13:0], ei1_ge1} : ei1_q1;
+  wire es1_on0 = div_cnt < 5'd15;
+  wire es1_ge0 = es1_p >= es1_d;
+  wire [33:0] es1_p1 = (es1_on0 && es1_ge0) ? es1_p - es1_d : es1_p;
+  wire [33:0] es1_d1 = es1_on0 ? es1_d >> 1 : es1_d;
+  wire [14:0] es1_q1 = es1_on0 ? {es1_q[13:0], es1_ge0} : es1_q;
+  wire es1_on1 = div_cnt >= 5'd1 && div_cnt - 5'd1 < 5'd15;
+  wire es1_ge1 = es1_p1 >= es1_d1;
+  wire [33:0] es1_p2 = (es1_on1 && es1_ge1) ? es1_p1 - es1_d1 : es1_p1;
+  wire [33:0] es1_d2 = es1_on1 ? es1_d1 >> 1 : es1_d1;
+  wire [14:0] es1_q2 = es1_on1 ? {es1_q1[13:0], es1_ge1} : es1_q1;
+  wire ei2_on0 = div_cnt < 5'd15;
+  wire ei2_ge0 = ei2_p >= ei2_d;
+  wire [41:0] ei2_p1 = (ei2_on0 && ei2_ge0) ? ei2_p - ei2_d : ei2_p;
+  wire [41:0] ei2_d1 = ei2_on0 ? ei2_d >> 1 : ei2_d;
+  wire [14:0] ei2_q1 = ei2_on0 ? {ei2_q[13:0], ei2_ge0} : ei2_q;
+  wire ei2_on1 = div_cnt >= 5'd1 && div_cnt - 5'd1 < 5'd15;
+  wire ei2_ge1 = ei2_p1 >= ei2_d1;
+  wire [41:0] ei2_p2 = (ei2_on1 && ei2_ge1) ? ei2_p1 - ei2_d1 : ei2_p1;
+  wire [41:0] ei2_d2 = ei2_on1 ? ei2_d1 >> 1 : ei2_d1;
+  wire [14:0] ei2_q2 = ei2_on1 ? {ei2_q1[13:0], ei2_ge1} : ei2_q1;
+  wire es2_on0 = div_cnt < 5'd15;
+  wire es2_ge0 = es2_p >= es2_d;
+  wire [33:0] es2_p1 = (es2_on0 && es2_ge0) ? es2_p - es2_d : es2_p;
+  wire [33:0] es2_d1 = es2_on0 ? es2_d >> 1 : es2_d;
+  wire [14:0] es2_q1 = es2_on0 ? {es2_q[13:0], es2_ge0} : es2_q;
+  wire es2_on1 = div_cnt >= 5'd1 && div_cnt - 5'd1 < 5'd15;
+  wire es2_ge1 = es2_p1 >= es2_d1;
+  wire [33:0] es2_p2 = (es2_on1 && es2_ge1) ? es2_p1 - es2_d1 : es2_p1;
+  wire [33:0] es2_d2 = es2_on1 ? es2_d1 >> 1 : es2_d1;
+  wire [14:0] es2_q2 = es2_on1 ? {es2_q1[13:0], es2_ge1} : es2_q1;
+  wire ddi_on0 = div_cnt < 5'd20;
+  wire ddi_ge0 = ddi_p >= ddi_d;
+  wire [62:0] ddi_p1 = (ddi_on0 && ddi_ge0) ? ddi_p - ddi_d : ddi_p;
+  wire [62:0] ddi_d1 = ddi_on0 ? ddi_d >> 1 : ddi_d;
+  wire [19:0] ddi_q1 = ddi_on0 ? {ddi_q[18:0], ddi_ge0} : ddi_q;
+  wire ddi_on1 = div_cnt >= 5'd1 && div_cnt - 5'd1 < 5'd20;
+  wire ddi_ge1 = ddi_p1 >= ddi_d1;
+  wire [62:0] ddi_p2 = (ddi_on1 && ddi_ge1) ? ddi_p1 - ddi_d1 : ddi_p1;
+  wire [62:0] ddi_d2 = ddi_on1 ? ddi_d1 >> 1 : ddi_d1;
+  wire [19:0] ddi_q2 = ddi_on1 ? {ddi_q1[18:0], ddi_ge1} : ddi_q1;
+  wire drn_on0 = div_cnt < 5'd23;
+  wire drn_ge0 = drn_p >= drn_d;
+  wire [65:0] drn_p1 = (drn_on0 && drn_ge0) ? drn_p - drn_d : drn_p;
+  wire [65:0] drn_d1 = drn_on0 ? drn_d >> 1 : drn_d;
+  wire [22:0] drn_q1 = drn_on0 ? {drn_q[21:0], drn_ge0} : drn_q;
+  wire drn_on1 = div_cnt >= 5'd1 && div_cnt - 5'd1 < 5'd23;
+  wire drn_ge1 = drn_p1 >= drn_d1;
+  wire [65:0] drn_p2 = (drn_on1 && drn_ge1) ? drn_p1 - drn_d1 : drn_p1;
+  wire [65:0] drn_d2 = drn_on1 ? drn_d1 >> 1 : drn_d1;
+  wire [22:0] drn_q2 = drn_on1 ? {drn_q1[21:0], drn_ge1} : drn_q1;
   // The set-up result, complete when the dividers are (HOLD).
   reg s_act0;
   reg s_right0;
@@ -329,66 +394,34 @@ module tri_frontend (
         end
       end
       if (st == DIV) begin
-        if (ei0_on) begin
-          if (ei0_ge) begin
-            ei0_p <= ei0_p - ei0_d;
-          end
-          ei0_d <= ei0_d >> 1;
-          ei0_q <= {ei0_q[13:0], ei0_ge};
-        end
-        if (es0_on) begin
-          if (es0_ge) begin
-            es0_p <= es0_p - es0_d;
-          end
-          es0_d <= es0_d >> 1;
-          es0_q <= {es0_q[13:0], es0_ge};
-        end
-        if (ei1_on) begin
-          if (ei1_ge) begin
-            ei1_p <= ei1_p - ei1_d;
-          end
-          ei1_d <= ei1_d >> 1;
-          ei1_q <= {ei1_q[13:0], ei1_ge};
-        end
-        if (es1_on) begin
-          if (es1_ge) begin
-            es1_p <= es1_p - es1_d;
-          end
-          es1_d <= es1_d >> 1;
-          es1_q <= {es1_q[13:0], es1_ge};
-        end
-        if (ei2_on) begin
-          if (ei2_ge) begin
-            ei2_p <= ei2_p - ei2_d;
-          end
-          ei2_d <= ei2_d >> 1;
-          ei2_q <= {ei2_q[13:0], ei2_ge};
-        end
-        if (es2_on) begin
-          if (es2_ge) begin
-            es2_p <= es2_p - es2_d;
-          end
-          es2_d <= es2_d >> 1;
-          es2_q <= {es2_q[13:0], es2_ge};
-        end
-        if (ddi_on) begin
-          if (ddi_ge) begin
-            ddi_p <= ddi_p - ddi_d;
-          end
-          ddi_d <= ddi_d >> 1;
-          ddi_q <= {ddi_q[18:0], ddi_ge};
-        end
-        if (drn_on) begin
-          if (drn_ge) begin
-            drn_p <= drn_p - drn_d;
-          end
-          drn_d <= drn_d >> 1;
-          drn_q <= {drn_q[21:0], drn_ge};
-        end
-        if (div_cnt == 5'd0) begin
+        ei0_p <= ei0_p2;
+        ei0_d <= ei0_d2;
+        ei0_q <= ei0_q2;
+        es0_p <= es0_p2;
+        es0_d <= es0_d2;
+        es0_q <= es0_q2;
+        ei1_p <= ei1_p2;
+        ei1_d <= ei1_d2;
+        ei1_q <= ei1_q2;
+        es1_p <= es1_p2;
+        es1_d <= es1_d2;
+        es1_q <= es1_q2;
+        ei2_p <= ei2_p2;
+        ei2_d <= ei2_d2;
+        ei2_q <= ei2_q2;
+        es2_p <= es2_p2;
+        es2_d <= es2_d2;
+        es2_q <= es2_q2;
+        ddi_p <= ddi_p2;
+        ddi_d <= ddi_d2;
+        ddi_q <= ddi_q2;
+        drn_p <= drn_p2;
+        drn_d <= drn_d2;
+        drn_q <= drn_q2;
+        if (div_cnt < 5'd2) begin
           st <= HOLD;
         end else begin
-          div_cnt <= div_cnt - 5'd1;
+          div_cnt <= div_cnt - 5'd2;
         end
       end
       if (take) begin

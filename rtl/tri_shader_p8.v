@@ -4,7 +4,7 @@
 // Chain: tri_frontend (set-up, edge walker) -> segment_shader_p8 -> out; out_y from a 4-entry FIFO
 // pushed when a span enters the shader and popped with its last segment.
 // Configuration: P = 8, F = 12, XW = 12, align = span, screen 640x480.
-// Latency: first segment 30 clocks after the triangle's transfer when idle.
+// Latency: first segment 19 clocks after the triangle's transfer when idle.
 
 `default_nettype none
 

@@ -22,7 +22,8 @@ const LAYOUT: &str = "one translation unit per model: class files, then the shim
 
 /// The segment widths built by default, each in both alignments; each p's BFPI is built too.
 const BUILT_P: [u32; 7] = [1, 2, 4, 8, 16, 32, 64];
-/// The triangle-to-segment chains built by default (SPEC §6), on 640x480.
+/// The triangle-to-segment chains built by default (SPEC §6), on 640x480; with
+/// `SEGSHADE_ALL_CHAINS` set, every P in both alignments.
 const BUILT_TRI: [(u32, Align); 4] = [(1, Align::Span), (8, Align::Span), (8, Align::Screen), (64, Align::Screen)];
 
 #[derive(Clone, Copy, PartialEq)]
@@ -54,6 +55,7 @@ fn main() {
     println!("cargo:rerun-if-changed=build.rs");
     println!("cargo:rerun-if-changed=csrc/shim.h");
     println!("cargo:rerun-if-env-changed=COSIM_RTL_DIR");
+    println!("cargo:rerun-if-env-changed=SEGSHADE_ALL_CHAINS");
     let out = PathBuf::from(std::env::var("OUT_DIR").unwrap());
     let models = match std::env::var_os("COSIM_RTL_DIR") {
         Some(dir) => {
@@ -106,13 +108,23 @@ fn generated_models() -> Vec<Model> {
                 models.push(Model { tag: format!("bfpi_p{p}"), kind: Kind::Bfpi, cfg, screen: Screen::default(), top: names.bfpi.clone(), latency: 0, sources: bfpi });
             }
             let latency = hdl_gen::segment::LATENCY;
-            if BUILT_TRI.contains(&(p, align)) {
+            // The chain at every P and alignment only on request (`sweep`'s front-end table):
+            // each is a few seconds of compiling that the test suite does not need.
+            if BUILT_TRI.contains(&(p, align)) || std::env::var_os("SEGSHADE_ALL_CHAINS").is_some() {
                 let opts = hdl_gen::Options { cfg, screen: Some(Screen::default()), ..Default::default() };
-                let fe = opts.frontend().expect("640x480 front-end");
-                let (fe_lat, top_lat) = (hdl_gen::frontend::latency(&fe), hdl_gen::frontend::latency(&fe) + latency);
+                let hw = opts.frontend().expect("640x480 front-end");
+                let fe = hw.fe;
+                let (fe_lat, top_lat) = (hw.latency(), hw.latency() + latency);
                 if p == 8 && align == Align::Span {
                     let src = sources.iter().filter(|(n, _)| *n == format!("{}.v", names.frontend)).cloned().collect();
                     models.push(Model { tag: "fe".into(), kind: Kind::Frontend, cfg, screen: fe.screen, top: names.frontend.clone(), latency: fe_lat, sources: src });
+                    // The other divider rates (`--fe-div-bits`), so co-simulation covers every option.
+                    for div_bits in hdl_gen::frontend::DIV_BITS.into_iter().filter(|&b| b != hw.div_bits) {
+                        let hw = hdl_gen::frontend::Hw { div_bits, ..hw };
+                        let m = hdl_gen::frontend::module(&hw, &names);
+                        let src = vec![(format!("{}.v", m.name), m.render())];
+                        models.push(Model { tag: format!("fe_div{div_bits}"), kind: Kind::Frontend, cfg, screen: fe.screen, top: m.name, latency: hw.latency(), sources: src });
+                    }
                 }
                 let chain = [&names.bfpi, &names.segment, &names.frontend, &names.top].map(|n| format!("{n}.v"));
                 let src = sources.iter().filter(|(n, _)| chain.contains(n)).cloned().collect();

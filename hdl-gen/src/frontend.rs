@@ -19,16 +19,35 @@ use crate::verilog::{assign, comment, lit, reg, set, sext, sreg, swire, wire, ze
 use crate::Names;
 use golden::frontend::{FrontEnd, Widths};
 
-/// Clocks from a triangle's transfer to the first span's `out_valid` when the walker is idle:
-/// CALC, RW clocks of DIV, the hand-off, the walker's clock, two pipeline stages.
-pub fn latency(fe: &FrontEnd) -> u32 {
-    fe.widths().rw + 5
+/// Quotient bits the set-up's dividers take per clock (`--fe-div-bits`): area against rate.
+pub const DIV_BITS: [u32; 3] = [1, 2, 4];
+pub const DEFAULT_DIV_BITS: u32 = 2;
+
+/// A front-end as generated: golden's configuration and the hardware's own choices.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Hw {
+    pub fe: FrontEnd,
+    /// Quotient bits per clock of every set-up divider (one of [`DIV_BITS`]).
+    pub div_bits: u32,
 }
 
-/// Clocks set-up spends per triangle that is walked (the rate limit for tiny triangles), and per
-/// triangle dropped in set-up (guard band, zero area, off-screen).
-pub fn setup_clocks(fe: &FrontEnd) -> (u32, u32) {
-    (fe.widths().rw + 3, 2)
+impl Hw {
+    /// Clocks the dividers run: the reciprocal's RW quotient bits, `div_bits` a clock.
+    pub fn div_clocks(&self) -> u32 {
+        self.fe.widths().rw.div_ceil(self.div_bits)
+    }
+
+    /// Clocks from a triangle's transfer to the first span's `out_valid` when the walker is
+    /// idle: CALC, the dividers, the hand-off, the walker's clock, two pipeline stages.
+    pub fn latency(&self) -> u32 {
+        self.div_clocks() + 5
+    }
+
+    /// Set-up clocks per triangle that is walked (the rate limit for tiny triangles: IDLE,
+    /// CALC, the dividers, HOLD), and per triangle dropped in set-up (IDLE, CALC).
+    pub fn setup_clocks(&self) -> (u32, u32) {
+        (self.div_clocks() + 3, 2)
+    }
 }
 
 fn slit(w: u32, v: i64) -> String {
@@ -90,29 +109,37 @@ fn div_load(d: &Div, dividend: &str, divisor_shifted: &str) -> Vec<Stmt> {
     ]
 }
 
-fn div_step(d: &Div, cnt_w: u32) -> Vec<Item> {
+/// `bits` restoring steps in one clock, chained: step j takes quotient bit `div_cnt - j`, if
+/// that bit exists and is one of this divider's `qb`.
+fn div_chain(d: &Div, cnt_w: u32, bits: u32) -> Vec<Item> {
     let n = d.name;
-    vec![
-        wire(&format!("{n}_ge"), 1, format!("{n}_p >= {n}_d")),
-        wire(&format!("{n}_on"), 1, format!("div_cnt < {}", lit(cnt_w, d.qb as u64))),
-    ]
+    let mut items = Vec::new();
+    for j in 0..bits {
+        let (p, dd, q) = if j == 0 { (format!("{n}_p"), format!("{n}_d"), format!("{n}_q")) } else { (format!("{n}_p{j}"), format!("{n}_d{j}"), format!("{n}_q{j}")) };
+        let on = if j == 0 {
+            format!("div_cnt < {}", lit(cnt_w, d.qb as u64))
+        } else {
+            format!("div_cnt >= {} && div_cnt - {} < {}", lit(cnt_w, j as u64), lit(cnt_w, j as u64), lit(cnt_w, d.qb as u64))
+        };
+        items.push(wire(&format!("{n}_on{j}"), 1, on));
+        items.push(wire(&format!("{n}_ge{j}"), 1, format!("{p} >= {dd}")));
+        let k = j + 1;
+        let shifted = if d.qb == 1 { format!("{n}_ge{j}") } else { format!("{{{q}[{}:0], {n}_ge{j}}}", d.qb - 2) };
+        items.push(wire(&format!("{n}_p{k}"), d.pw, format!("({n}_on{j} && {n}_ge{j}) ? {p} - {dd} : {p}")));
+        items.push(wire(&format!("{n}_d{k}"), d.pw, format!("{n}_on{j} ? {dd} >> 1 : {dd}")));
+        items.push(wire(&format!("{n}_q{k}"), d.qb, format!("{n}_on{j} ? {shifted} : {q}")));
+    }
+    items
 }
 
-fn div_iter(d: &Div) -> Stmt {
+fn div_iter(d: &Div, bits: u32) -> Vec<Stmt> {
     let n = d.name;
-    let q = if d.qb == 1 { format!("{n}_ge") } else { format!("{{{n}_q[{}:0], {n}_ge}}", d.qb - 2) };
-    Stmt::If(
-        format!("{n}_on"),
-        vec![
-            Stmt::If(format!("{n}_ge"), vec![set(format!("{n}_p"), format!("{n}_p - {n}_d"))], vec![]),
-            set(format!("{n}_d"), format!("{n}_d >> 1")),
-            set(format!("{n}_q"), q),
-        ],
-        vec![],
-    )
+    vec![set(format!("{n}_p"), format!("{n}_p{bits}")), set(format!("{n}_d"), format!("{n}_d{bits}")), set(format!("{n}_q"), format!("{n}_q{bits}"))]
 }
 
-pub fn module(fe: &FrontEnd, names: &Names) -> Module {
+pub fn module(hw: &Hw, names: &Names) -> Module {
+    let fe = &hw.fe;
+    let bits = hw.div_bits;
     let cfg = &fe.cfg;
     let wd = fe.widths();
     let Widths { yw, cx, cy, aw, gw, dw_edge: de, k: kk, rw, sw } = wd;
@@ -134,8 +161,12 @@ pub fn module(fe: &FrontEnd, names: &Names) -> Module {
         "Coverage: exactly golden::setup's (top-left rule, pixel centres, clipped), by an integer DDA per edge.".into(),
         format!("Spans: (y, x0, m, I0, dI) in SPEC §2's formats; I0 correctly rounded, dI rounded once per triangle;"),
         format!("every pixel within 1/2 + W 2^-(F+1) <= 1 of the plane through the vertex intensities."),
-        format!("Set-up: CALC 1 clock, {rw} divider clocks (8 restoring dividers in parallel), hand-off; dropped triangles take 2."),
-        format!("Latency: first span valid {} clocks after the triangle's transfer when the walker is idle.", latency(fe)),
+        format!(
+            "Set-up: CALC 1 clock, {} divider clocks (8 restoring dividers in parallel, {bits} quotient bit(s) a clock), hand-off;",
+            hw.div_clocks()
+        ),
+        format!("{} clocks per walked triangle, 2 per dropped one.", hw.setup_clocks().0),
+        format!("Latency: first span valid {} clocks after the triangle's transfer when the walker is idle.", hw.latency()),
         "Walker: one row per clock (rows with no covered pixel make a bubble); the next triangle's set-up overlaps it.".into(),
         format!("Widths: |A| {aw}, edge bound {gw} signed, edge divisor {de}, intensity sums modulo 2^{kk}, reciprocal {rw}."),
     ];
@@ -348,7 +379,7 @@ pub fn module(fe: &FrontEnd, names: &Names) -> Module {
         body.extend(div_regs(d));
     }
     for d in &divs {
-        body.extend(div_step(d, cnt_w));
+        body.extend(div_chain(d, cnt_w, bits));
     }
     body.push(comment("The set-up result, complete when the dividers are (HOLD)."));
     for k in 0..3 {
@@ -391,11 +422,11 @@ pub fn module(fe: &FrontEnd, names: &Names) -> Module {
         set("s_sat", "di_sat"),
         set("s_dineg", "nx_neg"),
     ]);
-    let mut div_run: Vec<Stmt> = divs.iter().map(div_iter).collect();
+    let mut div_run: Vec<Stmt> = divs.iter().flat_map(|d| div_iter(d, bits)).collect();
     div_run.push(Stmt::If(
-        format!("div_cnt == {}", lit(cnt_w, 0)),
+        format!("div_cnt < {}", lit(cnt_w, bits as u64)),
         vec![set("st", "HOLD")],
-        vec![set("div_cnt", format!("div_cnt - {}", lit(cnt_w, 1)))],
+        vec![set("div_cnt", format!("div_cnt - {}", lit(cnt_w, bits as u64)))],
     ));
     let mut take_in = vec![set("st", "CALC")];
     for k in 0..3 {
@@ -581,7 +612,8 @@ pub fn module(fe: &FrontEnd, names: &Names) -> Module {
 /// `tri_shader_p<P>`: the front-end, then the segment shader; `y` waits in a four-entry FIFO
 /// from the span's transfer into the shader to its last segment, so the shader keeps SPEC §3's
 /// ports exactly.
-pub fn top_module(fe: &FrontEnd, names: &Names) -> Module {
+pub fn top_module(hw: &Hw, names: &Names) -> Module {
+    let fe = &hw.fe;
     let cfg = &fe.cfg;
     let wd = fe.widths();
     let (xw, iw, dw, yw, p) = (cfg.xbits, cfg.iw(), cfg.dw(), wd.yw, cfg.p);
@@ -592,7 +624,7 @@ pub fn top_module(fe: &FrontEnd, names: &Names) -> Module {
         format!("Chain: {} (set-up, edge walker) -> {} -> out; out_y from a 4-entry FIFO", names.frontend, names.segment),
         "pushed when a span enters the shader and popped with its last segment.".into(),
         format!("Configuration: P = {p}, F = {}, XW = {xw}, align = {}, screen {}x{}.", cfg.frac, cfg.align, fe.screen.width, fe.screen.height),
-        format!("Latency: first segment {} clocks after the triangle's transfer when idle.", latency(fe) + crate::segment::LATENCY),
+        format!("Latency: first segment {} clocks after the triangle's transfer when idle.", hw.latency() + crate::segment::LATENCY),
     ];
     let mut ports: Vec<Port> = ports(fe, &wd).into_iter().map(|mut p| {
         p.reg = false;

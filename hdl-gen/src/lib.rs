@@ -62,6 +62,9 @@ pub struct Options {
     pub brdf: Option<golden::specular::SpecularPlan>,
     /// The front-end's screen (`--width`, `--height`); `None`: [`Options::default_screen`].
     pub screen: Option<golden::setup::Screen>,
+    /// Quotient bits per clock of the front-end's set-up dividers (`--fe-div-bits`); `None`:
+    /// [`frontend::DEFAULT_DIV_BITS`].
+    pub fe_div_bits: Option<u32>,
 }
 
 impl Options {
@@ -72,8 +75,9 @@ impl Options {
     }
 
     /// The front-end these options describe.
-    pub fn frontend(&self) -> Result<golden::frontend::FrontEnd, golden::frontend::FrontEndError> {
-        golden::frontend::FrontEnd::new(self.cfg, self.screen.unwrap_or_else(|| Options::default_screen(&self.cfg)))
+    pub fn frontend(&self) -> Result<frontend::Hw, golden::frontend::FrontEndError> {
+        let fe = golden::frontend::FrontEnd::new(self.cfg, self.screen.unwrap_or_else(|| Options::default_screen(&self.cfg)))?;
+        Ok(frontend::Hw { fe, div_bits: self.fe_div_bits.unwrap_or(frontend::DEFAULT_DIV_BITS) })
     }
 
     /// The specular unit these options describe, with its ROM images.

@@ -34,6 +34,10 @@ enum Command {
         /// Screen height of the triangle front-end (1..65536). Default: 480.
         #[arg(long, value_parser = clap::value_parser!(u32).range(1..=65536))]
         height: Option<u32>,
+        /// Quotient bits per clock of the front-end's set-up dividers: 1, 2 or 4. More bits,
+        /// fewer set-up clocks per triangle (tiny triangles go faster), longer paths. Default: 2.
+        #[arg(long = "fe-div-bits", value_parser = ["1", "2", "4"])]
+        fe_div_bits: Option<String>,
         /// Output folder (created if missing).
         #[arg(long)]
         out: PathBuf,
@@ -200,14 +204,15 @@ fn parse_cli() -> Cli {
 fn main() -> ExitCode {
     let cli = parse_cli();
     let result = match cli.command {
-        Command::Generate { config, bfpi_arch, brdf, width, height, out } => {
+        Command::Generate { config, bfpi_arch, brdf, width, height, fe_div_bits, out } => {
             let bfpi_arch = bfpi_arch.parse().expect("clap checked the bfpi arch");
             config
                 .options(&brdf)
                 .and_then(|opts| {
                     let default = Options::default_screen(&opts.cfg);
                     let screen = golden::setup::Screen { width: width.unwrap_or(default.width), height: height.unwrap_or(default.height) };
-                    let opts = Options { bfpi_arch, screen: Some(screen), ..opts };
+                    let fe_div_bits = fe_div_bits.map(|b| b.parse().expect("clap checked it"));
+                    let opts = Options { bfpi_arch, screen: Some(screen), fe_div_bits, ..opts };
                     opts.frontend().map_err(|e| format!("--width/--height: {e}"))?;
                     Ok(opts)
                 })

@@ -34,6 +34,8 @@ struct Frontend {
     screen: golden::setup::Screen,
     guard_band: String,
     widths: golden::frontend::Widths,
+    /// Quotient bits per clock of the set-up dividers (`--fe-div-bits`).
+    div_bits: u32,
     /// Clocks from a triangle's transfer to its first span when the walker is idle.
     latency: u32,
     /// Set-up clocks per walked triangle (its rate limit) and per dropped triangle.
@@ -149,7 +151,7 @@ pub fn render(opts: &Options, names: &Names, modules: &[Module], unit: &Specular
     let plan = BfpiPlan::new(cfg.p);
     let spec = SpecNames::new(&opts.prefix);
     let fe = opts.frontend().ok();
-    let fe_latency = fe.as_ref().map_or(0, crate::frontend::latency);
+    let fe_latency = fe.as_ref().map_or(0, |hw| hw.latency());
     let entry = |m: &Module| {
         let (role, latency, throughput) = if m.name == names.bfpi {
             ("bfpi", 0, "combinational")
@@ -199,21 +201,22 @@ pub fn render(opts: &Options, names: &Names, modules: &[Module], unit: &Specular
             nk_rom: RomEntry::new(&spec.nk, NK_HEX, unit.nk_rom()),
             geometry: unit.plan().geometry(),
         },
-        frontend: fe.map(|fe| Frontend {
+        frontend: fe.map(|hw| Frontend {
             module: names.frontend.clone(),
             top: names.top.clone(),
-            screen: fe.screen,
+            screen: hw.fe.screen,
             guard_band: format!(
                 "-{w} <= x < {}, -{h} <= y < {} pixels",
-                2 * fe.screen.width,
-                2 * fe.screen.height,
-                w = fe.screen.width,
-                h = fe.screen.height
+                2 * hw.fe.screen.width,
+                2 * hw.fe.screen.height,
+                w = hw.fe.screen.width,
+                h = hw.fe.screen.height
             ),
-            widths: fe.widths(),
-            latency: crate::frontend::latency(&fe),
-            setup_clocks_walked: crate::frontend::setup_clocks(&fe).0,
-            setup_clocks_dropped: crate::frontend::setup_clocks(&fe).1,
+            widths: hw.fe.widths(),
+            div_bits: hw.div_bits,
+            latency: hw.latency(),
+            setup_clocks_walked: hw.setup_clocks().0,
+            setup_clocks_dropped: hw.setup_clocks().1,
             walker: "one clock per row from the first to the last row of the bounding box on screen",
         }),
     };

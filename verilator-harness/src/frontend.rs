@@ -288,9 +288,17 @@ pub struct ChainRun {
 /// Streams triangles through `tri_shader_p<P>`: every segment and its y against golden, then
 /// the painted frame against golden's spans and the f64 reference, and no pixel written twice.
 pub fn run_chain(info: &'static ModelInfo<TriIn, TriSegOut>, seed: u64, traffic: Traffic, tris: &[FixedTriangle]) -> ChainRun {
+    run_chain_at(info, seed, traffic, tris, 0)
+}
+
+/// [`run_chain`] with the triangles numbered from `first` in the report (batches of one run).
+pub fn run_chain_at(info: &'static ModelInfo<TriIn, TriSegOut>, seed: u64, traffic: Traffic, tris: &[FixedTriangle], first: usize) -> ChainRun {
     let (cfg, screen) = (info.cfg, info.screen);
     let fe = FrontEnd::new(cfg, screen).expect("the model's front-end");
-    let exp = Expected::new(fe, tris);
+    let mut exp = Expected::new(fe, tris);
+    for s in &mut exp.stims {
+        s.triangle += first;
+    }
     let unit = TsUnit { fe, mask_bytes: cfg.p.div_ceil(8) as usize };
     let mut driver = Driver::new(Rtl::new(info, seed), TrafficGen::new(traffic, seed));
     let mut report = Report::default();

@@ -2,7 +2,7 @@
 //! segment and frame against the golden model. Ends with `N passed, M failed` (triangles).
 //! With `--specular`, the same for the specular unit, pixel by pixel (spans).
 
-use clap::Parser;
+use clap::{Parser, ValueEnum};
 use golden::setup::Screen;
 use golden::Align;
 use rand::rngs::StdRng;
@@ -11,7 +11,8 @@ use std::process::ExitCode;
 use std::time::Instant;
 use verilator_harness::cosim::{Report, SegmentCosim, Traffic};
 use golden::specular::SpecularUnit;
-use verilator_harness::ffi::{segment_model, SEGMENT_MODELS, SPECULAR_MODELS};
+use verilator_harness::ffi::{segment_model, SEGMENT_MODELS, SPECULAR_MODELS, TRISHADER_MODELS};
+use verilator_harness::frontend::{random_triangles, run_chain_at};
 use verilator_harness::specular::{random_span, SpecularCosim};
 use verilator_harness::stimulus::random_triangle;
 
@@ -41,6 +42,10 @@ struct Args {
     /// Triangles painted into one frame between frame checks.
     #[arg(long, default_value_t = 64, value_parser = clap::value_parser!(u64).range(1..))]
     batch: u64,
+    /// Who sets up the triangles: `host` (golden::setup feeds spans to segment_shader_p<P>) or
+    /// `rtl` (triangles into tri_shader_p<P>: the generated front-end, then the shader).
+    #[arg(long, value_enum, default_value_t = Frontend::Host)]
+    frontend: Frontend,
     /// Run the specular unit instead: random spans set up from random normals and
     /// half-vectors, every pixel checked; `N passed, M failed` then counts spans.
     #[arg(long)]
@@ -50,10 +55,19 @@ struct Args {
     pixels: u64,
 }
 
+#[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
+enum Frontend {
+    Host,
+    Rtl,
+}
+
 fn main() -> ExitCode {
     let args = Args::parse();
     if args.specular {
         return specular(&args);
+    }
+    if args.frontend == Frontend::Rtl {
+        return rtl_frontend(&args);
     }
     let align: Align = args.align.parse().expect("clap checked it");
     let Some(info) = segment_model(args.p, align) else {
@@ -100,6 +114,48 @@ fn main() -> ExitCode {
         report.pixels as f64 / secs,
         report.cycles as f64 / secs
     );
+    println!("{} passed, {} failed", report.passed_count(), report.failed_count());
+    exit_code(&report)
+}
+
+/// Random triangles of every kind into `tri_shader_p<P>`; every segment, `y` and frame checked.
+fn rtl_frontend(args: &Args) -> ExitCode {
+    let align: Align = args.align.parse().expect("clap checked it");
+    let Some(info) = TRISHADER_MODELS.iter().find(|m| m.cfg.p == args.p && m.cfg.align == align) else {
+        let built: Vec<&str> = TRISHADER_MODELS.iter().map(|m| m.tag).collect();
+        eprintln!("error: --frontend rtl --p {} --align {align}: no such model in this build (built: {})", args.p, built.join(", "));
+        return ExitCode::from(2);
+    };
+    if (args.width, args.height) != (info.screen.width, info.screen.height) {
+        eprintln!("error: --width/--height: the front-end model draws on {}x{}", info.screen.width, info.screen.height);
+        return ExitCode::from(2);
+    }
+    let seed = args.seed.unwrap_or_else(|| verilator_harness::seed("cosim --frontend rtl"));
+    let traffic = if args.traffic == "full" { Traffic::FULL } else { Traffic::RANDOM };
+    println!("model {} ({}), screen {}x{}, seed {seed}, traffic {}", info.tag, info.top, info.screen.width, info.screen.height, args.traffic);
+    let fe = golden::frontend::FrontEnd::new(info.cfg, info.screen).expect("the model's front-end");
+    let mut rng = StdRng::seed_from_u64(seed);
+    let mut report = Report::default();
+    let start = Instant::now();
+    let mut done = 0;
+    while done < args.triangles {
+        let n = (args.batch as usize).min(args.triangles - done);
+        let tris = random_triangles(&mut rng, &fe, n);
+        report.absorb(run_chain_at(info, seed.wrapping_add(done as u64), traffic, &tris, done).report);
+        done += n;
+    }
+    let secs = start.elapsed().as_secs_f64();
+    for m in &report.mismatches {
+        println!("MISMATCH (seed {seed}) {m}");
+    }
+    println!("triangles:  {} ({} dropped for the guard band)", report.triangles, report.pulses);
+    println!("segments:   {} compared", report.segments);
+    println!("pixels:     {} compared", report.pixels);
+    println!("mismatches: {}", report.mismatch_count);
+    println!("cycles:     {}", report.cycles);
+    println!("pixels per clock: {:.3}", report.pixels_per_clock());
+    println!("worst |pixel - exact|: {:.3}", report.max_error);
+    println!("wall: {secs:.2} s, {:.0} triangles/s, {:.0} clocks/s", report.triangles as f64 / secs, report.cycles as f64 / secs);
     println!("{} passed, {} failed", report.passed_count(), report.failed_count());
     exit_code(&report)
 }

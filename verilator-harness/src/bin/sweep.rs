@@ -18,7 +18,8 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 use std::time::Instant;
 use verilator_harness::cosim::{Report, SegmentCosim, Stim, Traffic};
-use verilator_harness::ffi::SEGMENT_MODELS;
+use verilator_harness::ffi::{SEGMENT_MODELS, TRISHADER_MODELS};
+use verilator_harness::frontend::run_chain;
 use verilator_harness::render::busy_cycles;
 
 #[derive(Parser)]
@@ -160,6 +161,30 @@ fn main() -> ExitCode {
         rows.push((format!("segment shader p = {p}, {align}"), "RTL", cells));
         rtl.push((p, align, ppcs));
     }
+    // Triangles into the RTL front-end and shader (tri_shader_p<P>), the same workload.
+    let mut chains: Vec<(String, Vec<String>)> = Vec::new();
+    let mut chain_models: Vec<_> = TRISHADER_MODELS.iter().filter(|m| m.screen == screen).collect();
+    chain_models.sort_by_key(|m| (m.cfg.p, m.cfg.align == Align::Screen));
+    for info in chain_models {
+        let (p, align) = (info.cfg.p, info.cfg.align);
+        let mut cells = Vec::new();
+        for (k, tris) in workloads.iter().enumerate() {
+            if show {
+                eprint!("\rsweep: {} on class {k}   ", info.tag);
+                let _ = std::io::stderr().flush();
+            }
+            let fixed: Vec<_> = tris.iter().map(|t| golden::frontend::FixedTriangle::from_triangle(t, info.cfg.frac)).collect();
+            let run = run_chain(info, args.seed, Traffic::FULL, &fixed);
+            if !run.report.ok() {
+                failures.push(format!("{}: class {k}: {} mismatches, first: {}", info.tag, run.report.mismatch_count, run.report.mismatches[0]));
+            }
+            let ppc = run.report.pixels_per_clock();
+            let fed = rtl.iter().find(|r| (r.0, r.1) == (p, align)).map(|r| r.2[k]);
+            let share = fed.map_or(String::new(), |f| format!(" ({:.0}%)", 100.0 * ppc / f));
+            cells.push(format!("{ppc:.2}{share}, {:.1}", 1000.0 * tris.len() as f64 / run.report.cycles.max(1) as f64));
+        }
+        chains.push((format!("front-end + shader p = {p}, {align}"), cells));
+    }
     if show {
         eprintln!();
     }
@@ -214,6 +239,19 @@ fn main() -> ExitCode {
     for (k, class) in ["~10 px", "~100 px", "~1000 px"].iter().enumerate() {
         let show = |a| best(a, k).map_or("-".to_string(), |p| p.to_string());
         let _ = writeln!(md, "- {class}: p = {} span-aligned, p = {} screen-aligned", show(Align::Span), show(Align::Screen));
+    }
+
+    if !chains.is_empty() {
+        let _ = writeln!(
+            md,
+            "\nTriangles into the generated front-end and shader (`tri_shader_p<P>`, SPEC §6), the same triangles, \
+             both ends always ready, every segment and the frame checked. Each cell: pixels per clock (in brackets: \
+             of the spans-fed shader's above), then triangles per 1000 clocks.\n"
+        );
+        let _ = writeln!(md, "| chain | ~10 px | ~100 px | ~1000 px |\n|---|---:|---:|---:|");
+        for (name, cells) in &chains {
+            let _ = writeln!(md, "| {name} | {} |", cells.join(" | "));
+        }
     }
 
     match &args.out {
