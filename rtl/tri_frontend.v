@@ -8,7 +8,7 @@
 // Spans: (y, x0, m, I0, dI) in SPEC §2's formats; I0 correctly rounded, dI rounded once per triangle;
 // every pixel within 1/2 + W 2^-(F+1) <= 1 of the plane through the vertex intensities.
 // Set-up: CALC 1 clock, 12 divider clocks (8 restoring dividers in parallel, 2 quotient bit(s) a clock), hand-off;
-// 15 clocks per walked triangle, 2 per dropped one.
+// 13 clocks per walked triangle, 1 per dropped one; the next triangle is latched meanwhile.
 // Latency: first span valid 17 clocks after the triangle's transfer when the walker is idle.
 // Walker: one row per clock (rows with no covered pixel make a bubble); the next triangle's set-up overlaps it.
 // Widths: |A| 42, edge bound 15 signed, edge divisor 27, intensity sums modulo 2^64, reciprocal 23.
@@ -38,9 +38,10 @@ module tri_frontend (
   output reg  [19:0] out_i0,        // UQ8.12; intensity at the first pixel's centre
   output reg  signed [20:0] out_di  // signed Q8.12; dI/dx, once per triangle
 );
-  // Set-up state: IDLE takes a triangle, CALC computes and loads the dividers, DIV runs them, HOLD offers the result.
+  // Set-up: a triangle waits in the vertex registers (v_full) until the dividers are free: idle, or
+  // handing their last result to the walker (take). In that clock CALC computes everything and loads
+  // the dividers; DIV runs them; HOLD offers the result. The next triangle is latched meanwhile.
   localparam [1:0] IDLE = 2'd0;
-  localparam [1:0] CALC = 2'd1;
   localparam [1:0] DIV = 2'd2;
   localparam [1:0] HOLD = 2'd3;
   reg [1:0] st;
@@ -54,7 +55,10 @@ module tri_frontend (
   reg signed [21:0] vx2;
   reg signed [18:0] vy2;
   reg [19:0] vi2;
-  assign in_ready = st == IDLE;
+  reg v_full;
+  wire take;
+  wire calc = v_full && (st == IDLE || take);
+  assign in_ready = !v_full || calc;
 
   // Guard band, on the registered vertices.
   wire guard_ok = (vx0 >= -22'sd163840 && vx0 < 22'sd327680) && (vy0 >= -19'sd122880 && vy0 < 19'sd245760) && (vx1 >= -22'sd163840 && vx1 < 22'sd327680) && (vy1 >= -19'sd122880 && vy1 < 19'sd245760) && (vx2 >= -22'sd163840 && vx2 < 22'sd327680) && (vy2 >= -19'sd122880 && vy2 < 19'sd245760);
@@ -320,11 +324,12 @@ module tri_frontend (
   always @(posedge clk) begin
     if (rst) begin
       st <= IDLE;
+      v_full <= 1'b0;
       err <= 1'b0;
     end else begin
       err <= 1'b0;
-      if (st == IDLE && in_valid) begin
-        st <= CALC;
+      if (in_valid && in_ready) begin
+        v_full <= 1'b1;
         vx0 <= in_x0;
         vy0 <= in_y0;
         vi0 <= in_i0;
@@ -334,8 +339,10 @@ module tri_frontend (
         vx2 <= in_x2;
         vy2 <= in_y2;
         vi2 <= in_i2;
+      end else if (calc) begin
+        v_full <= 1'b0;
       end
-      if (st == CALC) begin
+      if (calc) begin
         if (!guard_ok) begin
           err <= 1'b1;
           st <= IDLE;
@@ -392,40 +399,41 @@ module tri_frontend (
           s_sat <= di_sat;
           s_dineg <= nx_neg;
         end
-      end
-      if (st == DIV) begin
-        ei0_p <= ei0_p2;
-        ei0_d <= ei0_d2;
-        ei0_q <= ei0_q2;
-        es0_p <= es0_p2;
-        es0_d <= es0_d2;
-        es0_q <= es0_q2;
-        ei1_p <= ei1_p2;
-        ei1_d <= ei1_d2;
-        ei1_q <= ei1_q2;
-        es1_p <= es1_p2;
-        es1_d <= es1_d2;
-        es1_q <= es1_q2;
-        ei2_p <= ei2_p2;
-        ei2_d <= ei2_d2;
-        ei2_q <= ei2_q2;
-        es2_p <= es2_p2;
-        es2_d <= es2_d2;
-        es2_q <= es2_q2;
-        ddi_p <= ddi_p2;
-        ddi_d <= ddi_d2;
-        ddi_q <= ddi_q2;
-        drn_p <= drn_p2;
-        drn_d <= drn_d2;
-        drn_q <= drn_q2;
-        if (div_cnt < 5'd2) begin
-          st <= HOLD;
-        end else begin
-          div_cnt <= div_cnt - 5'd2;
+      end else begin
+        if (st == DIV) begin
+          ei0_p <= ei0_p2;
+          ei0_d <= ei0_d2;
+          ei0_q <= ei0_q2;
+          es0_p <= es0_p2;
+          es0_d <= es0_d2;
+          es0_q <= es0_q2;
+          ei1_p <= ei1_p2;
+          ei1_d <= ei1_d2;
+          ei1_q <= ei1_q2;
+          es1_p <= es1_p2;
+          es1_d <= es1_d2;
+          es1_q <= es1_q2;
+          ei2_p <= ei2_p2;
+          ei2_d <= ei2_d2;
+          ei2_q <= ei2_q2;
+          es2_p <= es2_p2;
+          es2_d <= es2_d2;
+          es2_q <= es2_q2;
+          ddi_p <= ddi_p2;
+          ddi_d <= ddi_d2;
+          ddi_q <= ddi_q2;
+          drn_p <= drn_p2;
+          drn_d <= drn_d2;
+          drn_q <= drn_q2;
+          if (div_cnt < 5'd2) begin
+            st <= HOLD;
+          end else begin
+            div_cnt <= div_cnt - 5'd2;
+          end
         end
-      end
-      if (take) begin
-        st <= IDLE;
+        if (take) begin
+          st <= IDLE;
+        end
       end
     end
   end
@@ -486,7 +494,7 @@ module tri_frontend (
   reg [63:0] w_dyn;
   wire adv = !out_valid || out_ready;
   wire w_end = w_row == w_last;
-  wire take = st == HOLD && adv && (!w_valid || w_end);
+  assign take = st == HOLD && adv && (!w_valid || w_end);
   wire signed [15:0] lo0 = 16'sd0;
   wire signed [15:0] hi0 = 16'sd639;
   wire in0 = w_act0 && w_row >= w_rs0 && w_row <= w_re0;

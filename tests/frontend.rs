@@ -100,3 +100,25 @@ fn the_scoreboard_catches_a_wrong_span() {
     let report = verilator_harness::frontend::run_frontend_against(m, seed, &tris, &exp_bad);
     assert!(!report.ok(), "a wrong expectation went unnoticed");
 }
+
+#[test]
+fn set_up_costs_what_the_manifest_says() {
+    // Triangles of one row each are set-up bound; zero-area ones cost their CALC clock only.
+    let m = FRONTEND_MODELS.iter().find(|m| m.tag == "fe").expect("the default front-end model");
+    let hw = hdl_gen::frontend::Hw { fe: frontend(m), div_bits: hdl_gen::frontend::DEFAULT_DIV_BITS };
+    let (walked, dropped) = hw.setup_clocks();
+    let n = 400u64;
+    let row = FixedTriangle { x: [2560, 7680, 2560], y: [2600, 2600, 2800], i: [100 << 12; 3] };
+    let flat = FixedTriangle { x: [2560, 5120, 7680], y: [2560, 5120, 7680], i: [0; 3] };
+    for (tri, per, what) in [(row, walked, "one-row"), (flat, dropped, "zero-area")] {
+        let tris = vec![tri; n as usize];
+        let report = run_frontend(m, 1, Traffic::FULL, Stress::NONE, &tris);
+        assert_clean(m.tag, 1, &report);
+        let slack = hw.latency() as u64 + 8;
+        assert!(
+            report.cycles >= n * per as u64 && report.cycles <= n * per as u64 + slack,
+            "{n} {what} triangles took {} clocks; the manifest says {per} each (+ at most {slack})",
+            report.cycles
+        );
+    }
+}

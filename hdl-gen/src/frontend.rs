@@ -4,10 +4,11 @@
 //! why it is exact and how accurate the intensities are.
 //!
 //! Structure of `tri_frontend`:
-//! - **set-up**, a small state machine: `IDLE` takes a triangle into registers; `CALC` (one
-//!   clock) checks the guard band, computes the area, orients the edges, finds the rows, culls,
-//!   and loads eight restoring dividers; `DIV` runs them together (one quotient bit per clock,
-//!   RW = IW + 3 clocks); `HOLD` offers the result to the walker.
+//! - **set-up**: a triangle waits in the vertex registers until the dividers are free; in that
+//!   clock CALC checks the guard band, computes the area, orients the edges, finds the rows,
+//!   culls, and loads eight restoring dividers (`--fe-div-bits` quotient bits a clock); `DIV`
+//!   runs them together; `HOLD` offers the result to the walker. The hand-off clock is also the
+//!   next triangle's CALC, and the next triangle is latched while the dividers run.
 //! - **edge walker**: one row per clock. Per active edge one DDA step (add, compare, subtract);
 //!   `lo` and `hi` are the max and min of the active bounds, clipped to the screen. It loads the
 //!   next triangle in the clock its current one finishes, so set-up overlaps the walk.
@@ -15,7 +16,7 @@
 //!   walker's clock, then `q~ = (S2n Rn) >> K`, then the correction `q~ + (S2n - 2 An q~ >= 2 An)`.
 //!   One stall signal holds the walker and every stage while the output waits.
 
-use crate::verilog::{assign, comment, lit, reg, set, sext, sreg, swire, wire, zext, Item, Module, Port, Stmt};
+use crate::verilog::{assign, comment, lit, net, reg, set, sext, sreg, swire, wire, zext, Item, Module, Port, Stmt};
 use crate::Names;
 use golden::frontend::{FrontEnd, Widths};
 
@@ -43,10 +44,11 @@ impl Hw {
         self.div_clocks() + 5
     }
 
-    /// Set-up clocks per triangle that is walked (the rate limit for tiny triangles: IDLE,
-    /// CALC, the dividers, HOLD), and per triangle dropped in set-up (IDLE, CALC).
+    /// Set-up clocks per triangle that is walked (the rate limit for tiny triangles: the
+    /// dividers, then the hand-off clock, which is also the next triangle's CALC), and per
+    /// triangle dropped in set-up (its CALC).
     pub fn setup_clocks(&self) -> (u32, u32) {
-        (self.div_clocks() + 3, 2)
+        (self.div_clocks() + 1, 1)
     }
 }
 
@@ -165,15 +167,18 @@ pub fn module(hw: &Hw, names: &Names) -> Module {
             "Set-up: CALC 1 clock, {} divider clocks (8 restoring dividers in parallel, {bits} quotient bit(s) a clock), hand-off;",
             hw.div_clocks()
         ),
-        format!("{} clocks per walked triangle, 2 per dropped one.", hw.setup_clocks().0),
+        format!("{} clocks per walked triangle, 1 per dropped one; the next triangle is latched meanwhile.", hw.setup_clocks().0),
         format!("Latency: first span valid {} clocks after the triangle's transfer when the walker is idle.", hw.latency()),
         "Walker: one row per clock (rows with no covered pixel make a bubble); the next triangle's set-up overlaps it.".into(),
         format!("Widths: |A| {aw}, edge bound {gw} signed, edge divisor {de}, intensity sums modulo 2^{kk}, reciprocal {rw}."),
     ];
 
-    let mut body = vec![comment("Set-up state: IDLE takes a triangle, CALC computes and loads the dividers, DIV runs them, HOLD offers the result.")];
+    let mut body = vec![
+        comment("Set-up: a triangle waits in the vertex registers (v_full) until the dividers are free: idle, or"),
+        comment("handing their last result to the walker (take). In that clock CALC computes everything and loads"),
+        comment("the dividers; DIV runs them; HOLD offers the result. The next triangle is latched meanwhile."),
+    ];
     body.push(Item::Localparam { name: "IDLE".into(), width: 2, value: "2'd0".into() });
-    body.push(Item::Localparam { name: "CALC".into(), width: 2, value: "2'd1".into() });
     body.push(Item::Localparam { name: "DIV".into(), width: 2, value: "2'd2".into() });
     body.push(Item::Localparam { name: "HOLD".into(), width: 2, value: "2'd3".into() });
     body.push(reg("st", 2));
@@ -183,7 +188,10 @@ pub fn module(hw: &Hw, names: &Names) -> Module {
         body.push(sreg(&format!("vy{k}"), cy));
         body.push(reg(&format!("vi{k}"), iw));
     }
-    body.push(assign("in_ready", "st == IDLE"));
+    body.push(reg("v_full", 1));
+    body.push(net("take", 1));
+    body.push(wire("calc", 1, "v_full && (st == IDLE || take)"));
+    body.push(assign("in_ready", "!v_full || calc"));
     body.push(Item::Blank);
 
     // ---- CALC: everything from the vertex registers, combinational.
@@ -428,7 +436,7 @@ pub fn module(hw: &Hw, names: &Names) -> Module {
         vec![set("st", "HOLD")],
         vec![set("div_cnt", format!("div_cnt - {}", lit(cnt_w, bits as u64)))],
     ));
-    let mut take_in = vec![set("st", "CALC")];
+    let mut take_in = vec![set("v_full", "1'b1")];
     for k in 0..3 {
         take_in.push(set(format!("vx{k}"), format!("in_x{k}")));
         take_in.push(set(format!("vy{k}"), format!("in_y{k}")));
@@ -436,21 +444,19 @@ pub fn module(hw: &Hw, names: &Names) -> Module {
     }
     body.push(Item::Always(vec![Stmt::If(
         "rst".into(),
-        vec![set("st", "IDLE"), set("err", "1'b0")],
+        vec![set("st", "IDLE"), set("v_full", "1'b0"), set("err", "1'b0")],
         vec![
             set("err", "1'b0"),
-            Stmt::If("st == IDLE && in_valid".into(), take_in, vec![]),
+            Stmt::If("in_valid && in_ready".into(), take_in, vec![Stmt::If("calc".into(), vec![set("v_full", "1'b0")], vec![])]),
             Stmt::If(
-                "st == CALC".into(),
+                "calc".into(),
                 vec![Stmt::If(
                     "!guard_ok".into(),
                     vec![set("err", "1'b1"), set("st", "IDLE")],
                     vec![Stmt::If("cull".into(), vec![set("st", "IDLE")], calc_load)],
                 )],
-                vec![],
+                vec![Stmt::If("st == DIV".into(), div_run, vec![]), Stmt::If("take".into(), vec![set("st", "IDLE")], vec![])],
             ),
-            Stmt::If("st == DIV".into(), div_run, vec![]),
-            Stmt::If("take".into(), vec![set("st", "IDLE")], vec![]),
         ],
     )]));
     body.push(Item::Blank);
@@ -492,7 +498,7 @@ pub fn module(hw: &Hw, names: &Names) -> Module {
     }
     body.push(wire("adv", 1, "!out_valid || out_ready"));
     body.push(wire("w_end", 1, "w_row == w_last"));
-    body.push(wire("take", 1, "st == HOLD && adv && (!w_valid || w_end)"));
+    body.push(assign("take", "st == HOLD && adv && (!w_valid || w_end)"));
     let bw = gw + 1;
     body.push(swire("lo0", bw, slit(bw, 0)));
     body.push(swire("hi0", bw, slit(bw, w - 1)));
