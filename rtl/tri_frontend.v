@@ -7,9 +7,9 @@
 // Coverage: exactly golden::setup's (top-left rule, pixel centres, clipped), by an integer DDA per edge.
 // Spans: (y, x0, m, I0, dI) in SPEC §2's formats; I0 correctly rounded, dI rounded once per triangle;
 // every pixel within 1/2 + W 2^-(F+1) <= 1 of the plane through the vertex intensities.
-// Set-up: CALC 1 clock, 12 divider clocks (8 restoring dividers in parallel, 2 quotient bit(s) a clock), hand-off;
-// 13 clocks per walked triangle, 1 per dropped one; the next triangle is latched meanwhile.
-// Latency: first span valid 17 clocks after the triangle's transfer when the walker is idle.
+// Set-up: CALC 1 clock, 6 divider clocks (8 restoring dividers in parallel, 4 quotient bit(s) a clock), hand-off;
+// 7 clocks per walked triangle, 1 per dropped one; the next triangle is latched meanwhile.
+// Latency: first span valid 11 clocks after the triangle's transfer when the walker is idle.
 // Walker: one row per clock (rows with no covered pixel make a bubble); the next triangle's set-up overlaps it.
 // Widths: |A| 42, edge bound 15 signed, edge divisor 27, intensity sums modulo 2^64, reciprocal 23.
 
@@ -226,6 +226,16 @@ module tri_frontend (
   wire [41:0] ei0_p2 = (ei0_on1 && ei0_ge1) ? ei0_p1 - ei0_d1 : ei0_p1;
   wire [41:0] ei0_d2 = ei0_on1 ? ei0_d1 >> 1 : ei0_d1;
   wire [14:0] ei0_q2 = ei0_on1 ? {ei0_q1[13:0], ei0_ge1} : ei0_q1;
+  wire ei0_on2 = div_cnt >= 5'd2 && div_cnt - 5'd2 < 5'd15;
+  wire ei0_ge2 = ei0_p2 >= ei0_d2;
+  wire [41:0] ei0_p3 = (ei0_on2 && ei0_ge2) ? ei0_p2 - ei0_d2 : ei0_p2;
+  wire [41:0] ei0_d3 = ei0_on2 ? ei0_d2 >> 1 : ei0_d2;
+  wire [14:0] ei0_q3 = ei0_on2 ? {ei0_q2[13:0], ei0_ge2} : ei0_q2;
+  wire ei0_on3 = div_cnt >= 5'd3 && div_cnt - 5'd3 < 5'd15;
+  wire ei0_ge3 = ei0_p3 >= ei0_d3;
+  wire [41:0] ei0_p4 = (ei0_on3 && ei0_ge3) ? ei0_p3 - ei0_d3 : ei0_p3;
+  wire [41:0] ei0_d4 = ei0_on3 ? ei0_d3 >> 1 : ei0_d3;
+  wire [14:0] ei0_q4 = ei0_on3 ? {ei0_q3[13:0], ei0_ge3} : ei0_q3;
   wire es0_on0 = div_cnt < 5'd15;
   wire es0_ge0 = es0_p >= es0_d;
   wire [33:0] es0_p1 = (es0_on0 && es0_ge0) ? es0_p - es0_d : es0_p;
@@ -236,6 +246,16 @@ module tri_frontend (
   wire [33:0] es0_p2 = (es0_on1 && es0_ge1) ? es0_p1 - es0_d1 : es0_p1;
   wire [33:0] es0_d2 = es0_on1 ? es0_d1 >> 1 : es0_d1;
   wire [14:0] es0_q2 = es0_on1 ? {es0_q1[13:0], es0_ge1} : es0_q1;
+  wire es0_on2 = div_cnt >= 5'd2 && div_cnt - 5'd2 < 5'd15;
+  wire es0_ge2 = es0_p2 >= es0_d2;
+  wire [33:0] es0_p3 = (es0_on2 && es0_ge2) ? es0_p2 - es0_d2 : es0_p2;
+  wire [33:0] es0_d3 = es0_on2 ? es0_d2 >> 1 : es0_d2;
+  wire [14:0] es0_q3 = es0_on2 ? {es0_q2[13:0], es0_ge2} : es0_q2;
+  wire es0_on3 = div_cnt >= 5'd3 && div_cnt - 5'd3 < 5'd15;
+  wire es0_ge3 = es0_p3 >= es0_d3;
+  wire [33:0] es0_p4 = (es0_on3 && es0_ge3) ? es0_p3 - es0_d3 : es0_p3;
+  wire [33:0] es0_d4 = es0_on3 ? es0_d3 >> 1 : es0_d3;
+  wire [14:0] es0_q4 = es0_on3 ? {es0_q3[13:0], es0_ge3} : es0_q3;
   wire ei1_on0 = div_cnt < 5'd15;
   wire ei1_ge0 = ei1_p >= ei1_d;
   wire [41:0] ei1_p1 = (ei1_on0 && ei1_ge0) ? ei1_p - ei1_d : ei1_p;
@@ -246,6 +266,16 @@ module tri_frontend (
   wire [41:0] ei1_p2 = (ei1_on1 && ei1_ge1) ? ei1_p1 - ei1_d1 : ei1_p1;
   wire [41:0] ei1_d2 = ei1_on1 ? ei1_d1 >> 1 : ei1_d1;
   wire [14:0] ei1_q2 = ei1_on1 ? {ei1_q1[13:0], ei1_ge1} : ei1_q1;
+  wire ei1_on2 = div_cnt >= 5'd2 && div_cnt - 5'd2 < 5'd15;
+  wire ei1_ge2 = ei1_p2 >= ei1_d2;
+  wire [41:0] ei1_p3 = (ei1_on2 && ei1_ge2) ? ei1_p2 - ei1_d2 : ei1_p2;
+  wire [41:0] ei1_d3 = ei1_on2 ? ei1_d2 >> 1 : ei1_d2;
+  wire [14:0] ei1_q3 = ei1_on2 ? {ei1_q2[13:0], ei1_ge2} : ei1_q2;
+  wire ei1_on3 = div_cnt >= 5'd3 && div_cnt - 5'd3 < 5'd15;
+  wire ei1_ge3 = ei1_p3 >= ei1_d3;
+  wire [41:0] ei1_p4 = (ei1_on3 && ei1_ge3) ? ei1_p3 - ei1_d3 : ei1_p3;
+  wire [41:0] ei1_d4 = ei1_on3 ? ei1_d3 >> 1 : ei1_d3;
+  wire [14:0] ei1_q4 = ei1_on3 ? {ei1_q3[13:0], ei1_ge3} : ei1_q3;
   wire es1_on0 = div_cnt < 5'd15;
   wire es1_ge0 = es1_p >= es1_d;
   wire [33:0] es1_p1 = (es1_on0 && es1_ge0) ? es1_p - es1_d : es1_p;
@@ -256,6 +286,16 @@ module tri_frontend (
   wire [33:0] es1_p2 = (es1_on1 && es1_ge1) ? es1_p1 - es1_d1 : es1_p1;
   wire [33:0] es1_d2 = es1_on1 ? es1_d1 >> 1 : es1_d1;
   wire [14:0] es1_q2 = es1_on1 ? {es1_q1[13:0], es1_ge1} : es1_q1;
+  wire es1_on2 = div_cnt >= 5'd2 && div_cnt - 5'd2 < 5'd15;
+  wire es1_ge2 = es1_p2 >= es1_d2;
+  wire [33:0] es1_p3 = (es1_on2 && es1_ge2) ? es1_p2 - es1_d2 : es1_p2;
+  wire [33:0] es1_d3 = es1_on2 ? es1_d2 >> 1 : es1_d2;
+  wire [14:0] es1_q3 = es1_on2 ? {es1_q2[13:0], es1_ge2} : es1_q2;
+  wire es1_on3 = div_cnt >= 5'd3 && div_cnt - 5'd3 < 5'd15;
+  wire es1_ge3 = es1_p3 >= es1_d3;
+  wire [33:0] es1_p4 = (es1_on3 && es1_ge3) ? es1_p3 - es1_d3 : es1_p3;
+  wire [33:0] es1_d4 = es1_on3 ? es1_d3 >> 1 : es1_d3;
+  wire [14:0] es1_q4 = es1_on3 ? {es1_q3[13:0], es1_ge3} : es1_q3;
   wire ei2_on0 = div_cnt < 5'd15;
   wire ei2_ge0 = ei2_p >= ei2_d;
   wire [41:0] ei2_p1 = (ei2_on0 && ei2_ge0) ? ei2_p - ei2_d : ei2_p;
@@ -266,6 +306,16 @@ module tri_frontend (
   wire [41:0] ei2_p2 = (ei2_on1 && ei2_ge1) ? ei2_p1 - ei2_d1 : ei2_p1;
   wire [41:0] ei2_d2 = ei2_on1 ? ei2_d1 >> 1 : ei2_d1;
   wire [14:0] ei2_q2 = ei2_on1 ? {ei2_q1[13:0], ei2_ge1} : ei2_q1;
+  wire ei2_on2 = div_cnt >= 5'd2 && div_cnt - 5'd2 < 5'd15;
+  wire ei2_ge2 = ei2_p2 >= ei2_d2;
+  wire [41:0] ei2_p3 = (ei2_on2 && ei2_ge2) ? ei2_p2 - ei2_d2 : ei2_p2;
+  wire [41:0] ei2_d3 = ei2_on2 ? ei2_d2 >> 1 : ei2_d2;
+  wire [14:0] ei2_q3 = ei2_on2 ? {ei2_q2[13:0], ei2_ge2} : ei2_q2;
+  wire ei2_on3 = div_cnt >= 5'd3 && div_cnt - 5'd3 < 5'd15;
+  wire ei2_ge3 = ei2_p3 >= ei2_d3;
+  wire [41:0] ei2_p4 = (ei2_on3 && ei2_ge3) ? ei2_p3 - ei2_d3 : ei2_p3;
+  wire [41:0] ei2_d4 = ei2_on3 ? ei2_d3 >> 1 : ei2_d3;
+  wire [14:0] ei2_q4 = ei2_on3 ? {ei2_q3[13:0], ei2_ge3} : ei2_q3;
   wire es2_on0 = div_cnt < 5'd15;
   wire es2_ge0 = es2_p >= es2_d;
   wire [33:0] es2_p1 = (es2_on0 && es2_ge0) ? es2_p - es2_d : es2_p;
@@ -276,6 +326,16 @@ module tri_frontend (
   wire [33:0] es2_p2 = (es2_on1 && es2_ge1) ? es2_p1 - es2_d1 : es2_p1;
   wire [33:0] es2_d2 = es2_on1 ? es2_d1 >> 1 : es2_d1;
   wire [14:0] es2_q2 = es2_on1 ? {es2_q1[13:0], es2_ge1} : es2_q1;
+  wire es2_on2 = div_cnt >= 5'd2 && div_cnt - 5'd2 < 5'd15;
+  wire es2_ge2 = es2_p2 >= es2_d2;
+  wire [33:0] es2_p3 = (es2_on2 && es2_ge2) ? es2_p2 - es2_d2 : es2_p2;
+  wire [33:0] es2_d3 = es2_on2 ? es2_d2 >> 1 : es2_d2;
+  wire [14:0] es2_q3 = es2_on2 ? {es2_q2[13:0], es2_ge2} : es2_q2;
+  wire es2_on3 = div_cnt >= 5'd3 && div_cnt - 5'd3 < 5'd15;
+  wire es2_ge3 = es2_p3 >= es2_d3;
+  wire [33:0] es2_p4 = (es2_on3 && es2_ge3) ? es2_p3 - es2_d3 : es2_p3;
+  wire [33:0] es2_d4 = es2_on3 ? es2_d3 >> 1 : es2_d3;
+  wire [14:0] es2_q4 = es2_on3 ? {es2_q3[13:0], es2_ge3} : es2_q3;
   wire ddi_on0 = div_cnt < 5'd20;
   wire ddi_ge0 = ddi_p >= ddi_d;
   wire [62:0] ddi_p1 = (ddi_on0 && ddi_ge0) ? ddi_p - ddi_d : ddi_p;
@@ -286,6 +346,16 @@ module tri_frontend (
   wire [62:0] ddi_p2 = (ddi_on1 && ddi_ge1) ? ddi_p1 - ddi_d1 : ddi_p1;
   wire [62:0] ddi_d2 = ddi_on1 ? ddi_d1 >> 1 : ddi_d1;
   wire [19:0] ddi_q2 = ddi_on1 ? {ddi_q1[18:0], ddi_ge1} : ddi_q1;
+  wire ddi_on2 = div_cnt >= 5'd2 && div_cnt - 5'd2 < 5'd20;
+  wire ddi_ge2 = ddi_p2 >= ddi_d2;
+  wire [62:0] ddi_p3 = (ddi_on2 && ddi_ge2) ? ddi_p2 - ddi_d2 : ddi_p2;
+  wire [62:0] ddi_d3 = ddi_on2 ? ddi_d2 >> 1 : ddi_d2;
+  wire [19:0] ddi_q3 = ddi_on2 ? {ddi_q2[18:0], ddi_ge2} : ddi_q2;
+  wire ddi_on3 = div_cnt >= 5'd3 && div_cnt - 5'd3 < 5'd20;
+  wire ddi_ge3 = ddi_p3 >= ddi_d3;
+  wire [62:0] ddi_p4 = (ddi_on3 && ddi_ge3) ? ddi_p3 - ddi_d3 : ddi_p3;
+  wire [62:0] ddi_d4 = ddi_on3 ? ddi_d3 >> 1 : ddi_d3;
+  wire [19:0] ddi_q4 = ddi_on3 ? {ddi_q3[18:0], ddi_ge3} : ddi_q3;
   wire drn_on0 = div_cnt < 5'd23;
   wire drn_ge0 = drn_p >= drn_d;
   wire [65:0] drn_p1 = (drn_on0 && drn_ge0) ? drn_p - drn_d : drn_p;
@@ -296,6 +366,16 @@ module tri_frontend (
   wire [65:0] drn_p2 = (drn_on1 && drn_ge1) ? drn_p1 - drn_d1 : drn_p1;
   wire [65:0] drn_d2 = drn_on1 ? drn_d1 >> 1 : drn_d1;
   wire [22:0] drn_q2 = drn_on1 ? {drn_q1[21:0], drn_ge1} : drn_q1;
+  wire drn_on2 = div_cnt >= 5'd2 && div_cnt - 5'd2 < 5'd23;
+  wire drn_ge2 = drn_p2 >= drn_d2;
+  wire [65:0] drn_p3 = (drn_on2 && drn_ge2) ? drn_p2 - drn_d2 : drn_p2;
+  wire [65:0] drn_d3 = drn_on2 ? drn_d2 >> 1 : drn_d2;
+  wire [22:0] drn_q3 = drn_on2 ? {drn_q2[21:0], drn_ge2} : drn_q2;
+  wire drn_on3 = div_cnt >= 5'd3 && div_cnt - 5'd3 < 5'd23;
+  wire drn_ge3 = drn_p3 >= drn_d3;
+  wire [65:0] drn_p4 = (drn_on3 && drn_ge3) ? drn_p3 - drn_d3 : drn_p3;
+  wire [65:0] drn_d4 = drn_on3 ? drn_d3 >> 1 : drn_d3;
+  wire [22:0] drn_q4 = drn_on3 ? {drn_q3[21:0], drn_ge3} : drn_q3;
   // The set-up result, complete when the dividers are (HOLD).
   reg s_act0;
   reg s_right0;
@@ -401,34 +481,34 @@ module tri_frontend (
         end
       end else begin
         if (st == DIV) begin
-          ei0_p <= ei0_p2;
-          ei0_d <= ei0_d2;
-          ei0_q <= ei0_q2;
-          es0_p <= es0_p2;
-          es0_d <= es0_d2;
-          es0_q <= es0_q2;
-          ei1_p <= ei1_p2;
-          ei1_d <= ei1_d2;
-          ei1_q <= ei1_q2;
-          es1_p <= es1_p2;
-          es1_d <= es1_d2;
-          es1_q <= es1_q2;
-          ei2_p <= ei2_p2;
-          ei2_d <= ei2_d2;
-          ei2_q <= ei2_q2;
-          es2_p <= es2_p2;
-          es2_d <= es2_d2;
-          es2_q <= es2_q2;
-          ddi_p <= ddi_p2;
-          ddi_d <= ddi_d2;
-          ddi_q <= ddi_q2;
-          drn_p <= drn_p2;
-          drn_d <= drn_d2;
-          drn_q <= drn_q2;
-          if (div_cnt < 5'd2) begin
+          ei0_p <= ei0_p4;
+          ei0_d <= ei0_d4;
+          ei0_q <= ei0_q4;
+          es0_p <= es0_p4;
+          es0_d <= es0_d4;
+          es0_q <= es0_q4;
+          ei1_p <= ei1_p4;
+          ei1_d <= ei1_d4;
+          ei1_q <= ei1_q4;
+          es1_p <= es1_p4;
+          es1_d <= es1_d4;
+          es1_q <= es1_q4;
+          ei2_p <= ei2_p4;
+          ei2_d <= ei2_d4;
+          ei2_q <= ei2_q4;
+          es2_p <= es2_p4;
+          es2_d <= es2_d4;
+          es2_q <= es2_q4;
+          ddi_p <= ddi_p4;
+          ddi_d <= ddi_d4;
+          ddi_q <= ddi_q4;
+          drn_p <= drn_p4;
+          drn_d <= drn_d4;
+          drn_q <= drn_q4;
+          if (div_cnt < 5'd4) begin
             st <= HOLD;
           end else begin
-            div_cnt <= div_cnt - 5'd2;
+            div_cnt <= div_cnt - 5'd4;
           end
         end
         if (take) begin
