@@ -589,6 +589,7 @@ mod tests {
                 }
             });
         }
+        eprintln!("widest screen (4096 px, F = 12): worst |pixel - plane| {worst:.4}");
         assert!(worst <= 1.0, "{worst}");
         assert!(worst > 0.5, "the test should reach past the rounding alone: {worst}");
     }
