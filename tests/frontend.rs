@@ -122,3 +122,21 @@ fn set_up_costs_what_the_manifest_says() {
         );
     }
 }
+
+#[test]
+fn scenes_render_through_the_rtl_chain_as_golden() {
+    use golden::setup::Screen;
+    use verilator_harness::render::{run_with, scene_job, SceneKind};
+    let chain = TRISHADER_MODELS.iter().find(|m| m.cfg.p == 8 && m.cfg.align == golden::Align::Span).expect("tris_p8_span");
+    let seg = verilator_harness::ffi::segment_model(8, golden::Align::Span).expect("seg_p8_span");
+    for kind in [SceneKind::Sphere, SceneKind::Torus] {
+        let job = scene_job(kind, 40, &seg.cfg, &Screen::default()).unwrap();
+        let o = run_with(&job, seg, Some(chain), None, |_| {});
+        assert!(o.cosim_ok(), "{:?}", o.segment.iter().flat_map(|r| &r.mismatches).next());
+        assert_eq!(o.differing_pixels(3), 0, "RTL image differs from golden's front-end image");
+        // Against the host set-up only the rounding of vertex intensities onto the ports shows.
+        let host = o.host.as_ref().expect("the host image");
+        let differ = (0..host.len() / 3).filter(|&k| host[3 * k..3 * k + 3] != o.rtl[3 * k..3 * k + 3]).count();
+        assert!(differ * 1000 < job.visible_pixels() as usize, "{differ} pixels differ from the host image");
+    }
+}

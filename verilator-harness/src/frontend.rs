@@ -299,12 +299,8 @@ pub fn run_chain_at(info: &'static ModelInfo<TriIn, TriSegOut>, seed: u64, traff
     for s in &mut exp.stims {
         s.triangle += first;
     }
-    let unit = TsUnit { fe, mask_bytes: cfg.p.div_ceil(8) as usize };
-    let mut driver = Driver::new(Rtl::new(info, seed), TrafficGen::new(traffic, seed));
-    let mut report = Report::default();
     let mut frame = Frame::new(screen.width, screen.height);
     let mut writes = vec![0u8; (screen.width * screen.height) as usize];
-    let mut row = golden_row(&cfg);
     let paint = |_t: usize, y: u32, out: &SegView| {
         for i in 0..cfg.p {
             let x = out.out_x + i;
@@ -315,9 +311,28 @@ pub fn run_chain_at(info: &'static ModelInfo<TriIn, TriSegOut>, seed: u64, traff
             }
         }
     };
-    let check = TsCheck { unit: &unit, exp: &exp, at: None, row_of: None, row: &mut row, paint };
+    let mut report = stream_chain(info, seed, traffic, &exp, paint);
+    check_frame(&exp, &frame, &writes, &mut report);
+    ChainRun { report, frame, writes }
+}
+
+/// Streams golden's `exp` through `tri_shader_p<P>`, checking every segment and `y` and the
+/// guard-band pulses; `paint(triangle, y, segment)` gets every checked segment, in order.
+pub fn stream_chain(
+    info: &'static ModelInfo<TriIn, TriSegOut>,
+    seed: u64,
+    traffic: Traffic,
+    exp: &Expected,
+    paint: impl FnMut(usize, u32, &SegView) + Send,
+) -> Report {
+    let cfg = info.cfg;
+    let unit = TsUnit { fe: exp.fe, mask_bytes: cfg.p.div_ceil(8) as usize };
+    let mut driver = Driver::new(Rtl::new(info, seed), TrafficGen::new(traffic, seed));
+    let mut report = Report::default();
+    let mut row = golden_row(&cfg);
+    let check = TsCheck { unit: &unit, exp, at: None, row_of: None, row: &mut row, paint };
     driver.stream(&unit, &exp.stims, &mut report, check);
-    report.triangles = tris.len();
+    report.triangles = exp.stims.len();
     if report.pulses != exp.guard_drops() {
         report.mismatch(Mismatch {
             triangle: None,
@@ -325,8 +340,7 @@ pub fn run_chain_at(info: &'static ModelInfo<TriIn, TriSegOut>, seed: u64, traff
             what: format!("{} guard-band pulses, golden drops {} triangles", report.pulses, exp.guard_drops()),
         });
     }
-    check_frame(&exp, &frame, &writes, &mut report);
-    ChainRun { report, frame, writes }
+    report
 }
 
 /// The RTL frame against golden's spans (equal), the f64 reference (SPEC §6: within 1, same

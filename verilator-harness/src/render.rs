@@ -15,13 +15,15 @@
 //! triangle's pixel is kept when the shaded segments come back. Triangle files: no depth; later
 //! triangles are drawn over earlier ones, so a pixel belongs to the last triangle covering it.
 
-use crate::cosim::{Report, SegmentCosim, Stim, Traffic, DRAIN_CLOCKS};
-use crate::ffi::{ModelInfo, SegIn, SegOut, SpecIn, SpecOut};
+use crate::cosim::{Report, SegView, SegmentCosim, Stim, Traffic, DRAIN_CLOCKS};
+use crate::ffi::{ModelInfo, SegIn, SegOut, SpecIn, SpecOut, TriIn, TriSegOut};
+use crate::frontend::{stream_chain, Expected};
+use golden::frontend::{FixedTriangle, FrontEnd};
 use crate::specular::SpecularCosim;
 use golden::setup::{parse_triangles, triangle_spans, Screen, Triangle, Vertex};
 use golden::specular::setup::{cross, dot, normalize, setup_span, SpanEnds, Vec3};
 use golden::specular::{SpecularSpan, SpecularUnit, C_FRAC};
-use golden::Config;
+use golden::{Config, Span};
 use std::f64::consts::{PI, TAU};
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::time::Duration;
@@ -199,6 +201,9 @@ pub struct Job {
     pub specular: Vec<SpecularSpan>,
     /// Per pixel (row-major), the triangle whose pixel is visible, or [`BACKGROUND`].
     pub owner: Vec<u32>,
+    /// Per colour channel, the drawn triangles as they stand on the front-end's ports (the
+    /// triangle ids of `stims` index them): what `--frontend rtl` streams.
+    pub tris: Vec<Vec<FixedTriangle>>,
     /// Triangles in the input (tessellated or read).
     pub triangles: usize,
     /// Triangles streamed (after back-face culling).
@@ -256,6 +261,7 @@ pub fn scene_job(kind: SceneKind, shininess: u16, cfg: &Config, screen: &Screen)
         stims: vec![Vec::new(); 3],
         specular: Vec::new(),
         owner: vec![BACKGROUND; npix],
+        tris: vec![Vec::new(); 3],
         triangles: mesh.faces.len(),
         drawn: 0,
     };
@@ -273,6 +279,7 @@ pub fn scene_job(kind: SceneKind, shininess: u16, cfg: &Config, screen: &Screen)
         for (c, stims) in job.stims.iter_mut().enumerate() {
             let t = Triangle { v: [0, 1, 2].map(|k| Vertex { x: v[k].0, y: v[k].1, i: lit[f[k] as usize][c] }) };
             triangle_spans(cfg, screen, &t, |y, span| stims.push(Stim { triangle: tri as usize, y, span }))?;
+            job.tris[c].push(FixedTriangle::from_triangle(&t, cfg.frac));
         }
         let interp = Interp::new(v);
         for s in &job.stims[0][first..] {
@@ -366,6 +373,7 @@ pub fn triangles_job_of(tris: &[Triangle], cfg: &Config, screen: &Screen) -> Res
         stims: vec![Vec::new()],
         specular: Vec::new(),
         owner: vec![BACKGROUND; (screen.width * screen.height) as usize],
+        tris: vec![tris.iter().map(|t| FixedTriangle::from_triangle(t, cfg.frac)).collect()],
         triangles: tris.len(),
         drawn: tris.len(),
     };
@@ -389,6 +397,8 @@ pub struct Outcome {
     /// Channels interleaved per pixel (1 or 3 bytes), row-major.
     pub rtl: Vec<u8>,
     pub golden: Vec<u8>,
+    /// With the RTL front-end: the image of the host's set-up, to compare with.
+    pub host: Option<Vec<u8>>,
     /// Per pixel, how many enabled output lanes of the (first) segment shader wrote it.
     pub coverage: Vec<u16>,
     /// One report per channel's segment shader.
@@ -425,8 +435,26 @@ pub fn run(
     job: &Job,
     seg: &'static ModelInfo<SegIn, SegOut>,
     spec: Option<&'static ModelInfo<SpecIn, SpecOut>>,
+    progress: impl FnMut(f64),
+) -> Outcome {
+    run_with(job, seg, None, spec, progress)
+}
+
+/// [`run`], with `chain` (`tri_shader_p<P>`) drawing the triangles instead of `seg` drawing the
+/// host's spans: the RTL image must then equal golden's front-end image, and `Outcome::host`
+/// holds the host-set-up image to compare with.
+pub fn run_with(
+    job: &Job,
+    seg: &'static ModelInfo<SegIn, SegOut>,
+    chain: Option<&'static ModelInfo<TriIn, TriSegOut>>,
+    spec: Option<&'static ModelInfo<SpecIn, SpecOut>>,
     mut progress: impl FnMut(f64),
 ) -> Outcome {
+    let exps: Option<Vec<Expected>> = chain.map(|info| {
+        let fe = FrontEnd::new(info.cfg, info.screen).expect("the model's front-end");
+        job.tris.iter().map(|t| Expected::new(fe, t)).collect()
+    });
+    let exps = &exps;
     let screen = job.screen;
     let (width, npix) = (screen.width, (screen.width * screen.height) as usize);
     let channels = job.channels();
@@ -447,26 +475,33 @@ pub fn run(
                 s.spawn(move || {
                     let mut img = vec![0u8; npix];
                     let mut cov = if c == 0 { vec![0u16; npix] } else { Vec::new() };
-                    let mut sim = SegmentCosim::new(seg, SEED + c as u64, Traffic::FULL);
-                    let mut report = Report { triangles: job.drawn, ..Report::default() };
-                    sim.stream(stims, &mut report, |stim, out| {
+                    let mut paint = |triangle: usize, y: u32, out: &SegView| {
                         let mut n = 0;
                         for i in (0..p).filter(|&i| out.lane_enabled(i)) {
                             let x = out.out_x + i;
                             if x >= width {
                                 continue;
                             }
-                            let idx = (stim.y * width + x) as usize;
+                            let idx = (y * width + x) as usize;
                             n += 1;
                             if c == 0 {
                                 cov[idx] = cov[idx].saturating_add(1);
                             }
-                            if owner[idx] == stim.triangle as u32 {
+                            if owner[idx] == triangle as u32 {
                                 img[idx] = out.pix[i as usize];
                             }
                         }
                         done.fetch_add(n, Ordering::Relaxed);
-                    });
+                    };
+                    let report = match (chain, exps) {
+                        (Some(info), Some(exps)) => stream_chain(info, SEED + c as u64, Traffic::FULL, &exps[c], paint),
+                        _ => {
+                            let mut sim = SegmentCosim::new(seg, SEED + c as u64, Traffic::FULL);
+                            let mut report = Report { triangles: job.drawn, ..Report::default() };
+                            sim.stream(stims, &mut report, |stim, out| paint(stim.triangle, stim.y, out));
+                            report
+                        }
+                    };
                     (img, cov, report)
                 })
             })
@@ -509,19 +544,34 @@ pub fn run(
         (diffuse, coverage, reports, spec_out)
     });
 
-    // Golden: the same spans, the same ownership, golden's pixels.
+    // Golden: the same spans, the same ownership, golden's pixels (the host's spans, or with
+    // the RTL front-end golden's front-end spans; then the host's image is kept beside).
     let frac = seg.cfg.frac;
-    let mut gold_diffuse = vec![vec![0u8; npix]; channels];
-    for (c, stims) in job.stims.iter().enumerate() {
-        for st in stims {
-            for j in 0..st.span.len {
-                let idx = (st.y * width + st.span.x0 + j) as usize;
-                if owner[idx] == st.triangle as u32 {
-                    gold_diffuse[c][idx] = st.span.pixel(j, frac);
+    let paint_golden = |spans: &mut dyn Iterator<Item = (usize, u32, Span)>, img: &mut [u8]| {
+        for (triangle, y, span) in spans {
+            for j in 0..span.len {
+                let idx = (y * width + span.x0 + j) as usize;
+                if owner[idx] == triangle as u32 {
+                    img[idx] = span.pixel(j, frac);
                 }
             }
         }
+    };
+    let mut host_diffuse = vec![vec![0u8; npix]; channels];
+    for (c, stims) in job.stims.iter().enumerate() {
+        paint_golden(&mut stims.iter().map(|s| (s.triangle, s.y, s.span)), &mut host_diffuse[c]);
     }
+    let gold_diffuse = match exps {
+        Some(exps) => {
+            let mut g = vec![vec![0u8; npix]; channels];
+            for (c, exp) in exps.iter().enumerate() {
+                let mut it = exp.stims.iter().flat_map(|st| exp.spans[st.first..st.first + st.count as usize].iter().map(move |&(y, s)| (st.triangle, y, s)));
+                paint_golden(&mut it, &mut g[c]);
+            }
+            g
+        }
+        None => host_diffuse.clone(),
+    };
     let gold_spec = with_spec.then(|| {
         let unit = SpecularUnit::default();
         let mut out = vec![0u16; npix];
@@ -542,6 +592,7 @@ pub fn run(
     Outcome {
         rtl: compose(&diffuse, spec_img.as_deref(), owner),
         golden: compose(&gold_diffuse, gold_spec.as_deref(), owner),
+        host: exps.is_some().then(|| compose(&host_diffuse, gold_spec.as_deref(), owner)),
         coverage,
         segment,
         specular: spec_report,

@@ -6,7 +6,7 @@
 //! failed), the images are written anyway; 2 bad arguments or input (one `error: ...` message,
 //! nothing written).
 
-use clap::{ArgGroup, Parser};
+use clap::{ArgGroup, Parser, ValueEnum};
 use golden::setup::Screen;
 use golden::Align;
 use image::codecs::png::PngEncoder;
@@ -15,13 +15,18 @@ use std::io::{IsTerminal, Write};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::time::Instant;
-use verilator_harness::ffi::{segment_model, SEGMENT_MODELS, SPECULAR_MODELS};
-use verilator_harness::render::{busy_cycles, difference_image, run, scene_job, triangles_job, Job, SceneKind};
+use verilator_harness::ffi::{segment_model, SEGMENT_MODELS, SPECULAR_MODELS, TRISHADER_MODELS};
+use verilator_harness::render::{busy_cycles, difference_image, run_with, scene_job, triangles_job, Job, SceneKind};
 
 #[derive(Parser)]
 #[command(about = "Render a scene or a triangle file through the generated RTL to PNG, checked against golden")]
 #[command(group(ArgGroup::new("input").required(true).args(["scene", "triangles"])))]
 struct Args {
+    /// Who sets up the triangles: `host` (golden::setup, spans into segment_shader_p<P>) or `rtl`
+    /// (the generated front-end and shader, tri_shader_p<P>); the image must then equal golden's
+    /// front-end image, and how it differs from the host-set-up image is printed.
+    #[arg(long, value_enum, default_value_t = Frontend::Host)]
+    frontend: Frontend,
     /// A built-in scene: a lit RGB object, Gouraud diffuse through one segment shader per
     /// channel plus the specular unit's highlight.
     #[arg(long, value_parser = ["sphere", "torus"])]
@@ -67,6 +72,12 @@ fn sibling(out: &Path, suffix: &str) -> PathBuf {
     PathBuf::from(format!("{stem}{suffix}"))
 }
 
+#[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
+enum Frontend {
+    Host,
+    Rtl,
+}
+
 fn main() -> ExitCode {
     let args = Args::parse();
     let start = Instant::now();
@@ -79,6 +90,17 @@ fn main() -> ExitCode {
     if let Err(e) = screen.check_for(&info.cfg) {
         return fail(format!("--width/--height: {e}"));
     }
+    let chain = match args.frontend {
+        Frontend::Host => None,
+        Frontend::Rtl => match TRISHADER_MODELS.iter().find(|m| m.cfg.p == args.p && m.cfg.align == align) {
+            Some(m) if m.screen == screen => Some(m),
+            Some(m) => return fail(format!("--frontend rtl: the front-end model draws on {}x{}, not {}x{}", m.screen.width, m.screen.height, screen.width, screen.height)),
+            None => {
+                let built: Vec<&str> = TRISHADER_MODELS.iter().map(|m| m.tag).collect();
+                return fail(format!("--frontend rtl --p {} --align {align}: no such model in this build (built: {})", args.p, built.join(", ")));
+            }
+        },
+    };
     let dir = match args.out.parent() {
         Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
         _ => PathBuf::from("."),
@@ -122,7 +144,7 @@ fn main() -> ExitCode {
     let show = !args.quiet && std::io::stderr().is_terminal();
     let mut shown = false;
     let mut last = start;
-    let outcome = run(&job, info, SPECULAR_MODELS.first(), |f| {
+    let outcome = run_with(&job, info, chain, SPECULAR_MODELS.first(), |f| {
         // Only renders that take a while get a progress line, redrawn at most 10 times a second.
         let now = Instant::now();
         if show && (now - start).as_secs_f64() > 0.5 && ((now - last).as_secs_f64() >= 0.1 || f >= 1.0) {
@@ -160,6 +182,13 @@ fn main() -> ExitCode {
     for r in outcome.segment.iter().chain(&outcome.specular) {
         for m in &r.mismatches {
             println!("MISMATCH {m}");
+        }
+    }
+    if let Some(host) = &outcome.host {
+        let n = (0..host.len() / channels).filter(|&k| host[k * channels..(k + 1) * channels] != outcome.rtl[k * channels..(k + 1) * channels]).count();
+        println!("front-end:  {} (RTL set-up); differs from the host-set-up image in {n} pixels", chain.map_or("", |m| m.tag));
+        if n > 0 {
+            println!("            (vertex intensities are rounded onto the UQ8.F ports; the host interpolates the exact ones)");
         }
     }
     if differing == 0 && outcome.cosim_ok() {
