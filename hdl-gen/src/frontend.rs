@@ -77,7 +77,7 @@ pub fn ports(fe: &FrontEnd, wd: &Widths) -> Vec<Port> {
     v
 }
 
-fn span_ports(fe: &FrontEnd, wd: &Widths) -> Vec<Port> {
+pub fn span_ports(fe: &FrontEnd, wd: &Widths) -> Vec<Port> {
     let cfg = &fe.cfg;
     vec![
         Port::output("out_valid", 1, "", "span valid").reg(),
