@@ -60,12 +60,12 @@ pub fn testbench(opts: &Options, vectors: u32, seed: u64) -> Result<Vec<Generate
     let bench = BenchNames::new(opts);
     let mut rng = Rng::new(seed);
     let spans = segment_spans(&opts.cfg, vectors as usize, &mut rng);
-    files.extend(segment_bench(opts, &bench.segment, &spans, rng.next() as u32 | 1));
+    files.extend(segment_bench(opts, &bench.segment, &spans, rng.next_u64() as u32 | 1));
     let spec = specular_spans(&opts.cfg, vectors as usize, &mut rng);
-    files.extend(specular_bench(opts, &bench.specular, &spec, rng.next() as u32 | 1));
+    files.extend(specular_bench(opts, &bench.specular, &spec, rng.next_u64() as u32 | 1));
     if let Ok(hw) = opts.frontend() {
         let tris = frontend_triangles(&hw.fe, vectors as usize, &mut rng);
-        files.extend(frontend_bench(opts, &hw, &bench.frontend, &tris, rng.next() as u32 | 1));
+        files.extend(frontend_bench(opts, &hw, &bench.frontend, &tris, rng.next_u64() as u32 | 1));
     }
     Ok(files)
 }
@@ -173,7 +173,7 @@ impl Rng {
     pub fn new(seed: u64) -> Rng {
         Rng(seed)
     }
-    pub fn next(&mut self) -> u64 {
+    pub fn next_u64(&mut self) -> u64 {
         self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
         let mut z = self.0;
         z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
@@ -183,11 +183,11 @@ impl Rng {
     /// Uniform in `lo..=hi`.
     pub fn range(&mut self, lo: i64, hi: i64) -> i64 {
         debug_assert!(lo <= hi);
-        lo + (self.next() % (hi - lo + 1) as u64) as i64
+        lo + (self.next_u64() % (hi - lo + 1) as u64) as i64
     }
     /// Uniform in [0, 1).
     pub fn unit(&mut self) -> f64 {
-        (self.next() >> 11) as f64 / (1u64 << 53) as f64
+        (self.next_u64() >> 11) as f64 / (1u64 << 53) as f64
     }
     pub fn uniform(&mut self, lo: f64, hi: f64) -> f64 {
         lo + (hi - lo) * self.unit()

@@ -313,7 +313,7 @@ impl CosK {
     /// Whether `got` is surely within SPEC §4's bound of `c cos^k(x)` (`x >= 0`).
     #[inline]
     fn surely_within(&self, x: f64, c: f64, got: f64, inside: bool) -> bool {
-        if !(x < FRAC_PI_2) {
+        if x.is_nan() || x >= FRAC_PI_2 {
             return false;
         }
         let u = x * self.inv_h;

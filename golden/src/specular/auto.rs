@@ -99,8 +99,8 @@ pub fn best_reachable(max_tables: usize) -> (f64, Vec<u32>) {
     for c in 1..max_tables {
         for b in 2..=K {
             let mut cand: Option<(f64, Vec<u32>)> = None;
-            for a in 1..b {
-                if let Some((e, chain)) = &best[c - 1][a] {
+            for (a, prev) in best[c - 1].iter().enumerate().take(b).skip(1) {
+                if let Some((e, chain)) = prev {
                     let e = e.max(tb.gap(a, b).0);
                     if cand.as_ref().is_none_or(|(ce, _)| e < *ce) {
                         let mut ch = chain.clone();

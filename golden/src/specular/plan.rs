@@ -267,6 +267,8 @@ impl SpecularPlan {
             nk_mant_bits: nw,
             sel_bits: addr_bits(decoder.tables()),
         };
+        // An index, not an iterator: the loop resizes `plan`'s tables as it goes.
+        #[allow(clippy::needless_range_loop)]
         for t in 0..plan.tables.len() {
             loop {
                 plan.resize(t, plan.tables[t].len)?;
