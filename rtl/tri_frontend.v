@@ -68,7 +68,13 @@ module tri_frontend (
   wire signed [22:0] u2 = {{1{vx2[21]}}, vx2} - {{1{vx0[21]}}, vx0};
   wire signed [19:0] v1 = {{1{vy1[18]}}, vy1} - {{1{vy0[18]}}, vy0};
   wire signed [19:0] v2 = {{1{vy2[18]}}, vy2} - {{1{vy0[18]}}, vy0};
-  wire signed [42:0] area = {{20{u1[22]}}, u1} * {{23{v2[19]}}, v2} - {{23{v1[19]}}, v1} * {{20{u2[22]}}, u2};
+  // verilator lint_off WIDTH
+  wire signed [42:0] m_a1 = u1 * v2;
+  // verilator lint_on WIDTH
+  // verilator lint_off WIDTH
+  wire signed [42:0] m_a2 = v1 * u2;
+  // verilator lint_on WIDTH
+  wire signed [42:0] area = m_a1 - m_a2;
   wire neg = area[42];
   // verilator lint_off UNUSEDSIGNAL
   wire [42:0] area_n = neg ? -area : area;
@@ -127,9 +133,15 @@ module tri_frontend (
   wire act0 = dy0 != 20'sd0 && rs0 <= re0;
   wire [18:0] ady0 = dy0[19] ? -dy0[18:0] : dy0[18:0];
   wire [8:0] rsu0 = rs0[8:0];
-  wire [45:0] ry0 = {29'd0, {rsu0, 8'd128}} - {{27{vy1[18]}}, vy1};
-  wire [45:0] rx0 = 46'd128 - {{24{vx1[21]}}, vx1};
-  wire [45:0] n0 = {{23{dx0[22]}}, dx0} * ry0 - {{26{dy0[19]}}, dy0} * rx0 - {45'd0, !tl0} + ({27'd0, ady0} << 22);
+  wire signed [20:0] ry0 = {4'd0, {rsu0, 8'd128}} - {{2{vy1[18]}}, vy1};
+  wire signed [23:0] rx0 = 24'd128 - {{2{vx1[21]}}, vx1};
+  // verilator lint_off WIDTH
+  wire signed [43:0] m_e0 = dx0 * ry0;
+  // verilator lint_on WIDTH
+  // verilator lint_off WIDTH
+  wire signed [43:0] m_f0 = dy0 * rx0;
+  // verilator lint_on WIDTH
+  wire [45:0] n0 = {{2{m_e0[43]}}, m_e0} - {{2{m_f0[43]}}, m_f0} - {45'd0, !tl0} + ({27'd0, ady0} << 22);
   wire [34:0] sn0 = {{12{dx0[22]}}, dx0} + ({16'd0, ady0} << 14);
   wire signed [18:0] yt1 = vy2 < vy0 ? vy2 : vy0;
   wire signed [18:0] yb1 = vy2 < vy0 ? vy0 : vy2;
@@ -142,9 +154,15 @@ module tri_frontend (
   wire act1 = dy1 != 20'sd0 && rs1 <= re1;
   wire [18:0] ady1 = dy1[19] ? -dy1[18:0] : dy1[18:0];
   wire [8:0] rsu1 = rs1[8:0];
-  wire [45:0] ry1 = {29'd0, {rsu1, 8'd128}} - {{27{vy2[18]}}, vy2};
-  wire [45:0] rx1 = 46'd128 - {{24{vx2[21]}}, vx2};
-  wire [45:0] n1 = {{23{dx1[22]}}, dx1} * ry1 - {{26{dy1[19]}}, dy1} * rx1 - {45'd0, !tl1} + ({27'd0, ady1} << 22);
+  wire signed [20:0] ry1 = {4'd0, {rsu1, 8'd128}} - {{2{vy2[18]}}, vy2};
+  wire signed [23:0] rx1 = 24'd128 - {{2{vx2[21]}}, vx2};
+  // verilator lint_off WIDTH
+  wire signed [43:0] m_e1 = dx1 * ry1;
+  // verilator lint_on WIDTH
+  // verilator lint_off WIDTH
+  wire signed [43:0] m_f1 = dy1 * rx1;
+  // verilator lint_on WIDTH
+  wire [45:0] n1 = {{2{m_e1[43]}}, m_e1} - {{2{m_f1[43]}}, m_f1} - {45'd0, !tl1} + ({27'd0, ady1} << 22);
   wire [34:0] sn1 = {{12{dx1[22]}}, dx1} + ({16'd0, ady1} << 14);
   wire signed [18:0] yt2 = vy0 < vy1 ? vy0 : vy1;
   wire signed [18:0] yb2 = vy0 < vy1 ? vy1 : vy0;
@@ -157,16 +175,36 @@ module tri_frontend (
   wire act2 = dy2 != 20'sd0 && rs2 <= re2;
   wire [18:0] ady2 = dy2[19] ? -dy2[18:0] : dy2[18:0];
   wire [8:0] rsu2 = rs2[8:0];
-  wire [45:0] ry2 = {29'd0, {rsu2, 8'd128}} - {{27{vy0[18]}}, vy0};
-  wire [45:0] rx2 = 46'd128 - {{24{vx0[21]}}, vx0};
-  wire [45:0] n2 = {{23{dx2[22]}}, dx2} * ry2 - {{26{dy2[19]}}, dy2} * rx2 - {45'd0, !tl2} + ({27'd0, ady2} << 22);
+  wire signed [20:0] ry2 = {4'd0, {rsu2, 8'd128}} - {{2{vy0[18]}}, vy0};
+  wire signed [23:0] rx2 = 24'd128 - {{2{vx0[21]}}, vx0};
+  // verilator lint_off WIDTH
+  wire signed [43:0] m_e2 = dx2 * ry2;
+  // verilator lint_on WIDTH
+  // verilator lint_off WIDTH
+  wire signed [43:0] m_f2 = dy2 * rx2;
+  // verilator lint_on WIDTH
+  wire [45:0] n2 = {{2{m_e2[43]}}, m_e2} - {{2{m_f2[43]}}, m_f2} - {45'd0, !tl2} + ({27'd0, ady2} << 22);
   wire [34:0] sn2 = {{12{dx2[22]}}, dx2} + ({16'd0, ady2} << 14);
   // verilator lint_on UNUSEDSIGNAL
 
   // The plane: Nx, Ny (oriented), dI's dividend 2*256|Nx| + |A| and its saturation.
   // verilator lint_off UNUSEDSIGNAL
-  wire [41:0] nx = ({22'd0, vi1} - {22'd0, vi0}) * {{22{v2[19]}}, v2} - ({22'd0, vi2} - {22'd0, vi0}) * {{22{v1[19]}}, v1};
-  wire [44:0] ny = ({25'd0, vi2} - {25'd0, vi0}) * {{22{u1[22]}}, u1} - ({25'd0, vi1} - {25'd0, vi0}) * {{22{u2[22]}}, u2};
+  wire signed [20:0] d1 = {1'd0, vi1} - {1'd0, vi0};
+  wire signed [20:0] d2 = {1'd0, vi2} - {1'd0, vi0};
+  // verilator lint_off WIDTH
+  wire signed [40:0] m_x1 = d1 * v2;
+  // verilator lint_on WIDTH
+  // verilator lint_off WIDTH
+  wire signed [40:0] m_x2 = d2 * v1;
+  // verilator lint_on WIDTH
+  // verilator lint_off WIDTH
+  wire signed [43:0] m_y1 = d2 * u1;
+  // verilator lint_on WIDTH
+  // verilator lint_off WIDTH
+  wire signed [43:0] m_y2 = d1 * u2;
+  // verilator lint_on WIDTH
+  wire [41:0] nx = {{1{m_x1[40]}}, m_x1} - {{1{m_x2[40]}}, m_x2};
+  wire [44:0] ny = {{1{m_y1[43]}}, m_y1} - {{1{m_y2[43]}}, m_y2};
   wire signed [41:0] onx = neg ? -nx : nx;
   wire signed [44:0] ony = neg ? -ny : ny;
   wire nx_neg = onx[41];
@@ -183,9 +221,20 @@ module tri_frontend (
   wire [8:0] first_u = first_s[8:0];
   wire [8:0] last_u = last_s[8:0];
   // verilator lint_on UNUSEDSIGNAL
-  wire [63:0] xo = 64'd128 - {{42{vx0[21]}}, vx0};
-  wire [63:0] yo = {47'd0, {first_u, 8'd128}} - {{45{vy0[18]}}, vy0};
-  wire [63:0] s0 = {44'd0, vi0} * {22'd0, aabs} + {{22{onx[41]}}, onx} * xo + {{19{ony[44]}}, ony} * yo;
+  wire signed [23:0] xo = 24'd128 - {{2{vx0[21]}}, vx0};
+  wire signed [20:0] yo = {4'd0, {first_u, 8'd128}} - {{2{vy0[18]}}, vy0};
+  // verilator lint_off WIDTH
+  wire [61:0] m_s1 = vi0 * aabs;
+  // verilator lint_on WIDTH
+  // verilator lint_off UNUSEDSIGNAL
+  // verilator lint_off WIDTH
+  wire signed [65:0] m_s2 = onx * xo;
+  // verilator lint_on WIDTH
+  // verilator lint_off WIDTH
+  wire signed [65:0] m_s3 = ony * yo;
+  // verilator lint_on WIDTH
+  // verilator lint_on UNUSEDSIGNAL
+  wire [63:0] s0 = {2'd0, m_s1} + m_s2[63:0] + m_s3[63:0];
   wire [63:0] tn0 = s0 << lz;
   wire [63:0] gxn0 = ({{22{onx[41]}}, onx} << 8) << lz;
   wire [63:0] dyn0 = ({{19{ony[44]}}, ony} << 8) << lz;

@@ -60,6 +60,17 @@ fn slit(w: u32, v: i64) -> String {
     }
 }
 
+/// `out = a * b` at the product's natural width. Both operands are signed names of their own
+/// widths: the language extends them to the result, and synthesis builds a `wa` x `wb`
+/// multiplier (extending them by hand would make it as wide as the result on both sides).
+fn smul(out: &str, a: &str, wa: u32, b: &str, wb: u32) -> Vec<Item> {
+    vec![
+        comment("verilator lint_off WIDTH"),
+        swire(out, wa + wb, format!("{a} * {b}")),
+        comment("verilator lint_on WIDTH"),
+    ]
+}
+
 pub fn ports(fe: &FrontEnd, wd: &Widths) -> Vec<Port> {
     let cfg = &fe.cfg;
     let mut v = vec![
@@ -213,7 +224,9 @@ pub fn module(hw: &Hw, names: &Names) -> Module {
     for (n, a, b, ww) in [("u1", "vx1", "vx0", cx), ("u2", "vx2", "vx0", cx), ("v1", "vy1", "vy0", cy), ("v2", "vy2", "vy0", cy)] {
         body.push(swire(n, ww + 1, format!("{} - {}", sext(a, ww, ww + 1), sext(b, ww, ww + 1))));
     }
-    body.push(swire("area", aw + 1, format!("{} * {} - {} * {}", sext("u1", cx + 1, aw + 1), sext("v2", cy + 1, aw + 1), sext("v1", cy + 1, aw + 1), sext("u2", cx + 1, aw + 1))));
+    body.extend(smul("m_a1", "u1", cx + 1, "v2", cy + 1));
+    body.extend(smul("m_a2", "v1", cy + 1, "u2", cx + 1));
+    body.push(swire("area", aw + 1, "m_a1 - m_a2"));
     body.push(wire("neg", 1, format!("area[{aw}]")));
     body.push(comment("verilator lint_off UNUSEDSIGNAL"));
     body.push(wire("area_n", aw + 1, "neg ? -area : area"));
@@ -292,15 +305,17 @@ pub fn module(hw: &Hw, names: &Names) -> Module {
         body.push(wire(&format!("ady{k}"), cy, format!("dy{k}[{cy}] ? -dy{k}[{}:0] : dy{k}[{}:0]", cy - 1, cy - 1)));
         body.push(wire(&format!("rsu{k}"), yw, format!("rs{k}[{}:0]", yw - 1)));
         // e(128, 256 rs + 128) - t + B D, from vertex a on the edge's line.
-        body.push(wire(&format!("ry{k}"), nw, format!("{} - {}", zext(&format!("{{rsu{k}, 8'd128}}"), yw + 8, nw), sext(&ya, cy, nw))));
-        body.push(wire(&format!("rx{k}"), nw, format!("{} - {}", lit(nw, 128), sext(&xa, cx, nw))));
+        body.push(swire(&format!("ry{k}"), cy + 2, format!("{} - {}", zext(&format!("{{rsu{k}, 8'd128}}"), yw + 8, cy + 2), sext(&ya, cy, cy + 2))));
+        body.push(swire(&format!("rx{k}"), cx + 2, format!("{} - {}", lit(cx + 2, 128), sext(&xa, cx, cx + 2))));
+        body.extend(smul(&format!("m_e{k}"), &format!("dx{k}"), cx + 1, &format!("ry{k}"), cy + 2));
+        body.extend(smul(&format!("m_f{k}"), &format!("dy{k}"), cy + 1, &format!("rx{k}"), cx + 2));
         body.push(wire(
             &format!("n{k}"),
             nw,
             format!(
-                "{} * ry{k} - {} * rx{k} - {} + ({} << {})",
-                sext(&format!("dx{k}"), cx + 1, nw),
-                sext(&format!("dy{k}"), cy + 1, nw),
+                "{} - {} - {} + ({} << {})",
+                sext(&format!("m_e{k}"), nw - 2, nw),
+                sext(&format!("m_f{k}"), nw - 2, nw),
                 zext(&format!("!tl{k}"), 1, nw),
                 zext(&format!("ady{k}"), cy, nw),
                 gw + 7
@@ -315,32 +330,14 @@ pub fn module(hw: &Hw, names: &Names) -> Module {
     body.push(comment("The plane: Nx, Ny (oriented), dI's dividend 2*256|Nx| + |A| and its saturation."));
     body.push(comment("verilator lint_off UNUSEDSIGNAL"));
     let iz = |v: &str, to: u32| zext(v, iw, to);
-    body.push(wire(
-        "nx",
-        nxw,
-        format!(
-            "({} - {}) * {} - ({} - {}) * {}",
-            iz("vi1", nxw),
-            iz("vi0", nxw),
-            sext("v2", cy + 1, nxw),
-            iz("vi2", nxw),
-            iz("vi0", nxw),
-            sext("v1", cy + 1, nxw)
-        ),
-    ));
-    body.push(wire(
-        "ny",
-        nyw,
-        format!(
-            "({} - {}) * {} - ({} - {}) * {}",
-            iz("vi2", nyw),
-            iz("vi0", nyw),
-            sext("u1", cx + 1, nyw),
-            iz("vi1", nyw),
-            iz("vi0", nyw),
-            sext("u2", cx + 1, nyw)
-        ),
-    ));
+    body.push(swire("d1", iw + 1, format!("{} - {}", iz("vi1", iw + 1), iz("vi0", iw + 1))));
+    body.push(swire("d2", iw + 1, format!("{} - {}", iz("vi2", iw + 1), iz("vi0", iw + 1))));
+    body.extend(smul("m_x1", "d1", iw + 1, "v2", cy + 1));
+    body.extend(smul("m_x2", "d2", iw + 1, "v1", cy + 1));
+    body.extend(smul("m_y1", "d2", iw + 1, "u1", cx + 1));
+    body.extend(smul("m_y2", "d1", iw + 1, "u2", cx + 1));
+    body.push(wire("nx", nxw, format!("{} - {}", sext("m_x1", nxw - 1, nxw), sext("m_x2", nxw - 1, nxw))));
+    body.push(wire("ny", nyw, format!("{} - {}", sext("m_y1", nyw - 1, nyw), sext("m_y2", nyw - 1, nyw))));
     body.push(swire("onx", nxw, "neg ? -nx : nx"));
     body.push(swire("ony", nyw, "neg ? -ny : ny"));
     body.push(wire("nx_neg", 1, format!("onx[{}]", nxw - 1)));
@@ -364,13 +361,17 @@ pub fn module(hw: &Hw, names: &Names) -> Module {
     body.push(wire("first_u", yw, format!("first_s[{}:0]", yw - 1)));
     body.push(wire("last_u", yw, format!("last_s[{}:0]", yw - 1)));
     body.push(comment("verilator lint_on UNUSEDSIGNAL"));
-    body.push(wire("xo", kk, format!("{} - {}", lit(kk, 128), sext("vx0", cx, kk))));
-    body.push(wire("yo", kk, format!("{} - {}", zext("{first_u, 8'd128}", yw + 8, kk), sext("vy0", cy, kk))));
-    body.push(wire(
-        "s0",
-        kk,
-        format!("{} * {} + {} * xo + {} * yo", iz("vi0", kk), zext("aabs", aw, kk), sext("onx", nxw, kk), sext("ony", nyw, kk)),
-    ));
+    body.push(swire("xo", cx + 2, format!("{} - {}", lit(cx + 2, 128), sext("vx0", cx, cx + 2))));
+    body.push(swire("yo", cy + 2, format!("{} - {}", zext("{first_u, 8'd128}", yw + 8, cy + 2), sext("vy0", cy, cy + 2))));
+    body.push(comment("verilator lint_off WIDTH"));
+    body.push(wire("m_s1", iw + aw, "vi0 * aabs"));
+    body.push(comment("verilator lint_on WIDTH"));
+    body.push(comment("verilator lint_off UNUSEDSIGNAL"));
+    body.extend(smul("m_s2", "onx", nxw, "xo", cx + 2));
+    body.extend(smul("m_s3", "ony", nyw, "yo", cy + 2));
+    body.push(comment("verilator lint_on UNUSEDSIGNAL"));
+    let low = |m: &str, w: u32| if w > kk { format!("{m}[{}:0]", kk - 1) } else { sext(m, w, kk) };
+    body.push(wire("s0", kk, format!("{} + {} + {}", zext("m_s1", iw + aw, kk), low("m_s2", nxw + cx + 2), low("m_s3", nyw + cy + 2))));
     body.push(wire("tn0", kk, "s0 << lz"));
     body.push(wire("gxn0", kk, format!("({} << 8) << lz", sext("onx", nxw, kk))));
     body.push(wire("dyn0", kk, format!("({} << 8) << lz", sext("ony", nyw, kk))));
