@@ -554,7 +554,7 @@ mod tests {
     #[test]
     fn coverage_equals_the_host_set_up_at_640x480() {
         let fe = FrontEnd::new(Config::default(), Screen::default()).unwrap();
-        check_against_host(&fe, 20_000, 1);
+        check_against_host(&fe, 8_000, 1);
     }
 
     #[test]
@@ -562,13 +562,13 @@ mod tests {
         // The widest screen each configuration allows: 2^XW = 2^F = 4096 at the defaults, and
         // a 65536-pixel screen with XW = 16, F = 16.
         let fe = FrontEnd::new(Config::default(), Screen { width: 4096, height: 4096 }).unwrap();
-        check_against_host(&fe, 2_000, 2);
+        check_against_host(&fe, 1_000, 2);
         let wide = Config::new(8, 16, 16, Align::Span).unwrap();
         let fe = FrontEnd::new(wide, Screen { width: 65536, height: 65536 }).unwrap();
         check_against_host(&fe, 300, 3);
         // Small screens: most triangles clip.
         let fe = FrontEnd::new(Config::default(), Screen { width: 37, height: 23 }).unwrap();
-        check_against_host(&fe, 20_000, 4);
+        check_against_host(&fe, 8_000, 4);
     }
 
     #[test]

@@ -61,13 +61,26 @@ fn verilator_lint_and_icarus_are_clean() {
     for bits in hdl_gen::frontend::DIV_BITS {
         runs.push((Config::default(), "", BfpiArch::ShiftAdd, Some(bits)));
     }
-    for (k, (cfg, prefix, arch, fe_div_bits)) in runs.into_iter().enumerate() {
+    // The work is external processes (Verilator, Icarus): two at a time, one per core.
+    let runs: Vec<_> = runs.into_iter().enumerate().map(|(k, r)| (k, r, fe_seen.insert((r.0.frac, r.0.xbits, r.1, r.3)))).collect();
+    let next = std::sync::atomic::AtomicUsize::new(0);
+    std::thread::scope(|s| {
+        for _ in 0..2 {
+            s.spawn(|| loop {
+                let Some(&(k, (cfg, prefix, arch, fe_div_bits), fe_first)) = runs.get(next.fetch_add(1, std::sync::atomic::Ordering::Relaxed)) else { break };
+                lint_one(k, cfg, prefix, arch, fe_div_bits, fe_first);
+            });
+        }
+    });
+}
+
+fn lint_one(k: usize, cfg: Config, prefix: &str, arch: BfpiArch, fe_div_bits: Option<u32>, fe_first: bool) {
+    {
         let what = format!("{cfg:?}, prefix '{prefix}', --bfpi-arch {arch}, --fe-div-bits {fe_div_bits:?}");
         let dir = std::env::temp_dir().join(format!("hdl-gen-lint-{}-{k}", std::process::id()));
         let _ = std::fs::remove_dir_all(&dir);
         let opts = Options { cfg, prefix: prefix.into(), bfpi_arch: arch, fe_div_bits, ..Default::default() };
         let names = hdl_gen::Names::new(prefix, &cfg);
-        let fe_first = fe_seen.insert((cfg.frac, cfg.xbits, prefix, opts.frontend().map(|hw| hw.div_bits).ok()));
         let chain = fe_first || (arch == BfpiArch::ShiftAdd && [1, 256].contains(&cfg.p));
         let skip = |module: &str| (module == names.frontend && !fe_first) || (module == names.top && !chain);
         let files = generate(&opts);
