@@ -3,6 +3,7 @@
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
+use verilator_harness::ffi::default_model_args;
 
 fn run(bin: &str, args: &[&str]) -> Output {
     Command::new(bin).args(args).output().unwrap_or_else(|e| panic!("running {bin}: {e}"))
@@ -17,6 +18,12 @@ fn assert_rejected(bin: &str, args: &[&str], needle: &str) {
     assert_eq!(err.lines().filter(|l| l.starts_with("error")).count(), 1, "{args:?}: one message: {err}");
     assert!(!err.contains("panicked"), "{args:?}: {err}");
     assert!(out.stdout.is_empty(), "{args:?}: wrote to stdout: {}", String::from_utf8_lossy(&out.stdout));
+}
+
+/// `args` after `model` (from [`default_model_args`]) unless the case sets --p or --align itself.
+fn with_model<'a>(model: &'a [String], args: &[&'a str]) -> Vec<&'a str> {
+    let own = args.iter().any(|a| *a == "--p" || *a == "--align");
+    model.iter().map(String::as_str).filter(|_| !own).chain(args.iter().copied()).collect()
 }
 
 const COSIM: &str = env!("CARGO_BIN_EXE_cosim");
@@ -70,15 +77,17 @@ fn cosim_rejects_every_bad_flag() {
         (&["--frobnicate"], "--frobnicate"),
         (&["extra"], "extra"),
     ];
+    let Some(model) = default_model_args("cli_harness: cosim's bad flags") else { return };
     for (args, needle) in cases {
-        assert_rejected(COSIM, args, needle);
+        assert_rejected(COSIM, &with_model(&model, args), needle);
     }
 }
 
 /// The good path still works, so the rejections above are not a broken binary.
 #[test]
 fn cosim_runs_a_few_triangles() {
-    let out = run(COSIM, &["--triangles", "5", "--seed", "1"]);
+    let Some(model) = default_model_args("cli_harness: cosim on a few triangles") else { return };
+    let out = run(COSIM, &with_model(&model, &["--triangles", "5", "--seed", "1"]));
     let text = String::from_utf8_lossy(&out.stdout);
     assert!(out.status.success(), "{text}{}", String::from_utf8_lossy(&out.stderr));
     assert!(text.trim_end().ends_with("5 passed, 0 failed"), "{text}");
@@ -136,9 +145,10 @@ fn render_rejects_every_bad_flag_and_input_file() {
         (vec!["--triangles", &word, "--out", o], "line 1".into()),
         (vec!["--triangles", g, "--out", o, "--bogus"], "--bogus".into()),
     ];
+    let Some(model) = default_model_args("cli_harness: render's bad flags and files") else { return };
     let before = listing(&dir);
     for (args, needle) in &cases {
-        assert_rejected(RENDER, args, needle);
+        assert_rejected(RENDER, &with_model(&model, args), needle);
         assert_eq!(listing(&dir), before, "{args:?} wrote or removed files");
     }
 }

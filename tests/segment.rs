@@ -8,7 +8,7 @@ use golden::Span;
 use rand::rngs::StdRng;
 use rand::{Rng, SeedableRng};
 use verilator_harness::cosim::{assert_clean, Report, DRAIN_CLOCKS, SegmentCosim, Stim, Traffic};
-use verilator_harness::ffi::SEGMENT_MODELS;
+use verilator_harness::ffi::{require_models, SEGMENT_MODELS};
 use verilator_harness::stimulus::{directed, random_triangle};
 
 const RANDOM_TRIANGLES: usize = 2_000;
@@ -16,10 +16,10 @@ const BATCH: usize = 50;
 
 #[test]
 fn random_triangles_every_model() {
-    assert!(!SEGMENT_MODELS.is_empty(), "no segment shader was built");
+    let Some(models) = require_models(SEGMENT_MODELS, "segment shader", "segment: random triangles") else { return };
     let seed = verilator_harness::seed("random_triangles_every_model");
     let screen = Screen::default();
-    for (k, info) in SEGMENT_MODELS.iter().enumerate() {
+    for (k, info) in models.iter().enumerate() {
         let model_seed = seed.wrapping_add(k as u64);
         let mut rng = StdRng::seed_from_u64(model_seed);
         let mut sim = SegmentCosim::new(info, model_seed, Traffic::RANDOM);

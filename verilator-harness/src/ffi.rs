@@ -217,6 +217,73 @@ pub fn segment_model(p: u32, align: Align) -> Option<&'static ModelInfo<SegIn, S
     SEGMENT_MODELS.iter().find(|m| m.cfg.p == p && m.cfg.align == align)
 }
 
+/// The segment-shader model for `p` and `align`, for a test that needs it (`what` names that
+/// test); see [`require`] for what happens when this build has none.
+pub fn require_segment_model(p: u32, align: Align, what: &str) -> Option<&'static ModelInfo<SegIn, SegOut>> {
+    require(segment_model(p, align), &format!("seg_p{p}_{align}"), what)
+}
+
+/// The specular unit's model, for a test that needs it; see [`require`].
+pub fn require_specular_model(what: &str) -> Option<&'static ModelInfo<SpecIn, SpecOut>> {
+    require(SPECULAR_MODELS.first(), "specular_unit", what)
+}
+
+/// Every model of one kind (`kind`: "segment shader", "bfpi"), for a test that runs them all;
+/// `None` when there are none, see [`require`].
+pub fn require_models<I, O>(models: &'static [ModelInfo<I, O>], kind: &str, what: &str) -> Option<&'static [ModelInfo<I, O>]> {
+    require((!models.is_empty()).then_some(models), kind, what)
+}
+
+/// For a test of the `cosim` or `render` binary run with their default model (p = 8 span): the
+/// `--p`/`--align` arguments to add. None when that model is built (a default build must have
+/// it, see [`require`]); else, under COSIM_RTL_DIR, those of the folder's first segment shader.
+/// `None` when there is no segment shader at all.
+pub fn default_model_args(what: &str) -> Option<Vec<String>> {
+    let other = SEGMENT_MODELS.first().filter(|_| RTL_DIR.is_some() && segment_model(8, Align::Span).is_none());
+    let Some(m) = other else { return require_segment_model(8, Align::Span, what).map(|_| Vec::new()) };
+    let args = vec!["--p".into(), m.cfg.p.to_string(), "--align".into(), m.cfg.align.to_string()];
+    use std::io::Write;
+    let _ = writeln!(
+        std::io::stderr().lock(),
+        "{what}: this build has no seg_p8_span model (the default): runs {} ({})",
+        m.tag,
+        args.join(" ")
+    );
+    Some(args)
+}
+
+/// The one rule every suite follows for a model it needs. A default build (no COSIM_RTL_DIR)
+/// builds every model, so a missing one is a bug: panic. A build against COSIM_RTL_DIR has only
+/// what that folder provides: say on stderr what is skipped and why, and return `None`.
+///
+/// The note goes to stderr directly, not through `eprintln!`, which the test harness captures
+/// and shows only for failing tests: a skip must be visible when everything passes.
+pub fn require<T>(found: Option<T>, model: &str, what: &str) -> Option<T> {
+    if found.is_some() {
+        return found;
+    }
+    let built: Vec<&str> = SEGMENT_MODELS
+        .iter()
+        .map(|m| m.tag)
+        .chain(BFPI_MODELS.iter().map(|m| m.tag))
+        .chain(SPECULAR_MODELS.iter().map(|m| m.tag))
+        .collect();
+    let built = if built.is_empty() { "nothing".to_string() } else { built.join(", ") };
+    match RTL_DIR {
+        None => {
+            panic!("{what}: this build has no {model} model, and a default build (no COSIM_RTL_DIR) must have every model (built: {built})")
+        }
+        Some(dir) => {
+            use std::io::Write;
+            let _ = writeln!(
+                std::io::stderr().lock(),
+                "{what}: skipped: this build has no {model} model (COSIM_RTL_DIR={dir} provides {built} only)"
+            );
+            None
+        }
+    }
+}
+
 /// One instance of a verilated model with its own VerilatedContext.
 pub struct Rtl<I: 'static, O: 'static> {
     handle: *mut c_void,
@@ -259,4 +326,30 @@ impl<I, O> Drop for Rtl<I, O> {
 /// A two's complement value masked to `width` bits, as Verilator stores a signed port.
 pub fn to_port(v: i64, width: u32) -> u32 {
     (v as u64 & ((1u64 << width) - 1)) as u32
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// [`require`]'s rule: a missing model fails a default build and is skipped (`None`) in a
+    /// COSIM_RTL_DIR build; a built one is returned either way.
+    #[test]
+    fn a_missing_model_fails_only_a_default_build() {
+        let missing = std::panic::catch_unwind(|| {
+            require_segment_model(3, Align::Span, "ffi: the rule's own test (a p = 3 shader is never built)").map(|m| m.tag)
+        });
+        match RTL_DIR {
+            None => {
+                let e = missing.expect_err("a default build with a model missing must fail");
+                let msg = e.downcast_ref::<String>().expect("a formatted message");
+                assert!(msg.contains("this build has no seg_p3_span model"), "{msg}");
+            }
+            Some(_) => assert!(missing.unwrap().is_none()),
+        }
+        for m in SEGMENT_MODELS {
+            assert_eq!(require_segment_model(m.cfg.p, m.cfg.align, "ffi").map(|x| x.tag), Some(m.tag));
+        }
+        assert_eq!(require_specular_model("ffi").map(|x| x.tag), SPECULAR_MODELS.first().map(|x| x.tag));
+    }
 }
