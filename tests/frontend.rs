@@ -5,7 +5,7 @@ use golden::frontend::{FixedTriangle, FrontEnd, Outcome};
 use rand::rngs::StdRng;
 use rand::SeedableRng;
 use verilator_harness::cosim::{assert_clean, Stress, Traffic};
-use verilator_harness::ffi::{FRONTEND_MODELS, TRISHADER_MODELS};
+use verilator_harness::ffi::{require, require_models, FRONTEND_MODELS, TRISHADER_MODELS};
 use verilator_harness::frontend::{mesh, random_triangles, run_chain, run_frontend, Expected};
 
 fn frontend(m: &verilator_harness::ffi::ModelInfo<impl Sized, impl Sized>) -> FrontEnd {
@@ -15,8 +15,8 @@ fn frontend(m: &verilator_harness::ffi::ModelInfo<impl Sized, impl Sized>) -> Fr
 #[test]
 fn spans_equal_golden_for_every_kind_of_triangle() {
     let seed = verilator_harness::seed("frontend spans");
-    assert!(!FRONTEND_MODELS.is_empty(), "this build has no tri_frontend model");
-    for m in FRONTEND_MODELS {
+    let Some(models) = require_models(FRONTEND_MODELS, "tri_frontend", "frontend spans") else { return };
+    for m in models {
         let fe = frontend(m);
         let tris = random_triangles(&mut StdRng::seed_from_u64(seed), &fe, 3000);
         let exp = Expected::new(fe, &tris);
@@ -38,7 +38,8 @@ fn spans_equal_golden_for_every_kind_of_triangle() {
 #[test]
 fn resets_in_the_middle_of_triangles_drop_them_cleanly() {
     let seed = verilator_harness::seed("frontend resets");
-    for m in FRONTEND_MODELS {
+    let Some(models) = require_models(FRONTEND_MODELS, "tri_frontend", "frontend resets") else { return };
+    for m in models {
         let fe = frontend(m);
         let tris = random_triangles(&mut StdRng::seed_from_u64(seed ^ 1), &fe, 1500);
         let report = run_frontend(m, seed, Traffic::RANDOM, Stress::HARSH, &tris);
@@ -50,8 +51,8 @@ fn resets_in_the_middle_of_triangles_drop_them_cleanly() {
 #[test]
 fn segments_and_frames_through_the_chain() {
     let seed = verilator_harness::seed("tri_shader");
-    assert!(!TRISHADER_MODELS.is_empty(), "this build has no tri_shader model");
-    for m in TRISHADER_MODELS {
+    let Some(models) = require_models(TRISHADER_MODELS, "tri_shader", "tri_shader segments") else { return };
+    for m in models {
         let fe = frontend(m);
         let mut rng = StdRng::seed_from_u64(seed ^ m.cfg.p as u64);
         // Few enough per frame that the frame comparison stays meaningful where they overlap:
@@ -68,7 +69,8 @@ fn segments_and_frames_through_the_chain() {
 #[test]
 fn a_shared_edge_mesh_writes_every_covered_pixel_exactly_once() {
     let seed = verilator_harness::seed("tri_shader mesh");
-    for m in TRISHADER_MODELS {
+    let Some(models) = require_models(TRISHADER_MODELS, "tri_shader", "tri_shader mesh") else { return };
+    for m in models {
         let fe = frontend(m);
         let tris: Vec<FixedTriangle> = mesh(&mut StdRng::seed_from_u64(seed), &fe, 17, 11);
         let run = run_chain(m, seed, Traffic::RANDOM, &tris);
@@ -87,7 +89,7 @@ fn a_shared_edge_mesh_writes_every_covered_pixel_exactly_once() {
 fn the_scoreboard_catches_a_wrong_span() {
     // Negative control: the same run against golden spans with one I0 off by one must fail.
     let seed = verilator_harness::seed("frontend negative control");
-    let m = &FRONTEND_MODELS[0];
+    let Some(m) = require(FRONTEND_MODELS.first(), "tri_frontend", "frontend negative control") else { return };
     let fe = frontend(m);
     let tris = random_triangles(&mut StdRng::seed_from_u64(seed), &fe, 200);
     let mut bad = tris.clone();
@@ -104,8 +106,13 @@ fn the_scoreboard_catches_a_wrong_span() {
 #[test]
 fn set_up_costs_what_the_manifest_says() {
     // Triangles of one row each are set-up bound; zero-area ones cost their CALC clock only.
-    let m = FRONTEND_MODELS.iter().find(|m| m.tag == "fe").expect("the default front-end model");
-    let hw = hdl_gen::frontend::Hw { fe: frontend(m), div_bits: hdl_gen::frontend::DEFAULT_DIV_BITS };
+    let Some(m) = require(FRONTEND_MODELS.iter().find(|m| m.tag == "fe"), "fe", "frontend set-up clocks") else { return };
+    // The model's divider rate, from the latency the build recorded for it.
+    let hw = hdl_gen::frontend::DIV_BITS
+        .map(|div_bits| hdl_gen::frontend::Hw { fe: frontend(m), div_bits })
+        .into_iter()
+        .find(|hw| hw.latency() == m.latency)
+        .expect("a divider rate with the model's latency");
     let (walked, dropped) = hw.setup_clocks();
     let n = 400u64;
     let row = FixedTriangle { x: [2560, 7680, 2560], y: [2600, 2600, 2800], i: [100 << 12; 3] };
@@ -127,8 +134,9 @@ fn set_up_costs_what_the_manifest_says() {
 fn scenes_render_through_the_rtl_chain_as_golden() {
     use golden::setup::Screen;
     use verilator_harness::render::{run_with, scene_job, SceneKind};
-    let chain = TRISHADER_MODELS.iter().find(|m| m.cfg.p == 8 && m.cfg.align == golden::Align::Span).expect("tris_p8_span");
-    let seg = verilator_harness::ffi::segment_model(8, golden::Align::Span).expect("seg_p8_span");
+    let what = "render through the chain";
+    let Some(chain) = require(TRISHADER_MODELS.iter().find(|m| m.cfg.p == 8 && m.cfg.align == golden::Align::Span), "tris_p8_span", what) else { return };
+    let Some(seg) = verilator_harness::ffi::require_segment_model(8, golden::Align::Span, what) else { return };
     for kind in [SceneKind::Sphere, SceneKind::Torus] {
         let job = scene_job(kind, 40, &seg.cfg, &Screen::default()).unwrap();
         let o = run_with(&job, seg, Some(chain), None, |_| {});

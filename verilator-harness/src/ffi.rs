@@ -267,6 +267,8 @@ pub fn require<T>(found: Option<T>, model: &str, what: &str) -> Option<T> {
         .map(|m| m.tag)
         .chain(BFPI_MODELS.iter().map(|m| m.tag))
         .chain(SPECULAR_MODELS.iter().map(|m| m.tag))
+        .chain(FRONTEND_MODELS.iter().map(|m| m.tag))
+        .chain(TRISHADER_MODELS.iter().map(|m| m.tag))
         .collect();
     let built = if built.is_empty() { "nothing".to_string() } else { built.join(", ") };
     match RTL_DIR {
