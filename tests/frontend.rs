@@ -135,7 +135,10 @@ fn scenes_render_through_the_rtl_chain_as_golden() {
     use golden::setup::Screen;
     use verilator_harness::render::{run_with, scene_job, SceneKind};
     let what = "render through the chain";
-    let Some(chain) = require(TRISHADER_MODELS.iter().find(|m| m.cfg.p == 8 && m.cfg.align == golden::Align::Span), "tris_p8_span", what) else { return };
+    let Some(chain) = require(TRISHADER_MODELS.iter().find(|m| m.cfg.p == 8 && m.cfg.align == golden::Align::Span), "tris_p8_span", what)
+    else {
+        return;
+    };
     let Some(seg) = verilator_harness::ffi::require_segment_model(8, golden::Align::Span, what) else { return };
     for kind in [SceneKind::Sphere, SceneKind::Torus] {
         let job = scene_job(kind, 40, &seg.cfg, &Screen::default()).unwrap();

@@ -118,7 +118,10 @@ fn specular_unit_survives_resets_stalls_and_gaps() {
     assert_clean("specular unit under reset stress", seed, &report);
     assert!(report.resets >= 10 && report.cut_spans > 0, "{} resets, {} cut (seed {seed})", report.resets, report.cut_spans);
     assert!(report.spans > 2 * report.cut_spans, "most spans must complete: {} cut of {} (seed {seed})", report.cut_spans, report.spans);
-    eprintln!("{}: {} spans ({} cut by {} resets), {} pixels, {} clocks", info.tag, report.spans, report.cut_spans, report.resets, report.pixels, report.cycles);
+    eprintln!(
+        "{}: {} spans ({} cut by {} resets), {} pixels, {} clocks",
+        info.tag, report.spans, report.cut_spans, report.resets, report.pixels, report.cycles
+    );
 }
 
 /// SPEC §3: a source never waits for `ready` before raising `valid`. With `out_ready` held low
@@ -133,7 +136,14 @@ fn out_valid_does_not_wait_for_out_ready() {
         let mut input = SegIn { rst: 1, ..SegIn::default() };
         rtl.step_into(&input, &mut out);
         rtl.step_into(&input, &mut out);
-        input = SegIn { in_valid: 1, in_x: 3, in_len: 2 * cfg.p + 1, in_i0: 40 << cfg.frac, in_di: to_port(1 << cfg.frac, cfg.dw()), ..SegIn::default() };
+        input = SegIn {
+            in_valid: 1,
+            in_x: 3,
+            in_len: 2 * cfg.p + 1,
+            in_i0: 40 << cfg.frac,
+            in_di: to_port(1 << cfg.frac, cfg.dw()),
+            ..SegIn::default()
+        };
         rtl.step_into(&input, &mut out);
         assert_eq!(out.in_ready, 1, "{}: an idle shader takes a span", info.tag);
         input.in_valid = 0;
@@ -144,7 +154,11 @@ fn out_valid_does_not_wait_for_out_ready() {
         let mut first = None;
         for k in 0..20 {
             rtl.step_into(&input, &mut out);
-            assert_eq!(out.out_valid, 1, "{}: out_valid must rise {} clocks after the transfer with out_ready low (clock +{k})", info.tag, info.latency);
+            assert_eq!(
+                out.out_valid, 1,
+                "{}: out_valid must rise {} clocks after the transfer with out_ready low (clock +{k})",
+                info.tag, info.latency
+            );
             let now = (out.out_x, out.pix[0], out.mask[0], out.out_last);
             assert_eq!(*first.get_or_insert(now), now, "{}: the offered segment changed while out_ready was low", info.tag);
         }
@@ -273,7 +287,9 @@ fn harness_rejects_spans_the_rtl_cannot_take() {
     let Some(info) = spec_model("the specular unit's port limits") else { return };
     let port_max = (1u32 << (info.cfg.xbits + 1)) - 1;
     let good = SpecularSpan { c: 100, n: 10, theta0: 0, dtheta: 1000, len: 3 };
-    for (span, needle) in [(SpecularSpan { len: port_max + 1, ..good }, "in_len port"), (SpecularSpan { n: 1 << N_BITS, ..good }, "in_n port")] {
+    for (span, needle) in
+        [(SpecularSpan { len: port_max + 1, ..good }, "in_len port"), (SpecularSpan { n: 1 << N_BITS, ..good }, "in_n port")]
+    {
         let mut sim = SpecularCosim::new(info, SpecularUnit::default(), 1, Traffic::FULL);
         let mut report = Report::default();
         let e = sim.try_stream(&[good, span], &mut report).expect_err("accepted");
@@ -355,7 +371,9 @@ fn extreme_triangles_are_clipped_not_garbled() {
             let mut tris = vec![
                 Triangle { v: [Vertex { x: -l, y: -l, i: 0.0 }, Vertex { x: l, y: -l, i: 255.0 }, Vertex { x: -l, y: l, i: 128.0 }] },
                 Triangle { v: [Vertex { x: l, y: l, i: 255.0 }, Vertex { x: -l, y: 10.5, i: 0.0 }, Vertex { x: l, y: -l, i: 30.0 }] },
-                Triangle { v: [Vertex { x: -l, y: 3.25, i: 0.0 }, Vertex { x: l, y: 3.75, i: 255.0 }, Vertex { x: 0.0, y: 40.0, i: 77.0 }] },
+                Triangle {
+                    v: [Vertex { x: -l, y: 3.25, i: 0.0 }, Vertex { x: l, y: 3.75, i: 255.0 }, Vertex { x: 0.0, y: 40.0, i: 77.0 }],
+                },
             ];
             for _ in 0..6 {
                 let mut v = || Vertex { x: rng.gen_range(-l..=l), y: rng.gen_range(-l..=l), i: rng.gen_range(0.0..=255.0) };

@@ -7,7 +7,7 @@ use golden::setup::Screen;
 use golden::Span;
 use rand::rngs::StdRng;
 use rand::{Rng, SeedableRng};
-use verilator_harness::cosim::{assert_clean, Report, DRAIN_CLOCKS, SegmentCosim, Stim, Traffic};
+use verilator_harness::cosim::{assert_clean, Report, SegmentCosim, Stim, Traffic, DRAIN_CLOCKS};
 use verilator_harness::ffi::{require_models, SEGMENT_MODELS};
 use verilator_harness::stimulus::{directed, random_triangle};
 

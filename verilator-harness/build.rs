@@ -105,7 +105,15 @@ fn generated_models() -> Vec<Model> {
             let names = hdl_gen::Names::new("", &cfg);
             if align == Align::Span {
                 let bfpi = sources.iter().filter(|(n, _)| *n == format!("{}.v", names.bfpi)).cloned().collect();
-                models.push(Model { tag: format!("bfpi_p{p}"), kind: Kind::Bfpi, cfg, screen: Screen::default(), top: names.bfpi.clone(), latency: 0, sources: bfpi });
+                models.push(Model {
+                    tag: format!("bfpi_p{p}"),
+                    kind: Kind::Bfpi,
+                    cfg,
+                    screen: Screen::default(),
+                    top: names.bfpi.clone(),
+                    latency: 0,
+                    sources: bfpi,
+                });
             }
             let latency = hdl_gen::segment::LATENCY;
             // The chain at every P and alignment only on request (`sweep`'s front-end table):
@@ -117,21 +125,54 @@ fn generated_models() -> Vec<Model> {
                 let (fe_lat, top_lat) = (hw.latency(), hw.latency() + latency);
                 if p == 8 && align == Align::Span {
                     let src = sources.iter().filter(|(n, _)| *n == format!("{}.v", names.frontend)).cloned().collect();
-                    models.push(Model { tag: "fe".into(), kind: Kind::Frontend, cfg, screen: fe.screen, top: names.frontend.clone(), latency: fe_lat, sources: src });
+                    models.push(Model {
+                        tag: "fe".into(),
+                        kind: Kind::Frontend,
+                        cfg,
+                        screen: fe.screen,
+                        top: names.frontend.clone(),
+                        latency: fe_lat,
+                        sources: src,
+                    });
                     // The other divider rates (`--fe-div-bits`), so co-simulation covers every option.
                     for div_bits in hdl_gen::frontend::DIV_BITS.into_iter().filter(|&b| b != hw.div_bits) {
                         let hw = hdl_gen::frontend::Hw { div_bits, ..hw };
                         let m = hdl_gen::frontend::module(&hw, &names);
                         let src = vec![(format!("{}.v", m.name), m.render())];
-                        models.push(Model { tag: format!("fe_div{div_bits}"), kind: Kind::Frontend, cfg, screen: fe.screen, top: m.name, latency: hw.latency(), sources: src });
+                        models.push(Model {
+                            tag: format!("fe_div{div_bits}"),
+                            kind: Kind::Frontend,
+                            cfg,
+                            screen: fe.screen,
+                            top: m.name,
+                            latency: hw.latency(),
+                            sources: src,
+                        });
                     }
                 }
                 let chain = [&names.bfpi, &names.segment, &names.frontend, &names.top].map(|n| format!("{n}.v"));
                 let src = sources.iter().filter(|(n, _)| chain.contains(n)).cloned().collect();
-                models.push(Model { tag: format!("tris_p{p}_{align}"), kind: Kind::TriShader, cfg, screen: fe.screen, top: names.top.clone(), latency: top_lat, sources: src });
+                models.push(Model {
+                    tag: format!("tris_p{p}_{align}"),
+                    kind: Kind::TriShader,
+                    cfg,
+                    screen: fe.screen,
+                    top: names.top.clone(),
+                    latency: top_lat,
+                    sources: src,
+                });
             }
-            let sources = sources.into_iter().filter(|(n, _)| *n == format!("{}.v", names.segment) || *n == format!("{}.v", names.bfpi)).collect();
-            models.push(Model { tag: format!("seg_p{p}_{align}"), kind: Kind::Segment, cfg, screen: Screen::default(), top: names.segment, latency, sources });
+            let sources =
+                sources.into_iter().filter(|(n, _)| *n == format!("{}.v", names.segment) || *n == format!("{}.v", names.bfpi)).collect();
+            models.push(Model {
+                tag: format!("seg_p{p}_{align}"),
+                kind: Kind::Segment,
+                cfg,
+                screen: Screen::default(),
+                top: names.segment,
+                latency,
+                sources,
+            });
         }
     }
     models
@@ -166,11 +207,27 @@ fn models_from_dir(dir: &Path) -> Vec<Model> {
     if let Some(top) = top_of("bfpi") {
         let file = format!("{top}.v");
         let src = sources.iter().filter(|(n, _)| *n == file).cloned().collect();
-        models.push(Model { tag: format!("bfpi_p{}", cfg.p), kind: Kind::Bfpi, cfg, screen: Screen::default(), top, latency: 0, sources: src });
+        models.push(Model {
+            tag: format!("bfpi_p{}", cfg.p),
+            kind: Kind::Bfpi,
+            cfg,
+            screen: Screen::default(),
+            top,
+            latency: 0,
+            sources: src,
+        });
     }
     if let Some(top) = top_of("segment_shader") {
         let latency = latency_of("segment_shader");
-        models.push(Model { tag: format!("seg_p{}_{}", cfg.p, cfg.align), kind: Kind::Segment, cfg, screen: Screen::default(), top, latency, sources: sources.clone() });
+        models.push(Model {
+            tag: format!("seg_p{}_{}", cfg.p, cfg.align),
+            kind: Kind::Segment,
+            cfg,
+            screen: Screen::default(),
+            top,
+            latency,
+            sources: sources.clone(),
+        });
     }
     if let (Some(fe_top), Some(tri_top)) = (top_of("frontend"), top_of("triangle_shader")) {
         let sc = &m["frontend"]["screen"];
@@ -180,7 +237,15 @@ fn models_from_dir(dir: &Path) -> Vec<Model> {
         let mut all = sources.clone();
         all.extend(fe_src.iter().cloned());
         all.extend(files_of(&["triangle_shader"]));
-        models.push(Model { tag: "fe".into(), kind: Kind::Frontend, cfg, screen, top: fe_top, latency: latency_of("frontend"), sources: fe_src });
+        models.push(Model {
+            tag: "fe".into(),
+            kind: Kind::Frontend,
+            cfg,
+            screen,
+            top: fe_top,
+            latency: latency_of("frontend"),
+            sources: fe_src,
+        });
         let tag = format!("tris_p{}_{}", cfg.p, cfg.align);
         models.push(Model { tag, kind: Kind::TriShader, cfg, screen, top: tri_top, latency: latency_of("triangle_shader"), sources: all });
     }
@@ -338,7 +403,8 @@ fn build_model(v: &Verilator, out: &Path, m: &Model) -> Vec<String> {
         b.compile(&m.tag);
         fs::rename(obj.join(format!("lib{}.a", m.tag)), &lib).unwrap();
         let total = start.elapsed().as_secs_f64();
-        fs::write(obj.join("build.time"), format!("verilate {verilated:.3}\ncompile {:.3}\ntotal {total:.3}\n", total - verilated)).unwrap();
+        fs::write(obj.join("build.time"), format!("verilate {verilated:.3}\ncompile {:.3}\ntotal {total:.3}\n", total - verilated))
+            .unwrap();
         fs::write(&key_file, &key).unwrap();
     }
     mk.global
@@ -362,7 +428,11 @@ fn build_runtime(v: &Verilator, out: &Path, globals: &[String]) {
     }
     b.compile("verilated_rt");
     fs::rename(obj.join("libverilated_rt.a"), &lib).unwrap();
-    fs::write(obj.join("build.time"), format!("compile {:.3}\ntotal {:.3}\n", start.elapsed().as_secs_f64(), start.elapsed().as_secs_f64())).unwrap();
+    fs::write(
+        obj.join("build.time"),
+        format!("compile {:.3}\ntotal {:.3}\n", start.elapsed().as_secs_f64(), start.elapsed().as_secs_f64()),
+    )
+    .unwrap();
     fs::write(obj.join("build.key"), key).unwrap();
 }
 

@@ -137,11 +137,8 @@ fn best_adder(c: u32, built: &[u32], depth: &[Option<u32>], shift_max: u32, leve
             }
             for s in 1..=shift_max {
                 let sa = (a as i64) << s;
-                let candidates = [
-                    (sa + b as i64, Op::Add, a, s, b, 0),
-                    (sa - b as i64, Op::Sub, a, s, b, 0),
-                    (b as i64 - sa, Op::Sub, b, 0, a, s),
-                ];
+                let candidates =
+                    [(sa + b as i64, Op::Add, a, s, b, 0), (sa - b as i64, Op::Sub, a, s, b, 0), (b as i64 - sa, Op::Sub, b, 0, a, s)];
                 for (v, op, x, xs, y, ys) in candidates {
                     if v != c {
                         continue;

@@ -73,18 +73,10 @@ impl Config {
     pub fn new(p: u32, frac: u32, xbits: u32, align: Align) -> Result<Config, String> {
         check_p(p)?;
         if !FRAC_RANGE.contains(&frac) {
-            return Err(format!(
-                "fraction bits F = {frac} is outside {}..{}",
-                FRAC_RANGE.start(),
-                FRAC_RANGE.end()
-            ));
+            return Err(format!("fraction bits F = {frac} is outside {}..{}", FRAC_RANGE.start(), FRAC_RANGE.end()));
         }
         if !XBITS_RANGE.contains(&xbits) {
-            return Err(format!(
-                "screen-x bits XW = {xbits} is outside {}..{}",
-                XBITS_RANGE.start(),
-                XBITS_RANGE.end()
-            ));
+            return Err(format!("screen-x bits XW = {xbits} is outside {}..{}", XBITS_RANGE.start(), XBITS_RANGE.end()));
         }
         if p > 1 << xbits {
             // A segment wider than the whole screen could never be filled.
@@ -169,12 +161,7 @@ impl Span {
             return Err(format!("span length {} exceeds 2^XW = {}", self.len, cfg.max_len()));
         }
         if self.x0 as u64 + self.len as u64 > cfg.max_len() as u64 || self.x0 >= cfg.max_len() {
-            return Err(format!(
-                "span x0 = {} + len = {} reaches beyond the screen width 2^XW = {}",
-                self.x0,
-                self.len,
-                cfg.max_len()
-            ));
+            return Err(format!("span x0 = {} + len = {} reaches beyond the screen width 2^XW = {}", self.x0, self.len, cfg.max_len()));
         }
         if self.i0 >= 1 << cfg.iw() {
             return Err(format!("span I0 = {} does not fit UQ8.{}", self.i0, cfg.frac));

@@ -531,7 +531,13 @@ mod tests {
             let ours: Vec<_> = spans.iter().map(|&(y, s)| (y, s.x0, s.len)).collect();
             if ours != host {
                 let diff = ours.iter().zip(&host).position(|(a, b)| a != b).unwrap_or(ours.len().min(host.len()));
-                panic!("coverage differs for {t:?} at span {diff}: {:?} vs {:?} ({} vs {} spans)", ours.get(diff), host.get(diff), ours.len(), host.len());
+                panic!(
+                    "coverage differs for {t:?} at span {diff}: {:?} vs {:?} ({} vs {} spans)",
+                    ours.get(diff),
+                    host.get(diff),
+                    ours.len(),
+                    host.len()
+                );
             }
             walked += (outcome == Outcome::Walked) as usize;
             // Every pixel within 1 of the exact plane through the port intensities.
@@ -628,7 +634,9 @@ mod tests {
         let fe = FrontEnd::new(cfg, Screen::default()).unwrap();
         // dI/dx = 1 level per pixel exactly.
         let t = FixedTriangle::from_triangle(
-            &Triangle { v: [Vertex { x: 10.0, y: 10.0, i: 0.0 }, Vertex { x: 110.0, y: 10.0, i: 100.0 }, Vertex { x: 10.0, y: 60.0, i: 255.0 }] },
+            &Triangle {
+                v: [Vertex { x: 10.0, y: 10.0, i: 0.0 }, Vertex { x: 110.0, y: 10.0, i: 100.0 }, Vertex { x: 10.0, y: 60.0, i: 255.0 }],
+            },
             12,
         );
         let (_, spans) = fe.span_list(&t);

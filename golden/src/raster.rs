@@ -36,12 +36,7 @@ impl Frame {
     }
 
     fn index(&self, x: u32, y: u32) -> usize {
-        assert!(
-            x < self.width && y < self.height,
-            "pixel ({x}, {y}) outside the {}x{} frame",
-            self.width,
-            self.height
-        );
+        assert!(x < self.width && y < self.height, "pixel ({x}, {y}) outside the {}x{} frame", self.width, self.height);
         y as usize * self.width as usize + x as usize
     }
 
@@ -73,9 +68,7 @@ impl Frame {
             self.width
         );
         let end = start + span.len as usize;
-        for (j, (p, c)) in
-            self.pixels[start..end].iter_mut().zip(&mut self.covered[start..end]).enumerate()
-        {
+        for (j, (p, c)) in self.pixels[start..end].iter_mut().zip(&mut self.covered[start..end]).enumerate() {
             *p = span.pixel(j as u32, frac);
             *c = true;
         }
@@ -153,11 +146,7 @@ pub fn round_intensity(v: f64) -> u8 {
 /// Calls `f(x, y, I)` for every pixel of `screen` the triangle covers, `I` the exact plane
 /// intensity at its centre, in row-major order. Checks its inputs like `triangle_spans`
 /// (except that the screen need not fit a configuration).
-pub fn reference_pixels(
-    screen: &Screen,
-    tri: &Triangle,
-    mut f: impl FnMut(u32, u32, f64),
-) -> Result<(), String> {
+pub fn reference_pixels(screen: &Screen, tri: &Triangle, mut f: impl FnMut(u32, u32, f64)) -> Result<(), String> {
     screen.check()?;
     tri.check()?;
     let sn = Snapped::new(tri);
@@ -202,16 +191,9 @@ pub fn reference_pixels(
 }
 
 /// Paints the triangle's exact intensities into `frame` (later triangles overwrite earlier).
-pub fn reference_triangle(
-    screen: &Screen,
-    tri: &Triangle,
-    frame: &mut RefFrame,
-) -> Result<(), String> {
+pub fn reference_triangle(screen: &Screen, tri: &Triangle, frame: &mut RefFrame) -> Result<(), String> {
     if (screen.width, screen.height) != (frame.width, frame.height) {
-        return Err(format!(
-            "screen {}x{} and reference frame {}x{} differ",
-            screen.width, screen.height, frame.width, frame.height
-        ));
+        return Err(format!("screen {}x{} and reference frame {}x{} differ", screen.width, screen.height, frame.width, frame.height));
     }
     reference_pixels(screen, tri, |x, y, v| frame.set(x, y, v))
 }
@@ -243,11 +225,7 @@ impl Comparison {
 
 impl fmt::Display for Comparison {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(
-            f,
-            "{} covered pixels, {} only in frame, {} only in reference",
-            self.covered, self.only_frame, self.only_reference
-        )?;
+        write!(f, "{} covered pixels, {} only in frame, {} only in reference", self.covered, self.only_frame, self.only_reference)?;
         if let Some((x, y)) = self.first_mismatch {
             write!(f, " (first at ({x}, {y}))")?;
         }
@@ -265,11 +243,7 @@ impl fmt::Display for Comparison {
 
 /// Compares two frames of the same size pixel by pixel.
 pub fn compare(frame: &Frame, reference: &RefFrame) -> Comparison {
-    assert_eq!(
-        (frame.width, frame.height),
-        (reference.width, reference.height),
-        "frame and reference sizes differ"
-    );
+    assert_eq!((frame.width, frame.height), (reference.width, reference.height), "frame and reference sizes differ");
     let mut c = Comparison::default();
     for y in 0..frame.height {
         for x in 0..frame.width {
@@ -312,13 +286,9 @@ mod tests {
 
     /// GOLDEN_SEED replays a run; otherwise a fresh seed, printed so a failure can be replayed.
     fn seed() -> u64 {
-        let s =
-            std::env::var("GOLDEN_SEED").ok().and_then(|s| s.parse().ok()).unwrap_or_else(|| {
-                std::time::SystemTime::now()
-                    .duration_since(std::time::UNIX_EPOCH)
-                    .map(|d| d.as_nanos() as u64)
-                    .unwrap_or(1)
-            });
+        let s = std::env::var("GOLDEN_SEED").ok().and_then(|s| s.parse().ok()).unwrap_or_else(|| {
+            std::time::SystemTime::now().duration_since(std::time::UNIX_EPOCH).map(|d| d.as_nanos() as u64).unwrap_or(1)
+        });
         println!("GOLDEN_SEED={s}");
         s
     }
@@ -362,10 +332,7 @@ mod tests {
             // Medium.
             1 | 2 => {
                 for q in &mut p {
-                    *q = [
-                        anchor[0] + rng.gen_range(-60.0..60.0),
-                        anchor[1] + rng.gen_range(-60.0..60.0),
-                    ];
+                    *q = [anchor[0] + rng.gen_range(-60.0..60.0), anchor[1] + rng.gen_range(-60.0..60.0)];
                 }
             }
             // Sliver: the third vertex a hair off the line through the other two.
@@ -373,22 +340,12 @@ mod tests {
                 let a = [rng.gen_range(-w..2.0 * w), rng.gen_range(-h..2.0 * h)];
                 let t: f64 = rng.gen_range(0.0..1.0);
                 let off = rng.gen_range(-1.5..1.5) * if rng.gen_bool(0.5) { 1.0 } else { 0.01 };
-                p = [
-                    anchor,
-                    a,
-                    [
-                        anchor[0] + t * (a[0] - anchor[0]) + off,
-                        anchor[1] + t * (a[1] - anchor[1]) - off,
-                    ],
-                ];
+                p = [anchor, a, [anchor[0] + t * (a[0] - anchor[0]) + off, anchor[1] + t * (a[1] - anchor[1]) - off]];
             }
             // Huge: up to the coordinate limit.
             4 => {
                 for q in &mut p {
-                    *q = [
-                        rng.gen_range(-COORD_LIMIT..COORD_LIMIT),
-                        rng.gen_range(-COORD_LIMIT..COORD_LIMIT),
-                    ];
+                    *q = [rng.gen_range(-COORD_LIMIT..COORD_LIMIT), rng.gen_range(-COORD_LIMIT..COORD_LIMIT)];
                 }
             }
             // Large, around the screen, with an axis-aligned edge.
@@ -432,8 +389,7 @@ mod tests {
             }
             if spans.iter().any(|(_, s)| s.len >= 2) {
                 // The slope from the plane equation in pixels, independent of Snapped::didx.
-                let (x, y, i) =
-                    (sn.x.map(|v| v as f64 / 256.0), sn.y.map(|v| v as f64 / 256.0), sn.i);
+                let (x, y, i) = (sn.x.map(|v| v as f64 / 256.0), sn.y.map(|v| v as f64 / 256.0), sn.i);
                 let slope = ((i[1] - i[0]) * (y[2] - y[0]) - (i[2] - i[0]) * (y[1] - y[0]))
                     / ((x[1] - x[0]) * (y[2] - y[0]) - (y[1] - y[0]) * (x[2] - x[0]));
                 let scaled = slope * (1u64 << cfg.frac) as f64;
@@ -442,9 +398,7 @@ mod tests {
             let mut covered = 0u64;
             reference_pixels(screen, &t, |x, y, v| {
                 covered += 1;
-                let k = spans
-                    .binary_search_by_key(&y, |s| s.0)
-                    .unwrap_or_else(|_| panic!("({x}, {y}) in no span: {t}"));
+                let k = spans.binary_search_by_key(&y, |s| s.0).unwrap_or_else(|_| panic!("({x}, {y}) in no span: {t}"));
                 let s = spans[k].1;
                 assert!(x >= s.x0 && x < s.x0 + s.len, "({x}, {y}) outside span {s:?}: {t}");
                 let p = s.pixel(x - s.x0, cfg.frac);
@@ -477,10 +431,7 @@ mod tests {
         ];
         for (cfg, screen, count) in runs {
             let worst = property(&cfg, &screen, count, &mut rng);
-            println!(
-                "F = {}, {}x{}: max |pixel - exact| = {worst:.4}",
-                cfg.frac, screen.width, screen.height
-            );
+            println!("F = {}, {}x{}: max |pixel - exact| = {worst:.4}", cfg.frac, screen.width, screen.height);
         }
     }
 
@@ -525,12 +476,7 @@ mod tests {
             let mut tris = Vec::new();
             for j in 0..ny - 1 {
                 for i in 0..nx - 1 {
-                    let [a, b, c, d] = [
-                        grid[j * nx + i],
-                        grid[j * nx + i + 1],
-                        grid[(j + 1) * nx + i + 1],
-                        grid[(j + 1) * nx + i],
-                    ];
+                    let [a, b, c, d] = [grid[j * nx + i], grid[j * nx + i + 1], grid[(j + 1) * nx + i + 1], grid[(j + 1) * nx + i]];
                     if rng.gen_bool(0.5) {
                         tris.extend([tri([a, b, c]), tri([a, c, d])]);
                     } else {
@@ -539,11 +485,7 @@ mod tests {
                 }
             }
             let (spans, reference) = counts(&screen, &tris);
-            assert!(
-                spans.iter().all(|&c| c == 1),
-                "cell {cell}: spans cover a pixel {:?} times",
-                spans.iter().find(|&&c| c != 1)
-            );
+            assert!(spans.iter().all(|&c| c == 1), "cell {cell}: spans cover a pixel {:?} times", spans.iter().find(|&&c| c != 1));
             assert!(reference.iter().all(|&c| c == 1), "cell {cell}: reference");
         }
     }
@@ -558,8 +500,7 @@ mod tests {
                     [centre[0] + 500.0 * a.cos(), centre[1] + 500.0 * a.sin(), 100.0]
                 };
                 let c = [centre[0], centre[1], 0.0];
-                let tris: Vec<_> =
-                    (0..spokes).map(|k| tri([c, corner(k), corner(k + 1)])).collect();
+                let tris: Vec<_> = (0..spokes).map(|k| tri([c, corner(k), corner(k + 1)])).collect();
                 let (a, b) = counts(&screen, &tris);
                 assert!(a.iter().chain(&b).all(|&n| n == 1), "centre {centre:?}, {spokes} spokes");
             }
@@ -575,8 +516,7 @@ mod tests {
         assert_eq!(reference.get(0, 0), Some(10.0));
         assert_eq!(reference.get(7, 3), None);
         let mut frame = Frame::new(8, 4);
-        triangle_spans(&Config::default(), &screen, &t, |y, s| frame.write_span(y, &s, 12))
-            .unwrap();
+        triangle_spans(&Config::default(), &screen, &t, |y, s| frame.write_span(y, &s, 12)).unwrap();
         let c = compare(&frame, &reference);
         assert!(c.passed(), "{c}");
         assert_eq!((c.covered as usize, c.max_diff, c.max_error), (frame.covered_count(), 0, 0.0));
@@ -593,18 +533,12 @@ mod tests {
         assert!(!c.passed() && c.to_string().ends_with("FAIL"));
         frame.clear();
         let c = compare(&frame, &reference);
-        assert_eq!(
-            (c.only_reference, c.first_mismatch),
-            (reference_count(&reference), Some((0, 0)))
-        );
+        assert_eq!((c.only_reference, c.first_mismatch), (reference_count(&reference), Some((0, 0))));
         assert!(reference_triangle(&Screen { width: 9, height: 4 }, &t, &mut reference).is_err());
     }
 
     fn reference_count(r: &RefFrame) -> u64 {
-        (0..r.height())
-            .flat_map(|y| (0..r.width()).map(move |x| (x, y)))
-            .filter(|&(x, y)| r.get(x, y).is_some())
-            .count() as u64
+        (0..r.height()).flat_map(|y| (0..r.width()).map(move |x| (x, y))).filter(|&(x, y)| r.get(x, y).is_some()).count() as u64
     }
 
     #[test]

@@ -302,8 +302,7 @@ pub fn parse_mif(text: &str) -> Result<(u32, Vec<u64>), String> {
 /// by words separated by commas or whitespace, ended by `;`. `;` starts a comment elsewhere.
 pub fn parse_coe(text: &str) -> Result<Vec<u64>, String> {
     // A line starting with ';' is a comment; elsewhere ';' ends a statement.
-    let body: String =
-        text.lines().filter(|l| !l.trim_start().starts_with(';')).flat_map(|l| [l, "\n"]).collect();
+    let body: String = text.lines().filter(|l| !l.trim_start().starts_with(';')).flat_map(|l| [l, "\n"]).collect();
     let mut radix = 10;
     let mut vector = None;
     for stmt in body.split(';').map(str::trim).filter(|s| !s.is_empty()) {
@@ -315,10 +314,7 @@ pub fn parse_coe(text: &str) -> Result<Vec<u64>, String> {
         }
     }
     let v = vector.ok_or("COE has no memory_initialization_vector")?;
-    v.split(|c: char| c == ',' || c.is_whitespace())
-        .filter(|t| !t.is_empty())
-        .map(|t| num(t, radix))
-        .collect()
+    v.split(|c: char| c == ',' || c.is_whitespace()).filter(|t| !t.is_empty()).map(|t| num(t, radix)).collect()
 }
 
 /// The BRDF ROM: the plan's tables packed back to back, table `t` at `base_t..base_t+len_t`.

@@ -56,13 +56,8 @@ impl Scheme {
     /// The seeds' schemes that the segment shader is measured against, in SPEC §1's order
     /// (the seed-fill "wave" (c) is not modelled: its clock count depends on the contour-drawing
     /// and wave bookkeeping the seed leaves open).
-    pub const BASELINES: [Scheme; 5] = [
-        Scheme::Classical,
-        Scheme::CounterDirectional,
-        Scheme::EvenOdd,
-        Scheme::FourInterpolators,
-        Scheme::MidlineSplit,
-    ];
+    pub const BASELINES: [Scheme; 5] =
+        [Scheme::Classical, Scheme::CounterDirectional, Scheme::EvenOdd, Scheme::FourInterpolators, Scheme::MidlineSplit];
 
     /// Clocks of one span of `len` pixels starting at column `x0`, for the schemes that work
     /// span by span (`None` for [`Scheme::MidlineSplit`], which works on whole triangles).
@@ -175,12 +170,7 @@ pub fn midline_split(tri: &Triangle) -> [Triangle; 4] {
     let [a, b, c] = tri.v;
     let mid = |p: Vertex, q: Vertex| Vertex { x: (p.x + q.x) / 2.0, y: (p.y + q.y) / 2.0, i: (p.i + q.i) / 2.0 };
     let (ab, bc, ca) = (mid(a, b), mid(b, c), mid(c, a));
-    [
-        Triangle { v: [a, ab, ca] },
-        Triangle { v: [ab, b, bc] },
-        Triangle { v: [ca, bc, c] },
-        Triangle { v: [ab, bc, ca] },
-    ]
+    [Triangle { v: [a, ab, ca] }, Triangle { v: [ab, b, bc] }, Triangle { v: [ca, bc, c] }, Triangle { v: [ab, bc, ca] }]
 }
 
 /// Clocks of seed (d) for one triangle.
@@ -261,10 +251,7 @@ mod tests {
                 assert_eq!(count(Scheme::Segment { p: 1, align }).clocks, pixels);
             }
             assert_eq!(count(Scheme::Segment { p: 2, align: Align::Span }).clocks, half);
-            assert_eq!(
-                count(Scheme::Segment { p: 4, align: Align::Span }).clocks,
-                count(Scheme::FourInterpolators).clocks
-            );
+            assert_eq!(count(Scheme::Segment { p: 4, align: Align::Span }).clocks, count(Scheme::FourInterpolators).clocks);
             // The segment model agrees with the configuration's own segment count.
             for p in [8, 16, 64] {
                 for align in Align::ALL {

@@ -81,10 +81,7 @@ mod tests {
         let span = Span { x0: 5, len: 6, i0: 0, di: 0 };
         assert_eq!(
             lanes(&c, &span),
-            vec![
-                (5, vec![Some(0), Some(1), Some(2), Some(3)], false),
-                (9, vec![Some(4), Some(5), None, None], true),
-            ]
+            vec![(5, vec![Some(0), Some(1), Some(2), Some(3)], false), (9, vec![Some(4), Some(5), None, None], true),]
         );
     }
 
@@ -94,10 +91,7 @@ mod tests {
         let span = Span { x0: 5, len: 6, i0: 0, di: 0 };
         assert_eq!(
             lanes(&c, &span),
-            vec![
-                (4, vec![None, Some(0), Some(1), Some(2)], false),
-                (8, vec![Some(3), Some(4), Some(5), None], true),
-            ]
+            vec![(4, vec![None, Some(0), Some(1), Some(2)], false), (8, vec![Some(3), Some(4), Some(5), None], true),]
         );
         let one = Span { x0: 7, len: 1, i0: 0, di: 0 };
         assert_eq!(lanes(&c, &one), vec![(4, vec![None, None, None, Some(0)], true)]);

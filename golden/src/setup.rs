@@ -60,10 +60,7 @@ impl Screen {
     /// Both dimensions within [`SCREEN_LIMIT`] (needed for the exactness argument above).
     pub fn check(&self) -> Result<(), String> {
         if self.width > SCREEN_LIMIT || self.height > SCREEN_LIMIT {
-            return Err(format!(
-                "screen {}x{} exceeds {SCREEN_LIMIT}x{SCREEN_LIMIT}",
-                self.width, self.height
-            ));
+            return Err(format!("screen {}x{} exceeds {SCREEN_LIMIT}x{SCREEN_LIMIT}", self.width, self.height));
         }
         Ok(())
     }
@@ -72,11 +69,7 @@ impl Screen {
     pub fn check_for(&self, cfg: &Config) -> Result<(), String> {
         self.check()?;
         if self.width > cfg.max_len() {
-            return Err(format!(
-                "screen width {} exceeds 2^XW = {} pixels of the configuration",
-                self.width,
-                cfg.max_len()
-            ));
+            return Err(format!("screen width {} exceeds 2^XW = {} pixels of the configuration", self.width, cfg.max_len()));
         }
         Ok(())
     }
@@ -88,9 +81,7 @@ impl Triangle {
         for (n, v) in self.v.iter().enumerate() {
             for (name, c) in [("x", v.x), ("y", v.y)] {
                 if !c.is_finite() || c.abs() > COORD_LIMIT {
-                    return Err(format!(
-                        "vertex {n}: {name} = {c} is outside -{COORD_LIMIT}..={COORD_LIMIT}"
-                    ));
+                    return Err(format!("vertex {n}: {name} = {c} is outside -{COORD_LIMIT}..={COORD_LIMIT}"));
                 }
             }
             if !(v.i.is_finite() && (0.0..=255.0).contains(&v.i)) {
@@ -140,10 +131,7 @@ pub fn parse_triangles(text: &str) -> Result<Vec<Triangle>, ParseError> {
             continue;
         }
         if fields.len() != 9 {
-            return Err(err(format!(
-                "expected 9 numbers (x0 y0 i0 x1 y1 i1 x2 y2 i2), found {}",
-                fields.len()
-            )));
+            return Err(err(format!("expected 9 numbers (x0 y0 i0 x1 y1 i1 x2 y2 i2), found {}", fields.len())));
         }
         let mut f = [0.0f64; 9];
         for (k, s) in fields.iter().enumerate() {
@@ -248,8 +236,7 @@ impl Snapped {
             return 0.0;
         }
         let (y, i) = (&self.y, &self.i);
-        let n =
-            i[0] * (y[1] - y[2]) as f64 + i[1] * (y[2] - y[0]) as f64 + i[2] * (y[0] - y[1]) as f64;
+        let n = i[0] * (y[1] - y[2]) as f64 + i[1] * (y[2] - y[0]) as f64 + i[2] * (y[0] - y[1]) as f64;
         n * SUBPIXEL as f64 / self.area2 as f64
     }
 
@@ -312,12 +299,7 @@ impl Snapped {
 
 /// Validates `screen` against `cfg` and `tri`, then emits the triangle's spans (see
 /// [`Snapped::spans`]). No allocation; the hot path of the co-simulation.
-pub fn triangle_spans(
-    cfg: &Config,
-    screen: &Screen,
-    tri: &Triangle,
-    out: impl FnMut(u32, Span),
-) -> Result<(), String> {
+pub fn triangle_spans(cfg: &Config, screen: &Screen, tri: &Triangle, out: impl FnMut(u32, Span)) -> Result<(), String> {
     screen.check_for(cfg)?;
     tri.check()?;
     Snapped::new(tri).spans(cfg, screen, out);
@@ -369,8 +351,7 @@ mod tests {
 
     #[test]
     fn parses_comments_and_blank_lines() {
-        let text =
-            "# header\n\n  0 0 0  10 0 128 0 10 255 # trailing\n\t\n1.5 -2 3 4 5e1 6 7 8 255\n";
+        let text = "# header\n\n  0 0 0  10 0 128 0 10 255 # trailing\n\t\n1.5 -2 3 4 5e1 6 7 8 255\n";
         let t = parse_triangles(text).unwrap();
         assert_eq!(t.len(), 2);
         assert_eq!(t[0].v[2], Vertex { x: 0.0, y: 10.0, i: 255.0 });
@@ -426,15 +407,9 @@ mod tests {
         let (a, b) = (2.5, 10.5);
         for diag in [false, true] {
             let t = if diag {
-                [
-                    tri([[a, a, 0.0], [b, a, 0.0], [b, b, 0.0]]),
-                    tri([[a, a, 0.0], [b, b, 0.0], [a, b, 0.0]]),
-                ]
+                [tri([[a, a, 0.0], [b, a, 0.0], [b, b, 0.0]]), tri([[a, a, 0.0], [b, b, 0.0], [a, b, 0.0]])]
             } else {
-                [
-                    tri([[a, a, 0.0], [b, a, 0.0], [a, b, 0.0]]),
-                    tri([[b, a, 0.0], [b, b, 0.0], [a, b, 0.0]]),
-                ]
+                [tri([[a, a, 0.0], [b, a, 0.0], [a, b, 0.0]]), tri([[b, a, 0.0], [b, b, 0.0], [a, b, 0.0]])]
             };
             let c = coverage(&screen, &t);
             for y in 0..16 {
@@ -525,11 +500,7 @@ mod tests {
         assert!(s.iter().all(|(_, s)| (s.x0, s.len) == (60, 4)));
         // Entirely off each side.
         for (dx, dy) in [(-200.0, 0.0), (200.0, 0.0), (0.0, -200.0), (0.0, 200.0)] {
-            let t = tri([
-                [10.0 + dx, 10.0 + dy, 0.0],
-                [50.0 + dx, 10.0 + dy, 0.0],
-                [10.0 + dx, 40.0 + dy, 0.0],
-            ]);
+            let t = tri([[10.0 + dx, 10.0 + dy, 0.0], [50.0 + dx, 10.0 + dy, 0.0], [10.0 + dx, 40.0 + dy, 0.0]]);
             assert!(spans_of(&cfg, &screen, &t).is_empty());
         }
     }

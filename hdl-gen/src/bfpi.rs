@@ -45,10 +45,7 @@ impl fmt::Display for BfpiArch {
 impl FromStr for BfpiArch {
     type Err = String;
     fn from_str(s: &str) -> Result<Self, String> {
-        BfpiArch::ALL
-            .into_iter()
-            .find(|a| a.name() == s)
-            .ok_or_else(|| format!("bfpi arch '{s}' is not one of shift-add, naive, tree"))
+        BfpiArch::ALL.into_iter().find(|a| a.name() == s).ok_or_else(|| format!("bfpi arch '{s}' is not one of shift-add, naive, tree"))
     }
 }
 

@@ -64,11 +64,7 @@ fn slit(w: u32, v: i64) -> String {
 /// widths: the language extends them to the result, and synthesis builds a `wa` x `wb`
 /// multiplier (extending them by hand would make it as wide as the result on both sides).
 fn smul(out: &str, a: &str, wa: u32, b: &str, wb: u32) -> Vec<Item> {
-    vec![
-        comment("verilator lint_off WIDTH"),
-        swire(out, wa + wb, format!("{a} * {b}")),
-        comment("verilator lint_on WIDTH"),
-    ]
+    vec![comment("verilator lint_off WIDTH"), swire(out, wa + wb, format!("{a} * {b}")), comment("verilator lint_on WIDTH")]
 }
 
 pub fn ports(fe: &FrontEnd, wd: &Widths) -> Vec<Port> {
@@ -115,11 +111,7 @@ fn div_regs(d: &Div) -> Vec<Item> {
 
 /// Statements that load a divider: dividend and divisor, both `pw` bits wide already.
 fn div_load(d: &Div, dividend: &str, divisor_shifted: &str) -> Vec<Stmt> {
-    vec![
-        set(format!("{}_p", d.name), dividend),
-        set(format!("{}_d", d.name), divisor_shifted),
-        set(format!("{}_q", d.name), lit(d.qb, 0)),
-    ]
+    vec![set(format!("{}_p", d.name), dividend), set(format!("{}_d", d.name), divisor_shifted), set(format!("{}_q", d.name), lit(d.qb, 0))]
 }
 
 /// `bits` restoring steps in one clock, chained: step j takes quotient bit `div_cnt - j`, if
@@ -128,7 +120,11 @@ fn div_chain(d: &Div, cnt_w: u32, bits: u32) -> Vec<Item> {
     let n = d.name;
     let mut items = Vec::new();
     for j in 0..bits {
-        let (p, dd, q) = if j == 0 { (format!("{n}_p"), format!("{n}_d"), format!("{n}_q")) } else { (format!("{n}_p{j}"), format!("{n}_d{j}"), format!("{n}_q{j}")) };
+        let (p, dd, q) = if j == 0 {
+            (format!("{n}_p"), format!("{n}_d"), format!("{n}_q"))
+        } else {
+            (format!("{n}_p{j}"), format!("{n}_d{j}"), format!("{n}_q{j}"))
+        };
         let on = if j == 0 {
             format!("div_cnt < {}", lit(cnt_w, d.qb as u64))
         } else {
@@ -147,7 +143,11 @@ fn div_chain(d: &Div, cnt_w: u32, bits: u32) -> Vec<Item> {
 
 fn div_iter(d: &Div, bits: u32) -> Vec<Stmt> {
     let n = d.name;
-    vec![set(format!("{n}_p"), format!("{n}_p{bits}")), set(format!("{n}_d"), format!("{n}_d{bits}")), set(format!("{n}_q"), format!("{n}_q{bits}"))]
+    vec![
+        set(format!("{n}_p"), format!("{n}_p{bits}")),
+        set(format!("{n}_d"), format!("{n}_d{bits}")),
+        set(format!("{n}_q"), format!("{n}_q{bits}")),
+    ]
 }
 
 pub fn module(hw: &Hw, names: &Names) -> Module {
@@ -237,8 +237,16 @@ pub fn module(hw: &Hw, names: &Names) -> Module {
     body.push(comment("Edge k runs from vertex k+1 to vertex k+2, oriented so the interior is positive."));
     for k in 0..3 {
         let (a, b) = ((k + 1) % 3, (k + 2) % 3);
-        body.push(swire(&format!("rdx{k}"), cx + 1, format!("{} - {}", sext(&format!("vx{b}"), cx, cx + 1), sext(&format!("vx{a}"), cx, cx + 1))));
-        body.push(swire(&format!("rdy{k}"), cy + 1, format!("{} - {}", sext(&format!("vy{b}"), cy, cy + 1), sext(&format!("vy{a}"), cy, cy + 1))));
+        body.push(swire(
+            &format!("rdx{k}"),
+            cx + 1,
+            format!("{} - {}", sext(&format!("vx{b}"), cx, cx + 1), sext(&format!("vx{a}"), cx, cx + 1)),
+        ));
+        body.push(swire(
+            &format!("rdy{k}"),
+            cy + 1,
+            format!("{} - {}", sext(&format!("vy{b}"), cy, cy + 1), sext(&format!("vy{a}"), cy, cy + 1)),
+        ));
         body.push(swire(&format!("dx{k}"), cx + 1, format!("neg ? -rdx{k} : rdx{k}")));
         body.push(swire(&format!("dy{k}"), cy + 1, format!("neg ? -rdy{k} : rdy{k}")));
         body.push(wire(&format!("tl{k}"), 1, format!("dy{k}[{cy}] || (dy{k} == {} && dx{k} > {})", slit(cy + 1, 0), slit(cx + 1, 0))));
@@ -271,15 +279,9 @@ pub fn module(hw: &Hw, names: &Names) -> Module {
     body.push(wire(
         "cull",
         1,
-        format!(
-            "area == {} || first_s > last_s || cfirst > clast || cfirst > {} || clast[{}]",
-            slit(aw + 1, 0),
-            slit(rxw, w - 1),
-            rxw - 1
-        ),
+        format!("area == {} || first_s > last_s || cfirst > clast || cfirst > {} || clast[{}]", slit(aw + 1, 0), slit(rxw, w - 1), rxw - 1),
     ));
     body.push(Item::Blank);
-
 
     // ---- Edge dividers' inputs. Arithmetic is done at the full target width on sign- or
     // zero-extended operands (right modulo 2^width); only named signed wires are compared.
@@ -305,7 +307,11 @@ pub fn module(hw: &Hw, names: &Names) -> Module {
         body.push(wire(&format!("ady{k}"), cy, format!("dy{k}[{cy}] ? -dy{k}[{}:0] : dy{k}[{}:0]", cy - 1, cy - 1)));
         body.push(wire(&format!("rsu{k}"), yw, format!("rs{k}[{}:0]", yw - 1)));
         // e(128, 256 rs + 128) - t + B D, from vertex a on the edge's line.
-        body.push(swire(&format!("ry{k}"), cy + 2, format!("{} - {}", zext(&format!("{{rsu{k}, 8'd128}}"), yw + 8, cy + 2), sext(&ya, cy, cy + 2))));
+        body.push(swire(
+            &format!("ry{k}"),
+            cy + 2,
+            format!("{} - {}", zext(&format!("{{rsu{k}, 8'd128}}"), yw + 8, cy + 2), sext(&ya, cy, cy + 2)),
+        ));
         body.push(swire(&format!("rx{k}"), cx + 2, format!("{} - {}", lit(cx + 2, 128), sext(&xa, cx, cx + 2))));
         body.extend(smul(&format!("m_e{k}"), &format!("dx{k}"), cx + 1, &format!("ry{k}"), cy + 2));
         body.extend(smul(&format!("m_f{k}"), &format!("dy{k}"), cy + 1, &format!("rx{k}"), cx + 2));
@@ -321,7 +327,11 @@ pub fn module(hw: &Hw, names: &Names) -> Module {
                 gw + 7
             ),
         ));
-        body.push(wire(&format!("sn{k}"), snw, format!("{} + ({} << {})", sext(&format!("dx{k}"), cx + 1, snw), zext(&format!("ady{k}"), cy, snw), gw - 1)));
+        body.push(wire(
+            &format!("sn{k}"),
+            snw,
+            format!("{} + ({} << {})", sext(&format!("dx{k}"), cx + 1, snw), zext(&format!("ady{k}"), cy, snw), gw - 1),
+        ));
     }
     body.push(comment("verilator lint_on UNUSEDSIGNAL"));
     body.push(Item::Blank);
@@ -379,7 +389,9 @@ pub fn module(hw: &Hw, names: &Names) -> Module {
 
     // ---- Dividers and the set-up result registers.
     let divs: Vec<Div> = (0..3)
-        .flat_map(|k| [Div { name: ["ei0", "ei1", "ei2"][k], pw: pw_init, qb: gw }, Div { name: ["es0", "es1", "es2"][k], pw: pw_step, qb: gw }])
+        .flat_map(|k| {
+            [Div { name: ["ei0", "ei1", "ei2"][k], pw: pw_init, qb: gw }, Div { name: ["es0", "es1", "es2"][k], pw: pw_step, qb: gw }]
+        })
         .chain([Div { name: "ddi", pw: iw + aw + 1, qb: iw }, Div { name: "drn", pw: aw + rw + 1, qb: rw }])
         .collect();
     body.push(comment("Eight restoring dividers, one quotient bit per clock, sharing one counter: per edge its first"));
@@ -409,8 +421,16 @@ pub fn module(hw: &Hw, names: &Names) -> Module {
     for k in 0..3 {
         let ei = &divs[2 * k];
         let es = &divs[2 * k + 1];
-        calc_load.extend(div_load(ei, &format!("n{k}[{}:0]", pw_init - 1), &format!("{} << {}", zext(&format!("ady{k}"), cy, pw_init), gw + 7)));
-        calc_load.extend(div_load(es, &format!("sn{k}[{}:0]", pw_step - 1), &format!("{} << {}", zext(&format!("ady{k}"), cy, pw_step), gw - 1)));
+        calc_load.extend(div_load(
+            ei,
+            &format!("n{k}[{}:0]", pw_init - 1),
+            &format!("{} << {}", zext(&format!("ady{k}"), cy, pw_init), gw + 7),
+        ));
+        calc_load.extend(div_load(
+            es,
+            &format!("sn{k}[{}:0]", pw_step - 1),
+            &format!("{} << {}", zext(&format!("ady{k}"), cy, pw_step), gw - 1),
+        ));
         calc_load.push(set(format!("s_act{k}"), format!("act{k}")));
         calc_load.push(set(format!("s_right{k}"), format!("!dy{k}[{cy}]")));
         calc_load.push(set(format!("s_rs{k}"), format!("rsu{k}")));
@@ -420,7 +440,11 @@ pub fn module(hw: &Hw, names: &Names) -> Module {
     let ddi_pw = iw + aw + 1;
     let x2_fit = if x2w >= ddi_pw { format!("x2[{}:0]", ddi_pw - 1) } else { zext("x2", x2w, ddi_pw) };
     calc_load.extend(div_load(&divs[6], &x2_fit, &format!("{} << {}", zext("aabs", aw, ddi_pw), iw)));
-    calc_load.extend(div_load(&divs[7], &format!("{} << {}", lit(aw + rw + 1, 1), kk), &format!("{} << {}", zext("an", aw, aw + rw + 1), rw)));
+    calc_load.extend(div_load(
+        &divs[7],
+        &format!("{} << {}", lit(aw + rw + 1, 1), kk),
+        &format!("{} << {}", zext("an", aw, aw + rw + 1), rw),
+    ));
     calc_load.extend([
         set("s_first", "first_u"),
         set("s_last", "last_u"),
@@ -518,7 +542,11 @@ pub fn module(hw: &Hw, names: &Names) -> Module {
     body.push(wire("lo_u", xw, format!("lo3[{}:0]", xw - 1)));
     body.push(wire("s2n", kk, format!("((w_tn + w_gxn * {}) << 1) + {}", zext("lo_u", xw, kk), zext("w_an", aw, kk))));
     for k in 0..3 {
-        body.push(wire(&format!("rsum{k}"), de + 1, format!("{} + {}", zext(&format!("w_rem{k}"), de, de + 1), zext(&format!("w_rs256_{k}"), de, de + 1))));
+        body.push(wire(
+            &format!("rsum{k}"),
+            de + 1,
+            format!("{} + {}", zext(&format!("w_rem{k}"), de, de + 1), zext(&format!("w_rs256_{k}"), de, de + 1)),
+        ));
         body.push(wire(&format!("cy{k}"), 1, format!("rsum{k} >= {}", zext(&format!("w_d{k}"), de, de + 1))));
         body.push(comment("verilator lint_off UNUSEDSIGNAL"));
         body.push(wire(&format!("rnext{k}"), de + 1, format!("cy{k} ? rsum{k} - {} : rsum{k}", zext(&format!("w_d{k}"), de, de + 1))));
@@ -526,7 +554,13 @@ pub fn module(hw: &Hw, names: &Names) -> Module {
     }
     let mut load = vec![set("w_valid", "1'b1"), set("w_row", "s_first"), set("w_last", "s_last")];
     for k in 0..3 {
-        for (n, v) in [("act", format!("s_act{k}")), ("right", format!("s_right{k}")), ("rs", format!("s_rs{k}")), ("re", format!("s_re{k}")), ("d", format!("s_d{k}"))] {
+        for (n, v) in [
+            ("act", format!("s_act{k}")),
+            ("right", format!("s_right{k}")),
+            ("rs", format!("s_rs{k}")),
+            ("re", format!("s_re{k}")),
+            ("d", format!("s_d{k}")),
+        ] {
             load.push(set(format!("w_{n}{k}"), v));
         }
         load.push(set(format!("w_g{k}"), format!("r_g{k}")));
@@ -566,10 +600,14 @@ pub fn module(hw: &Hw, names: &Names) -> Module {
 
     // ---- I0 pipeline.
     body.push(comment("I0: q~ = (S2n Rn) >> K is the quotient or one below it; one compare corrects it."));
-    for (n, ww) in [("p1_v", 1), ("p1_y", yw), ("p1_x", xw), ("p1_len", xw + 1), ("p1_di", dw), ("p1_s2n", kk), ("p1_rn", rw), ("p1_an", aw)] {
+    for (n, ww) in
+        [("p1_v", 1), ("p1_y", yw), ("p1_x", xw), ("p1_len", xw + 1), ("p1_di", dw), ("p1_s2n", kk), ("p1_rn", rw), ("p1_an", aw)]
+    {
         body.push(reg(n, ww));
     }
-    for (n, ww) in [("p2_v", 1), ("p2_y", yw), ("p2_x", xw), ("p2_len", xw + 1), ("p2_di", dw), ("p2_lo", aw + 2), ("p2_qt", iw), ("p2_an", aw)] {
+    for (n, ww) in
+        [("p2_v", 1), ("p2_y", yw), ("p2_x", xw), ("p2_len", xw + 1), ("p2_di", dw), ("p2_lo", aw + 2), ("p2_qt", iw), ("p2_an", aw)]
+    {
         body.push(reg(n, ww));
     }
     let pr = kk + rw;
@@ -613,7 +651,13 @@ pub fn module(hw: &Hw, names: &Names) -> Module {
         )],
     )]));
 
-    Module { name: names.frontend.clone(), header, params: vec![], ports: ports(fe, &wd).into_iter().chain(span_ports(fe, &wd)).collect(), body }
+    Module {
+        name: names.frontend.clone(),
+        header,
+        params: vec![],
+        ports: ports(fe, &wd).into_iter().chain(span_ports(fe, &wd)).collect(),
+        body,
+    }
 }
 
 /// `tri_shader_p<P>`: the front-end, then the segment shader; `y` waits in a four-entry FIFO
@@ -632,13 +676,19 @@ pub fn top_module(hw: &Hw, names: &Names) -> Module {
         "The span FIFO lets the walker run on while the shader cuts a long span (and the shader on through".into(),
         "the walker's bubbles); out_y comes from a 4-entry FIFO pushed when a span enters the shader and".into(),
         "popped with its last segment, so the shader keeps SPEC §3's ports.".into(),
-        format!("Configuration: P = {p}, F = {}, XW = {xw}, align = {}, screen {}x{}.", cfg.frac, cfg.align, fe.screen.width, fe.screen.height),
+        format!(
+            "Configuration: P = {p}, F = {}, XW = {xw}, align = {}, screen {}x{}.",
+            cfg.frac, cfg.align, fe.screen.width, fe.screen.height
+        ),
         format!("Latency: first segment {} clocks after the triangle's transfer when idle.", hw.latency() + crate::segment::LATENCY),
     ];
-    let mut ports: Vec<Port> = ports(fe, &wd).into_iter().map(|mut p| {
-        p.reg = false;
-        p
-    }).collect();
+    let mut ports: Vec<Port> = ports(fe, &wd)
+        .into_iter()
+        .map(|mut p| {
+            p.reg = false;
+            p
+        })
+        .collect();
     ports.extend([
         Port::output("out_valid", 1, "", "segment valid"),
         Port::input("out_ready", 1, "", "segment taken when out_valid && out_ready"),
@@ -678,13 +728,22 @@ pub fn top_module(hw: &Hw, names: &Names) -> Module {
         wire("pop", 1, "out_valid && out_ready && out_last"),
         assign("out_y", "fifo[fifo_rd]"),
     ]);
-    let mut fe_conns: Vec<(String, String)> = ["clk", "rst", "in_valid", "in_ready", "err"].iter().map(|n| (n.to_string(), n.to_string())).collect();
+    let mut fe_conns: Vec<(String, String)> =
+        ["clk", "rst", "in_valid", "in_ready", "err"].iter().map(|n| (n.to_string(), n.to_string())).collect();
     for k in 0..3 {
         for n in ["x", "y", "i"] {
             fe_conns.push((format!("in_{n}{k}"), format!("in_{n}{k}")));
         }
     }
-    for (port, sig) in [("out_valid", "f_valid"), ("out_ready", "f_ready"), ("out_y", "f_y"), ("out_x", "f_x"), ("out_len", "f_len"), ("out_i0", "f_i0"), ("out_di", "f_di")] {
+    for (port, sig) in [
+        ("out_valid", "f_valid"),
+        ("out_ready", "f_ready"),
+        ("out_y", "f_y"),
+        ("out_x", "f_x"),
+        ("out_len", "f_len"),
+        ("out_i0", "f_i0"),
+        ("out_di", "f_di"),
+    ] {
         fe_conns.push((port.into(), sig.into()));
     }
     body.push(Item::Instance { module: names.frontend.clone(), name: "u_frontend".into(), params: vec![], conns: fe_conns });
@@ -710,14 +769,29 @@ pub fn top_module(hw: &Hw, names: &Names) -> Module {
     body.push(Item::Instance { module: names.segment.clone(), name: "u_shader".into(), params: vec![], conns: sh_conns });
     body.push(Item::Always(vec![Stmt::If(
         "rst".into(),
-        vec![set("fifo_n", "3'd0"), set("fifo_rd", "2'd0"), set("fifo_wr", "2'd0"), set("sf_n", "3'd0"), set("sf_rd", "2'd0"), set("sf_wr", "2'd0")],
+        vec![
+            set("fifo_n", "3'd0"),
+            set("fifo_rd", "2'd0"),
+            set("fifo_wr", "2'd0"),
+            set("sf_n", "3'd0"),
+            set("sf_rd", "2'd0"),
+            set("sf_wr", "2'd0"),
+        ],
         vec![
             Stmt::If("f_push".into(), vec![set("sfifo[sf_wr]", "{f_y, f_x, f_len, f_i0, f_di}"), set("sf_wr", "sf_wr + 2'd1")], vec![]),
             Stmt::If("s_pop".into(), vec![set("sf_rd", "sf_rd + 2'd1")], vec![]),
-            Stmt::If("f_push && !s_pop".into(), vec![set("sf_n", "sf_n + 3'd1")], vec![Stmt::If("s_pop && !f_push".into(), vec![set("sf_n", "sf_n - 3'd1")], vec![])]),
+            Stmt::If(
+                "f_push && !s_pop".into(),
+                vec![set("sf_n", "sf_n + 3'd1")],
+                vec![Stmt::If("s_pop && !f_push".into(), vec![set("sf_n", "sf_n - 3'd1")], vec![])],
+            ),
             Stmt::If("s_pop".into(), vec![set("fifo[fifo_wr]", "s_y"), set("fifo_wr", "fifo_wr + 2'd1")], vec![]),
             Stmt::If("pop".into(), vec![set("fifo_rd", "fifo_rd + 2'd1")], vec![]),
-            Stmt::If("s_pop && !pop".into(), vec![set("fifo_n", "fifo_n + 3'd1")], vec![Stmt::If("pop && !s_pop".into(), vec![set("fifo_n", "fifo_n - 3'd1")], vec![])]),
+            Stmt::If(
+                "s_pop && !pop".into(),
+                vec![set("fifo_n", "fifo_n + 3'd1")],
+                vec![Stmt::If("pop && !s_pop".into(), vec![set("fifo_n", "fifo_n - 3'd1")], vec![])],
+            ),
         ],
     )]));
     Module { name: names.top.clone(), header, params: vec![], ports, body }

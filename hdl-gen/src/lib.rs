@@ -108,10 +108,8 @@ pub fn generate(opts: &Options) -> Vec<GeneratedFile> {
     }
     let unit = opts.specular_unit();
     modules.extend(specular::modules(&opts.cfg, &unit, &specular::SpecNames::new(&opts.prefix)));
-    let mut files: Vec<GeneratedFile> = modules
-        .iter()
-        .map(|m| GeneratedFile { name: format!("{}.v", m.name), contents: m.render() })
-        .collect();
+    let mut files: Vec<GeneratedFile> =
+        modules.iter().map(|m| GeneratedFile { name: format!("{}.v", m.name), contents: m.render() }).collect();
     for (name, rom) in [(golden::rom::BRDF_HEX, unit.brdf_rom()), (golden::rom::NK_HEX, unit.nk_rom())] {
         files.push(GeneratedFile { name: name.into(), contents: rom.to_hex() });
     }

@@ -242,13 +242,11 @@ fn main() -> ExitCode {
             .and_then(|ports| hdl_gen::wrapper::module(&module, &ports))
             .and_then(|m| output::write_one(&out, m.render().as_bytes()))
             .map(|()| eprintln!("wrote {}", out.display())),
-        Command::Testbench { config, brdf, vectors, seed, out } => {
-            config
-                .options(&brdf)
-                .and_then(|opts| hdl_gen::testbench::testbench(&opts, vectors, seed))
-                .and_then(|files| output::write_all(&out, &files))
-                .map(|()| eprintln!("wrote {}", out.display()))
-        }
+        Command::Testbench { config, brdf, vectors, seed, out } => config
+            .options(&brdf)
+            .and_then(|opts| hdl_gen::testbench::testbench(&opts, vectors, seed))
+            .and_then(|files| output::write_all(&out, &files))
+            .map(|()| eprintln!("wrote {}", out.display())),
         Command::Report { report: Report::Accuracy { brdf, png } } => brdf.plan().and_then(|plan| {
             let unit = Options { brdf: plan, ..Options::default() }.specular_unit();
             let report = hdl_gen::report::AccuracyReport::measure(&unit);

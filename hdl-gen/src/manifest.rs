@@ -1,8 +1,8 @@
 //! `manifest.json` and the FuseSoC CAPI2 core: machine-readable descriptions of what
 //! `generate` wrote, derived from the same module descriptions that print the Verilog.
 
-use crate::verilog::{Dir, Module};
 use crate::specular::SpecNames;
+use crate::verilog::{Dir, Module};
 use crate::{segment, BfpiArch, Names, Options, VERSION};
 use golden::bfpi::{Adder, BfpiPlan};
 use golden::rom::{Rom, BRDF_HEX, NK_HEX};

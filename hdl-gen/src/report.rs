@@ -127,11 +127,7 @@ impl AccuracyReport {
         let series = |f: &dyn Fn(u32) -> f64| (N_MIN..=N_MAX).map(f).collect::<Vec<f64>>();
         let approx = series(&|n| self.row(n).approx_vs_exact);
         let mut left = vec![
-            Curve {
-                label: "cos^2(sqrt(n/2) x), prototype".into(),
-                color: RED,
-                ys: series(&|n| approx_error(n, PROTOTYPE_K)),
-            },
+            Curve { label: "cos^2(sqrt(n/2) x), prototype".into(), color: RED, ys: series(&|n| approx_error(n, PROTOTYPE_K)) },
             Curve { label: format!("cos^k(sqrt(n/k) x), k = {set}"), color: BLUE, ys: approx.clone() },
         ];
         if self.decoder != self.patent {
@@ -140,11 +136,7 @@ impl AccuracyReport {
             left.insert(1, Curve { label, color: GREEN, ys: series(&|n| self.patent_error(n)) });
         }
         let right = [
-            Curve {
-                label: "RTL (= golden) vs exact C cos^n, C max".into(),
-                color: BLACK,
-                ys: series(&|n| self.row(n).model_vs_exact),
-            },
+            Curve { label: "RTL (= golden) vs exact C cos^n, C max".into(), color: BLACK, ys: series(&|n| self.row(n).model_vs_exact) },
             Curve { label: format!("approximation alone, k = {set}"), color: GREY, ys: approx },
         ];
         let mut img = RgbImage::from_pixel(2 * PANEL_W, IMG_H, WHITE);
@@ -218,11 +210,7 @@ fn panel(img: &mut RgbImage, x0: u32, title: &str, curves: &[Curve]) {
     rect(img, l, t, l, b, BLACK);
     rect(img, l, b, r, b, BLACK);
     for (i, c) in curves.iter().enumerate() {
-        let pts: Vec<(f64, f64)> =
-            c.ys.iter()
-                .enumerate()
-                .map(|(j, &y)| (x_of((j as u32 + N_MIN) as f64), y_of(y * 100.0)))
-                .collect();
+        let pts: Vec<(f64, f64)> = c.ys.iter().enumerate().map(|(j, &y)| (x_of((j as u32 + N_MIN) as f64), y_of(y * 100.0))).collect();
         for w in pts.windows(2) {
             line(img, w[0], w[1], c.color);
         }

@@ -11,10 +11,8 @@
 //! With `--bfpi-arch tree` (a comparison form) there is no BFPI: lane `j + 2^k` is lane `j` plus
 //! `dI << k`, a doubling tree of P - 1 accumulator-wide adders, and the step is `dI << log2 P`.
 
-use crate::verilog::{
-    assign, bit, bus, comment, lit, net, reg, set, sext, sreg, swire, wire, zext, Item, Module, Port, Stmt,
-};
 use crate::bfpi::BfpiArch;
+use crate::verilog::{assign, bit, bus, comment, lit, net, reg, set, sext, sreg, swire, wire, zext, Item, Module, Port, Stmt};
 use crate::Names;
 use golden::{Align, Config};
 
@@ -189,11 +187,7 @@ pub fn module_with(cfg: &Config, names: &Names, arch: BfpiArch) -> Module {
     body.push(Item::Blank);
 
     let x_step = lit(xw, (p as u64) % (1u64 << xw));
-    let mut load = vec![
-        set("cur_valid", "in_len != 0"),
-        set("cur_di", "in_di"),
-        set("cur_acc", "start_acc"),
-    ];
+    let mut load = vec![set("cur_valid", "in_len != 0"), set("cur_di", "in_di"), set("cur_acc", "start_acc")];
     let mut advance = vec![
         set("cur_acc", "cur_acc + step"),
         set("cur_x", format!("cur_x + {x_step}")),

@@ -6,9 +6,7 @@
 //! the same `adv`, which makes them ordinary enable-gated block RAM reads.
 
 use crate::rom;
-use crate::verilog::{
-    assign, comment, lit, reg, set, wire, zext, Item, Module, Param, Port, Stmt,
-};
+use crate::verilog::{assign, comment, lit, reg, set, wire, zext, Item, Module, Param, Port, Stmt};
 use golden::rom::{BRDF_HEX, NK_HEX};
 use golden::specular::{SpecularUnit, C_FRAC, N_BITS, THETA_FRAC};
 use golden::Config;
@@ -153,7 +151,11 @@ fn module(cfg: &Config, unit: &SpecularUnit, names: &SpecNames) -> Module {
             )],
         )]),
         Item::Blank,
-        comment(format!("Stage 1: |theta| (2^31 for -2^31, exact) without the {} bits below 2^-{} rad; n-table read.", p.theta_drop, p.mag_frac())),
+        comment(format!(
+            "Stage 1: |theta| (2^31 for -2^31, exact) without the {} bits below 2^-{} rad; n-table read.",
+            p.theta_drop,
+            p.mag_frac()
+        )),
         comment("verilator lint_off UNUSEDSIGNAL"),
         wire("abs_theta", THETA_BITS, "theta[31] ? -theta : theta"),
         comment("verilator lint_on UNUSEDSIGNAL"),
@@ -248,13 +250,7 @@ fn module(cfg: &Config, unit: &SpecularUnit, names: &SpecNames) -> Module {
             [
                 vec![set("v1", "busy"), set("mag1", "mag0"), set("c1", "c0"), set("last1", "last0")],
                 stage2,
-                vec![
-                    set("v3", "v2"),
-                    set("cut3", "err2 || !in_table"),
-                    set("err3", "err2"),
-                    set("c3", "c2"),
-                    set("last3", "last2"),
-                ],
+                vec![set("v3", "v2"), set("cut3", "err2 || !in_table"), set("err3", "err2"), set("c3", "c2"), set("last3", "last2")],
                 vec![
                     set("out_valid", "v3"),
                     set("out_spec", format!("cut3 ? {} : scaled[{}:{w}]", lit(C_BITS, 0), C_BITS + w - 1)),

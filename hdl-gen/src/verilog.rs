@@ -73,24 +73,61 @@ pub enum Item {
     Blank,
     Comment(String),
     /// `wire [w-1:0] name;` or, with a value, `wire [w-1:0] name = value;`.
-    Wire { name: String, width: u32, signed: bool, value: Option<String> },
+    Wire {
+        name: String,
+        width: u32,
+        signed: bool,
+        value: Option<String>,
+    },
     /// A lane bus driven elsewhere, declared with a range even at width 1.
-    Bus { name: String, width: u32 },
-    Reg { name: String, width: u32, signed: bool },
+    Bus {
+        name: String,
+        width: u32,
+    },
+    Reg {
+        name: String,
+        width: u32,
+        signed: bool,
+    },
     /// `localparam [w-1:0] NAME = value;` (width 0: unsized).
-    Localparam { name: String, width: u32, value: String },
+    Localparam {
+        name: String,
+        width: u32,
+        value: String,
+    },
     Assign(String, String),
     /// `always @(posedge clk)`.
     Always(Vec<Stmt>),
-    Instance { module: String, name: String, params: Vec<(String, String)>, conns: Vec<(String, String)> },
+    Instance {
+        module: String,
+        name: String,
+        params: Vec<(String, String)>,
+        conns: Vec<(String, String)>,
+    },
     /// `for (var = 0; var < count; var = var + 1) begin : label ... end` in a generate region.
-    ForGenerate { var: String, count: u32, label: String, body: Vec<Item> },
+    ForGenerate {
+        var: String,
+        count: u32,
+        label: String,
+        body: Vec<Item>,
+    },
     /// `if (cond) begin : label ... end else begin : label2 ... end` inside a generate region.
-    IfGenerate { cond: String, then: (String, Vec<Item>), els: (String, Vec<Item>) },
+    IfGenerate {
+        cond: String,
+        then: (String, Vec<Item>),
+        els: (String, Vec<Item>),
+    },
     /// A ROM load: `initial $readmemh(file, mem);` — the only `initial` SPEC allows.
-    ReadMemH { file: String, mem: String },
+    ReadMemH {
+        file: String,
+        mem: String,
+    },
     /// `reg [w-1:0] name [0:depth-1];`
-    Memory { name: String, width: u32, depth: u32 },
+    Memory {
+        name: String,
+        width: u32,
+        depth: u32,
+    },
     /// Testbench only (SPEC §3 allows no `initial` in the modules): `initial begin ... end`.
     Initial(Vec<Stmt>),
 }
@@ -317,9 +354,7 @@ fn render_items(o: &mut String, items: &[Item], level: usize) {
                 o.push_str("end\n");
             }
             Item::ReadMemH { file, mem } => writeln!(o, "initial $readmemh({file}, {mem});").unwrap(),
-            Item::Memory { name, width, depth } => {
-                writeln!(o, "reg {}{name} [0:{}];", range(*width), depth - 1).unwrap()
-            }
+            Item::Memory { name, width, depth } => writeln!(o, "reg {}{name} [0:{}];", range(*width), depth - 1).unwrap(),
             Item::Initial(stmts) => {
                 o.push_str("initial begin\n");
                 render_stmts(o, stmts, level + 1);
@@ -380,11 +415,7 @@ mod tests {
             name: "t".into(),
             header: vec!["A test.".into()],
             params: vec![],
-            ports: vec![
-                Port::input("clk", 1, "", "clock"),
-                Port::input("a", 4, "UQ4.0", "").signed(),
-                Port::output("y", 4, "", "").reg(),
-            ],
+            ports: vec![Port::input("clk", 1, "", "clock"), Port::input("a", 4, "UQ4.0", "").signed(), Port::output("y", 4, "", "").reg()],
             body: vec![Item::Always(vec![Stmt::If(
                 "a[3]".into(),
                 vec![set("y", "a")],

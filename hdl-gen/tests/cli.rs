@@ -2,7 +2,7 @@
 //! and nothing written for every bad argument.
 
 mod common;
-use common::{hdl_gen, scratch, listing};
+use common::{hdl_gen, listing, scratch};
 
 #[test]
 fn same_command_same_bytes() {

@@ -105,7 +105,11 @@ fn synth_wrapper_bad_flags_and_input() {
     std::fs::write(bad.join("manifest.json"), "{ \"modules\": [ { \"name\": \"x\", ").unwrap();
     let no_ports = dir.join("noports");
     std::fs::create_dir_all(&no_ports).unwrap();
-    std::fs::write(no_ports.join("manifest.json"), r#"{"modules": [{"name": "m", "ports": [{"name": "clk", "direction": "sideways", "width": 1}]}]}"#).unwrap();
+    std::fs::write(
+        no_ports.join("manifest.json"),
+        r#"{"modules": [{"name": "m", "ports": [{"name": "clk", "direction": "sideways", "width": 1}]}]}"#,
+    )
+    .unwrap();
     let empty = dir.join("empty");
     std::fs::create_dir_all(&empty).unwrap();
     let r = rtl.to_str().unwrap();
@@ -116,12 +120,18 @@ fn synth_wrapper_bad_flags_and_input() {
         (vec!["synth-wrapper", "--module", "segment_shader_p8", "--out", w], "--rtl".into()),
         (vec!["synth-wrapper", "--rtl", r, "--out", w], "--module".into()),
         (vec!["synth-wrapper", "--rtl", r, "--module", "segment_shader_p8"], "--out".into()),
-        (vec!["synth-wrapper", "--rtl", empty.to_str().unwrap(), "--module", "m", "--out", w], empty.join("manifest.json").display().to_string()),
+        (
+            vec!["synth-wrapper", "--rtl", empty.to_str().unwrap(), "--module", "m", "--out", w],
+            empty.join("manifest.json").display().to_string(),
+        ),
         (vec!["synth-wrapper", "--rtl", bad.to_str().unwrap(), "--module", "x", "--out", w], "manifest.json".into()),
         (vec!["synth-wrapper", "--rtl", no_ports.to_str().unwrap(), "--module", "m", "--out", w], "sideways".into()),
         (vec!["synth-wrapper", "--rtl", r, "--module", "no_such_module", "--out", w], "no_such_module".into()),
         (vec!["synth-wrapper", "--rtl", r, "--module", "bfpi_p8", "--out", w], "clk".into()),
-        (vec!["synth-wrapper", "--rtl", r, "--module", "segment_shader_p8", "--out", unwritable.to_str().unwrap()], unwritable.display().to_string()),
+        (
+            vec!["synth-wrapper", "--rtl", r, "--module", "segment_shader_p8", "--out", unwritable.to_str().unwrap()],
+            unwritable.display().to_string(),
+        ),
     ];
     let before = files_under(&dir);
     for (args, needle) in &cases {

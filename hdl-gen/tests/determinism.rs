@@ -10,7 +10,7 @@
 //! `SEGSHADE_BLESS=1 cargo test -p hdl-gen --test determinism` and commit the file.
 
 mod common;
-use common::{scratch_dir as scratch, listing};
+use common::{listing, scratch_dir as scratch};
 use std::path::Path;
 use std::process::Command;
 

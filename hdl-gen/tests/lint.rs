@@ -66,9 +66,12 @@ fn verilator_lint_and_icarus_are_clean() {
     let next = std::sync::atomic::AtomicUsize::new(0);
     std::thread::scope(|s| {
         for _ in 0..2 {
-            s.spawn(|| loop {
-                let Some(&(k, (cfg, prefix, arch, fe_div_bits), fe_first)) = runs.get(next.fetch_add(1, std::sync::atomic::Ordering::Relaxed)) else { break };
-                lint_one(k, cfg, prefix, arch, fe_div_bits, fe_first);
+            s.spawn(|| {
+                while let Some(&(k, (cfg, prefix, arch, fe_div_bits), fe_first)) =
+                    runs.get(next.fetch_add(1, std::sync::atomic::Ordering::Relaxed))
+                {
+                    lint_one(k, cfg, prefix, arch, fe_div_bits, fe_first);
+                }
             });
         }
     });

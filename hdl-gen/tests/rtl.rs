@@ -7,10 +7,8 @@ use hdl_gen::{generate, Options};
 fn committed_rtl_matches_the_generator() {
     let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../rtl");
     let files = generate(&Options::default());
-    let mut on_disk: Vec<String> = std::fs::read_dir(&dir)
-        .expect("rtl/ exists")
-        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
-        .collect();
+    let mut on_disk: Vec<String> =
+        std::fs::read_dir(&dir).expect("rtl/ exists").map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).collect();
     on_disk.sort();
     let mut wanted: Vec<String> = files.iter().map(|f| f.name.clone()).collect();
     wanted.sort();

@@ -9,10 +9,7 @@ use golden::specular::{best_reachable, SpecularPlan, SpecularUnit, MAX_AUTO_TABL
 use std::path::PathBuf;
 
 fn entries(dir: &PathBuf) -> Vec<String> {
-    let mut names: Vec<String> = std::fs::read_dir(dir)
-        .unwrap()
-        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
-        .collect();
+    let mut names: Vec<String> = std::fs::read_dir(dir).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).collect();
     names.sort();
     names
 }
@@ -43,8 +40,7 @@ fn rom_images_read_back_to_golden_words() {
             let ext = format.extension();
             let printed = succeeds(&["rom", "--table", table, "--format", ext]);
             let path = dir.join(format!("{table}.{ext}"));
-            assert!(succeeds(&["rom", "--table", table, "--format", ext, "--out", path.to_str().unwrap()])
-                .is_empty());
+            assert!(succeeds(&["rom", "--table", table, "--format", ext, "--out", path.to_str().unwrap()]).is_empty());
             let written = std::fs::read_to_string(&path).unwrap();
             assert_eq!(written, printed, "{table} {ext}: file and standard output differ");
             let back = Rom::parse(&rom.name, rom.width, format, &written).unwrap();
@@ -116,9 +112,7 @@ fn report_accuracy_prints_spec_figures() {
         .filter(|l| l.starts_with('|') && !l.starts_with("|---"))
         .map(|l| l.trim_matches('|').split('|').map(str::trim).collect())
         .collect();
-    let col = |name: &str| {
-        rows[0].iter().position(|h| h.contains(name)).unwrap_or_else(|| panic!("no column '{name}'"))
-    };
+    let col = |name: &str| rows[0].iter().position(|h| h.contains(name)).unwrap_or_else(|| panic!("no column '{name}'"));
     let firsts: Vec<&str> = rows[1..].iter().map(|r| r[0]).collect();
     assert_eq!(firsts, ["1", "2", "3..6", "7..1000", "**1..1000, worst**"], "{text}");
     let worst = rows.last().unwrap();
@@ -131,10 +125,7 @@ fn report_accuracy_prints_spec_figures() {
     assert!(approx <= total && total <= approx + 0.25 + 1e-3, "{approx} {total}");
     let unit = SpecularUnit::default();
     for rom in [unit.brdf_rom(), unit.nk_rom()] {
-        assert!(
-            text.contains(&format!("{}: {} x {} = {} bits", rom.name, rom.depth(), rom.width, rom.bits())),
-            "{text}"
-        );
+        assert!(text.contains(&format!("{}: {} x {} = {} bits", rom.name, rom.depth(), rom.width, rom.bits())), "{text}");
     }
 }
 

@@ -3,7 +3,7 @@
 //! fails the test with the command that installs it: a bench that did not run must not pass.
 
 mod common;
-use common::{scratch};
+use common::scratch;
 use std::path::Path;
 use std::process::Command;
 

@@ -491,8 +491,5 @@ pub(crate) fn agrees(out: &SegView, span: &Span, seg: &Segment, row: &[u8], p: u
 }
 
 pub(crate) fn describe(s: &Stim) -> String {
-    format!(
-        "span y = {} x0 = {} len = {} i0 = {} di = {}",
-        s.y, s.span.x0, s.span.len, s.span.i0, s.span.di
-    )
+    format!("span y = {} x0 = {} len = {} i0 = {} di = {}", s.y, s.span.x0, s.span.len, s.span.i0, s.span.di)
 }

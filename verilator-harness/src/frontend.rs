@@ -224,7 +224,11 @@ impl<F: FnMut(usize, u32, &SegView) + Send> Check for TsCheck<'_, F> {
         }
         let seg = segment(cfg, &span, seg_s);
         if out_y != y {
-            report.mismatch(Mismatch { triangle: Some(st.triangle), context: describe(&stim), what: format!("out_y expected {y}, got {out_y}") });
+            report.mismatch(Mismatch {
+                triangle: Some(st.triangle),
+                context: describe(&stim),
+                what: format!("out_y expected {y}, got {out_y}"),
+            });
         }
         match agrees(&out, &span, &seg, self.row.pixels(), cfg.p) {
             Some(pixels) => {
@@ -292,7 +296,13 @@ pub fn run_chain(info: &'static ModelInfo<TriIn, TriSegOut>, seed: u64, traffic:
 }
 
 /// [`run_chain`] with the triangles numbered from `first` in the report (batches of one run).
-pub fn run_chain_at(info: &'static ModelInfo<TriIn, TriSegOut>, seed: u64, traffic: Traffic, tris: &[FixedTriangle], first: usize) -> ChainRun {
+pub fn run_chain_at(
+    info: &'static ModelInfo<TriIn, TriSegOut>,
+    seed: u64,
+    traffic: Traffic,
+    tris: &[FixedTriangle],
+    first: usize,
+) -> ChainRun {
     let (cfg, screen) = (info.cfg, info.screen);
     let fe = FrontEnd::new(cfg, screen).expect("the model's front-end");
     let mut exp = Expected::new(fe, tris);
@@ -361,7 +371,11 @@ fn check_frame(exp: &Expected, frame: &Frame, writes: &[u8], report: &mut Report
     }
     if let Some(at) = (0..writes.len()).find(|&i| frame.pixels()[i] != gold.pixels()[i]) {
         let (x, y) = (at as u32 % screen.width, at as u32 / screen.width);
-        report.mismatch(Mismatch { triangle: None, context: format!("frame pixel ({x}, {y})"), what: format!("golden {:?}, RTL {:?}", gold.get(x, y), frame.get(x, y)) });
+        report.mismatch(Mismatch {
+            triangle: None,
+            context: format!("frame pixel ({x}, {y})"),
+            what: format!("golden {:?}, RTL {:?}", gold.get(x, y), frame.get(x, y)),
+        });
     }
     let cmp = compare(frame, &reference);
     report.max_error = report.max_error.max(cmp.max_error);
@@ -394,7 +408,10 @@ pub fn random_triangles(rng: &mut StdRng, fe: &FrontEnd, n: usize) -> Vec<FixedT
                     5 => (cx + rng.gen_range(-8000..8000), if k < 2 { cy } else { cy + rng.gen_range(-8000..8000) }),
                     6 => (if rng.gen_bool(0.5) { -w } else { 2 * w - 1 }, rng.gen_range(-h..2 * h)),
                     // Mostly outside the guard band, within the ports.
-                    7 => (rng.gen_range(-(1i64 << (wd.cx - 1))..(1i64 << (wd.cx - 1))), rng.gen_range(-(1i64 << (wd.cy - 1))..(1i64 << (wd.cy - 1)))),
+                    7 => (
+                        rng.gen_range(-(1i64 << (wd.cx - 1))..(1i64 << (wd.cx - 1))),
+                        rng.gen_range(-(1i64 << (wd.cy - 1))..(1i64 << (wd.cy - 1))),
+                    ),
                     8 => (cx + 300 * k as i64, cy + 300 * k as i64),
                     _ => (cx + rng.gen_range(-6000..6000) - 2 * w, cy + rng.gen_range(-6000..6000)),
                 };
@@ -430,7 +447,11 @@ pub fn mesh(rng: &mut StdRng, fe: &FrontEnd, cols: i64, rows: i64) -> Vec<FixedT
         }
     }
     let at = |c: i64, r: i64| pts[(r * (cols + 1) + c) as usize];
-    let tri = |a: (i64, i64, u32), b: (i64, i64, u32), c: (i64, i64, u32)| FixedTriangle { x: [a.0, b.0, c.0], y: [a.1, b.1, c.1], i: [a.2, b.2, c.2] };
+    let tri = |a: (i64, i64, u32), b: (i64, i64, u32), c: (i64, i64, u32)| FixedTriangle {
+        x: [a.0, b.0, c.0],
+        y: [a.1, b.1, c.1],
+        i: [a.2, b.2, c.2],
+    };
     let mut out = Vec::new();
     for r in 0..rows {
         for c in 0..cols {

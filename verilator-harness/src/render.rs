@@ -18,8 +18,8 @@
 use crate::cosim::{Report, SegView, SegmentCosim, Stim, Traffic, DRAIN_CLOCKS};
 use crate::ffi::{ModelInfo, SegIn, SegOut, SpecIn, SpecOut, TriIn, TriSegOut};
 use crate::frontend::{stream_chain, Expected};
-use golden::frontend::{FixedTriangle, FrontEnd};
 use crate::specular::SpecularCosim;
+use golden::frontend::{FixedTriangle, FrontEnd};
 use golden::setup::{parse_triangles, triangle_spans, Screen, Triangle, Vertex};
 use golden::specular::setup::{cross, dot, normalize, setup_span, SpanEnds, Vec3};
 use golden::specular::{SpecularSpan, SpecularUnit, C_FRAC};
@@ -296,9 +296,7 @@ pub fn scene_job(kind: SceneKind, shininess: u16, cfg: &Config, screen: &Screen)
             // Specular set-up of the span: N and H at its first and last pixel.
             let end = |x: u32| {
                 let mu = interp.weights(x as f64 + 0.5, py);
-                let blend = |a: &dyn Fn(usize) -> Vec3| {
-                    add(add(scale(a(0), mu[0]), scale(a(1), mu[1])), scale(a(2), mu[2]))
-                };
+                let blend = |a: &dyn Fn(usize) -> Vec3| add(add(scale(a(0), mu[0]), scale(a(1), mu[1])), scale(a(2), mu[2]));
                 let n = blend(&|k| mesh.normals[f[k] as usize]);
                 let pos = blend(&|k| mesh.positions[f[k] as usize]);
                 let l = normalize(sub(light.light, pos)).unwrap_or([0.0, 0.0, 1.0]);
@@ -565,7 +563,10 @@ pub fn run_with(
         Some(exps) => {
             let mut g = vec![vec![0u8; npix]; channels];
             for (c, exp) in exps.iter().enumerate() {
-                let mut it = exp.stims.iter().flat_map(|st| exp.spans[st.first..st.first + st.count as usize].iter().map(move |&(y, s)| (st.triangle, y, s)));
+                let mut it = exp
+                    .stims
+                    .iter()
+                    .flat_map(|st| exp.spans[st.first..st.first + st.count as usize].iter().map(move |&(y, s)| (st.triangle, y, s)));
                 paint_golden(&mut it, &mut g[c]);
             }
             g

@@ -8,9 +8,7 @@ use crate::ffi::{to_port, ModelInfo, Rtl, SpecIn, SpecOut};
 use crate::traffic::TrafficGen;
 use golden::specular::reference::{approx, cos_k, epicentre};
 use golden::specular::setup::{norm, normalize, setup_span, SpanEnds, Vec3};
-use golden::specular::{
-    n_valid, theta_at, SpecularSpan, SpecularUnit, ABS_TOL, C_FRAC, INSIDE_REL, N_MAX, OUTSIDE_REL, THETA_FRAC,
-};
+use golden::specular::{n_valid, theta_at, SpecularSpan, SpecularUnit, ABS_TOL, C_FRAC, INSIDE_REL, N_MAX, OUTSIDE_REL, THETA_FRAC};
 use rand::Rng;
 use std::f64::consts::FRAC_PI_2;
 
@@ -269,15 +267,12 @@ impl Judge {
             let tol = if inside { INSIDE_REL * want } else { OUTSIDE_REL * c } + ABS_TOL;
             if (got - want).abs() > tol {
                 let place = if inside { "inside" } else { "outside" };
-                problems.push(format!("{got:.5} is {:.5} from approx {want:.5} {place} the epicentre (bound {tol:.5})", (got - want).abs()));
+                problems
+                    .push(format!("{got:.5} is {:.5} from approx {want:.5} {place} the epicentre (bound {tol:.5})", (got - want).abs()));
             }
         }
         if !problems.is_empty() {
-            report.mismatch(Mismatch {
-                triangle: Some(k),
-                context: format!("{}, pixel {j}", describe(k, s)),
-                what: problems.join("; "),
-            });
+            report.mismatch(Mismatch { triangle: Some(k), context: format!("{}, pixel {j}", describe(k, s)), what: problems.join("; ") });
         }
     }
 }
@@ -455,8 +450,7 @@ mod tests {
             let len = rng.gen_range(0..40);
             let theta0: i64 = rng.gen_range(-60..60);
             let dtheta: i64 = if case % 7 == 0 { 0 } else { rng.gen_range(-9..9) };
-            let mut along: Vec<(u32, u16)> =
-                (0..len).map(|j| ((theta0 + j * dtheta).unsigned_abs() as u32, 0)).collect();
+            let mut along: Vec<(u32, u16)> = (0..len).map(|j| ((theta0 + j * dtheta).unsigned_abs() as u32, 0)).collect();
             for a in along.iter_mut() {
                 a.1 = (1000 - a.0.min(1000)) as u16 / rng.gen_range(1..3);
             }

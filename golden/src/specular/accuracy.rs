@@ -33,9 +33,7 @@ pub struct AccuracySummary {
 
 impl AccuracySummary {
     pub fn of(rows: &[NAccuracy]) -> AccuracySummary {
-        let worst = |f: fn(&NAccuracy) -> f64| {
-            rows.iter().map(|r| (f(r), r.n)).fold((0.0, 0), |a, b| if b.0 > a.0 { b } else { a })
-        };
+        let worst = |f: fn(&NAccuracy) -> f64| rows.iter().map(|r| (f(r), r.n)).fold((0.0, 0), |a, b| if b.0 > a.0 { b } else { a });
         AccuracySummary {
             approx_vs_exact: worst(|r| r.approx_vs_exact),
             model_vs_approx: worst(|r| r.model_vs_approx),
@@ -76,13 +74,7 @@ pub fn accuracy_of(unit: &SpecularUnit, n: u32, c: u16) -> Option<NAccuracy> {
             }
         }
     }
-    Some(NAccuracy {
-        n,
-        k,
-        approx_vs_exact: approx_error(n, k),
-        model_vs_approx: vs_approx,
-        model_vs_exact: vs_exact,
-    })
+    Some(NAccuracy { n, k, approx_vs_exact: approx_error(n, k), model_vs_approx: vs_approx, model_vs_exact: vs_exact })
 }
 
 /// [`accuracy_of`] for every valid n.
@@ -166,13 +158,7 @@ mod tests {
         for n in [1u32, 2, 3, 5, 6, 7, 9, 31, 250, 999, 1000] {
             let k = unit.plan().decoder.k_of(n).unwrap();
             let edge = epicentre_code(n) as i64;
-            let s = super::super::SpecularSpan {
-                c: u16::MAX,
-                n: n as u16,
-                theta0: -(3 << 27),
-                dtheta: 12_345,
-                len: 4096 * 8,
-            };
+            let s = super::super::SpecularSpan { c: u16::MAX, n: n as u16, theta0: -(3 << 27), dtheta: 12_345, len: 4096 * 8 };
             let mut prev: Option<(i64, u16)> = None;
             for (j, p) in unit.span(&s).enumerate() {
                 let code = (s.theta0 as i64 + j as i64 * s.dtheta as i64).abs();

@@ -75,9 +75,7 @@ impl Tables {
 
     /// The n from 1 up to b, all on b.
     fn head(&self, b: usize) -> (f64, f64) {
-        (1..=b as u32).fold((0.0f64, 0.0f64), |(e, x), n| {
-            (e.max(self.err[n as usize][b]), x.max(epicentre_arg(n, b as u32)))
-        })
+        (1..=b as u32).fold((0.0f64, 0.0f64), |(e, x), n| (e.max(self.err[n as usize][b]), x.max(epicentre_arg(n, b as u32))))
     }
 
     /// Worst error of the n above a, all on a (they never raise a's epicentre argument,
@@ -148,8 +146,7 @@ pub fn auto_plan(max_err: f64) -> Result<SpecularPlan, String> {
                 .collect()
         })
         .collect();
-    let heads: Vec<Option<f64>> =
-        (0..=K).map(|b| (b > 0).then(|| tb.head(b)).filter(|h| e_ok(h.0)).map(|h| h.1)).collect();
+    let heads: Vec<Option<f64>> = (0..=K).map(|b| (b > 0).then(|| tb.head(b)).filter(|h| e_ok(h.0)).map(|h| h.1)).collect();
     let tails: Vec<bool> = (0..=K).map(|a| a > 0 && e_ok(tb.tail(a))).collect();
 
     // Table 1's own cost depends on whether n = 2 stays on it, which its upper neighbour

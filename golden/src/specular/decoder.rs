@@ -43,18 +43,14 @@ impl TryFrom<DecoderRepr> for Decoder {
         let mut next = N_MIN;
         for g in &r.ranges {
             if g.n_lo != next || g.n_hi < g.n_lo || r.ks.get(g.table as usize) != Some(&g.k) {
-                return Err(format!(
-                    "decoder range {g:?} does not continue from n = {next} on the k set {:?}",
-                    r.ks
-                ));
+                return Err(format!("decoder range {g:?} does not continue from n = {next} on the k set {:?}", r.ks));
             }
             next = g.n_hi + 1;
         }
         if next != N_MAX + 1 {
             return Err(format!("decoder ranges end at n = {}, not {N_MAX}", next - 1));
         }
-        let at =
-            |n: u32| r.ranges.iter().find(|g| g.n_lo <= n && n <= g.n_hi).map_or(0, |g| g.table as usize);
+        let at = |n: u32| r.ranges.iter().find(|g| g.n_lo <= n && n <= g.n_hi).map_or(0, |g| g.table as usize);
         Decoder::from_fn(&r.ks, at)
     }
 }
@@ -146,13 +142,7 @@ impl Decoder {
     }
     /// Worst approximation error over all n, and the n where it occurs.
     pub fn max_error(&self) -> (f64, u32) {
-        (N_MIN..=N_MAX).map(|n| (self.error_of(n).unwrap_or(0.0), n)).fold((0.0, 0), |a, b| {
-            if b.0 > a.0 {
-                b
-            } else {
-                a
-            }
-        })
+        (N_MIN..=N_MAX).map(|n| (self.error_of(n).unwrap_or(0.0), n)).fold((0.0, 0), |a, b| if b.0 > a.0 { b } else { a })
     }
 
     pub fn ranges(&self) -> Vec<KRange> {
@@ -174,8 +164,7 @@ impl fmt::Display for Decoder {
             .ranges()
             .iter()
             .map(|r| {
-                let ns =
-                    if r.n_lo == r.n_hi { r.n_lo.to_string() } else { format!("{}..{}", r.n_lo, r.n_hi) };
+                let ns = if r.n_lo == r.n_hi { r.n_lo.to_string() } else { format!("{}..{}", r.n_lo, r.n_hi) };
                 format!("n={ns}->k={}", r.k)
             })
             .collect();

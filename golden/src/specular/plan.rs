@@ -218,15 +218,10 @@ impl SpecularPlan {
         let mut candidates: Vec<(u64, u32, u32, Vec<u32>)> = Vec::new();
         for w in word_bits.map_or(WORD_BITS_RANGE, |w| w..=w) {
             for nw in NK_MANT_RANGE {
-                let lens: Option<Vec<u32>> = decoder
-                    .ks()
-                    .iter()
-                    .zip(&shape)
-                    .map(|(&k, &(x, spread))| analytic_len(k, x, w, spread / (1u64 << nw) as f64))
-                    .collect();
+                let lens: Option<Vec<u32>> =
+                    decoder.ks().iter().zip(&shape).map(|(&k, &(x, spread))| analytic_len(k, x, w, spread / (1u64 << nw) as f64)).collect();
                 if let Some(l) = lens {
-                    let bits = w as u64 * l.iter().map(|&l| l as u64).sum::<u64>()
-                        + NK_DEPTH as u64 * (sel_bits + nw) as u64;
+                    let bits = w as u64 * l.iter().map(|&l| l as u64).sum::<u64>() + NK_DEPTH as u64 * (sel_bits + nw) as u64;
                     candidates.push((bits, w, nw, l));
                 }
             }
@@ -278,10 +273,7 @@ impl SpecularPlan {
                 let len = plan.tables[t].len;
                 // Far past the estimate, more entries are not what is missing (M or W is).
                 if len >= MAX_TABLE_LEN || len > 2 * lens[t] {
-                    return Err(format!(
-                        "table k = {} cannot meet SPEC §4 with {w}-bit words and {nw}-bit M",
-                        plan.tables[t].k
-                    ));
+                    return Err(format!("table k = {} cannot meet SPEC §4 with {w}-bit words and {nw}-bit M", plan.tables[t].k));
                 }
                 plan.tables[t].len = (len + len.div_ceil(200)).min(MAX_TABLE_LEN);
             }
@@ -388,8 +380,7 @@ impl SpecularPlan {
     /// The register stages, in order. Stage 0 is the accumulator; a stall (out_ready low with
     /// a valid output) holds every stage, ROM output registers included.
     pub fn stages(&self) -> Vec<PipeStage> {
-        let reg =
-            |name: &str, bits: u32, format: &str| PipeReg { name: name.into(), bits, format: format.into() };
+        let reg = |name: &str, bits: u32, format: &str| PipeReg { name: name.into(), bits, format: format.into() };
         let (w, drop) = (self.word_bits, self.theta_drop);
         let body = [
             (
@@ -402,19 +393,12 @@ impl SpecularPlan {
             (
                 "abs_nk",
                 format!("mag = |theta| >> {drop} (|-2^31| = 2^31 exact); n-table ROM registered read at n"),
-                vec![
-                    reg("mag", self.mag_bits, &format!("UQ3.{}", self.mag_frac())),
-                    reg("nk", self.nk_width(), "{sel, M}"),
-                ],
+                vec![reg("mag", self.mag_bits, &format!("UQ3.{}", self.mag_frac())), reg("nk", self.nk_width(), "{sel, M}")],
             ),
             (
                 "arg_mul",
                 "prod = mag * M (unsigned); err = (M == 0)".to_string(),
-                vec![
-                    reg("prod", self.prod_bits(), "uint"),
-                    reg("sel", self.sel_bits, "uint"),
-                    reg("err", 1, "flag"),
-                ],
+                vec![reg("prod", self.prod_bits(), "uint"), reg("sel", self.sel_bits, "uint"), reg("err", 1, "flag")],
             ),
             (
                 "brdf",

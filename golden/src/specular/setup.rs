@@ -171,13 +171,9 @@ pub fn setup_span(ends: &SpanEnds, il: f64, ks: f64, n: u16, l: u32) -> Specular
         fallbacks: fb,
     };
     let ilks = il * ks;
-    let (Some(n1), Some(h1), Some(n2), Some(h2), true) = (
-        normalize(ends.n1),
-        normalize(ends.h1),
-        normalize(ends.n2),
-        normalize(ends.h2),
-        ilks.is_finite() && ilks >= 0.0,
-    ) else {
+    let (Some(n1), Some(h1), Some(n2), Some(h2), true) =
+        (normalize(ends.n1), normalize(ends.h1), normalize(ends.n2), normalize(ends.h2), ilks.is_finite() && ilks >= 0.0)
+    else {
         fb.bad_input = true;
         return dark(fb, 0.0);
     };
@@ -199,11 +195,7 @@ pub fn setup_span(ends: &SpanEnds, il: f64, ks: f64, n: u16, l: u32) -> Specular
         None
     } else {
         fb.gamma_pi = true;
-        Some(
-            normalize(add(n1, scale(h1, -c1)))
-                .filter(|_| c1.abs() < 1.0 - 1e-12)
-                .unwrap_or_else(|| perpendicular(h1)),
-        )
+        Some(normalize(add(n1, scale(h1, -c1))).filter(|_| c1.abs() < 1.0 - 1e-12).unwrap_or_else(|| perpendicular(h1)))
     };
     let (a, lambda, gamma_used) = match e2 {
         Some(e2) => {
@@ -258,10 +250,7 @@ mod tests {
 
     /// Seeded from GOLDEN_SEED if set, else fresh; the seed is printed so a failure replays.
     fn rng() -> StdRng {
-        let seed = std::env::var("GOLDEN_SEED")
-            .ok()
-            .and_then(|s| s.parse().ok())
-            .unwrap_or_else(rand::random::<u64>);
+        let seed = std::env::var("GOLDEN_SEED").ok().and_then(|s| s.parse().ok()).unwrap_or_else(rand::random::<u64>);
         eprintln!("GOLDEN_SEED={seed}");
         StdRng::seed_from_u64(seed)
     }
@@ -339,9 +328,7 @@ mod tests {
             let e = SpanEnds { n1, h1, n2: n1, h2 };
             let (n, l) = (r.gen_range(1..=200u16), r.gen_range(1..=500u32));
             let s = setup_span(&e, 200.0, 1.0, n, l);
-            if s.fallbacks != Fallbacks::default()
-                && s.fallbacks != (Fallbacks { shifted_2pi: true, ..Fallbacks::default() })
-            {
+            if s.fallbacks != Fallbacks::default() && s.fallbacks != (Fallbacks { shifted_2pi: true, ..Fallbacks::default() }) {
                 assert!(s.fallbacks.dark, "{s:?}");
             }
             for j in [0, l / 3, l / 2, l] {
@@ -419,22 +406,10 @@ mod tests {
         let s = setup_span(&SpanEnds { n1: x, h1: h, n2: x, h2: h }, 100.0, 1.0, 2, 9);
         assert!(s.fallbacks.gamma_zero && s.port.dtheta == 0 && s.port.theta0 == 0);
         // Light behind the whole span.
-        let s = setup_span(
-            &SpanEnds { n1: x, h1: [-1.0, 0.0, 0.0], n2: x, h2: [-1.0, 0.1, 0.0] },
-            100.0,
-            1.0,
-            8,
-            9,
-        );
+        let s = setup_span(&SpanEnds { n1: x, h1: [-1.0, 0.0, 0.0], n2: x, h2: [-1.0, 0.1, 0.0] }, 100.0, 1.0, 8, 9);
         assert!(s.fallbacks.dark && s.port.c == 0);
         // Antiparallel normals.
-        let s = setup_span(
-            &SpanEnds { n1: x, h1: x, n2: [-1.0, 0.0, 0.0], h2: [-1.0, 0.0, 0.0] },
-            100.0,
-            1.0,
-            8,
-            9,
-        );
+        let s = setup_span(&SpanEnds { n1: x, h1: x, n2: [-1.0, 0.0, 0.0], h2: [-1.0, 0.0, 0.0] }, 100.0, 1.0, 8, 9);
         assert!(s.fallbacks.antiparallel_normals && s.fallbacks.gamma_zero);
         assert_eq!(s.port.c, 100 << 8);
         // gamma = pi: the circle through N1's side, lit at the start.

@@ -378,11 +378,7 @@ fn harness(path: &std::path::Path, limit: usize) -> ExitCode {
             let info = segment_model(h.p, Align::Span).unwrap_or_else(|| panic!("no segment model for p = {}", h.p));
             let stims: Vec<Stim> = recs
                 .iter()
-                .map(|r| Stim {
-                    triangle: r[6] as usize,
-                    y: r[7],
-                    span: Span { x0: r[0], len: r[1], i0: r[2], di: from_port(r[3], h.dw) },
-                })
+                .map(|r| Stim { triangle: r[6] as usize, y: r[7], span: Span { x0: r[0], len: r[1], i0: r[2], di: from_port(r[3], h.dw) } })
                 .collect();
             let mut sim = SegmentCosim::new(info, h.seed, traffic);
             (info.tag, timed(|| sim.stream(&stims, &mut report, |_, _| {})))

@@ -4,13 +4,13 @@
 
 use clap::{Parser, ValueEnum};
 use golden::setup::Screen;
+use golden::specular::SpecularUnit;
 use golden::Align;
 use rand::rngs::StdRng;
 use rand::SeedableRng;
 use std::process::ExitCode;
 use std::time::Instant;
 use verilator_harness::cosim::{Report, SegmentCosim, Traffic};
-use golden::specular::SpecularUnit;
 use verilator_harness::ffi::{segment_model, SEGMENT_MODELS, SPECULAR_MODELS, TRISHADER_MODELS};
 use verilator_harness::frontend::{random_triangles, run_chain_at};
 use verilator_harness::specular::{random_span, SpecularCosim};
@@ -132,7 +132,10 @@ fn rtl_frontend(args: &Args) -> ExitCode {
     }
     let seed = args.seed.unwrap_or_else(|| verilator_harness::seed("cosim --frontend rtl"));
     let traffic = if args.traffic == "full" { Traffic::FULL } else { Traffic::RANDOM };
-    println!("model {} ({}), screen {}x{}, seed {seed}, traffic {}", info.tag, info.top, info.screen.width, info.screen.height, args.traffic);
+    println!(
+        "model {} ({}), screen {}x{}, seed {seed}, traffic {}",
+        info.tag, info.top, info.screen.width, info.screen.height, args.traffic
+    );
     let fe = golden::frontend::FrontEnd::new(info.cfg, info.screen).expect("the model's front-end");
     let mut rng = StdRng::seed_from_u64(seed);
     let mut report = Report::default();

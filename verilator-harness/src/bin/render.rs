@@ -94,10 +94,19 @@ fn main() -> ExitCode {
         Frontend::Host => None,
         Frontend::Rtl => match TRISHADER_MODELS.iter().find(|m| m.cfg.p == args.p && m.cfg.align == align) {
             Some(m) if m.screen == screen => Some(m),
-            Some(m) => return fail(format!("--frontend rtl: the front-end model draws on {}x{}, not {}x{}", m.screen.width, m.screen.height, screen.width, screen.height)),
+            Some(m) => {
+                return fail(format!(
+                    "--frontend rtl: the front-end model draws on {}x{}, not {}x{}",
+                    m.screen.width, m.screen.height, screen.width, screen.height
+                ))
+            }
             None => {
                 let built: Vec<&str> = TRISHADER_MODELS.iter().map(|m| m.tag).collect();
-                return fail(format!("--frontend rtl --p {} --align {align}: no such model in this build (built: {})", args.p, built.join(", ")));
+                return fail(format!(
+                    "--frontend rtl --p {} --align {align}: no such model in this build (built: {})",
+                    args.p,
+                    built.join(", ")
+                ));
             }
         },
     };
@@ -161,10 +170,8 @@ fn main() -> ExitCode {
 
     let channels = job.channels();
     let color = if channels == 3 { ExtendedColorType::Rgb8 } else { ExtendedColorType::L8 };
-    let mut files = vec![
-        (args.out.clone(), png(&outcome.rtl, &screen, color)),
-        (golden_path.clone(), png(&outcome.golden, &screen, color)),
-    ];
+    let mut files =
+        vec![(args.out.clone(), png(&outcome.rtl, &screen, color)), (golden_path.clone(), png(&outcome.golden, &screen, color))];
     if args.diff {
         let d = difference_image(&outcome.rtl, &outcome.golden, channels);
         files.push((diff_path.clone(), png(&d, &screen, ExtendedColorType::Rgb8)));
@@ -185,7 +192,9 @@ fn main() -> ExitCode {
         }
     }
     if let Some(host) = &outcome.host {
-        let n = (0..host.len() / channels).filter(|&k| host[k * channels..(k + 1) * channels] != outcome.rtl[k * channels..(k + 1) * channels]).count();
+        let n = (0..host.len() / channels)
+            .filter(|&k| host[k * channels..(k + 1) * channels] != outcome.rtl[k * channels..(k + 1) * channels])
+            .count();
         println!("front-end:  {} (RTL set-up); differs from the host-set-up image in {n} pixels", chain.map_or("", |m| m.tag));
         if n > 0 {
             println!("            (vertex intensities are rounded onto the UQ8.F ports; the host interpolates the exact ones)");

@@ -176,7 +176,10 @@ fn main() -> ExitCode {
             let fixed: Vec<_> = tris.iter().map(|t| golden::frontend::FixedTriangle::from_triangle(t, info.cfg.frac)).collect();
             let run = run_chain(info, args.seed, Traffic::FULL, &fixed);
             if !run.report.ok() {
-                failures.push(format!("{}: class {k}: {} mismatches, first: {}", info.tag, run.report.mismatch_count, run.report.mismatches[0]));
+                failures.push(format!(
+                    "{}: class {k}: {} mismatches, first: {}",
+                    info.tag, run.report.mismatch_count, run.report.mismatches[0]
+                ));
             }
             let ppc = run.report.pixels_per_clock();
             let fed = rtl.iter().find(|r| (r.0, r.1) == (p, align)).map(|r| r.2[k]);
@@ -229,13 +232,15 @@ fn main() -> ExitCode {
     let _ = writeln!(md, "Pixels per clock (in brackets: of the pixels the scheme could make per clock). **Bold**: the best p of each class and alignment.\n");
     let _ = writeln!(md, "| scheme | clocks | ~10 px | ~100 px | ~1000 px |\n|---|---|---:|---:|---:|");
     for (name, source, cells) in &rows {
-        let bold = |k: usize| {
-            rtl.iter().any(|r| *name == format!("segment shader p = {}, {}", r.0, r.1) && best(r.1, k) == Some(r.0))
-        };
+        let bold = |k: usize| rtl.iter().any(|r| *name == format!("segment shader p = {}, {}", r.0, r.1) && best(r.1, k) == Some(r.0));
         let c: Vec<String> = cells.iter().enumerate().map(|(k, c)| c.show(bold(k))).collect();
         let _ = writeln!(md, "| {name} | {source} | {} |", c.join(" | "));
     }
-    let _ = writeln!(md, "\nBest p: the smallest p within 10% of the pixels per clock of the widest model (p = {}), per alignment:\n", rtl.iter().map(|r| r.0).max().unwrap_or(0));
+    let _ = writeln!(
+        md,
+        "\nBest p: the smallest p within 10% of the pixels per clock of the widest model (p = {}), per alignment:\n",
+        rtl.iter().map(|r| r.0).max().unwrap_or(0)
+    );
     for (k, class) in ["~10 px", "~100 px", "~1000 px"].iter().enumerate() {
         let show = |a| best(a, k).map_or("-".to_string(), |p| p.to_string());
         let _ = writeln!(md, "- {class}: p = {} span-aligned, p = {} screen-aligned", show(Align::Span), show(Align::Screen));
