@@ -97,25 +97,29 @@ fn main() -> ExitCode {
     }
     let secs = start.elapsed().as_secs_f64();
 
+    let triangles = report.triangles.to_string();
+    let speed = format!("{:.0} segments/s, {:.0} pixels/s", report.segments as f64 / secs, report.pixels as f64 / secs);
+    finish(seed, &report, &triangles, Some(report.spans), &speed, secs)
+}
+
+/// The closing lines every triangle run prints (ending `N passed, M failed`), and its exit code.
+fn finish(seed: u64, report: &Report, triangles: &str, spans: Option<u64>, speed: &str, secs: f64) -> ExitCode {
     for m in &report.mismatches {
         println!("MISMATCH (seed {seed}) {m}");
     }
-    println!("triangles:  {}", report.triangles);
-    println!("spans:      {}", report.spans);
+    println!("triangles:  {triangles}");
+    if let Some(spans) = spans {
+        println!("spans:      {spans}");
+    }
     println!("segments:   {} compared", report.segments);
     println!("pixels:     {} compared", report.pixels);
     println!("mismatches: {}", report.mismatch_count);
     println!("cycles:     {}", report.cycles);
     println!("pixels per clock: {:.3}", report.pixels_per_clock());
     println!("worst |pixel - exact|: {:.3}", report.max_error);
-    println!(
-        "wall: {secs:.2} s, {:.0} segments/s, {:.0} pixels/s, {:.0} clocks/s",
-        report.segments as f64 / secs,
-        report.pixels as f64 / secs,
-        report.cycles as f64 / secs
-    );
+    println!("wall: {secs:.2} s, {speed}, {:.0} clocks/s", report.cycles as f64 / secs);
     println!("{} passed, {} failed", report.passed_count(), report.failed_count());
-    exit_code(&report)
+    exit_code(report)
 }
 
 /// Random triangles of every kind into `tri_shader_p<P>`; every segment, `y` and frame checked.
@@ -148,19 +152,9 @@ fn rtl_frontend(args: &Args) -> ExitCode {
         done += n;
     }
     let secs = start.elapsed().as_secs_f64();
-    for m in &report.mismatches {
-        println!("MISMATCH (seed {seed}) {m}");
-    }
-    println!("triangles:  {} ({} dropped for the guard band)", report.triangles, report.pulses);
-    println!("segments:   {} compared", report.segments);
-    println!("pixels:     {} compared", report.pixels);
-    println!("mismatches: {}", report.mismatch_count);
-    println!("cycles:     {}", report.cycles);
-    println!("pixels per clock: {:.3}", report.pixels_per_clock());
-    println!("worst |pixel - exact|: {:.3}", report.max_error);
-    println!("wall: {secs:.2} s, {:.0} triangles/s, {:.0} clocks/s", report.triangles as f64 / secs, report.cycles as f64 / secs);
-    println!("{} passed, {} failed", report.passed_count(), report.failed_count());
-    exit_code(&report)
+    let triangles = format!("{} ({} dropped for the guard band)", report.triangles, report.pulses);
+    let speed = format!("{:.0} triangles/s", report.triangles as f64 / secs);
+    finish(seed, &report, &triangles, None, &speed, secs)
 }
 
 fn exit_code(report: &Report) -> ExitCode {
