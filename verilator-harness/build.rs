@@ -342,17 +342,17 @@ fn build_models(v: &Verilator, out: &Path, models: &[Model]) -> Vec<String> {
 /// Verilates and compiles one model unless its key (everything the result depends on) is the
 /// one recorded by the last build. Returns the runtime files its makefile asks for.
 fn build_model(v: &Verilator, out: &Path, m: &Model) -> Vec<String> {
-    let obj = out.join("obj").join(&m.tag);
-    let rtl = out.join("rtl").join(&m.tag);
     let class = format!("V{}", m.tag);
     let shim = shim_cpp(m, &class);
     let mut key = format!("{}\n{LAYOUT}\n{}\n{}\n{}\n", v.version, m.top, include_str!("csrc/shim.h"), shim);
     for (name, text) in &m.sources {
         write!(key, "== {name}\n{text}").unwrap();
     }
+    let cache = cache_dir(out, &m.tag, &key);
+    let (obj, rtl) = (cache.join("obj"), cache.join("rtl"));
     let key_file = obj.join("build.key");
     let classes_mk = obj.join(format!("{class}_classes.mk"));
-    let lib = out.join(format!("lib{}.a", m.tag));
+    let lib = obj.join(format!("lib{}.a", m.tag));
     let fresh = fs::read_to_string(&key_file).is_ok_and(|k| k == key) && lib.exists() && classes_mk.exists();
     let start = Instant::now();
     if !fresh {
@@ -401,22 +401,45 @@ fn build_model(v: &Verilator, out: &Path, m: &Model) -> Vec<String> {
         let mut b = cc_build(v);
         b.include(&obj).include(Path::new(env!("CARGO_MANIFEST_DIR")).join("csrc")).out_dir(&obj).file(&all_path);
         b.compile(&m.tag);
-        fs::rename(obj.join(format!("lib{}.a", m.tag)), &lib).unwrap();
         let total = start.elapsed().as_secs_f64();
         fs::write(obj.join("build.time"), format!("verilate {verilated:.3}\ncompile {:.3}\ntotal {total:.3}\n", total - verilated))
             .unwrap();
         fs::write(&key_file, &key).unwrap();
     }
+    // Into OUT_DIR: the library to link, and what `bench info` reads (build time, sources).
+    fs::copy(&lib, out.join(format!("lib{}.a", m.tag))).unwrap();
+    let (out_obj, out_rtl) = (out.join("obj").join(&m.tag), out.join("rtl").join(&m.tag));
+    fs::create_dir_all(&out_obj).unwrap();
+    fs::create_dir_all(&out_rtl).unwrap();
+    fs::copy(obj.join("build.time"), out_obj.join("build.time")).unwrap();
+    for (name, text) in &m.sources {
+        fs::write(out_rtl.join(name), text).unwrap();
+    }
     mk.global
+}
+
+/// Where a build with this `key` lives: a folder per profile named by the key's hash, shared by
+/// every `OUT_DIR` of the profile. `cargo clippy` and `cargo test` run this script in OUT_DIRs of
+/// their own; with the models here, the second finds them built. (Two cargo processes building
+/// the same new key at the same moment would race; scripts/test runs them one after the other.)
+fn cache_dir(out: &Path, tag: &str, key: &str) -> PathBuf {
+    use std::hash::{Hash, Hasher};
+    let mut h = std::collections::hash_map::DefaultHasher::new();
+    key.hash(&mut h);
+    // OUT_DIR is <target>/<profile>/build/<package>-<hash>/out.
+    let root = out.ancestors().nth(3).map_or_else(|| out.join("cache"), |p| p.join("segshade-models"));
+    root.join(format!("{tag}-{:016x}", h.finish()))
 }
 
 /// Verilator's runtime (`verilated.cpp`, `verilated_threads.cpp`, as the makefile lists them),
 /// compiled once for every model.
 fn build_runtime(v: &Verilator, out: &Path, globals: &[String]) {
-    let obj = out.join("obj").join("runtime");
     let key = format!("{}\n{LAYOUT}\n{}\n", v.version, globals.join(" "));
-    let lib = out.join("libverilated_rt.a");
+    let obj = cache_dir(out, "runtime", &key);
+    let lib = obj.join("libverilated_rt.a");
+    let linked = out.join("libverilated_rt.a");
     if fs::read_to_string(obj.join("build.key")).is_ok_and(|k| k == key) && lib.exists() {
+        fs::copy(&lib, &linked).unwrap();
         return;
     }
     fs::create_dir_all(&obj).unwrap();
@@ -427,7 +450,7 @@ fn build_runtime(v: &Verilator, out: &Path, globals: &[String]) {
         b.file(v.root.join("include").join(format!("{g}.cpp")));
     }
     b.compile("verilated_rt");
-    fs::rename(obj.join("libverilated_rt.a"), &lib).unwrap();
+    fs::copy(&lib, &linked).unwrap();
     fs::write(
         obj.join("build.time"),
         format!("compile {:.3}\ntotal {:.3}\n", start.elapsed().as_secs_f64(), start.elapsed().as_secs_f64()),
