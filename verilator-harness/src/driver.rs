@@ -149,6 +149,11 @@ pub(crate) trait Unit: Sync {
     fn same(&self, held: &[u8], out: &Self::Out) -> bool;
     /// What differs when `out` is not [`Unit::same`] as `held`.
     fn describe_change(&self, held: &[u8], out: &Self::Out) -> String;
+    /// Quiet clocks after the last expected output before the stream ends. A unit whose inputs
+    /// may owe no output but a late side pulse (a front-end dropping a triangle) waits longer.
+    fn drain_clocks(&self) -> u64 {
+        DRAIN_CLOCKS
+    }
     /// A one-clock side pulse of the unit (the front-end's `err`), counted in `Report::pulses`.
     #[inline(always)]
     fn pulse(&self, _out: &Self::Out) -> bool {
@@ -272,7 +277,7 @@ impl<U: Unit> Driver<U> {
         loop {
             if next == spans.len() && front.is_none() {
                 // Everything came out; a few more clocks must bring nothing.
-                if drain == DRAIN_CLOCKS {
+                if drain == unit.drain_clocks() {
                     break;
                 }
                 drain += 1;

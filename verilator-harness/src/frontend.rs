@@ -9,7 +9,7 @@
 //! counted against golden's.
 
 use crate::cosim::{agrees, check_lanes, describe, golden_row, Mismatch, Report, SegView, Stim};
-use crate::driver::{Check, Driver, Stress, Unit};
+use crate::driver::{Check, Driver, Stress, Unit, DRAIN_CLOCKS};
 use crate::ffi::{to_port, FeOut, ModelInfo, Rtl, TriIn, TriSegOut};
 use crate::traffic::{Traffic, TrafficGen};
 use golden::frontend::{FixedTriangle, FrontEnd, Outcome};
@@ -74,6 +74,10 @@ fn blame(s: &TriStim) -> (Option<usize>, String) {
 /// `tri_frontend`: a span's record is y, x0, len, I0, dI (5 words).
 struct FeUnit {
     fe: FrontEnd,
+    /// Clocks after the last owed output in which a dropped triangle's `err` pulse may still
+    /// come: the walker may step through up to H rows that yield nothing (a sliver, a triangle
+    /// clipped at the right) before set-up reaches it, then its latency.
+    drain: u64,
 }
 
 impl Unit for FeUnit {
@@ -102,6 +106,9 @@ impl Unit for FeUnit {
     }
     fn describe_change(&self, held: &[u8], out: &FeOut) -> String {
         format!("span changed while waiting for out_ready: {held:?} -> y = {} x = {}", out.out_y, out.out_x)
+    }
+    fn drain_clocks(&self) -> u64 {
+        self.drain
     }
     fn pulse(&self, out: &FeOut) -> bool {
         out.err == 1
@@ -140,6 +147,8 @@ impl Check for FeCheck<'_> {
 struct TsUnit {
     fe: FrontEnd,
     mask_bytes: usize,
+    /// As [`FeUnit`]'s.
+    drain: u64,
 }
 
 impl TsUnit {
@@ -187,6 +196,9 @@ impl Unit for TsUnit {
     fn describe_change(&self, held: &[u8], out: &TriSegOut) -> String {
         let (y, h) = self.view(held);
         format!("segment (y {y}, x {}) changed while waiting for out_ready (now y {}, x {})", h.out_x, out.out_y, out.out_x)
+    }
+    fn drain_clocks(&self) -> u64 {
+        self.drain
     }
     fn pulse(&self, out: &TriSegOut) -> bool {
         out.err == 1
@@ -246,6 +258,11 @@ impl<F: FnMut(usize, u32, &SegView) + Send> Check for TsCheck<'_, F> {
     }
 }
 
+/// See [`FeUnit::drain`].
+fn drain_clocks(latency: u32, fe: &FrontEnd) -> u64 {
+    fe.screen.height as u64 + latency as u64 + DRAIN_CLOCKS
+}
+
 /// Streams triangles through `tri_frontend` and compares every span with golden's. In the
 /// report, `spans` counts the triangles the model accepted and `segments` the spans it output.
 pub fn run_frontend(info: &'static ModelInfo<TriIn, FeOut>, seed: u64, traffic: Traffic, stress: Stress, tris: &[FixedTriangle]) -> Report {
@@ -266,7 +283,7 @@ pub fn run_frontend_against(info: &'static ModelInfo<TriIn, FeOut>, seed: u64, t
 fn run_expected(info: &'static ModelInfo<TriIn, FeOut>, seed: u64, traffic: Traffic, stress: Stress, exp: &Expected) -> Report {
     let fe = exp.fe;
     let tris = &exp.stims;
-    let unit = FeUnit { fe };
+    let unit = FeUnit { fe, drain: drain_clocks(info.latency, &fe) };
     let mut driver = Driver::new(Rtl::new(info, seed), TrafficGen::new(traffic, seed));
     driver.stress = stress;
     let mut report = Report::default();
@@ -336,7 +353,7 @@ pub fn stream_chain(
     paint: impl FnMut(usize, u32, &SegView) + Send,
 ) -> Report {
     let cfg = info.cfg;
-    let unit = TsUnit { fe: exp.fe, mask_bytes: cfg.p.div_ceil(8) as usize };
+    let unit = TsUnit { fe: exp.fe, mask_bytes: cfg.p.div_ceil(8) as usize, drain: drain_clocks(info.latency, &exp.fe) };
     let mut driver = Driver::new(Rtl::new(info, seed), TrafficGen::new(traffic, seed));
     let mut report = Report::default();
     let mut row = golden_row(&cfg);
