@@ -278,7 +278,7 @@ impl FrontEnd {
     }
 
     pub fn widths(&self) -> Widths {
-        let yw = bits((self.screen.height - 1) as u128).max(1);
+        let yw = self.screen.y_bits();
         let cx = self.cfg.xbits + 10;
         let cy = yw + 10;
         let aw = cx + cy + 1;

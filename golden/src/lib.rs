@@ -11,5 +11,6 @@ pub mod schemes;
 pub mod segment;
 pub mod setup;
 pub mod specular;
+pub mod writer;
 
 pub use format::{Align, Config, Span};

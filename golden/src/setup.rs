@@ -65,6 +65,11 @@ impl Screen {
         Ok(())
     }
 
+    /// Bits of a scanline number `0..H` (at least 1): the `y` ports of the front-end and writer.
+    pub fn y_bits(&self) -> u32 {
+        (32 - self.height.saturating_sub(1).leading_zeros()).max(1)
+    }
+
     /// As [`Screen::check`], and every span of this screen fits `cfg`'s `in_x`/`in_len` ports.
     pub fn check_for(&self, cfg: &Config) -> Result<(), String> {
         self.check()?;

@@ -12,6 +12,7 @@ pub mod specular;
 pub mod testbench;
 pub mod verilog;
 pub mod wrapper;
+pub mod writer;
 
 pub use bfpi::BfpiArch;
 use golden::Config;
@@ -27,6 +28,9 @@ pub struct Names {
     /// SPEC §6's front-end (set-up and edge walker), and the chain of it with the shader.
     pub frontend: String,
     pub top: String,
+    /// SPEC §7's segment writer, and the chain from triangles to memory.
+    pub writer: String,
+    pub fb_top: String,
 }
 
 impl Names {
@@ -37,6 +41,8 @@ impl Names {
             segment: format!("{prefix}segment_shader_p{}", cfg.p),
             frontend: format!("{prefix}tri_frontend"),
             top: format!("{prefix}tri_shader_p{}", cfg.p),
+            writer: format!("{prefix}fb_writer_p{}", cfg.p),
+            fb_top: format!("{prefix}tri_fb_p{}", cfg.p),
         }
     }
 }
@@ -80,6 +86,11 @@ impl Options {
         Ok(frontend::Hw { fe, div_bits: self.fe_div_bits.unwrap_or(frontend::DEFAULT_DIV_BITS) })
     }
 
+    /// The segment writer of the front-end's screen (the same screen: the chain shares it).
+    pub fn writer(&self) -> Result<golden::writer::Writer, golden::writer::WriterError> {
+        golden::writer::Writer::new(self.cfg, self.screen.unwrap_or_else(|| Options::default_screen(&self.cfg)))
+    }
+
     /// The specular unit these options describe, with its ROM images.
     pub fn specular_unit(&self) -> golden::specular::SpecularUnit {
         match &self.brdf {
@@ -102,9 +113,11 @@ pub fn generate(opts: &Options) -> Vec<GeneratedFile> {
     let mut modules: Vec<verilog::Module> = bfpi::module_for(&opts.cfg, &names, opts.bfpi_arch).into_iter().collect();
     modules.push(segment::module_with(&opts.cfg, &names, opts.bfpi_arch));
     // The CLI validates the screen; a library caller with a bad one gets no front-end.
-    if let Ok(fe) = opts.frontend() {
+    if let (Ok(fe), Ok(w)) = (opts.frontend(), opts.writer()) {
         modules.push(frontend::module(&fe, &names));
         modules.push(frontend::top_module(&fe, &names));
+        modules.push(writer::module(&w, &names));
+        modules.push(writer::top_module(&fe, &w, &names));
     }
     let unit = opts.specular_unit();
     modules.extend(specular::modules(&opts.cfg, &unit, &specular::SpecNames::new(&opts.prefix)));

@@ -24,6 +24,24 @@ struct Manifest<'a> {
     /// SPEC §6's front-end; absent when the configuration cannot host the screen.
     #[serde(skip_serializing_if = "Option::is_none")]
     frontend: Option<Frontend>,
+    /// SPEC §7's segment writer and block memory; present with the front-end.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    writer: Option<WriterEntry>,
+}
+
+/// The block memory the writer addresses, and its timing.
+#[derive(Serialize)]
+struct WriterEntry {
+    module: String,
+    top: String,
+    screen: golden::setup::Screen,
+    blocks_per_row: u32,
+    blocks: u32,
+    addr_bits: u32,
+    address: &'static str,
+    /// Clocks from a segment's transfer to its write.
+    latency: u32,
+    writes: &'static str,
 }
 
 /// The front-end's screen, guard band, widths and timing.
@@ -152,6 +170,7 @@ pub fn render(opts: &Options, names: &Names, modules: &[Module], unit: &Specular
     let spec = SpecNames::new(&opts.prefix);
     let fe = opts.frontend().ok();
     let fe_latency = fe.as_ref().map_or(0, |hw| hw.latency());
+    let wr = opts.writer().ok().filter(|_| fe.is_some());
     let entry = |m: &Module| {
         let (role, latency, throughput) = if m.name == names.bfpi {
             ("bfpi", 0, "combinational")
@@ -161,6 +180,10 @@ pub fn render(opts: &Options, names: &Names, modules: &[Module], unit: &Specular
             ("frontend", fe_latency, "one span per clock; set-up per walked triangle as in frontend.setup_clocks")
         } else if m.name == names.top {
             ("triangle_shader", fe_latency + segment::LATENCY, "one segment per clock")
+        } else if m.name == names.writer {
+            ("writer", golden::writer::LATENCY, "one block write per clock")
+        } else if m.name == names.fb_top {
+            ("triangle_writer", fe_latency + segment::LATENCY + golden::writer::LATENCY, "one block write per clock")
         } else if m.name == spec.unit {
             ("specular_unit", unit.plan().latency(), "one pixel per clock")
         } else {
@@ -218,6 +241,20 @@ pub fn render(opts: &Options, names: &Names, modules: &[Module], unit: &Specular
             setup_clocks_walked: hw.setup_clocks().0,
             setup_clocks_dropped: hw.setup_clocks().1,
             walker: "one clock per row from the first to the last row of the bounding box on screen",
+        }),
+        writer: wr.map(|w| WriterEntry {
+            module: names.writer.clone(),
+            top: names.fb_top.clone(),
+            screen: w.screen,
+            blocks_per_row: w.blocks_per_row(),
+            blocks: w.blocks(),
+            addr_bits: w.addr_bits(),
+            address: "y * blocks_per_row + x div P; pixel x mod P in mem_data[8i +: 8], enable mem_we[i]",
+            latency: golden::writer::LATENCY,
+            writes: match opts.cfg.align {
+                golden::Align::Span => "ceil((x0 mod P + m) / P) per span: each block the span touches, once, ascending (glue)",
+                golden::Align::Screen => "one per segment: each block the span touches, once, ascending",
+            },
         }),
     };
     serde_json::to_string_pretty(&manifest).expect("manifest serializes") + "\n"

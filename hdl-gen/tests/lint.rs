@@ -85,7 +85,7 @@ fn lint_one(k: usize, cfg: Config, prefix: &str, arch: BfpiArch, fe_div_bits: Op
         let opts = Options { cfg, prefix: prefix.into(), bfpi_arch: arch, fe_div_bits, ..Default::default() };
         let names = hdl_gen::Names::new(prefix, &cfg);
         let chain = fe_first || (arch == BfpiArch::ShiftAdd && [1, 256].contains(&cfg.p));
-        let skip = |module: &str| (module == names.frontend && !fe_first) || (module == names.top && !chain);
+        let skip = |module: &str| (module == names.frontend && !fe_first) || ((module == names.top || module == names.fb_top) && !chain);
         let files = generate(&opts);
         output::write_all(&dir, &files).unwrap();
         let path = |name: &str| dir.join(name).display().to_string();

@@ -5,6 +5,7 @@
 // A per-model translation unit written by build.rs includes the model's header and expands
 // one of the SEGSHADE_*_SHIM macros with the model's class and the symbol prefix.
 
+#include <cstddef>
 #include <cstdint>
 #include <cstring>
 #include "verilated.h"
@@ -18,6 +19,16 @@ template <class T> static inline void segshade_copy(uint8_t* dst, const T& v, si
 }
 template <std::size_t N> static inline void segshade_copy(uint8_t* dst, const VlWide<N>& v, size_t bytes) {
     std::memcpy(dst, v.data(), bytes);
+}
+
+// And back: bytes into a packed input bus (the bytes' unused top bits are zero).
+template <class T> static inline void segshade_load(T& v, const uint8_t* src, size_t bytes) {
+    v = 0;
+    std::memcpy(&v, src, bytes);
+}
+template <std::size_t N> static inline void segshade_load(VlWide<N>& v, const uint8_t* src, size_t bytes) {
+    std::memset(v.data(), 0, sizeof(EData) * N);
+    std::memcpy(v.data(), src, bytes);
 }
 
 struct SegIn {
@@ -213,6 +224,67 @@ struct TriSegOut {
             });                                                                               \
     }
 
+// fb_writer_p<P> (SPEC §7): segments with their y in, block writes out. The memory port's
+// mem_valid/mem_ready are the driver's out_valid/out_ready.
+struct WrIn {
+    uint32_t in_x, in_y;
+    uint8_t rst, in_valid, out_ready, keep;
+    uint8_t in_last, pad[3];
+    uint8_t pix[256];  // lane i in byte i
+    uint8_t mask[32];  // lane i in bit i % 8 of byte i / 8
+};
+
+// The memory port of fb_writer_p<P> and tri_fb_p<P> (err: the latter's guard-band pulse).
+struct WrOut {
+    uint32_t mem_addr;
+    uint8_t in_ready, out_valid, err, pad;
+    uint8_t data[256];  // lane i in byte i
+    uint8_t we[32];     // lane i in bit i % 8 of byte i / 8
+};
+
+// One clock of a unit with a memory port (same order as segshade_clock): DATA writes the data
+// ports, ERR is what out->err reads.
+#define SEGSHADE_MEM_CLOCK(m, in, out, P, DATA, ERR)                                         \
+    m->clk = 0;                                                                               \
+    m->rst = in->rst;                                                                         \
+    m->in_valid = in->in_valid;                                                               \
+    m->mem_ready = in->out_ready;                                                             \
+    if (!in->keep) DATA                                                                       \
+    m->eval();                                                                                \
+    out->in_ready = m->in_ready;                                                              \
+    out->err = ERR;                                                                           \
+    out->out_valid = m->mem_valid;                                                            \
+    out->mem_addr = m->mem_addr;                                                              \
+    segshade_copy(out->data, m->mem_data, P);                                                 \
+    segshade_copy(out->we, m->mem_we, (P + 7) / 8);                                           \
+    m->clk = 1;                                                                               \
+    m->eval();
+
+#define SEGSHADE_WRITER_SHIM(CLASS, SYM, P)                                                  \
+    SEGSHADE_LIFETIME(CLASS, SYM)                                                             \
+    extern "C" void SYM##_step(void* h, const WrIn* in, WrOut* out) {                         \
+        CLASS* m = static_cast<SegshadeModel<CLASS>*>(h)->top;                                \
+        SEGSHADE_MEM_CLOCK(m, in, out, P, {                                                   \
+            m->in_x = in->in_x;                                                               \
+            m->in_y = in->in_y;                                                               \
+            m->in_last = in->in_last;                                                         \
+            segshade_load(m->in_pix, in->pix, P);                                             \
+            segshade_load(m->in_mask, in->mask, (P + 7) / 8);                                 \
+        }, 0)                                                                                 \
+    }
+
+// tri_fb_p<P>: triangles in, block writes out.
+#define SEGSHADE_TRIWRITER_SHIM(CLASS, SYM, P)                                               \
+    SEGSHADE_LIFETIME(CLASS, SYM)                                                             \
+    extern "C" void SYM##_step(void* h, const TriIn* in, WrOut* out) {                        \
+        CLASS* m = static_cast<SegshadeModel<CLASS>*>(h)->top;                                \
+        SEGSHADE_MEM_CLOCK(m, in, out, P, { SEGSHADE_TRI_PORTS(m, in) }, m->err)               \
+    }
+
+static_assert(sizeof(WrIn) == 304, "WrIn layout is mirrored in ffi.rs");
+static_assert(offsetof(WrIn, pix) == 16, "WrIn layout is mirrored in ffi.rs");
+static_assert(sizeof(WrOut) == 296, "WrOut layout is mirrored in ffi.rs");
+static_assert(offsetof(WrOut, data) == 8, "WrOut layout is mirrored in ffi.rs");
 static_assert(sizeof(TriIn) == 40, "TriIn layout is mirrored in ffi.rs");
 static_assert(sizeof(FeOut) == 24, "FeOut layout is mirrored in ffi.rs");
 static_assert(sizeof(TriSegOut) == 300, "TriSegOut layout is mirrored in ffi.rs");

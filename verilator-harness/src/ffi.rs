@@ -159,7 +159,58 @@ impl Default for TriSegOut {
     }
 }
 
+/// Inputs of `fb_writer_p<P>` for one clock: a segment and its scanline; `out_ready` drives
+/// `mem_ready`.
+#[repr(C)]
+#[derive(Clone, Copy)]
+pub struct WrIn {
+    pub in_x: u32,
+    pub in_y: u32,
+    pub rst: u8,
+    pub in_valid: u8,
+    pub out_ready: u8,
+    pub keep: u8,
+    pub in_last: u8,
+    pub pad: [u8; 3],
+    /// Lane i in byte i.
+    pub pix: [u8; 256],
+    /// Lane i in bit i % 8 of byte i / 8; bits past P are zero.
+    pub mask: [u8; 32],
+}
+
+impl Default for WrIn {
+    fn default() -> Self {
+        WrIn { in_x: 0, in_y: 0, rst: 0, in_valid: 0, out_ready: 0, keep: 0, in_last: 0, pad: [0; 3], pix: [0; 256], mask: [0; 32] }
+    }
+}
+
+/// The memory port of `fb_writer_p<P>` and `tri_fb_p<P>`: `out_valid` is `mem_valid`; `err`
+/// the chain's guard-band pulse (0 for the writer alone).
+#[repr(C)]
+#[derive(Clone, Copy)]
+pub struct WrOut {
+    pub mem_addr: u32,
+    pub in_ready: u8,
+    pub out_valid: u8,
+    pub err: u8,
+    pub pad: u8,
+    /// Lane i in byte i.
+    pub data: [u8; 256],
+    /// Lane i in bit i % 8 of byte i / 8.
+    pub we: [u8; 32],
+}
+
+impl Default for WrOut {
+    fn default() -> Self {
+        WrOut { mem_addr: 0, in_ready: 0, out_valid: 0, err: 0, pad: 0, data: [0; 256], we: [0; 32] }
+    }
+}
+
 // The C++ side (csrc/shim.h) asserts the same sizes.
+const _: () = assert!(std::mem::size_of::<WrIn>() == 304);
+const _: () = assert!(std::mem::offset_of!(WrIn, pix) == 16);
+const _: () = assert!(std::mem::size_of::<WrOut>() == 296);
+const _: () = assert!(std::mem::offset_of!(WrOut, data) == 8);
 const _: () = assert!(std::mem::size_of::<TriIn>() == 40);
 const _: () = assert!(std::mem::size_of::<FeOut>() == 24);
 const _: () = assert!(std::mem::size_of::<TriSegOut>() == 300);
@@ -167,7 +218,7 @@ const _: () = assert!(std::mem::offset_of!(TriSegOut, pix) == 12);
 
 /// The control inputs and handshake outputs the streaming units share.
 macro_rules! streaming_ports {
-    ($in:ty, $($out:ty),+) => {
+    ($in:ty $(, $out:ty)*) => {
         impl Control for $in {
             #[inline(always)]
             fn set_control(&mut self, rst: bool, in_valid: bool, out_ready: bool) {
@@ -187,12 +238,13 @@ macro_rules! streaming_ports {
             fn out_valid(&self) -> bool {
                 self.out_valid == 1
             }
-        })+
+        })*
     };
 }
 streaming_ports!(SegIn, SegOut);
 streaming_ports!(SpecIn, SpecOut);
-streaming_ports!(TriIn, FeOut, TriSegOut);
+streaming_ports!(TriIn, FeOut, TriSegOut, WrOut);
+streaming_ports!(WrIn);
 
 /// A linked model: its configuration and its three symbols.
 pub struct ModelInfo<I: 'static, O: 'static> {
@@ -269,6 +321,8 @@ pub fn require<T>(found: Option<T>, model: &str, what: &str) -> Option<T> {
         .chain(SPECULAR_MODELS.iter().map(|m| m.tag))
         .chain(FRONTEND_MODELS.iter().map(|m| m.tag))
         .chain(TRISHADER_MODELS.iter().map(|m| m.tag))
+        .chain(WRITER_MODELS.iter().map(|m| m.tag))
+        .chain(TRIWRITER_MODELS.iter().map(|m| m.tag))
         .collect();
     let built = if built.is_empty() { "nothing".to_string() } else { built.join(", ") };
     match RTL_DIR {

@@ -29,6 +29,8 @@ pub struct TriStim {
     pub count: u32,
     /// Segments its spans make in the shader.
     pub segments: u32,
+    /// Block writes its spans make in the writer (SPEC §7).
+    pub writes: u32,
 }
 
 /// Golden's answer for a list of triangles.
@@ -44,11 +46,14 @@ impl Expected {
     pub fn new(fe: FrontEnd, tris: &[FixedTriangle]) -> Expected {
         let mut spans = Vec::new();
         let mut stims = Vec::with_capacity(tris.len());
+        // Every front-end screen is one the writer can address (W <= 2^XW).
+        let writer = golden::writer::Writer::new(fe.cfg, fe.screen).expect("the front-end's screen");
         for (k, t) in tris.iter().enumerate() {
             let first = spans.len();
             let outcome = fe.spans(t, |y, s| spans.push((y, s)));
             let segments = spans[first..].iter().map(|(_, s)| fe.cfg.segment_count(s.x0, s.len)).sum();
-            stims.push(TriStim { triangle: k, tri: *t, outcome, first, count: (spans.len() - first) as u32, segments });
+            let writes = spans[first..].iter().map(|(_, s)| writer.write_count(s)).sum();
+            stims.push(TriStim { triangle: k, tri: *t, outcome, first, count: (spans.len() - first) as u32, segments, writes });
         }
         Expected { fe, stims, spans }
     }
@@ -58,7 +63,7 @@ impl Expected {
     }
 }
 
-fn load(fe: &FrontEnd, input: &mut TriIn, t: &FixedTriangle) {
+pub(crate) fn load(fe: &FrontEnd, input: &mut TriIn, t: &FixedTriangle) {
     let w = fe.widths();
     for k in 0..3 {
         input.x[k] = to_port(t.x[k], w.cx);
@@ -259,7 +264,7 @@ impl<F: FnMut(usize, u32, &SegView) + Send> Check for TsCheck<'_, F> {
 }
 
 /// See [`FeUnit::drain`].
-fn drain_clocks(latency: u32, fe: &FrontEnd) -> u64 {
+pub(crate) fn drain_clocks(latency: u32, fe: &FrontEnd) -> u64 {
     fe.screen.height as u64 + latency as u64 + DRAIN_CLOCKS
 }
 
@@ -372,7 +377,7 @@ pub fn stream_chain(
 
 /// The RTL frame against golden's spans (equal), the f64 reference (SPEC §6: within 1, same
 /// coverage), and no pixel written by two triangles (meaningful when they do not overlap).
-fn check_frame(exp: &Expected, frame: &Frame, writes: &[u8], report: &mut Report) {
+pub(crate) fn check_frame(exp: &Expected, frame: &Frame, writes: &[u8], report: &mut Report) {
     let (cfg, screen) = (&exp.fe.cfg, exp.fe.screen);
     let mut gold = Frame::new(screen.width, screen.height);
     let mut reference = RefFrame::new(screen.width, screen.height);

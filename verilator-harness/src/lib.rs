@@ -16,6 +16,7 @@ pub mod render;
 pub mod specular;
 pub mod stimulus;
 pub mod traffic;
+pub mod writer;
 
 /// The seed of a random test: `COSIM_SEED` when set (to replay a failure), else a fresh one.
 /// Printed either way, so every failure can be replayed.
