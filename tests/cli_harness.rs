@@ -113,6 +113,8 @@ fn render_rejects_every_bad_flag_and_input_file() {
     let bright = bad_file("bright.txt", b"0 0 0 10 0 300 0 10 255\n");
     let word = bad_file("word.txt", b"0 0 zero 10 0 128 0 10 255\n");
     let binary = bad_file("binary.txt", &[0xff, 0xfe, 0x00, 0x41]);
+    let no_faces = bad_file("points.obj", b"v 0 0 0\nv 1 0 0\n");
+    let flat = bad_file("point.obj", b"v 1 1 1\nv 1 1 1\nv 1 1 1\nf 1 2 3\n");
     let missing = dir.join("missing.txt");
     let (g, d) = (good.to_str().unwrap(), dir.to_str().unwrap());
     let out = dir.join("out.png");
@@ -144,6 +146,11 @@ fn render_rejects_every_bad_flag_and_input_file() {
         (vec!["--triangles", &bright, "--out", o], "line 1".into()),
         (vec!["--triangles", &word, "--out", o], "line 1".into()),
         (vec!["--triangles", g, "--out", o, "--bogus"], "--bogus".into()),
+        (vec!["--obj", &no_faces, "--out", o], "no faces".into()),
+        (vec!["--obj", &flat, "--out", o], "no extent".into()),
+        (vec!["--obj", &no_faces, "--triangles", g, "--out", o], "--obj".into()),
+        (vec!["--triangles", g, "--out", o, "--writer", "disk"], "--writer".into()),
+        (vec!["--triangles", g, "--out", o, "--writer", "rtl", "--width", "320"], "--writer rtl".into()),
     ];
     let Some(model) = default_model_args("cli_harness: render's bad flags and files") else { return };
     let before = listing(&dir);

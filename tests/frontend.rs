@@ -134,7 +134,7 @@ fn set_up_costs_what_the_manifest_says() {
 #[test]
 fn scenes_render_through_the_rtl_chain_as_golden() {
     use golden::setup::Screen;
-    use verilator_harness::render::{run_with, scene_job, SceneKind};
+    use verilator_harness::render::{run_with, scene_job, Chain, SceneKind};
     let what = "render through the chain";
     let Some(chain) = require(TRISHADER_MODELS.iter().find(|m| m.cfg.p == 8 && m.cfg.align == golden::Align::Span), "tris_p8_span", what)
     else {
@@ -143,7 +143,7 @@ fn scenes_render_through_the_rtl_chain_as_golden() {
     let Some(seg) = verilator_harness::ffi::require_segment_model(8, golden::Align::Span, what) else { return };
     for kind in [SceneKind::Sphere, SceneKind::Torus] {
         let job = scene_job(kind, 40, &seg.cfg, &Screen::default()).unwrap();
-        let o = run_with(&job, seg, Some(chain), None, |_| {});
+        let o = run_with(&job, seg, Chain::Rtl(chain), None, |_| {});
         assert!(o.cosim_ok(), "{:?}", o.segment.iter().flat_map(|r| &r.mismatches).next());
         assert_eq!(o.differing_pixels(3), 0, "RTL image differs from golden's front-end image");
         // Against the host set-up only the rounding of vertex intensities onto the ports shows.

@@ -208,3 +208,28 @@ fn a_shared_edge_mesh_lands_in_memory_once_per_pixel() {
         assert!(writes.iter().all(|&n| n == 1), "{}: every pixel of the screen written exactly once", m.tag);
     }
 }
+
+/// `render --writer rtl`, with the host's or the RTL's set-up: the image read out of the memory
+/// model equals golden's in every pixel, with the hidden surfaces hidden.
+#[test]
+fn scenes_render_into_memory_as_golden() {
+    use verilator_harness::ffi::require;
+    use verilator_harness::render::{run_with, scene_job, Chain, SceneKind};
+    let what = "render into memory";
+    let Some(seg) = verilator_harness::ffi::require_segment_model(8, golden::Align::Span, what) else { return };
+    let Some(wr) = require(WRITER_MODELS.iter().find(|m| m.cfg.p == 8 && m.cfg.align == golden::Align::Span), "wr_p8_span", what) else {
+        return;
+    };
+    let Some(fb) = require(TRIWRITER_MODELS.iter().find(|m| m.cfg.p == 8 && m.cfg.align == golden::Align::Span), "trw_p8_span", what)
+    else {
+        return;
+    };
+    for chain in [Chain::HostToMemory(wr), Chain::RtlToMemory(fb)] {
+        let job = scene_job(SceneKind::Torus, 40, &seg.cfg, &Screen::default()).unwrap();
+        let o = run_with(&job, seg, chain, None, |_| {});
+        let first = o.segment.iter().chain(&o.writer).flat_map(|r| &r.mismatches).next();
+        assert!(o.cosim_ok(), "{first:?}");
+        assert_eq!(o.differing_pixels(3), 0, "the image out of memory differs from golden's");
+        assert!(o.rtl.iter().any(|&v| v != 0), "an empty image");
+    }
+}

@@ -15,14 +15,16 @@
 //! triangle's pixel is kept when the shaded segments come back. Triangle files: no depth; later
 //! triangles are drawn over earlier ones, so a pixel belongs to the last triangle covering it.
 
-use crate::cosim::{Report, SegView, SegmentCosim, Stim, Traffic, DRAIN_CLOCKS};
-use crate::ffi::{ModelInfo, SegIn, SegOut, SpecIn, SpecOut, TriIn, TriSegOut};
+use crate::cosim::{Report, SegView, SegmentCosim, Stim, Stress, Traffic, DRAIN_CLOCKS};
+use crate::ffi::{ModelInfo, SegIn, SegOut, SpecIn, SpecOut, TriIn, TriSegOut, WrIn, WrOut};
 use crate::frontend::{stream_chain, Expected};
 use crate::specular::SpecularCosim;
+use crate::writer::{run_segments, stream_fb, SegStim};
 use golden::frontend::{FixedTriangle, FrontEnd};
 use golden::setup::{parse_triangles, triangle_spans, Screen, Triangle, Vertex};
 use golden::specular::setup::{cross, dot, normalize, setup_span, SpanEnds, Vec3};
 use golden::specular::{SpecularSpan, SpecularUnit, C_FRAC};
+use golden::writer::Writer;
 use golden::{Config, Span};
 use std::f64::consts::{PI, TAU};
 use std::sync::atomic::{AtomicU64, Ordering};
@@ -159,18 +161,75 @@ pub struct Lighting {
     pub shininess: u16,
 }
 
+/// Every scene's camera, light and material, in its own colour.
+fn lighting(colour: [f64; 3], shininess: u16) -> Lighting {
+    Lighting { eye: [0.0, 0.0, 4.5], light: [-4.0, 4.5, 6.0], colour, ambient: 0.07, diffuse: 0.93, specular: 235.0, shininess }
+}
+
+/// A Wavefront OBJ mesh (`tobj`: polygons triangulated, every object of the file), moved and
+/// scaled into the unit sphere the camera frames. Normals: the file's where every vertex has
+/// one, else smooth normals from the faces (area-weighted), the faces' winding taken as given
+/// (counter-clockwise seen from outside, OBJ's convention). Materials are ignored.
+pub fn obj_mesh(text: &str) -> Result<Mesh, String> {
+    let opts = tobj::LoadOptions { triangulate: true, single_index: true, ..Default::default() };
+    let (models, _) = tobj::load_obj_buf(&mut text.as_bytes(), &opts, |_| Err(tobj::LoadError::OpenFileFailed))
+        .map_err(|e| format!("not a Wavefront OBJ mesh: {e}"))?;
+    let mut mesh = Mesh::default();
+    let mut given = Vec::new();
+    for m in &models {
+        let base = mesh.positions.len() as u32;
+        let mm = &m.mesh;
+        for k in 0..mm.positions.len() / 3 {
+            mesh.positions.push([0, 1, 2].map(|c| mm.positions[3 * k + c] as f64));
+            given.push((mm.normals.len() == mm.positions.len()).then(|| [0, 1, 2].map(|c| mm.normals[3 * k + c] as f64)));
+        }
+        for f in mm.indices.chunks_exact(3) {
+            mesh.faces.push([f[0] + base, f[1] + base, f[2] + base]);
+        }
+    }
+    if mesh.faces.is_empty() {
+        return Err("the OBJ file has no faces".into());
+    }
+    if mesh.positions.iter().flatten().any(|v| !v.is_finite()) {
+        return Err("the OBJ file has a vertex that is not a finite number".into());
+    }
+    // Into the unit sphere: the bounding box's centre to the origin, the farthest vertex at 1.
+    let lo = mesh.positions.iter().fold([f64::INFINITY; 3], |a, p| [0, 1, 2].map(|c| a[c].min(p[c])));
+    let hi = mesh.positions.iter().fold([f64::NEG_INFINITY; 3], |a, p| [0, 1, 2].map(|c| a[c].max(p[c])));
+    let centre = [0, 1, 2].map(|c| (lo[c] + hi[c]) / 2.0);
+    let r = mesh.positions.iter().map(|p| dot(sub(*p, centre), sub(*p, centre)).sqrt()).fold(0.0, f64::max);
+    if r <= 0.0 {
+        return Err("the OBJ mesh has no extent".into());
+    }
+    for p in mesh.positions.iter_mut() {
+        *p = scale(sub(*p, centre), 1.0 / r);
+    }
+    let mut normals = vec![[0.0; 3]; mesh.positions.len()];
+    for f in &mesh.faces {
+        let p = f.map(|k| mesh.positions[k as usize]);
+        let n = cross(sub(p[1], p[0]), sub(p[2], p[0]));
+        for &k in f {
+            normals[k as usize] = add(normals[k as usize], n);
+        }
+    }
+    mesh.normals =
+        normals.iter().zip(&given).map(|(n, g)| g.and_then(normalize).or_else(|| normalize(*n)).unwrap_or([0.0, 0.0, 1.0])).collect();
+    Ok(mesh)
+}
+
+/// The job of an OBJ mesh ([`obj_mesh`]), lit like the built-in scenes in a warm grey and
+/// turned like the torus, so a box shows three faces.
+pub fn obj_job(text: &str, shininess: u16, cfg: &Config, screen: &Screen) -> Result<Job, String> {
+    let mut mesh = obj_mesh(text)?;
+    for v in mesh.positions.iter_mut().chain(mesh.normals.iter_mut()) {
+        *v = rotate_xy(*v, 0.5, 0.35);
+    }
+    mesh_job(&mesh, &lighting([0.85, 0.78, 0.62], shininess), 1.0, cfg, screen)
+}
+
 /// The mesh and lighting of a scene (shininess as given).
 pub fn scene(kind: SceneKind, shininess: u16) -> (Mesh, Lighting, f64) {
-    // Both scenes: the same camera, light and material, in their own colour.
-    let lighting = |colour| Lighting {
-        eye: [0.0, 0.0, 4.5],
-        light: [-4.0, 4.5, 6.0],
-        colour,
-        ambient: 0.07,
-        diffuse: 0.93,
-        specular: 235.0,
-        shininess,
-    };
+    let lighting = |colour| lighting(colour, shininess);
     match kind {
         SceneKind::Sphere => {
             // 64 x 96: 12,096 triangles, about half of them facing the camera.
@@ -230,6 +289,11 @@ impl Job {
 /// every channel and the specular span of each, resolve the z-buffer.
 pub fn scene_job(kind: SceneKind, shininess: u16, cfg: &Config, screen: &Screen) -> Result<Job, String> {
     let (mesh, light, radius) = scene(kind, shininess);
+    mesh_job(&mesh, &light, radius, cfg, screen)
+}
+
+/// The job of a mesh inside a sphere of `radius` around the origin, lit by `light`.
+pub fn mesh_job(mesh: &Mesh, light: &Lighting, radius: f64, cfg: &Config, screen: &Screen) -> Result<Job, String> {
     let (w, h) = (screen.width as f64, screen.height as f64);
     let d = light.eye[2];
     // Focal length in pixels: the object's bounding sphere fills 84% of the shorter side.
@@ -402,6 +466,8 @@ pub struct Outcome {
     /// One report per channel's segment shader.
     pub segment: Vec<Report>,
     pub specular: Option<Report>,
+    /// With `Chain::HostToMemory`, one report per channel's segment writer.
+    pub writer: Vec<Report>,
 }
 
 impl Outcome {
@@ -411,7 +477,7 @@ impl Outcome {
     }
     /// Every co-simulation check passed.
     pub fn cosim_ok(&self) -> bool {
-        self.segment.iter().all(Report::ok) && self.specular.as_ref().is_none_or(Report::ok)
+        self.segment.iter().chain(&self.writer).all(Report::ok) && self.specular.as_ref().is_none_or(Report::ok)
     }
 }
 
@@ -426,6 +492,33 @@ pub fn spec_level(spec: u16) -> u32 {
     (spec as u32 + (1 << (C_FRAC - 1))) >> C_FRAC
 }
 
+/// Which RTL draws a render's diffuse channels, and where their pixels land.
+#[derive(Clone, Copy)]
+pub enum Chain {
+    /// The host's set-up: spans into one `segment_shader_p<P>` per channel; the harness paints
+    /// the segments.
+    Host,
+    /// The host's set-up, and each channel's RTL segments then stream through `fb_writer_p<P>`
+    /// into a memory model: the image is read out of memory.
+    HostToMemory(&'static ModelInfo<WrIn, WrOut>),
+    /// The RTL front-end: triangles into `tri_shader_p<P>`.
+    Rtl(&'static ModelInfo<TriIn, TriSegOut>),
+    /// The whole RTL chain: triangles into `tri_fb_p<P>`, the image read out of memory.
+    RtlToMemory(&'static ModelInfo<TriIn, WrOut>),
+}
+
+impl Chain {
+    /// The front-end's configuration and screen, when the RTL sets up the triangles.
+    fn frontend(self) -> Option<FrontEnd> {
+        let (cfg, screen) = match self {
+            Chain::Host | Chain::HostToMemory(_) => return None,
+            Chain::Rtl(m) => (m.cfg, m.screen),
+            Chain::RtlToMemory(m) => (m.cfg, m.screen),
+        };
+        Some(FrontEnd::new(cfg, screen).expect("the model's front-end"))
+    }
+}
+
 /// Streams `job` through one `seg` model per channel and, when the job has specular spans, the
 /// `spec` model, all at full rate on their own threads; builds the RTL and golden images.
 /// `progress` is called now and then on the calling thread with the fraction done.
@@ -435,23 +528,23 @@ pub fn run(
     spec: Option<&'static ModelInfo<SpecIn, SpecOut>>,
     progress: impl FnMut(f64),
 ) -> Outcome {
-    run_with(job, seg, None, spec, progress)
+    run_with(job, seg, Chain::Host, spec, progress)
 }
 
-/// [`run`], with `chain` (`tri_shader_p<P>`) drawing the triangles instead of `seg` drawing the
-/// host's spans: the RTL image must then equal golden's front-end image, and `Outcome::host`
-/// holds the host-set-up image to compare with.
+/// [`run`] through `chain`. With the RTL front-end the RTL image must equal golden's front-end
+/// image, and `Outcome::host` holds the host-set-up image to compare with. Through memory,
+/// hidden surfaces stay hidden by the memory model's ownership test ([`MemoryCheck::owner`]),
+/// the host's depth pre-pass, and the image is what memory holds.
+///
+/// [`MemoryCheck::owner`]: crate::writer::MemoryCheck::owner
 pub fn run_with(
     job: &Job,
     seg: &'static ModelInfo<SegIn, SegOut>,
-    chain: Option<&'static ModelInfo<TriIn, TriSegOut>>,
+    chain: Chain,
     spec: Option<&'static ModelInfo<SpecIn, SpecOut>>,
     mut progress: impl FnMut(f64),
 ) -> Outcome {
-    let exps: Option<Vec<Expected>> = chain.map(|info| {
-        let fe = FrontEnd::new(info.cfg, info.screen).expect("the model's front-end");
-        job.tris.iter().map(|t| Expected::new(fe, t)).collect()
-    });
+    let exps: Option<Vec<Expected>> = chain.frontend().map(|fe| job.tris.iter().map(|t| Expected::new(fe, t)).collect());
     let exps = &exps;
     let screen = job.screen;
     let (width, npix) = (screen.width, (screen.width * screen.height) as usize);
@@ -463,7 +556,7 @@ pub fn run_with(
     let owner = &job.owner;
     const SEED: u64 = 1;
 
-    let (diffuse, coverage, segment, spec_out) = std::thread::scope(|s| {
+    let (diffuse, coverage, segment, writer, spec_out) = std::thread::scope(|s| {
         let seg_threads: Vec<_> = job
             .stims
             .iter()
@@ -491,16 +584,63 @@ pub fn run_with(
                         }
                         done.fetch_add(n, Ordering::Relaxed);
                     };
+                    // Through memory the paint only counts: the image is read out of memory.
+                    let to_memory = matches!(chain, Chain::HostToMemory(_) | Chain::RtlToMemory(_));
+                    let mut lanes: Vec<SegStim> = Vec::new();
                     let report = match (chain, exps) {
-                        (Some(info), Some(exps)) => stream_chain(info, SEED + c as u64, Traffic::FULL, &exps[c], paint),
+                        (Chain::Rtl(info), Some(exps)) => stream_chain(info, SEED + c as u64, Traffic::FULL, &exps[c], paint),
+                        (Chain::RtlToMemory(info), Some(exps)) => {
+                            let run = stream_fb(info, SEED + c as u64, Traffic::FULL, &exps[c], Some(owner.clone()));
+                            done.fetch_add(run.report.pixels, Ordering::Relaxed);
+                            img = memory_image(&run.frame);
+                            if c == 0 {
+                                cov = run.mem.screen_writes().into_iter().map(u16::from).collect();
+                            }
+                            run.report
+                        }
                         _ => {
                             let mut sim = SegmentCosim::new(seg, SEED + c as u64, Traffic::FULL);
                             let mut report = Report { triangles: job.drawn, ..Report::default() };
-                            sim.stream(stims, &mut report, |stim, out| paint(stim.triangle, stim.y, out));
+                            // (span number, segment index) of the last segment; a span's
+                            // segments come one after another, so a new `&Stim` is a new span.
+                            let mut at: Option<(usize, usize, u32)> = None;
+                            sim.stream(stims, &mut report, |stim, out| {
+                                if to_memory {
+                                    // The RTL's segments, as they came out, go on to the writer.
+                                    let addr = stim as *const Stim as usize;
+                                    let (span_index, s) = match at {
+                                        Some((prev, k, s)) if prev == addr => (k, s + 1),
+                                        Some((_, k, _)) => (k + 1, 0),
+                                        None => (0, 0),
+                                    };
+                                    at = Some((addr, span_index, s));
+                                    let mut l = out.pix[..p as usize].to_vec();
+                                    l.extend_from_slice(&out.mask[..p.div_ceil(8) as usize]);
+                                    let lanes_of = Some(l.into_boxed_slice());
+                                    lanes.push(SegStim {
+                                        span_index,
+                                        triangle: Some(stim.triangle),
+                                        y: stim.y,
+                                        span: stim.span,
+                                        s,
+                                        lanes: lanes_of,
+                                    });
+                                }
+                                paint(stim.triangle, stim.y, out)
+                            });
                             report
                         }
                     };
-                    (img, cov, report)
+                    let writer = match chain {
+                        Chain::HostToMemory(info) => {
+                            let w = Writer::new(info.cfg, screen).expect("the job's screen fits the writer");
+                            let run = run_segments(info, SEED + c as u64, Traffic::FULL, Stress::NONE, &lanes, w, Some(owner.clone()));
+                            img = memory_image(&run.mem.memory.frame());
+                            Some(run.report)
+                        }
+                        _ => None,
+                    };
+                    (img, cov, report, writer)
                 })
             })
             .collect();
@@ -530,16 +670,18 @@ pub fn run_with(
         let mut diffuse = Vec::new();
         let mut coverage = Vec::new();
         let mut reports = Vec::new();
+        let mut writers = Vec::new();
         for (c, t) in seg_threads.into_iter().enumerate() {
-            let (img, cov, report) = t.join().expect("segment co-simulation thread panicked");
+            let (img, cov, report, writer) = t.join().expect("segment co-simulation thread panicked");
             if c == 0 {
                 coverage = cov;
             }
+            writers.extend(writer);
             diffuse.push(img);
             reports.push(report);
         }
         let spec_out = spec_thread.map(|t| t.join().expect("specular co-simulation thread panicked"));
-        (diffuse, coverage, reports, spec_out)
+        (diffuse, coverage, reports, writers, spec_out)
     });
 
     // Golden: the same spans, the same ownership, golden's pixels (the host's spans, or with
@@ -597,7 +739,14 @@ pub fn run_with(
         coverage,
         segment,
         specular: spec_report,
+        writer,
     }
+}
+
+/// A channel of the image out of memory: background (never written) 0.
+fn memory_image(frame: &golden::raster::Frame) -> Vec<u8> {
+    let w = frame.width();
+    (0..w * frame.height()).map(|k| frame.get(k % w, k / w).unwrap_or(0)).collect()
 }
 
 /// Diffuse channels plus the white highlight, saturated; background 0.
@@ -646,6 +795,22 @@ mod tests {
         assert_eq!(spec_level(127), 0);
         assert_eq!(spec_level(128), 1);
         assert_eq!(spec_level(u16::MAX), 256);
+    }
+
+    /// An OBJ quad mesh: triangulated, moved into the unit sphere, smooth unit normals pointing
+    /// outward; OBJ text that is not a mesh is refused with a reason.
+    #[test]
+    fn obj_meshes_are_read_triangulated_and_framed() {
+        let cube = "v 0 0 0\nv 2 0 0\nv 2 2 0\nv 0 2 0\nv 0 0 2\nv 2 0 2\nv 2 2 2\nv 0 2 2\n\
+                    f 1 4 3 2\nf 5 6 7 8\nf 1 2 6 5\nf 2 3 7 6\nf 3 4 8 7\nf 4 1 5 8\n";
+        let m = obj_mesh(cube).unwrap();
+        assert_eq!(m.faces.len(), 12);
+        for (p, n) in m.positions.iter().zip(&m.normals) {
+            assert!((dot(*p, *p).sqrt() - 1.0).abs() < 1e-9, "every corner on the unit sphere");
+            assert!((dot(*n, *n) - 1.0).abs() < 1e-9 && dot(*n, *p) > 0.0, "unit normals, outward");
+        }
+        assert!(obj_mesh("v 0 0 0\n").unwrap_err().contains("no faces"));
+        assert!(obj_mesh("f 1 2 3\n").is_err());
     }
 
     #[test]

@@ -19,14 +19,20 @@ use golden::writer::{BlockWrite, Memory, Writer};
 use golden::Span;
 
 /// A segment with its span: the writer's input item.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Debug)]
 pub struct SegStim {
     /// Index of the span in the run.
     pub span_index: usize,
+    /// The triangle the span belongs to, if any (the memory's ownership test, see
+    /// [`MemoryCheck::owner`]).
+    pub triangle: Option<usize>,
     pub y: u32,
     pub span: Span,
     /// Segment index within the span.
     pub s: u32,
+    /// The lanes as a segment shader's RTL put them out (P pixel bytes, then the mask bytes);
+    /// `None`: golden's pixels, garbage in the masked lanes.
+    pub lanes: Option<Box<[u8]>>,
 }
 
 /// The segments of `spans` (with their rows), in order: what the segment shader hands the writer.
@@ -34,7 +40,7 @@ pub fn segment_stims(w: &Writer, spans: &[(u32, Span)]) -> Vec<SegStim> {
     let mut out = Vec::new();
     for (k, (y, span)) in spans.iter().enumerate() {
         for s in 0..w.cfg.segment_count(span.x0, span.len) {
-            out.push(SegStim { span_index: k, y: *y, span: *span, s });
+            out.push(SegStim { span_index: k, triangle: None, y: *y, span: *span, s, lanes: None });
         }
     }
     out
@@ -100,10 +106,16 @@ impl Unit for WrUnit {
     }
     fn load(&self, input: &mut WrIn, st: &SegStim) {
         let cfg = &self.w.cfg;
+        let (p, mb) = (cfg.p as usize, cfg.p.div_ceil(8) as usize);
         let seg = segment(cfg, &st.span, st.s);
         input.in_x = seg.x;
         input.in_y = st.y;
         input.in_last = seg.last as u8;
+        if let Some(lanes) = &st.lanes {
+            input.pix[..p].copy_from_slice(&lanes[..p]);
+            input.mask[..mb].copy_from_slice(&lanes[p..p + mb]);
+            return;
+        }
         input.mask = [0; 32];
         for i in 0..cfg.p {
             input.pix[i as usize] = match seg.lane_pixel(i) {
@@ -136,6 +148,10 @@ impl Unit for WrUnit {
 /// The memory behind the port and the checks that need no golden: what every write leaves.
 pub struct MemoryCheck {
     pub memory: Memory,
+    /// Per screen pixel, the triangle whose pixel is visible: a write of another triangle's
+    /// pixel leaves memory as it is. A depth pre-pass resolved on the host, then a depth test
+    /// "equal" at the memory (how `render` keeps hidden surfaces hidden); `None`: every write lands.
+    pub owner: Option<Vec<u32>>,
     /// Per pixel of the memory: the span (run-wide number) that last wrote it, and writes.
     last_span: Vec<u64>,
     pub writes: Vec<u8>,
@@ -144,7 +160,7 @@ pub struct MemoryCheck {
 impl MemoryCheck {
     pub fn new(w: Writer) -> MemoryCheck {
         let n = (w.blocks() * w.cfg.p) as usize;
-        MemoryCheck { memory: Memory::new(w), last_span: vec![u64::MAX; n], writes: vec![0; n] }
+        MemoryCheck { memory: Memory::new(w), owner: None, last_span: vec![u64::MAX; n], writes: vec![0; n] }
     }
 
     /// Applies write `got` of span number `span` (run-wide, unique per span), reporting a
@@ -155,7 +171,17 @@ impl MemoryCheck {
         if got.we.iter().all(|&m| m == 0) {
             report.mismatch(Mismatch { triangle, context: context(), what: format!("a write with no enable set (addr {})", got.addr) });
         }
-        if let Err(e) = self.memory.apply(got) {
+        let mut kept = *got;
+        if let (Some(owner), Some(t)) = (&self.owner, triangle) {
+            let (bpr, width) = (w.blocks_per_row(), w.screen.width);
+            for i in 0..p {
+                let (x, y) = ((got.addr % bpr) * p + i, got.addr / bpr);
+                if x >= width || y >= w.screen.height || owner[(y * width + x) as usize] != t as u32 {
+                    kept.we[(i / 64) as usize] &= !(1 << (i % 64));
+                }
+            }
+        }
+        if let Err(e) = self.memory.apply(&kept) {
             report.mismatch(Mismatch { triangle, context: context(), what: e });
             return;
         }
@@ -214,7 +240,7 @@ impl Check for WrCheck<'_> {
                 what: format!("expected {}, got {}", describe_write(&want, p), describe_write(&got, p)),
             });
         }
-        self.mem.apply(st.span_index as u64, &got, context, None, report);
+        self.mem.apply(st.span_index as u64, &got, context, st.triangle, report);
     }
 }
 
@@ -259,8 +285,7 @@ impl WriterRun {
 /// Streams the segments of `spans` (each with its row) through `fb_writer_p<P>` into a memory
 /// model, comparing every write with golden's.
 pub fn run_writer(info: &'static ModelInfo<WrIn, WrOut>, seed: u64, traffic: Traffic, stress: Stress, spans: &[(u32, Span)]) -> WriterRun {
-    let w = Writer::new(info.cfg, info.screen).expect("the model's screen");
-    run_writer_against(info, seed, traffic, stress, spans, w)
+    run_writer_against(info, seed, traffic, stress, spans, Writer::new(info.cfg, info.screen).expect("the model's screen"))
 }
 
 /// [`run_writer`], judged by golden's writer `w` (another screen: the negative control).
@@ -272,13 +297,27 @@ pub fn run_writer_against(
     spans: &[(u32, Span)],
     w: Writer,
 ) -> WriterRun {
-    let stims = segment_stims(&w, spans);
+    run_segments(info, seed, traffic, stress, &segment_stims(&w, spans), w, None)
+}
+
+/// Streams `stims` through `fb_writer_p<P>` into a memory model (with `owner`'s test, if any),
+/// every write judged by golden's writer `w`.
+pub fn run_segments(
+    info: &'static ModelInfo<WrIn, WrOut>,
+    seed: u64,
+    traffic: Traffic,
+    stress: Stress,
+    stims: &[SegStim],
+    w: Writer,
+    owner: Option<Vec<u32>>,
+) -> WriterRun {
     let unit = WrUnit { w };
     let mut driver = Driver::new(Rtl::new(info, seed), TrafficGen::new(traffic, seed));
     driver.stress = stress;
     let mut report = Report::default();
     let mut mem = MemoryCheck::new(w);
-    driver.stream(&unit, &stims, &mut report, WrCheck { w, stims: &stims, mem: &mut mem });
+    mem.owner = owner;
+    driver.stream(&unit, stims, &mut report, WrCheck { w, stims, mem: &mut mem });
     WriterRun { report, mem }
 }
 
@@ -375,14 +414,24 @@ pub struct FbRun {
 /// reference, and no pixel written by two triangles (meaningful when none overlap).
 pub fn run_fb(info: &'static ModelInfo<TriIn, WrOut>, seed: u64, traffic: Traffic, tris: &[golden::frontend::FixedTriangle]) -> FbRun {
     let fe = FrontEnd::new(info.cfg, info.screen).expect("the model's front-end");
-    let w = Writer::new(info.cfg, info.screen).expect("the model's screen");
     let exp = Expected::new(fe, tris);
+    let mut run = stream_fb(info, seed, traffic, &exp, None);
+    crate::frontend::check_frame(&exp, &run.frame, &run.mem.screen_writes(), &mut run.report);
+    run
+}
+
+/// Streams golden's `exp` through `tri_fb_p<P>` into a memory model (with `owner`'s test, if
+/// any): every write and the guard-band pulses against golden; `frame` is the memory's picture.
+pub fn stream_fb(info: &'static ModelInfo<TriIn, WrOut>, seed: u64, traffic: Traffic, exp: &Expected, owner: Option<Vec<u32>>) -> FbRun {
+    let fe = exp.fe;
+    let w = Writer::new(fe.cfg, fe.screen).expect("the front-end's screen");
     let unit = TwUnit { w, fe, drain: crate::frontend::drain_clocks(info.latency, &fe) };
     let mut driver = Driver::new(Rtl::new(info, seed), TrafficGen::new(traffic, seed));
     let mut report = Report::default();
     let mut mem = MemoryCheck::new(w);
-    driver.stream(&unit, &exp.stims, &mut report, TwCheck { w, exp: &exp, at: None, mem: &mut mem });
-    report.triangles = tris.len();
+    mem.owner = owner;
+    driver.stream(&unit, &exp.stims, &mut report, TwCheck { w, exp, at: None, mem: &mut mem });
+    report.triangles = exp.stims.len();
     if report.pulses != exp.guard_drops() {
         report.mismatch(Mismatch {
             triangle: None,
@@ -390,7 +439,6 @@ pub fn run_fb(info: &'static ModelInfo<TriIn, WrOut>, seed: u64, traffic: Traffi
             what: format!("{} guard-band pulses, golden drops {} triangles", report.pulses, exp.guard_drops()),
         });
     }
-    let frame = mem.memory.frame();
     if mem.memory.wrote_off_screen() {
         report.mismatch(Mismatch {
             triangle: None,
@@ -398,58 +446,6 @@ pub fn run_fb(info: &'static ModelInfo<TriIn, WrOut>, seed: u64, traffic: Traffi
             what: "a pixel past the screen's right edge was written".into(),
         });
     }
-    crate::frontend::check_frame(&exp, &frame, &mem.screen_writes(), &mut report);
+    let frame = mem.memory.frame();
     FbRun { report, mem, frame }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use golden::setup::Screen;
-    use golden::Config;
-
-    /// The checks that need no golden catch what they are for: a write with no enable, a pixel
-    /// written twice within one span, an address outside the memory. A second span may rewrite.
-    #[test]
-    fn memory_checks_catch_planted_faults() {
-        let w = Writer::new(Config::default(), Screen { width: 64, height: 4 }).unwrap();
-        let span = Span { x0: 3, len: 20, i0: 0, di: 0 };
-        let good = w.write(1, &span, 0);
-        let mut mem = MemoryCheck::new(w);
-        let mut report = Report::default();
-        mem.apply(0, &good, String::new, None, &mut report);
-        assert!(report.ok());
-        mem.apply(1, &good, String::new, None, &mut report);
-        assert!(report.ok(), "another span may write the pixel again");
-        mem.apply(1, &good, String::new, None, &mut report);
-        assert!(report.mismatches[0].what.contains("written twice"), "{:?}", report.mismatches);
-        let mut report = Report::default();
-        mem.apply(2, &BlockWrite { we: [0; 4], ..good }, String::new, None, &mut report);
-        assert!(report.mismatches[0].what.contains("no enable"), "{:?}", report.mismatches);
-        let mut report = Report::default();
-        mem.apply(3, &BlockWrite { addr: w.blocks(), ..good }, String::new, None, &mut report);
-        assert!(report.mismatches[0].what.contains("outside"), "{:?}", report.mismatches);
-    }
-
-    /// A record round-trips to the write it came from.
-    #[test]
-    fn records_decode_to_their_write() {
-        for p in [1, 8, 64, 256] {
-            let mut out = WrOut { mem_addr: 77, ..Default::default() };
-            for i in 0..p {
-                out.data[i as usize] = (i * 3) as u8;
-                if i % 3 == 0 {
-                    out.we[(i / 8) as usize] |= 1 << (i % 8);
-                }
-            }
-            let mut rec = vec![0u8; record_bytes(p)];
-            record(&out, p.div_ceil(8) as usize, p, &mut rec);
-            let w = decode(&rec, p);
-            assert_eq!(w.addr, 77);
-            for i in 0..p {
-                assert_eq!(w.enabled(i), i % 3 == 0);
-                assert_eq!(w.pix[i as usize], (i * 3) as u8);
-            }
-        }
-    }
 }

@@ -15,18 +15,25 @@ use std::io::{IsTerminal, Write};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::time::Instant;
-use verilator_harness::ffi::{segment_model, SEGMENT_MODELS, SPECULAR_MODELS, TRISHADER_MODELS};
-use verilator_harness::render::{busy_cycles, difference_image, run_with, scene_job, triangles_job, Job, SceneKind};
+use verilator_harness::ffi::{
+    segment_model, ModelInfo, SEGMENT_MODELS, SPECULAR_MODELS, TRISHADER_MODELS, TRIWRITER_MODELS, WRITER_MODELS,
+};
+use verilator_harness::render::{busy_cycles, difference_image, obj_job, run_with, scene_job, triangles_job, Chain, Job, SceneKind};
 
 #[derive(Parser)]
 #[command(about = "Render a scene or a triangle file through the generated RTL to PNG, checked against golden")]
-#[command(group(ArgGroup::new("input").required(true).args(["scene", "triangles"])))]
+#[command(group(ArgGroup::new("input").required(true).args(["scene", "triangles", "obj"])))]
 struct Args {
     /// Who sets up the triangles: `host` (golden::setup, spans into segment_shader_p<P>) or `rtl`
     /// (the generated front-end and shader, tri_shader_p<P>); the image must then equal golden's
     /// front-end image, and how it differs from the host-set-up image is printed.
     #[arg(long, value_enum, default_value_t = Frontend::Host)]
     frontend: Frontend,
+    /// Where the shaded segments land: `host` (the harness paints them into the image) or `rtl`
+    /// (SPEC §7's fb_writer_p<P> writes them into a block-memory model, the image is read out
+    /// of memory; with --frontend rtl the whole chain tri_fb_p<P>, triangles to memory).
+    #[arg(long, value_enum, default_value_t = Writer::Host)]
+    writer: Writer,
     /// A built-in scene: a lit RGB object, Gouraud diffuse through one segment shader per
     /// channel plus the specular unit's highlight.
     #[arg(long, value_parser = ["sphere", "torus"])]
@@ -35,6 +42,10 @@ struct Args {
     /// grayscale, background 0, later triangles over earlier ones, diffuse only.
     #[arg(long, value_name = "FILE")]
     triangles: Option<PathBuf>,
+    /// A Wavefront OBJ mesh (polygons triangulated; normals from the file, else smoothed from
+    /// the faces), scaled to fill the view and lit like the scenes.
+    #[arg(long, value_name = "FILE.obj")]
+    obj: Option<PathBuf>,
     /// Segment width of the shader model.
     #[arg(long, default_value_t = 8)]
     p: u32,
@@ -78,6 +89,33 @@ enum Frontend {
     Rtl,
 }
 
+#[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
+enum Writer {
+    Host,
+    Rtl,
+}
+
+/// The model of `models` for `p`, `align` and `screen`, or the one-line reason there is none.
+fn model_for<I, O>(
+    models: &'static [ModelInfo<I, O>],
+    p: u32,
+    align: Align,
+    screen: Screen,
+    what: &str,
+) -> Result<&'static ModelInfo<I, O>, String> {
+    match models.iter().find(|m| m.cfg.p == p && m.cfg.align == align) {
+        Some(m) if m.screen == screen => Ok(m),
+        Some(m) => Err(format!(
+            "{what}: the model {} draws on {}x{}, not {}x{}",
+            m.tag, m.screen.width, m.screen.height, screen.width, screen.height
+        )),
+        None => {
+            let built: Vec<&str> = models.iter().map(|m| m.tag).collect();
+            Err(format!("{what} --p {p} --align {align}: no such model in this build (built: {})", built.join(", ")))
+        }
+    }
+}
+
 fn main() -> ExitCode {
     let args = Args::parse();
     let start = Instant::now();
@@ -90,25 +128,17 @@ fn main() -> ExitCode {
     if let Err(e) = screen.check_for(&info.cfg) {
         return fail(format!("--width/--height: {e}"));
     }
-    let chain = match args.frontend {
-        Frontend::Host => None,
-        Frontend::Rtl => match TRISHADER_MODELS.iter().find(|m| m.cfg.p == args.p && m.cfg.align == align) {
-            Some(m) if m.screen == screen => Some(m),
-            Some(m) => {
-                return fail(format!(
-                    "--frontend rtl: the front-end model draws on {}x{}, not {}x{}",
-                    m.screen.width, m.screen.height, screen.width, screen.height
-                ))
-            }
-            None => {
-                let built: Vec<&str> = TRISHADER_MODELS.iter().map(|m| m.tag).collect();
-                return fail(format!(
-                    "--frontend rtl --p {} --align {align}: no such model in this build (built: {})",
-                    args.p,
-                    built.join(", ")
-                ));
-            }
-        },
+    let chain = match (args.frontend, args.writer) {
+        (Frontend::Host, Writer::Host) => Ok(Chain::Host),
+        (Frontend::Host, Writer::Rtl) => model_for(WRITER_MODELS, args.p, align, screen, "--writer rtl").map(Chain::HostToMemory),
+        (Frontend::Rtl, Writer::Host) => model_for(TRISHADER_MODELS, args.p, align, screen, "--frontend rtl").map(Chain::Rtl),
+        (Frontend::Rtl, Writer::Rtl) => {
+            model_for(TRIWRITER_MODELS, args.p, align, screen, "--frontend rtl --writer rtl").map(Chain::RtlToMemory)
+        }
+    };
+    let chain = match chain {
+        Ok(c) => c,
+        Err(e) => return fail(e),
     };
     let dir = match args.out.parent() {
         Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
@@ -123,31 +153,29 @@ fn main() -> ExitCode {
     let golden_path = sibling(&args.out, ".golden.png");
     let diff_path = sibling(&args.out, ".diff.png");
 
-    let job = match (&args.scene, &args.triangles) {
-        (Some(scene), _) => {
-            if SPECULAR_MODELS.is_empty() {
-                return fail("--scene: this build has no specular unit");
-            }
+    let read = |file: &Path| match std::fs::read(file) {
+        Ok(bytes) => String::from_utf8(bytes).map_err(|_| format!("{}: not UTF-8 text", file.display())),
+        Err(e) => Err(format!("{}: {e}", file.display())),
+    };
+    if (args.scene.is_some() || args.obj.is_some()) && SPECULAR_MODELS.is_empty() {
+        return fail("--scene/--obj: this build has no specular unit");
+    }
+    let job = match (&args.scene, &args.triangles, &args.obj) {
+        (Some(scene), _, _) => {
             let kind: SceneKind = scene.parse().expect("clap checked it");
-            match scene_job(kind, args.shininess, &info.cfg, &screen) {
-                Ok(j) => j,
-                Err(e) => return fail(format!("--scene {scene}: {e}")),
-            }
+            scene_job(kind, args.shininess, &info.cfg, &screen).map_err(|e| format!("--scene {scene}: {e}"))
         }
-        (None, Some(file)) => {
-            let text = match std::fs::read(file) {
-                Ok(bytes) => match String::from_utf8(bytes) {
-                    Ok(t) => t,
-                    Err(_) => return fail(format!("{}: not UTF-8 text", file.display())),
-                },
-                Err(e) => return fail(format!("{}: {e}", file.display())),
-            };
-            match triangles_job(&text, &info.cfg, &screen) {
-                Ok(j) => j,
-                Err(e) => return fail(format!("{}: {e}", file.display())),
-            }
+        (None, Some(file), _) => {
+            read(file).and_then(|t| triangles_job(&t, &info.cfg, &screen).map_err(|e| format!("{}: {e}", file.display())))
         }
-        (None, None) => unreachable!("clap requires one"),
+        (None, None, Some(file)) => {
+            read(file).and_then(|t| obj_job(&t, args.shininess, &info.cfg, &screen).map_err(|e| format!("{}: {e}", file.display())))
+        }
+        (None, None, None) => unreachable!("clap requires one"),
+    };
+    let job = match job {
+        Ok(j) => j,
+        Err(e) => return fail(e),
     };
 
     let show = !args.quiet && std::io::stderr().is_terminal();
@@ -182,11 +210,11 @@ fn main() -> ExitCode {
     let secs = start.elapsed().as_secs_f64();
 
     let differing = outcome.differing_pixels(channels);
-    summary(&args, &job, &outcome, info.tag, secs);
+    summary(&args, &job, &outcome, info.tag, chain, secs);
     for (path, _) in &files {
         println!("wrote       {}", path.display());
     }
-    for r in outcome.segment.iter().chain(&outcome.specular) {
+    for r in outcome.segment.iter().chain(&outcome.writer).chain(&outcome.specular) {
         for m in &r.mismatches {
             println!("MISMATCH {m}");
         }
@@ -195,7 +223,12 @@ fn main() -> ExitCode {
         let n = (0..host.len() / channels)
             .filter(|&k| host[k * channels..(k + 1) * channels] != outcome.rtl[k * channels..(k + 1) * channels])
             .count();
-        println!("front-end:  {} (RTL set-up); differs from the host-set-up image in {n} pixels", chain.map_or("", |m| m.tag));
+        let tag = match chain {
+            Chain::Rtl(m) => m.tag,
+            Chain::RtlToMemory(m) => m.tag,
+            _ => "",
+        };
+        println!("front-end:  {tag} (RTL set-up); differs from the host-set-up image in {n} pixels");
         if n > 0 {
             println!("            (vertex intensities are rounded onto the UQ8.F ports; the host interpolates the exact ones)");
         }
@@ -209,10 +242,11 @@ fn main() -> ExitCode {
     }
 }
 
-fn summary(args: &Args, job: &Job, o: &verilator_harness::render::Outcome, tag: &str, secs: f64) {
-    let what = match (&args.scene, &args.triangles) {
-        (Some(s), _) => format!("scene {s}"),
-        (_, Some(f)) => format!("triangles {}", f.display()),
+fn summary(args: &Args, job: &Job, o: &verilator_harness::render::Outcome, tag: &str, chain: Chain, secs: f64) {
+    let what = match (&args.scene, &args.triangles, &args.obj) {
+        (Some(s), _, _) => format!("scene {s}"),
+        (_, Some(f), _) => format!("triangles {}", f.display()),
+        (_, _, Some(f)) => format!("mesh {}", f.display()),
         _ => String::new(),
     };
     println!("render {what}, {}x{}, model {tag} x {} channel(s)", job.screen.width, job.screen.height, job.channels());
@@ -224,9 +258,16 @@ fn summary(args: &Args, job: &Job, o: &verilator_harness::render::Outcome, tag: 
     let seg = &o.segment[0];
     let cycles = busy_cycles(seg);
     println!("spans:      {}", job.spans());
-    println!("segments:   {} per channel", seg.segments);
+    let (unit, outputs) = match chain {
+        Chain::RtlToMemory(_) => ("the chain to memory", "block writes"),
+        _ => ("segment shader", "segments"),
+    };
+    println!("{:<11} {} per channel", format!("{outputs}:"), seg.segments);
     println!("pixels:     {} shaded per channel, {} visible", seg.pixels, job.visible_pixels());
-    println!("RTL clocks: {cycles} (segment shader, each channel's instance)");
+    println!("RTL clocks: {cycles} ({unit}, each channel's instance)");
+    if let Some(w) = o.writer.first() {
+        println!("writer:     {} block writes in {} clocks per channel (fb_writer_p{}, memory model)", w.segments, busy_cycles(w), args.p);
+    }
     println!("pixels per clock: {:.3}", seg.pixels as f64 / cycles.max(1) as f64);
     if let Some(s) = &o.specular {
         println!("specular unit: {} pixels in {} clocks (one pixel per clock)", s.pixels, busy_cycles(s));
