@@ -17,10 +17,12 @@ use std::io::{IsTerminal, Write as _};
 use std::path::PathBuf;
 use std::process::ExitCode;
 use std::time::Instant;
+use verilator_harness::cosim::Stress;
 use verilator_harness::cosim::{Report, SegmentCosim, Stim, Traffic};
-use verilator_harness::ffi::{SEGMENT_MODELS, TRISHADER_MODELS};
+use verilator_harness::ffi::{SEGMENT_MODELS, TRISHADER_MODELS, WRITER_MODELS};
 use verilator_harness::frontend::run_chain;
-use verilator_harness::render::busy_cycles;
+use verilator_harness::render::{busy_cycles, scene_job, SceneKind};
+use verilator_harness::writer::run_writer;
 
 #[derive(Parser)]
 #[command(about = "Pixels per clock of the segment shader (RTL) and the seeds' other parallel schemes (models)")]
@@ -188,6 +190,69 @@ fn main() -> ExitCode {
         }
         chains.push((format!("front-end + shader p = {p}, {align}"), cells));
     }
+    // SPEC §7: the segment writer on the same spans (and on the two scenes' spans), at full rate.
+    let mut writer_rows: Vec<(String, &str, Vec<String>)> = Vec::new();
+    let mut wr_models: Vec<_> = WRITER_MODELS.iter().filter(|m| m.screen == screen && m.cfg.p > 1).collect();
+    wr_models.sort_by_key(|m| (m.cfg.p, m.cfg.align == Align::Screen));
+    let mut span_sets: Vec<Vec<(u32, golden::Span)>> = Vec::new();
+    if !wr_models.is_empty() {
+        let cfg = wr_models[0].cfg;
+        for tris in &workloads {
+            let mut spans = Vec::new();
+            for tri in tris {
+                golden::setup::triangle_spans(&cfg, &screen, tri, |y, span| spans.push((y, span))).expect("the workload fits");
+            }
+            span_sets.push(spans);
+        }
+        for kind in [SceneKind::Sphere, SceneKind::Torus] {
+            let job = scene_job(kind, 40, &cfg, &screen).expect("the scene fits the screen");
+            span_sets.push(job.stims[0].iter().map(|s| (s.y, s.span)).collect());
+        }
+    }
+    let mut last_p = 0;
+    for info in &wr_models {
+        let (p, align) = (info.cfg.p, info.cfg.align);
+        let w = golden::writer::Writer::new(info.cfg, screen).expect("the model's screen");
+        if p != last_p {
+            // The seed's alternatives, counted on golden's segments: no glue (a straddling
+            // segment written as two partial blocks) and a memory aligned to the segment.
+            let per = |f: &dyn Fn(&golden::Span) -> u32| -> Vec<String> {
+                span_sets
+                    .iter()
+                    .map(|spans| format!("{:.2}", spans.iter().map(|(_, s)| f(s) as f64).sum::<f64>() / spans.len().max(1) as f64))
+                    .collect()
+            };
+            writer_rows.push((format!("p = {p}, span, no glue"), "model", per(&|s| w.unglued_writes(s))));
+            writer_rows.push((format!("p = {p}, span, memory aligned to the segment"), "model", per(&|s| s.len.div_ceil(p))));
+            last_p = p;
+        }
+        let mut cells = Vec::new();
+        for (k, spans) in span_sets.iter().enumerate() {
+            if show {
+                eprint!("\rsweep: {} on workload {k}   ", info.tag);
+                let _ = std::io::stderr().flush();
+            }
+            let run = run_writer(info, args.seed, Traffic::FULL, Stress::NONE, spans);
+            if !run.report.ok() {
+                failures.push(format!(
+                    "{}: workload {k}: {} mismatches, first: {}",
+                    info.tag, run.report.mismatch_count, run.report.mismatches[0]
+                ));
+            }
+            let segments: u64 = spans.iter().map(|(_, s)| info.cfg.segment_count(s.x0, s.len) as u64).sum();
+            cells.push(format!(
+                "{:.2}, {:.0}k ({:.0}k)",
+                run.report.segments as f64 / spans.len().max(1) as f64,
+                busy_cycles(&run.report) as f64 / 1000.0,
+                segments as f64 / 1000.0
+            ));
+        }
+        let name = match align {
+            Align::Span => format!("p = {p}, span + glue"),
+            Align::Screen => format!("p = {p}, screen"),
+        };
+        writer_rows.push((name, "RTL", cells));
+    }
     if show {
         eprintln!();
     }
@@ -256,6 +321,21 @@ fn main() -> ExitCode {
         let _ = writeln!(md, "| chain | ~10 px | ~100 px | ~1000 px |\n|---|---:|---:|---:|");
         for (name, cells) in &chains {
             let _ = writeln!(md, "| {name} | {} |", cells.join(" | "));
+        }
+    }
+
+    if !writer_rows.is_empty() {
+        let _ = writeln!(
+            md,
+            "\nThe segment writer (`fb_writer_p<P>`, SPEC §7) on the same triangles' spans and on the two scenes' \
+             (640x480, every span the host's set-up makes, one channel), fed golden's segments at full rate, the \
+             memory always ready, every write checked. RTL cells: block writes per span, then the writer's clocks \
+             for the whole workload (in brackets: the segments the shader makes for it, its clocks). Model rows: \
+             block writes per span the seed's alternatives would make.\n"
+        );
+        let _ = writeln!(md, "| writer | clocks | ~10 px | ~100 px | ~1000 px | sphere | torus |\n|---|---|---:|---:|---:|---:|---:|");
+        for (name, source, cells) in &writer_rows {
+            let _ = writeln!(md, "| {name} | {source} | {} |", cells.join(" | "));
         }
     }
 
