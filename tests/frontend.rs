@@ -9,7 +9,7 @@ use verilator_harness::ffi::{require, require_models, FRONTEND_MODELS, TRISHADER
 use verilator_harness::frontend::{mesh, random_triangles, run_chain, run_frontend, Expected};
 
 fn frontend(m: &verilator_harness::ffi::ModelInfo<impl Sized, impl Sized>) -> FrontEnd {
-    FrontEnd::new(m.cfg, m.screen).unwrap()
+    m.frontend()
 }
 
 #[test]

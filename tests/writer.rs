@@ -176,7 +176,7 @@ fn a_reset_drops_a_pending_tail() {
 }
 
 fn frontend(m: &verilator_harness::ffi::ModelInfo<verilator_harness::ffi::TriIn, WrOut>) -> FrontEnd {
-    FrontEnd::new(m.cfg, m.screen).unwrap()
+    m.frontend()
 }
 
 #[test]

@@ -9,6 +9,7 @@
 //! as many threads as cargo gives jobs, and each records its build time in
 //! `OUT_DIR/obj/<tag>/build.time` (read by the `bench` binary).
 
+use golden::frontend::DiMode;
 use golden::setup::Screen;
 use golden::{Align, Config};
 use std::fmt::Write as _;
@@ -53,6 +54,8 @@ struct Model {
     cfg: Config,
     /// The front-end's screen (front-end models; the default elsewhere).
     screen: Screen,
+    /// Where a front-end model's dI comes from.
+    di: DiMode,
     top: String,
     /// Clocks from input transfer to first output valid (0: combinational).
     latency: u32,
@@ -96,6 +99,7 @@ fn generated_models() -> Vec<Model> {
         tag: "spec".into(),
         kind: Kind::Specular,
         cfg: Config::default(),
+        di: DiMode::Triangle,
         screen: Screen::default(),
         top: spec_names.unit.clone(),
         latency: hdl_gen::Options::default().specular_unit().plan().latency(),
@@ -118,6 +122,7 @@ fn generated_models() -> Vec<Model> {
                     tag: format!("bfpi_p{p}"),
                     kind: Kind::Bfpi,
                     cfg,
+                    di: DiMode::Triangle,
                     screen: Screen::default(),
                     top: names.bfpi.clone(),
                     latency: 0,
@@ -138,10 +143,24 @@ fn generated_models() -> Vec<Model> {
                         tag: "fe".into(),
                         kind: Kind::Frontend,
                         cfg,
+                        di: DiMode::Triangle,
                         screen: fe.screen,
                         top: names.frontend.clone(),
                         latency: fe_lat,
                         sources: src,
+                    });
+                    // The classical per-scanline dI (`--fe-di scanline`), the comparison option.
+                    let scan = hdl_gen::frontend::Hw { fe: fe.with_di(DiMode::Scanline), ..hw };
+                    let m = hdl_gen::frontend::module(&scan, &names);
+                    models.push(Model {
+                        tag: "fe_scan".into(),
+                        kind: Kind::Frontend,
+                        cfg,
+                        di: DiMode::Scanline,
+                        screen: fe.screen,
+                        top: m.name.clone(),
+                        latency: scan.latency(),
+                        sources: vec![(format!("{}.v", m.name), m.render())],
                     });
                     // The other divider rates (`--fe-div-bits`), so co-simulation covers every option.
                     for div_bits in hdl_gen::frontend::DIV_BITS.into_iter().filter(|&b| b != hw.div_bits) {
@@ -152,6 +171,7 @@ fn generated_models() -> Vec<Model> {
                             tag: format!("fe_div{div_bits}"),
                             kind: Kind::Frontend,
                             cfg,
+                            di: DiMode::Triangle,
                             screen: fe.screen,
                             top: m.name,
                             latency: hw.latency(),
@@ -160,11 +180,30 @@ fn generated_models() -> Vec<Model> {
                     }
                 }
                 let chain = [&names.bfpi, &names.segment, &names.frontend, &names.top].map(|n| format!("{n}.v"));
-                let src = sources.iter().filter(|(n, _)| chain.contains(n)).cloned().collect();
+                let src: Vec<(String, String)> = sources.iter().filter(|(n, _)| chain.contains(n)).cloned().collect();
+                if BUILT_TRI.contains(&(p, align)) && std::env::var_os("SEGSHADE_ALL_CHAINS").is_some() {
+                    // The chain with the per-scanline dI, for `sweep`'s comparison.
+                    let scan = hdl_gen::frontend::Hw { fe: fe.with_di(DiMode::Scanline), ..hw };
+                    let m = hdl_gen::frontend::module(&scan, &names);
+                    let mut src = src.clone();
+                    src.retain(|(n, _)| *n != format!("{}.v", names.frontend));
+                    src.push((format!("{}.v", m.name), m.render()));
+                    models.push(Model {
+                        tag: format!("tris_p{p}_{align}_scan"),
+                        kind: Kind::TriShader,
+                        cfg,
+                        di: DiMode::Scanline,
+                        screen: fe.screen,
+                        top: names.top.clone(),
+                        latency: scan.latency() + latency,
+                        sources: src,
+                    });
+                }
                 models.push(Model {
                     tag: format!("tris_p{p}_{align}"),
                     kind: Kind::TriShader,
                     cfg,
+                    di: DiMode::Triangle,
                     screen: fe.screen,
                     top: names.top.clone(),
                     latency: top_lat,
@@ -176,7 +215,16 @@ fn generated_models() -> Vec<Model> {
                 let src = sources.iter().filter(|(n, _)| *n == format!("{}.v", names.writer)).cloned().collect();
                 let (tag, top) = (format!("wr_p{p}_{align}"), names.writer.clone());
                 let latency = golden::writer::LATENCY;
-                models.push(Model { tag, kind: Kind::Writer, cfg, screen: Screen::default(), top, latency, sources: src });
+                models.push(Model {
+                    tag,
+                    kind: Kind::Writer,
+                    cfg,
+                    di: DiMode::Triangle,
+                    screen: Screen::default(),
+                    top,
+                    latency,
+                    sources: src,
+                });
             }
             if BUILT_FB.contains(&(p, align)) || all_chains {
                 let opts = hdl_gen::Options { cfg, screen: Some(Screen::default()), ..Default::default() };
@@ -185,7 +233,16 @@ fn generated_models() -> Vec<Model> {
                 let src = sources.iter().filter(|(n, _)| chain.contains(n)).cloned().collect();
                 let latency = opts.frontend().expect("640x480 front-end").latency() + latency + golden::writer::LATENCY;
                 let (tag, top) = (format!("trw_p{p}_{align}"), names.fb_top.clone());
-                models.push(Model { tag, kind: Kind::TriWriter, cfg, screen: Screen::default(), top, latency, sources: src });
+                models.push(Model {
+                    tag,
+                    kind: Kind::TriWriter,
+                    cfg,
+                    di: DiMode::Triangle,
+                    screen: Screen::default(),
+                    top,
+                    latency,
+                    sources: src,
+                });
             }
             let sources =
                 sources.into_iter().filter(|(n, _)| *n == format!("{}.v", names.segment) || *n == format!("{}.v", names.bfpi)).collect();
@@ -193,6 +250,7 @@ fn generated_models() -> Vec<Model> {
                 tag: format!("seg_p{p}_{align}"),
                 kind: Kind::Segment,
                 cfg,
+                di: DiMode::Triangle,
                 screen: Screen::default(),
                 top: names.segment,
                 latency,
@@ -236,6 +294,7 @@ fn models_from_dir(dir: &Path) -> Vec<Model> {
             tag: format!("bfpi_p{}", cfg.p),
             kind: Kind::Bfpi,
             cfg,
+            di: DiMode::Triangle,
             screen: Screen::default(),
             top,
             latency: 0,
@@ -248,6 +307,7 @@ fn models_from_dir(dir: &Path) -> Vec<Model> {
             tag: format!("seg_p{}_{}", cfg.p, cfg.align),
             kind: Kind::Segment,
             cfg,
+            di: DiMode::Triangle,
             screen: Screen::default(),
             top,
             latency,
@@ -258,6 +318,7 @@ fn models_from_dir(dir: &Path) -> Vec<Model> {
         let sc = &m["frontend"]["screen"];
         let dim = |k: &str| sc[k].as_u64().unwrap_or_else(|| fail(format!("manifest has no frontend.screen.{k}"))) as u32;
         let screen = Screen { width: dim("width"), height: dim("height") };
+        let di: DiMode = serde_json::from_value(m["frontend"]["di"].clone()).unwrap_or_default();
         let fe_src = files_of(&["frontend"]);
         let mut all = sources.clone();
         all.extend(fe_src.iter().cloned());
@@ -266,6 +327,7 @@ fn models_from_dir(dir: &Path) -> Vec<Model> {
             tag: "fe".into(),
             kind: Kind::Frontend,
             cfg,
+            di,
             screen,
             top: fe_top,
             latency: latency_of("frontend"),
@@ -276,6 +338,7 @@ fn models_from_dir(dir: &Path) -> Vec<Model> {
             tag,
             kind: Kind::TriShader,
             cfg,
+            di,
             screen,
             top: tri_top,
             latency: latency_of("triangle_shader"),
@@ -288,6 +351,7 @@ fn models_from_dir(dir: &Path) -> Vec<Model> {
                 tag,
                 kind: Kind::Writer,
                 cfg,
+                di,
                 screen,
                 top: wr_top,
                 latency: latency_of("writer"),
@@ -300,6 +364,7 @@ fn models_from_dir(dir: &Path) -> Vec<Model> {
                 tag,
                 kind: Kind::TriWriter,
                 cfg,
+                di,
                 screen,
                 top: fb_top,
                 latency: latency_of("triangle_writer"),
@@ -314,7 +379,16 @@ fn models_from_dir(dir: &Path) -> Vec<Model> {
             src.push(read(file));
         }
         let latency = latency_of("specular_unit");
-        models.push(Model { tag: "spec".into(), kind: Kind::Specular, cfg, screen: Screen::default(), top, latency, sources: src });
+        models.push(Model {
+            tag: "spec".into(),
+            kind: Kind::Specular,
+            cfg,
+            di: DiMode::Triangle,
+            screen: Screen::default(),
+            top,
+            latency,
+            sources: src,
+        });
     }
     if models.is_empty() {
         fail("manifest lists no bfpi, segment_shader or specular_unit module".into());
@@ -597,8 +671,9 @@ fn models_rs(models: &[Model], rtl_dir: Option<&Path>) -> String {
         writeln!(
             list,
             "    ModelInfo {{ tag: \"{t}\", top: \"{}\", latency: {}, cfg: Config {{ p: {}, frac: {}, xbits: {}, align: Align::{align} }}, \
-             screen: golden::setup::Screen {{ width: {}, height: {} }}, new: {t}_new, free: {t}_free, step: {t}_step }},",
-            m.top, m.latency, c.p, c.frac, c.xbits, m.screen.width, m.screen.height
+             screen: golden::setup::Screen {{ width: {}, height: {} }}, di: golden::frontend::DiMode::{:?}, \
+             new: {t}_new, free: {t}_free, step: {t}_step }},",
+            m.top, m.latency, c.p, c.frac, c.xbits, m.screen.width, m.screen.height, m.di
         )
         .unwrap();
     }

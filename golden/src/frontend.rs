@@ -90,11 +90,38 @@ impl fmt::Display for FrontEndError {
 
 impl std::error::Error for FrontEndError {}
 
-/// A front-end configuration: the shader's formats and the screen it draws on.
+/// Where a span's `dI` comes from.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum DiMode {
+    /// The constant-increment theorem: `dI = round(256 Nx / A)`, once per triangle.
+    #[default]
+    Triangle,
+    /// Classical Gouraud, for comparison: per scanline, from the intensities at the span's first
+    /// and last pixel (the edge intensities, exactly rounded like `I0`) by the same divider,
+    /// `dI = round((I_last - I0) / (m - 1))` half away from zero, 0 for `m = 1`. Each pixel stays
+    /// within `1/2 + (m - 1) 2^-(F+1)` of the plane: the same bound as the per-triangle `dI`.
+    Scanline,
+}
+
+impl DiMode {
+    pub const ALL: [DiMode; 2] = [DiMode::Triangle, DiMode::Scanline];
+    pub fn name(self) -> &'static str {
+        match self {
+            DiMode::Triangle => "triangle",
+            DiMode::Scanline => "scanline",
+        }
+    }
+}
+
+/// A front-end configuration: the shader's formats, the screen it draws on and where `dI`
+/// comes from.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 pub struct FrontEnd {
     pub cfg: Config,
     pub screen: Screen,
+    #[serde(default)]
+    pub di: DiMode,
 }
 
 /// Every width of the front-end, derived once from the configuration: the generator declares
@@ -274,7 +301,12 @@ impl FrontEnd {
         if screen.height == 0 || screen.height > 1 << 16 {
             return Err(FrontEndError::Height { height: screen.height });
         }
-        Ok(FrontEnd { cfg, screen })
+        Ok(FrontEnd { cfg, screen, di: DiMode::Triangle })
+    }
+
+    /// The same front-end with `dI` from `di`.
+    pub fn with_di(self, di: DiMode) -> FrontEnd {
+        FrontEnd { di, ..self }
     }
 
     pub fn widths(&self) -> Widths {
@@ -443,7 +475,16 @@ impl FrontEnd {
                     (2 * st.plane.s(lo, r as i64) + st.plane.a) / (2 * st.plane.a),
                     "I0 of row {r} at column {lo}, {st:?}"
                 );
-                out(r, Span { x0: lo as u32, len: (hi - lo + 1) as u32, i0, di: st.di });
+                let len = (hi - lo + 1) as u32;
+                let di = match self.di {
+                    DiMode::Triangle => st.di,
+                    DiMode::Scanline if len == 1 => 0,
+                    DiMode::Scanline => {
+                        let last = self.i0(st, tn, hi as u32);
+                        self.di(last as i128 - i0 as i128, (len - 1) as u128)
+                    }
+                };
+                out(r, Span { x0: lo as u32, len, i0, di });
             }
             for e in &mut edges {
                 e.step(r);
@@ -598,6 +639,39 @@ mod tests {
         eprintln!("widest screen (4096 px, F = 12): worst |pixel - plane| {worst:.4}");
         assert!(worst <= 1.0, "{worst}");
         assert!(worst > 0.5, "the test should reach past the rounding alone: {worst}");
+    }
+
+    /// The classical per-scanline `dI`: the same spans and `I0`, a `dI` per span that lands
+    /// within `(m - 1)/2` units of the exactly rounded last pixel, every pixel within 1.
+    #[test]
+    fn per_scanline_di_keeps_coverage_and_accuracy() {
+        let tri = FrontEnd::new(Config::default(), Screen::default()).unwrap();
+        let scan = tri.with_di(DiMode::Scanline);
+        let mut rng = Rng(77);
+        let (mut spans, mut differ) = (0, 0);
+        for _ in 0..600 {
+            let t = random_tri(&mut rng, &tri);
+            let (o1, a) = tri.span_list(&t);
+            let (o2, b) = scan.span_list(&t);
+            assert_eq!((o1, a.len()), (o2, b.len()));
+            let (_, st) = tri.setup(&t);
+            for ((y, s), (y2, s2)) in a.iter().zip(&b) {
+                assert_eq!((y, s.x0, s.len, s.i0), (y2, s2.x0, s2.len, s2.i0));
+                let st = st.as_ref().unwrap();
+                let last = (2 * st.plane.s((s.x0 + s.len - 1) as i64, *y as i64) + st.plane.a) / (2 * st.plane.a);
+                let end = s2.i0 as i128 + (s2.len as i128 - 1) * s2.di as i128;
+                assert!(2 * (end - last).abs() < s2.len as i128, "{s2:?}: ends at {end}, the plane at {last}");
+                for j in 0..s2.len {
+                    let exact = st.plane.value((s2.x0 + j) as i64, *y as i64, 12);
+                    assert!((s2.pixel(j, 12) as f64 - exact).abs() <= 1.0, "{s2:?} pixel {j}");
+                }
+                spans += 1;
+                differ += (s.di != s2.di) as usize;
+            }
+        }
+        // Mostly the same dI (both are the plane's slope, rounded); where they differ, the test
+        // above holds the scanline's to its own bound.
+        assert!(spans > 10_000 && differ > 0, "{differ} of {spans} spans changed dI");
     }
 
     #[test]

@@ -18,7 +18,7 @@
 
 use crate::verilog::{assign, comment, lit, net, reg, set, sext, sreg, swire, wire, zext, Item, Module, Port, Stmt};
 use crate::Names;
-use golden::frontend::{FrontEnd, Widths};
+use golden::frontend::{DiMode, FrontEnd, Widths};
 
 /// Quotient bits the set-up's dividers take per clock (`--fe-div-bits`): area against rate.
 pub const DIV_BITS: [u32; 3] = [1, 2, 4];
@@ -38,10 +38,20 @@ impl Hw {
         self.fe.widths().rw.div_ceil(self.div_bits)
     }
 
+    /// Clocks the per-scanline divider runs for a span of two pixels or more (`DiMode::Scanline`,
+    /// the comparison option; 0 with the per-triangle `dI`): IW quotient bits, `div_bits` a clock.
+    pub fn span_div_clocks(&self) -> u32 {
+        match self.fe.di {
+            DiMode::Triangle => 0,
+            DiMode::Scanline => self.fe.cfg.iw().div_ceil(self.div_bits),
+        }
+    }
+
     /// Clocks from a triangle's transfer to the first span's `out_valid` when the walker is
-    /// idle: CALC, the dividers, the hand-off, the walker's clock, two pipeline stages.
+    /// idle: CALC, the dividers, the hand-off, the walker's clock, two pipeline stages (and, per
+    /// scanline, the span's division when it has two pixels or more).
     pub fn latency(&self) -> u32 {
-        self.div_clocks() + 5
+        self.div_clocks() + 5 + self.span_div_clocks()
     }
 
     /// Set-up clocks per triangle that is walked (the rate limit for tiny triangles: the
@@ -114,9 +124,9 @@ fn div_load(d: &Div, dividend: &str, divisor_shifted: &str) -> Vec<Stmt> {
     vec![set(format!("{}_p", d.name), dividend), set(format!("{}_d", d.name), divisor_shifted), set(format!("{}_q", d.name), lit(d.qb, 0))]
 }
 
-/// `bits` restoring steps in one clock, chained: step j takes quotient bit `div_cnt - j`, if
+/// `bits` restoring steps in one clock, chained: step j takes quotient bit `cnt - j`, if
 /// that bit exists and is one of this divider's `qb`.
-fn div_chain(d: &Div, cnt_w: u32, bits: u32) -> Vec<Item> {
+fn div_chain(d: &Div, cnt: &str, cnt_w: u32, bits: u32) -> Vec<Item> {
     let n = d.name;
     let mut items = Vec::new();
     for j in 0..bits {
@@ -126,9 +136,9 @@ fn div_chain(d: &Div, cnt_w: u32, bits: u32) -> Vec<Item> {
             (format!("{n}_p{j}"), format!("{n}_d{j}"), format!("{n}_q{j}"))
         };
         let on = if j == 0 {
-            format!("div_cnt < {}", lit(cnt_w, d.qb as u64))
+            format!("{cnt} < {}", lit(cnt_w, d.qb as u64))
         } else {
-            format!("div_cnt >= {} && div_cnt - {} < {}", lit(cnt_w, j as u64), lit(cnt_w, j as u64), lit(cnt_w, d.qb as u64))
+            format!("{cnt} >= {} && {cnt} - {} < {}", lit(cnt_w, j as u64), lit(cnt_w, j as u64), lit(cnt_w, d.qb as u64))
         };
         items.push(wire(&format!("{n}_on{j}"), 1, on));
         items.push(wire(&format!("{n}_ge{j}"), 1, format!("{p} >= {dd}")));
@@ -400,7 +410,7 @@ pub fn module(hw: &Hw, names: &Names) -> Module {
         body.extend(div_regs(d));
     }
     for d in &divs {
-        body.extend(div_chain(d, cnt_w, bits));
+        body.extend(div_chain(d, "div_cnt", cnt_w, bits));
     }
     body.push(comment("The set-up result, complete when the dividers are (HOLD)."));
     for k in 0..3 {
@@ -521,7 +531,17 @@ pub fn module(hw: &Hw, names: &Names) -> Module {
     for (n, ww) in [("w_di", dw), ("w_an", aw), ("w_rn", rw), ("w_tn", kk), ("w_gxn", kk), ("w_dyn", kk)] {
         body.push(reg(n, ww));
     }
-    body.push(wire("adv", 1, "!out_valid || out_ready"));
+    let scan = fe.di == DiMode::Scanline;
+    let (sq, sd_cw) = (iw, 32 - (iw - 1).leading_zeros());
+    let sdv = Div { name: "sdv", pw: xw + iw + 2, qb: sq };
+    if scan {
+        body.push(comment("Per-scanline dI (the comparison option): a restoring divider, busy for each span of m >= 2."));
+        body.extend([reg("sd_busy", 1), reg("sd_cnt", sd_cw), reg("sd_neg", 1)]);
+        body.extend(div_regs(&sdv));
+        body.push(wire("adv", 1, "(!out_valid || out_ready) && !sd_busy"));
+    } else {
+        body.push(wire("adv", 1, "!out_valid || out_ready"));
+    }
     body.push(wire("w_end", 1, "w_row == w_last"));
     body.push(assign("take", "st == HOLD && adv && (!w_valid || w_end)"));
     let bw = gw + 1;
@@ -610,6 +630,12 @@ pub fn module(hw: &Hw, names: &Names) -> Module {
     {
         body.push(reg(n, ww));
     }
+    if scan {
+        body.push(comment("The same for the span's last pixel: its intensity, as the edge gives it."));
+        body.push(wire("hi_u", xw, format!("hi3[{}:0]", xw - 1)));
+        body.push(wire("s2h", kk, format!("((w_tn + w_gxn * {}) << 1) + {}", zext("hi_u", xw, kk), zext("w_an", aw, kk))));
+        body.extend([reg("p1_s2h", kk), reg("p2_hi", aw + 2), reg("p2_qh", iw)]);
+    }
     let pr = kk + rw;
     body.push(comment("verilator lint_off UNUSEDSIGNAL"));
     body.push(wire("prod", pr, format!("{} * {}", zext("p1_s2n", kk, pr), zext("p1_rn", rw, pr))));
@@ -618,6 +644,44 @@ pub fn module(hw: &Hw, names: &Names) -> Module {
     body.push(wire("an2", cw, format!("{} << 1", zext("p2_an", aw, cw))));
     body.push(wire("corr", cw, format!("p2_lo - {} * an2", zext("p2_qt", iw, cw))));
     body.push(wire("i0", iw, format!("p2_qt + {}", zext("corr >= an2", 1, iw))));
+    let mut p_scan = Vec::new();
+    if scan {
+        body.push(comment("verilator lint_off UNUSEDSIGNAL"));
+        body.push(wire("prodh", pr, format!("{} * {}", zext("p1_s2h", kk, pr), zext("p1_rn", rw, pr))));
+        body.push(comment("verilator lint_on UNUSEDSIGNAL"));
+        body.push(wire("corrh", cw, format!("p2_hi - {} * an2", zext("p2_qh", iw, cw))));
+        body.push(wire("ilast", iw, format!("p2_qh + {}", zext("corrh >= an2", 1, iw))));
+        body.push(comment("dI = round(|I_last - I0| / (m - 1)), its sign apart: (2 |N| + D) / 2D, D = m - 1."));
+        body.push(wire("p2_div", 1, format!("p2_len > {}", lit(xw + 1, 1))));
+        body.push(wire("nabs", iw, "ilast >= i0 ? ilast - i0 : i0 - ilast"));
+        body.push(wire("dm1", xw + 1, format!("p2_len - {}", lit(xw + 1, 1))));
+        body.extend(div_chain(&sdv, "sd_cnt", sd_cw, hw.div_bits));
+        body.push(wire("sd_fin", 1, format!("sd_cnt < {}", lit(sd_cw, hw.div_bits as u64))));
+        let q = format!("sdv_q{}", hw.div_bits);
+        body.push(wire("sd_di", dw, format!("sd_neg ? -{} : {}", zext(&q, iw, dw), zext(&q, iw, dw))));
+        let mut start = vec![set("sd_busy", "1'b1"), set("sd_cnt", lit(sd_cw, (sq - 1) as u64)), set("sd_neg", "ilast < i0")];
+        start.extend(div_load(
+            &sdv,
+            &format!("({} << 1) + {}", zext("nabs", iw, sdv.pw), zext("dm1", xw + 1, sdv.pw)),
+            &format!("{} << {sq}", zext("dm1", xw + 1, sdv.pw)),
+        ));
+        let mut run = div_iter(&sdv, hw.div_bits);
+        run.push(Stmt::If(
+            "sd_fin".into(),
+            vec![set("sd_busy", "1'b0")],
+            vec![set("sd_cnt", format!("sd_cnt - {}", lit(sd_cw, hw.div_bits as u64)))],
+        ));
+        body.push(Item::Always(vec![Stmt::If(
+            "rst".into(),
+            vec![set("sd_busy", "1'b0")],
+            vec![Stmt::If("adv && p2_v && p2_div".into(), start, vec![Stmt::If("sd_busy".into(), run, vec![])])],
+        )]));
+        body.push(comment("verilator lint_off UNUSEDSIGNAL"));
+        body.push(wire("unused_di", dw, "p2_di"));
+        body.push(comment("verilator lint_on UNUSEDSIGNAL"));
+        p_scan =
+            vec![set("p1_s2h", "s2h"), set("p2_hi", format!("p1_s2h[{}:0]", cw - 1)), set("p2_qh", format!("prodh[{}:{kk}]", kk + iw - 1))];
+    }
     body.push(Item::Always(vec![Stmt::If(
         "rst".into(),
         vec![set("p1_v", "1'b0"), set("p2_v", "1'b0"), set("out_valid", "1'b0")],
@@ -640,14 +704,20 @@ pub fn module(hw: &Hw, names: &Names) -> Module {
                 set("p2_lo", format!("p1_s2n[{}:0]", cw - 1)),
                 set("p2_qt", format!("prod[{}:{kk}]", kk + iw - 1)),
                 set("p2_an", "p1_an"),
-                set("out_valid", "p2_v"),
+                set("out_valid", if scan { "p2_v && !p2_div" } else { "p2_v" }),
                 set("out_y", "p2_y"),
                 set("out_x", "p2_x"),
                 set("out_len", "p2_len"),
                 set("out_i0", "i0"),
-                set("out_di", "p2_di"),
-            ],
-            vec![],
+                set("out_di", if scan { lit(dw, 0) } else { "p2_di".into() }),
+            ]
+            .into_iter()
+            .chain(p_scan)
+            .collect(),
+            match scan {
+                true => vec![Stmt::If("sd_busy && sd_fin".into(), vec![set("out_valid", "1'b1"), set("out_di", "sd_di")], vec![])],
+                false => vec![],
+            },
         )],
     )]));
 

@@ -71,6 +71,8 @@ pub struct Options {
     /// Quotient bits per clock of the front-end's set-up dividers (`--fe-div-bits`); `None`:
     /// [`frontend::DEFAULT_DIV_BITS`].
     pub fe_div_bits: Option<u32>,
+    /// Where the front-end's `dI` comes from (`--fe-di`); the default is once per triangle.
+    pub fe_di: golden::frontend::DiMode,
 }
 
 impl Options {
@@ -82,7 +84,8 @@ impl Options {
 
     /// The front-end these options describe.
     pub fn frontend(&self) -> Result<frontend::Hw, golden::frontend::FrontEndError> {
-        let fe = golden::frontend::FrontEnd::new(self.cfg, self.screen.unwrap_or_else(|| Options::default_screen(&self.cfg)))?;
+        let fe = golden::frontend::FrontEnd::new(self.cfg, self.screen.unwrap_or_else(|| Options::default_screen(&self.cfg)))?
+            .with_di(self.fe_di);
         Ok(frontend::Hw { fe, div_bits: self.fe_div_bits.unwrap_or(frontend::DEFAULT_DIV_BITS) })
     }
 

@@ -35,9 +35,14 @@ enum Command {
         #[arg(long, value_parser = clap::value_parser!(u32).range(1..=65536))]
         height: Option<u32>,
         /// Quotient bits per clock of the front-end's set-up dividers: 1, 2 or 4. More bits,
-        /// fewer set-up clocks per triangle (tiny triangles go faster), longer paths. Default: 2.
+        /// fewer set-up clocks per triangle (tiny triangles go faster), longer paths. Default: 4.
         #[arg(long = "fe-div-bits", value_parser = ["1", "2", "4"])]
         fe_div_bits: Option<String>,
+        /// Where the front-end's dI comes from: `triangle` (the constant-increment theorem, once
+        /// per triangle) or `scanline` (classical Gouraud, a division per span from the edge
+        /// intensities with the same divider: a comparison option, slower and larger).
+        #[arg(long = "fe-di", value_enum, default_value_t = FeDi::Triangle)]
+        fe_di: FeDi,
         /// Output folder (created if missing).
         #[arg(long)]
         out: PathBuf,
@@ -201,10 +206,17 @@ fn parse_cli() -> Cli {
     Cli::from_arg_matches(&negatives(Cli::command()).get_matches()).unwrap_or_else(|e| e.exit())
 }
 
+/// `--fe-di`: golden's `DiMode`, as a command-line choice.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+enum FeDi {
+    Triangle,
+    Scanline,
+}
+
 fn main() -> ExitCode {
     let cli = parse_cli();
     let result = match cli.command {
-        Command::Generate { config, bfpi_arch, brdf, width, height, fe_div_bits, out } => {
+        Command::Generate { config, bfpi_arch, brdf, width, height, fe_div_bits, fe_di, out } => {
             let bfpi_arch = bfpi_arch.parse().expect("clap checked the bfpi arch");
             config
                 .options(&brdf)
@@ -212,7 +224,11 @@ fn main() -> ExitCode {
                     let default = Options::default_screen(&opts.cfg);
                     let screen = golden::setup::Screen { width: width.unwrap_or(default.width), height: height.unwrap_or(default.height) };
                     let fe_div_bits = fe_div_bits.map(|b| b.parse().expect("clap checked it"));
-                    let opts = Options { bfpi_arch, screen: Some(screen), fe_div_bits, ..opts };
+                    let fe_di = match fe_di {
+                        FeDi::Triangle => golden::frontend::DiMode::Triangle,
+                        FeDi::Scanline => golden::frontend::DiMode::Scanline,
+                    };
+                    let opts = Options { bfpi_arch, screen: Some(screen), fe_div_bits, fe_di, ..opts };
                     opts.frontend().map_err(|e| format!("--width/--height: {e}"))?;
                     Ok(opts)
                 })

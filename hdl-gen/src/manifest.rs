@@ -54,6 +54,10 @@ struct Frontend {
     widths: golden::frontend::Widths,
     /// Quotient bits per clock of the set-up dividers (`--fe-div-bits`).
     div_bits: u32,
+    /// Where `dI` comes from (`--fe-di`): `triangle` (once per triangle) or `scanline`.
+    di: golden::frontend::DiMode,
+    /// Per-scanline dI only: clocks the span divider runs for a span of two pixels or more.
+    span_div_clocks: u32,
     /// Clocks from a triangle's transfer to its first span when the walker is idle.
     latency: u32,
     /// Set-up clocks per walked triangle (its rate limit) and per dropped triangle.
@@ -237,6 +241,8 @@ pub fn render(opts: &Options, names: &Names, modules: &[Module], unit: &Specular
             ),
             widths: hw.fe.widths(),
             div_bits: hw.div_bits,
+            di: hw.fe.di,
+            span_div_clocks: hw.span_div_clocks(),
             latency: hw.latency(),
             setup_clocks_walked: hw.setup_clocks().0,
             setup_clocks_dropped: hw.setup_clocks().1,

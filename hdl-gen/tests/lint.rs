@@ -6,6 +6,7 @@
 //!
 //! The full sweep (every P, both alignments, every form, plus Yosys) is `scripts/lint-all`.
 
+use golden::frontend::DiMode;
 use golden::{Align, Config};
 use hdl_gen::{generate, output, wrapper, BfpiArch, Options};
 use std::path::Path;
@@ -57,32 +58,36 @@ fn verilator_lint_and_icarus_are_clean() {
     // alignment or the increment form: it is linted once per front-end configuration, and the
     // chain there and at the extreme P values (scripts/lint-all lints every configuration).
     let mut fe_seen = std::collections::HashSet::new();
-    let mut runs = configs().into_iter().map(|(cfg, prefix, arch)| (cfg, prefix, arch, None)).collect::<Vec<_>>();
+    let mut runs = configs().into_iter().map(|(cfg, prefix, arch)| (cfg, prefix, arch, None, DiMode::Triangle)).collect::<Vec<_>>();
     for bits in hdl_gen::frontend::DIV_BITS {
-        runs.push((Config::default(), "", BfpiArch::ShiftAdd, Some(bits)));
+        runs.push((Config::default(), "", BfpiArch::ShiftAdd, Some(bits), DiMode::Triangle));
+    }
+    // The per-scanline dI (`--fe-di scanline`) at the slowest and the fastest divider.
+    for bits in [1, 4] {
+        runs.push((Config::default(), "", BfpiArch::ShiftAdd, Some(bits), DiMode::Scanline));
     }
     // The work is external processes (Verilator, Icarus): two at a time, one per core.
-    let runs: Vec<_> = runs.into_iter().enumerate().map(|(k, r)| (k, r, fe_seen.insert((r.0.frac, r.0.xbits, r.1, r.3)))).collect();
+    let runs: Vec<_> = runs.into_iter().enumerate().map(|(k, r)| (k, r, fe_seen.insert((r.0.frac, r.0.xbits, r.1, r.3, r.4)))).collect();
     let next = std::sync::atomic::AtomicUsize::new(0);
     std::thread::scope(|s| {
         for _ in 0..2 {
             s.spawn(|| {
-                while let Some(&(k, (cfg, prefix, arch, fe_div_bits), fe_first)) =
+                while let Some(&(k, (cfg, prefix, arch, fe_div_bits, fe_di), fe_first)) =
                     runs.get(next.fetch_add(1, std::sync::atomic::Ordering::Relaxed))
                 {
-                    lint_one(k, cfg, prefix, arch, fe_div_bits, fe_first);
+                    lint_one(k, cfg, prefix, arch, fe_div_bits, fe_di, fe_first);
                 }
             });
         }
     });
 }
 
-fn lint_one(k: usize, cfg: Config, prefix: &str, arch: BfpiArch, fe_div_bits: Option<u32>, fe_first: bool) {
+fn lint_one(k: usize, cfg: Config, prefix: &str, arch: BfpiArch, fe_div_bits: Option<u32>, fe_di: DiMode, fe_first: bool) {
     {
-        let what = format!("{cfg:?}, prefix '{prefix}', --bfpi-arch {arch}, --fe-div-bits {fe_div_bits:?}");
+        let what = format!("{cfg:?}, prefix '{prefix}', --bfpi-arch {arch}, --fe-div-bits {fe_div_bits:?}, --fe-di {fe_di:?}");
         let dir = std::env::temp_dir().join(format!("hdl-gen-lint-{}-{k}", std::process::id()));
         let _ = std::fs::remove_dir_all(&dir);
-        let opts = Options { cfg, prefix: prefix.into(), bfpi_arch: arch, fe_div_bits, ..Default::default() };
+        let opts = Options { cfg, prefix: prefix.into(), bfpi_arch: arch, fe_div_bits, fe_di, ..Default::default() };
         let names = hdl_gen::Names::new(prefix, &cfg);
         let chain = fe_first || (arch == BfpiArch::ShiftAdd && [1, 256].contains(&cfg.p));
         let skip = |module: &str| (module == names.frontend && !fe_first) || ((module == names.top || module == names.fb_top) && !chain);

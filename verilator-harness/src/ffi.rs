@@ -257,12 +257,21 @@ pub struct ModelInfo<I: 'static, O: 'static> {
     pub cfg: Config,
     /// The screen of a front-end model (`tri_frontend`, `tri_shader_p<P>`); 640x480 elsewhere.
     pub screen: golden::setup::Screen,
+    /// Where a front-end model's `dI` comes from (`--fe-di`).
+    pub di: golden::frontend::DiMode,
     pub new: unsafe extern "C" fn(u64) -> *mut c_void,
     pub free: unsafe extern "C" fn(*mut c_void),
     pub step: unsafe extern "C" fn(*mut c_void, *const I, *mut O),
 }
 
 include!(concat!(env!("OUT_DIR"), "/models.rs"));
+
+impl<I, O> ModelInfo<I, O> {
+    /// Golden's front-end for a front-end model (`tri_frontend`, `tri_shader_p<P>`, `tri_fb_p<P>`).
+    pub fn frontend(&self) -> golden::frontend::FrontEnd {
+        golden::frontend::FrontEnd::new(self.cfg, self.screen).expect("the model's front-end").with_di(self.di)
+    }
+}
 
 /// The segment-shader model built for `p` and `align`, if this build has one.
 pub fn segment_model(p: u32, align: Align) -> Option<&'static ModelInfo<SegIn, SegOut>> {

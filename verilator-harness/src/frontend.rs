@@ -271,7 +271,7 @@ pub(crate) fn drain_clocks(latency: u32, fe: &FrontEnd) -> u64 {
 /// Streams triangles through `tri_frontend` and compares every span with golden's. In the
 /// report, `spans` counts the triangles the model accepted and `segments` the spans it output.
 pub fn run_frontend(info: &'static ModelInfo<TriIn, FeOut>, seed: u64, traffic: Traffic, stress: Stress, tris: &[FixedTriangle]) -> Report {
-    let fe = FrontEnd::new(info.cfg, info.screen).expect("the model's front-end");
+    let fe = info.frontend();
     run_expected(info, seed, traffic, stress, &Expected::new(fe, tris))
 }
 
@@ -326,7 +326,7 @@ pub fn run_chain_at(
     first: usize,
 ) -> ChainRun {
     let (cfg, screen) = (info.cfg, info.screen);
-    let fe = FrontEnd::new(cfg, screen).expect("the model's front-end");
+    let fe = info.frontend();
     let mut exp = Expected::new(fe, tris);
     for s in &mut exp.stims {
         s.triangle += first;

@@ -510,12 +510,11 @@ pub enum Chain {
 impl Chain {
     /// The front-end's configuration and screen, when the RTL sets up the triangles.
     fn frontend(self) -> Option<FrontEnd> {
-        let (cfg, screen) = match self {
-            Chain::Host | Chain::HostToMemory(_) => return None,
-            Chain::Rtl(m) => (m.cfg, m.screen),
-            Chain::RtlToMemory(m) => (m.cfg, m.screen),
-        };
-        Some(FrontEnd::new(cfg, screen).expect("the model's front-end"))
+        match self {
+            Chain::Host | Chain::HostToMemory(_) => None,
+            Chain::Rtl(m) => Some(m.frontend()),
+            Chain::RtlToMemory(m) => Some(m.frontend()),
+        }
     }
 }
 

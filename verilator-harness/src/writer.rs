@@ -413,7 +413,7 @@ pub struct FbRun {
 /// the guard-band pulses, then the memory as a frame against golden's frame and the f64
 /// reference, and no pixel written by two triangles (meaningful when none overlap).
 pub fn run_fb(info: &'static ModelInfo<TriIn, WrOut>, seed: u64, traffic: Traffic, tris: &[golden::frontend::FixedTriangle]) -> FbRun {
-    let fe = FrontEnd::new(info.cfg, info.screen).expect("the model's front-end");
+    let fe = info.frontend();
     let exp = Expected::new(fe, tris);
     let mut run = stream_fb(info, seed, traffic, &exp, None);
     crate::frontend::check_frame(&exp, &run.frame, &run.mem.screen_writes(), &mut run.report);

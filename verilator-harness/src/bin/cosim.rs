@@ -140,7 +140,7 @@ fn rtl_frontend(args: &Args) -> ExitCode {
         "model {} ({}), screen {}x{}, seed {seed}, traffic {}",
         info.tag, info.top, info.screen.width, info.screen.height, args.traffic
     );
-    let fe = golden::frontend::FrontEnd::new(info.cfg, info.screen).expect("the model's front-end");
+    let fe = info.frontend();
     let mut rng = StdRng::seed_from_u64(seed);
     let mut report = Report::default();
     let start = Instant::now();

@@ -166,9 +166,13 @@ fn main() -> ExitCode {
     // Triangles into the RTL front-end and shader (tri_shader_p<P>), the same workload.
     let mut chains: Vec<(String, Vec<String>)> = Vec::new();
     let mut chain_models: Vec<_> = TRISHADER_MODELS.iter().filter(|m| m.screen == screen).collect();
-    chain_models.sort_by_key(|m| (m.cfg.p, m.cfg.align == Align::Screen));
+    chain_models.sort_by_key(|m| (m.cfg.p, m.cfg.align == Align::Screen, m.di == golden::frontend::DiMode::Scanline));
+    // Clocks of each per-triangle chain per class: the per-scanline rows are set against them.
+    let mut tri_clocks: Vec<((u32, Align), Vec<u64>)> = Vec::new();
     for info in chain_models {
         let (p, align) = (info.cfg.p, info.cfg.align);
+        let scan = info.di == golden::frontend::DiMode::Scanline;
+        let mut clocks = Vec::new();
         let mut cells = Vec::new();
         for (k, tris) in workloads.iter().enumerate() {
             if show {
@@ -186,9 +190,18 @@ fn main() -> ExitCode {
             let ppc = run.report.pixels_per_clock();
             let fed = rtl.iter().find(|r| (r.0, r.1) == (p, align)).map(|r| r.2[k]);
             let share = fed.map_or(String::new(), |f| format!(" ({:.0}%)", 100.0 * ppc / f));
-            cells.push(format!("{ppc:.2}{share}, {:.1}", 1000.0 * tris.len() as f64 / run.report.cycles.max(1) as f64));
+            let ratio = match tri_clocks.iter().find(|t| t.0 == (p, align)).filter(|_| scan) {
+                Some(t) => format!(", {:.2}x the clocks", run.report.cycles as f64 / t.1[k].max(1) as f64),
+                None => String::new(),
+            };
+            clocks.push(run.report.cycles);
+            cells.push(format!("{ppc:.2}{share}, {:.1}{ratio}", 1000.0 * tris.len() as f64 / run.report.cycles.max(1) as f64));
         }
-        chains.push((format!("front-end + shader p = {p}, {align}"), cells));
+        if !scan {
+            tri_clocks.push(((p, align), clocks));
+        }
+        let di = if scan { ", dI per scanline" } else { "" };
+        chains.push((format!("front-end + shader p = {p}, {align}{di}"), cells));
     }
     // SPEC §7: the segment writer on the same spans (and on the two scenes' spans), at full rate.
     let mut writer_rows: Vec<(String, &str, Vec<String>)> = Vec::new();
@@ -316,7 +329,8 @@ fn main() -> ExitCode {
             md,
             "\nTriangles into the generated front-end and shader (`tri_shader_p<P>`, SPEC §6), the same triangles, \
              both ends always ready, every segment and the frame checked. Each cell: pixels per clock (in brackets: \
-             of the spans-fed shader's above), then triangles per 1000 clocks.\n"
+             of the spans-fed shader's above), then triangles per 1000 clocks; for the classical per-scanline dI \
+             (`--fe-di scanline`, built with `SEGSHADE_ALL_CHAINS=1`), its clocks over the per-triangle chain's.\n"
         );
         let _ = writeln!(md, "| chain | ~10 px | ~100 px | ~1000 px |\n|---|---:|---:|---:|");
         for (name, cells) in &chains {
