@@ -264,7 +264,7 @@ impl<F: FnMut(usize, u32, &SegView) + Send> Check for TsCheck<'_, F> {
 }
 
 /// See [`FeUnit::drain`].
-pub(crate) fn drain_clocks(latency: u32, fe: &FrontEnd) -> u64 {
+pub fn drain_clocks(latency: u32, fe: &FrontEnd) -> u64 {
     fe.screen.height as u64 + latency as u64 + DRAIN_CLOCKS
 }
 

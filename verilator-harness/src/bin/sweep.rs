@@ -20,7 +20,7 @@ use std::time::Instant;
 use verilator_harness::cosim::Stress;
 use verilator_harness::cosim::{Report, SegmentCosim, Stim, Traffic};
 use verilator_harness::ffi::{SEGMENT_MODELS, TRISHADER_MODELS, WRITER_MODELS};
-use verilator_harness::frontend::run_chain;
+use verilator_harness::frontend::{drain_clocks, run_chain};
 use verilator_harness::render::{busy_cycles, scene_job, SceneKind};
 use verilator_harness::writer::run_writer;
 
@@ -187,15 +187,18 @@ fn main() -> ExitCode {
                     info.tag, run.report.mismatch_count, run.report.mismatches[0]
                 ));
             }
-            let ppc = run.report.pixels_per_clock();
+            // Busy clocks: without the quiet clocks the stream waits after its last output for
+            // a late `err` pulse (`frontend::drain_clocks`), as the spans-fed rows go without theirs.
+            let busy = run.report.cycles.saturating_sub(drain_clocks(info.latency, &info.frontend()));
+            let ppc = run.report.pixels as f64 / busy.max(1) as f64;
             let fed = rtl.iter().find(|r| (r.0, r.1) == (p, align)).map(|r| r.2[k]);
             let share = fed.map_or(String::new(), |f| format!(" ({:.0}%)", 100.0 * ppc / f));
             let ratio = match tri_clocks.iter().find(|t| t.0 == (p, align)).filter(|_| scan) {
-                Some(t) => format!(", {:.2}x the clocks", run.report.cycles as f64 / t.1[k].max(1) as f64),
+                Some(t) => format!(", {:.2}x the clocks", busy as f64 / t.1[k].max(1) as f64),
                 None => String::new(),
             };
-            clocks.push(run.report.cycles);
-            cells.push(format!("{ppc:.2}{share}, {:.1}{ratio}", 1000.0 * tris.len() as f64 / run.report.cycles.max(1) as f64));
+            clocks.push(busy);
+            cells.push(format!("{ppc:.2}{share}, {:.1}{ratio}", 1000.0 * tris.len() as f64 / busy.max(1) as f64));
         }
         if !scan {
             tri_clocks.push(((p, align), clocks));
