@@ -46,11 +46,7 @@ pub fn ports(cfg: &Config) -> Vec<Port> {
     ]
 }
 
-/// The shader with the default increment form (SPEC §3's BFPI).
-pub fn module(cfg: &Config, names: &Names) -> Module {
-    module_with(cfg, names, BfpiArch::default())
-}
-
+/// The shader, its increments formed by `arch` (SPEC §3's BFPI by default).
 pub fn module_with(cfg: &Config, names: &Names, arch: BfpiArch) -> Module {
     let (p, xw, f, log2p) = (cfg.p, cfg.xbits, cfg.frac, cfg.log2p());
     let (iw, dw, mw, aw) = (cfg.iw(), cfg.dw(), cfg.mw(), cfg.aw());

@@ -43,12 +43,6 @@ impl Default for SegOut {
     }
 }
 
-impl SegOut {
-    pub fn lane_enabled(&self, i: u32) -> bool {
-        self.mask[(i / 8) as usize] >> (i % 8) & 1 == 1
-    }
-}
-
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default)]
 pub struct BfpiIn {
@@ -373,12 +367,6 @@ impl<I, O: Default> Rtl<I, O> {
     /// One clock: apply `input` with the clock low, sample the outputs, raise the clock.
     pub fn step_into(&mut self, input: &I, output: &mut O) {
         unsafe { (self.info.step)(self.handle, input, output) }
-    }
-
-    pub fn step(&mut self, input: &I) -> O {
-        let mut out = O::default();
-        self.step_into(input, &mut out);
-        out
     }
 }
 
