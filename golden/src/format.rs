@@ -9,6 +9,7 @@ use std::fmt;
 
 /// How a span is cut into segments (SPEC §1 "Video memory blocks").
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
 #[serde(rename_all = "lowercase")]
 pub enum Align {
     /// The seed's scheme: the first segment starts at the span's first pixel.

@@ -92,6 +92,7 @@ impl std::error::Error for FrontEndError {}
 
 /// Where a span's `dI` comes from.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
 #[serde(rename_all = "lowercase")]
 pub enum DiMode {
     /// The constant-increment theorem: `dI = round(256 Nx / A)`, once per triangle.

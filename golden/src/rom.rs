@@ -28,6 +28,7 @@ pub struct Rom {
 
 /// The text formats a ROM image can be written in.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
 #[serde(rename_all = "lowercase")]
 pub enum RomFormat {
     /// Verilog `$readmemh`: one word per line, `//` comments.

@@ -13,7 +13,7 @@ use std::fmt;
 use std::str::FromStr;
 
 /// How the multiples `1..P` of the increment are formed.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, clap::ValueEnum)]
 pub enum BfpiArch {
     /// SPEC §3's `bfpi_p<P>`: golden's minimal shift-and-add graph (P/2 - 1 adders, minimal depth).
     #[default]

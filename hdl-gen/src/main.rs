@@ -1,10 +1,12 @@
 //! `hdl-gen`: the command line of the segshade generator.
 
+use clap::builder::TypedValueParser;
 use clap::{Args, Parser, Subcommand};
+use golden::frontend::DiMode;
 use golden::rom::RomFormat;
 use golden::specular::{BrdfK, SpecularPlan};
 use golden::{Align, Config};
-use hdl_gen::{check_prefix, generate, output, Options};
+use hdl_gen::{check_prefix, generate, output, BfpiArch, Options};
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -23,8 +25,8 @@ enum Command {
         config: ConfigArgs,
         /// Increments: shift-add (SPEC's BFPI), or the comparison forms naive (`*` by constants)
         /// and tree (doubling tree in the shader, no BFPI) used by scripts/synth.
-        #[arg(long = "bfpi-arch", default_value = "shift-add", value_parser = ["shift-add", "naive", "tree"])]
-        bfpi_arch: String,
+        #[arg(long = "bfpi-arch", value_enum, default_value_t = BfpiArch::ShiftAdd)]
+        bfpi_arch: BfpiArch,
         #[command(flatten)]
         brdf: BrdfArgs,
         /// Screen width of the triangle front-end (tri_frontend, tri_shader_p<P>), at most 2^XW
@@ -36,13 +38,13 @@ enum Command {
         height: Option<u32>,
         /// Quotient bits per clock of the front-end's set-up dividers: 1, 2 or 4. More bits,
         /// fewer set-up clocks per triangle (tiny triangles go faster), longer paths. Default: 4.
-        #[arg(long = "fe-div-bits", value_parser = ["1", "2", "4"])]
-        fe_div_bits: Option<String>,
+        #[arg(long = "fe-div-bits", value_parser = clap::builder::PossibleValuesParser::new(["1", "2", "4"]).map(|b| b.parse::<u32>().expect("a listed value")))]
+        fe_div_bits: Option<u32>,
         /// Where the front-end's dI comes from: `triangle` (the constant-increment theorem, once
         /// per triangle) or `scanline` (classical Gouraud, a division per span from the edge
         /// intensities with the same divider: a comparison option, slower and larger).
-        #[arg(long = "fe-di", value_enum, default_value_t = FeDi::Triangle)]
-        fe_di: FeDi,
+        #[arg(long = "fe-di", value_enum, default_value_t = DiMode::Triangle)]
+        fe_di: DiMode,
         /// Output folder (created if missing).
         #[arg(long)]
         out: PathBuf,
@@ -50,11 +52,11 @@ enum Command {
     /// Print or write one of the specular unit's ROM images.
     Rom {
         /// Which image: the BRDF tables or the n-table.
-        #[arg(long, value_parser = ["brdf", "nk"])]
-        table: String,
+        #[arg(long, value_enum)]
+        table: RomTable,
         /// $readmemh hex, Intel MIF or Xilinx COE.
-        #[arg(long, default_value = "hex", value_parser = ["hex", "mif", "coe"])]
-        format: String,
+        #[arg(long, value_enum, default_value_t = RomFormat::Hex)]
+        format: RomFormat,
         #[command(flatten)]
         brdf: BrdfArgs,
         /// File to write (standard output without it).
@@ -124,8 +126,8 @@ struct ConfigArgs {
     #[arg(long = "xbits", default_value_t = golden::format::DEFAULT_XBITS, value_parser = clap::value_parser!(u32).range(4..=16))]
     xbits: u32,
     /// Segmentation: span (the seed's) or screen (segments on multiples of P).
-    #[arg(long, default_value = "span", value_parser = ["span", "screen"])]
-    align: String,
+    #[arg(long, value_enum, default_value_t = Align::Span)]
+    align: Align,
     /// String prepended to every module name.
     #[arg(long, default_value = "", value_parser = parse_prefix)]
     prefix: String,
@@ -134,8 +136,7 @@ struct ConfigArgs {
 impl ConfigArgs {
     /// Options for this configuration with the table set `brdf`; the rest default.
     fn options(self, brdf: &BrdfArgs) -> Result<Options, String> {
-        let align: Align = self.align.parse().expect("clap checked the alignment");
-        let cfg = Config::new(self.p, self.frac, self.xbits, align)?;
+        let cfg = Config::new(self.p, self.frac, self.xbits, self.align)?;
         Ok(Options { cfg, prefix: self.prefix, brdf: brdf.plan()?, ..Options::default() })
     }
 }
@@ -206,42 +207,34 @@ fn parse_cli() -> Cli {
     Cli::from_arg_matches(&negatives(Cli::command()).get_matches()).unwrap_or_else(|e| e.exit())
 }
 
-/// `--fe-di`: golden's `DiMode`, as a command-line choice.
+/// `rom --table`: which of the specular unit's ROM images.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
-enum FeDi {
-    Triangle,
-    Scanline,
+enum RomTable {
+    /// The BRDF tables.
+    Brdf,
+    /// The n-table (k and the table per n).
+    Nk,
 }
 
 fn main() -> ExitCode {
     let cli = parse_cli();
     let result = match cli.command {
-        Command::Generate { config, bfpi_arch, brdf, width, height, fe_div_bits, fe_di, out } => {
-            let bfpi_arch = bfpi_arch.parse().expect("clap checked the bfpi arch");
-            config
-                .options(&brdf)
-                .and_then(|opts| {
-                    let default = Options::default_screen(&opts.cfg);
-                    let screen = golden::setup::Screen { width: width.unwrap_or(default.width), height: height.unwrap_or(default.height) };
-                    let fe_div_bits = fe_div_bits.map(|b| b.parse().expect("clap checked it"));
-                    let fe_di = match fe_di {
-                        FeDi::Triangle => golden::frontend::DiMode::Triangle,
-                        FeDi::Scanline => golden::frontend::DiMode::Scanline,
-                    };
-                    let opts = Options { bfpi_arch, screen: Some(screen), fe_div_bits, fe_di, ..opts };
-                    opts.frontend().map_err(|e| format!("--width/--height: {e}"))?;
-                    Ok(opts)
-                })
-                .and_then(|opts| output::write_all(&out, &generate(&opts)))
-                .map(|()| eprintln!("wrote {}", out.display()))
-        }
+        Command::Generate { config, bfpi_arch, brdf, width, height, fe_div_bits, fe_di, out } => config
+            .options(&brdf)
+            .and_then(|opts| {
+                let default = Options::default_screen(&opts.cfg);
+                let screen = golden::setup::Screen { width: width.unwrap_or(default.width), height: height.unwrap_or(default.height) };
+                let opts = Options { bfpi_arch, screen: Some(screen), fe_div_bits, fe_di, ..opts };
+                opts.frontend().map_err(|e| format!("--width/--height: {e}"))?;
+                Ok(opts)
+            })
+            .and_then(|opts| output::write_all(&out, &generate(&opts)))
+            .map(|()| eprintln!("wrote {}", out.display())),
         Command::Rom { table, format, brdf, out } => brdf.plan().and_then(|plan| {
             let unit = Options { brdf: plan, ..Options::default() }.specular_unit();
-            let rom = if table == "brdf" { unit.brdf_rom() } else { unit.nk_rom() };
-            let format = match format.as_str() {
-                "hex" => RomFormat::Hex,
-                "mif" => RomFormat::Mif,
-                _ => RomFormat::Coe,
+            let rom = match table {
+                RomTable::Brdf => unit.brdf_rom(),
+                RomTable::Nk => unit.nk_rom(),
             };
             let text = rom.to_text(format);
             match out {

@@ -129,19 +129,17 @@ fn rotate_xy(p: Vec3, ax: f64, ay: f64) -> Vec3 {
 }
 
 /// The built-in scenes.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
 pub enum SceneKind {
     Sphere,
     Torus,
 }
 
-impl std::str::FromStr for SceneKind {
-    type Err = String;
-    fn from_str(s: &str) -> Result<Self, String> {
-        match s {
-            "sphere" => Ok(SceneKind::Sphere),
-            "torus" => Ok(SceneKind::Torus),
-            _ => Err(format!("unknown scene '{s}' (expected 'sphere' or 'torus')")),
+impl SceneKind {
+    pub fn name(self) -> &'static str {
+        match self {
+            SceneKind::Sphere => "sphere",
+            SceneKind::Torus => "torus",
         }
     }
 }

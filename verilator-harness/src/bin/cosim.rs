@@ -16,6 +16,28 @@ use verilator_harness::frontend::{random_triangles, run_chain_at};
 use verilator_harness::specular::{random_span, SpecularCosim};
 use verilator_harness::stimulus::random_triangle;
 
+/// `--traffic`: the valid/ready pattern at both ends.
+#[derive(Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+enum TrafficArg {
+    Random,
+    Full,
+}
+
+impl TrafficArg {
+    fn traffic(self) -> Traffic {
+        match self {
+            TrafficArg::Random => Traffic::RANDOM,
+            TrafficArg::Full => Traffic::FULL,
+        }
+    }
+    fn name(self) -> &'static str {
+        match self {
+            TrafficArg::Random => "random",
+            TrafficArg::Full => "full",
+        }
+    }
+}
+
 #[derive(Parser)]
 #[command(about = "Co-simulate the generated segment shader against the golden model", allow_negative_numbers = true)]
 struct Args {
@@ -23,8 +45,8 @@ struct Args {
     #[arg(long, default_value_t = 8)]
     p: u32,
     /// Segmentation of the model to run.
-    #[arg(long, default_value = "span", value_parser = ["span", "screen"])]
-    align: String,
+    #[arg(long, value_enum, default_value_t = Align::Span)]
+    align: Align,
     /// Random triangles to stream.
     #[arg(long, default_value_t = 10_000)]
     triangles: usize,
@@ -37,8 +59,8 @@ struct Args {
     height: u32,
     /// `random`: random input gaps and output backpressure; `full`: both ends always ready
     /// (the shader's own throughput).
-    #[arg(long, default_value = "random", value_parser = ["random", "full"])]
-    traffic: String,
+    #[arg(long, value_enum, default_value_t = TrafficArg::Random)]
+    traffic: TrafficArg,
     /// Triangles painted into one frame between frame checks.
     #[arg(long, default_value_t = 64, value_parser = clap::value_parser!(u64).range(1..))]
     batch: u64,
@@ -69,7 +91,7 @@ fn main() -> ExitCode {
     if args.frontend == Frontend::Rtl {
         return rtl_frontend(&args);
     }
-    let align: Align = args.align.parse().expect("clap checked it");
+    let align = args.align;
     let Some(info) = segment_model(args.p, align) else {
         let built: Vec<&str> = SEGMENT_MODELS.iter().map(|m| m.tag).collect();
         eprintln!("error: --p {} --align {align}: no such model in this build (built: {})", args.p, built.join(", "));
@@ -81,8 +103,8 @@ fn main() -> ExitCode {
         return ExitCode::from(2);
     }
     let seed = args.seed.unwrap_or_else(|| verilator_harness::seed("cosim"));
-    let traffic = if args.traffic == "full" { Traffic::FULL } else { Traffic::RANDOM };
-    println!("model {} ({}), screen {}x{}, seed {seed}, traffic {}", info.tag, info.top, screen.width, screen.height, args.traffic);
+    let traffic = args.traffic.traffic();
+    println!("model {} ({}), screen {}x{}, seed {seed}, traffic {}", info.tag, info.top, screen.width, screen.height, args.traffic.name());
 
     let mut rng = StdRng::seed_from_u64(seed);
     let mut sim = SegmentCosim::new(info, seed, traffic);
@@ -124,7 +146,7 @@ fn finish(seed: u64, report: &Report, triangles: &str, spans: Option<u64>, speed
 
 /// Random triangles of every kind into `tri_shader_p<P>`; every segment, `y` and frame checked.
 fn rtl_frontend(args: &Args) -> ExitCode {
-    let align: Align = args.align.parse().expect("clap checked it");
+    let align = args.align;
     let Some(info) = TRISHADER_MODELS.iter().find(|m| m.cfg.p == args.p && m.cfg.align == align) else {
         let built: Vec<&str> = TRISHADER_MODELS.iter().map(|m| m.tag).collect();
         eprintln!("error: --frontend rtl --p {} --align {align}: no such model in this build (built: {})", args.p, built.join(", "));
@@ -135,10 +157,14 @@ fn rtl_frontend(args: &Args) -> ExitCode {
         return ExitCode::from(2);
     }
     let seed = args.seed.unwrap_or_else(|| verilator_harness::seed("cosim --frontend rtl"));
-    let traffic = if args.traffic == "full" { Traffic::FULL } else { Traffic::RANDOM };
+    let traffic = args.traffic.traffic();
     println!(
         "model {} ({}), screen {}x{}, seed {seed}, traffic {}",
-        info.tag, info.top, info.screen.width, info.screen.height, args.traffic
+        info.tag,
+        info.top,
+        info.screen.width,
+        info.screen.height,
+        args.traffic.name()
     );
     let fe = info.frontend();
     let mut rng = StdRng::seed_from_u64(seed);
@@ -171,8 +197,8 @@ fn specular(args: &Args) -> ExitCode {
         return ExitCode::from(2);
     };
     let seed = args.seed.unwrap_or_else(|| verilator_harness::seed("cosim --specular"));
-    let traffic = if args.traffic == "full" { Traffic::FULL } else { Traffic::RANDOM };
-    println!("model {} ({}), seed {seed}, traffic {}", info.tag, info.top, args.traffic);
+    let traffic = args.traffic.traffic();
+    println!("model {} ({}), seed {seed}, traffic {}", info.tag, info.top, args.traffic.name());
     let mut rng = StdRng::seed_from_u64(seed);
     let mut sim = SpecularCosim::new(info, SpecularUnit::default(), seed, traffic);
     let mut report = Report::default();

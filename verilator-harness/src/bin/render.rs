@@ -36,8 +36,8 @@ struct Args {
     writer: Writer,
     /// A built-in scene: a lit RGB object, Gouraud diffuse through one segment shader per
     /// channel plus the specular unit's highlight.
-    #[arg(long, value_parser = ["sphere", "torus"])]
-    scene: Option<String>,
+    #[arg(long, value_enum)]
+    scene: Option<SceneKind>,
     /// A triangle file (SPEC §5: `x0 y0 i0 x1 y1 i1 x2 y2 i2` per line, `#` comments): 8-bit
     /// grayscale, background 0, later triangles over earlier ones, diffuse only.
     #[arg(long, value_name = "FILE")]
@@ -50,8 +50,8 @@ struct Args {
     #[arg(long, default_value_t = 8)]
     p: u32,
     /// Segmentation of the shader model.
-    #[arg(long, default_value = "span", value_parser = ["span", "screen"])]
-    align: String,
+    #[arg(long, value_enum, default_value_t = Align::Span)]
+    align: Align,
     #[arg(long, default_value_t = 640, value_parser = clap::value_parser!(u32).range(1..=65536))]
     width: u32,
     #[arg(long, default_value_t = 480, value_parser = clap::value_parser!(u32).range(1..=65536))]
@@ -119,7 +119,7 @@ fn model_for<I, O>(
 fn main() -> ExitCode {
     let args = Args::parse();
     let start = Instant::now();
-    let align: Align = args.align.parse().expect("clap checked it");
+    let align = args.align;
     let Some(info) = segment_model(args.p, align) else {
         let built: Vec<&str> = SEGMENT_MODELS.iter().map(|m| m.tag).collect();
         return fail(format!("--p {} --align {align}: no such model in this build (built: {})", args.p, built.join(", ")));
@@ -161,10 +161,7 @@ fn main() -> ExitCode {
         return fail("--scene/--obj: this build has no specular unit");
     }
     let job = match (&args.scene, &args.triangles, &args.obj) {
-        (Some(scene), _, _) => {
-            let kind: SceneKind = scene.parse().expect("clap checked it");
-            scene_job(kind, args.shininess, &info.cfg, &screen).map_err(|e| format!("--scene {scene}: {e}"))
-        }
+        (Some(kind), _, _) => scene_job(*kind, args.shininess, &info.cfg, &screen).map_err(|e| format!("--scene {}: {e}", kind.name())),
         (None, Some(file), _) => {
             read(file).and_then(|t| triangles_job(&t, &info.cfg, &screen).map_err(|e| format!("{}: {e}", file.display())))
         }
@@ -244,7 +241,7 @@ fn main() -> ExitCode {
 
 fn summary(args: &Args, job: &Job, o: &verilator_harness::render::Outcome, tag: &str, chain: Chain, secs: f64) {
     let what = match (&args.scene, &args.triangles, &args.obj) {
-        (Some(s), _, _) => format!("scene {s}"),
+        (Some(s), _, _) => format!("scene {}", s.name()),
         (_, Some(f), _) => format!("triangles {}", f.display()),
         (_, _, Some(f)) => format!("mesh {}", f.display()),
         _ => String::new(),
