@@ -11,7 +11,6 @@ use golden::setup::Screen;
 use golden::Align;
 use image::codecs::png::PngEncoder;
 use image::{ExtendedColorType, ImageEncoder};
-use std::io::{IsTerminal, Write};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::time::Instant;
@@ -175,23 +174,14 @@ fn main() -> ExitCode {
         Err(e) => return fail(e),
     };
 
-    let show = !args.quiet && std::io::stderr().is_terminal();
-    let mut shown = false;
-    let mut last = start;
-    let outcome = run_with(&job, info, chain, SPECULAR_MODELS.first(), |f| {
-        // Only renders that take a while get a progress line, redrawn at most 10 times a second.
-        let now = Instant::now();
-        if show && (now - start).as_secs_f64() > 0.5 && ((now - last).as_secs_f64() >= 0.1 || f >= 1.0) {
-            shown = true;
-            last = now;
-            let bar = (f * 40.0) as usize;
-            eprint!("\rrendering [{}{}] {:5.1}%", "#".repeat(bar), " ".repeat(40 - bar.min(40)), 100.0 * f);
-            let _ = std::io::stderr().flush();
-        }
-    });
-    if shown {
-        eprintln!();
-    }
+    // indicatif hides the bar by itself when stderr is not a terminal.
+    let bar = match args.quiet {
+        true => indicatif::ProgressBar::hidden(),
+        false => indicatif::ProgressBar::new(1000)
+            .with_style(indicatif::ProgressStyle::with_template("rendering [{bar:40}] {percent:>3}%").expect("a valid template")),
+    };
+    let outcome = run_with(&job, info, chain, SPECULAR_MODELS.first(), |f| bar.set_position((f * 1000.0) as u64));
+    bar.finish_and_clear();
 
     let channels = job.channels();
     let color = if channels == 3 { ExtendedColorType::Rgb8 } else { ExtendedColorType::L8 };
@@ -201,7 +191,8 @@ fn main() -> ExitCode {
         let d = difference_image(&outcome.rtl, &outcome.golden, channels);
         files.push((diff_path.clone(), png(&d, &screen, ExtendedColorType::Rgb8)));
     }
-    if let Err(e) = write_all(&files) {
+    let staged: Vec<(PathBuf, &[u8])> = files.iter().map(|(p, b)| (p.clone(), b.as_slice())).collect();
+    if let Err(e) = hdl_gen::output::write_files(&staged) {
         return fail(e);
     }
     let secs = start.elapsed().as_secs_f64();
@@ -276,35 +267,4 @@ fn png(buf: &[u8], screen: &Screen, color: ExtendedColorType) -> Vec<u8> {
     let mut out = Vec::new();
     PngEncoder::new(&mut out).write_image(buf, screen.width, screen.height, color).expect("in-memory PNG encoding");
     out
-}
-
-/// Writes every file under a temporary name first, then renames them all: either every file is
-/// complete or (on an error) none is touched.
-fn write_all(files: &[(PathBuf, Vec<u8>)]) -> Result<(), String> {
-    let tmp: Vec<PathBuf> = files
-        .iter()
-        .map(|(p, _)| {
-            let mut t = p.as_os_str().to_owned();
-            t.push(format!(".tmp{}", std::process::id()));
-            PathBuf::from(t)
-        })
-        .collect();
-    let cleanup = |n: usize| {
-        for t in &tmp[..n] {
-            let _ = std::fs::remove_file(t);
-        }
-    };
-    for (k, ((path, bytes), t)) in files.iter().zip(&tmp).enumerate() {
-        if let Err(e) = std::fs::write(t, bytes) {
-            cleanup(k + 1);
-            return Err(format!("{}: {e}", path.display()));
-        }
-    }
-    for (k, ((path, _), t)) in files.iter().zip(&tmp).enumerate() {
-        if let Err(e) = std::fs::rename(t, path) {
-            cleanup(files.len());
-            return Err(format!("{}: {e} ({k} of {} files already written)", path.display(), files.len()));
-        }
-    }
-    Ok(())
 }

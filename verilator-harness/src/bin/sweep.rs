@@ -13,7 +13,6 @@ use golden::Align;
 use rand::rngs::StdRng;
 use rand::{Rng, SeedableRng};
 use std::fmt::Write as _;
-use std::io::{IsTerminal, Write as _};
 use std::path::PathBuf;
 use std::process::ExitCode;
 use std::time::Instant;
@@ -109,7 +108,11 @@ fn main() -> ExitCode {
     let mut rng = StdRng::seed_from_u64(args.seed);
     let workloads: Vec<Vec<Triangle>> =
         CLASSES.iter().map(|&a| (0..args.triangles).map(|_| sized_triangle(&mut rng, &screen, a)).collect()).collect();
-    let show = std::io::stderr().is_terminal();
+    // One bar over every RTL run; indicatif hides it when stderr is not a terminal.
+    let chain_runs = TRISHADER_MODELS.iter().filter(|m| m.screen == screen).count();
+    let writer_runs = WRITER_MODELS.iter().filter(|m| m.screen == screen && m.cfg.p > 1).count();
+    let bar = indicatif::ProgressBar::new(((models.len() + chain_runs) * workloads.len() + writer_runs * (workloads.len() + 2)) as u64)
+        .with_style(indicatif::ProgressStyle::with_template("sweep [{bar:30}] {pos}/{len} {msg}").expect("a valid template"));
     let mut failures = Vec::new();
 
     // Baselines: cycle models.
@@ -129,16 +132,13 @@ fn main() -> ExitCode {
 
     // The segment shader: RTL clocks.
     let mut rtl: Vec<(u32, Align, Vec<f64>)> = Vec::new();
-    let runs = models.len() * workloads.len();
-    for (n, info) in models.iter().enumerate() {
+    for info in &models {
         let (p, align) = (info.cfg.p, info.cfg.align);
         let mut cells = Vec::new();
         let mut ppcs = Vec::new();
         for (k, tris) in workloads.iter().enumerate() {
-            if show {
-                eprint!("\rsweep: {} on class {} ({}/{runs})   ", info.tag, k, n * workloads.len() + k + 1);
-                let _ = std::io::stderr().flush();
-            }
+            bar.set_message(format!("{} on class {k}", info.tag));
+            bar.inc(1);
             let mut stims = Vec::new();
             for (t, tri) in tris.iter().enumerate() {
                 golden::setup::triangle_spans(&info.cfg, &screen, tri, |y, span| stims.push(Stim { triangle: t, y, span }))
@@ -175,10 +175,8 @@ fn main() -> ExitCode {
         let mut clocks = Vec::new();
         let mut cells = Vec::new();
         for (k, tris) in workloads.iter().enumerate() {
-            if show {
-                eprint!("\rsweep: {} on class {k}   ", info.tag);
-                let _ = std::io::stderr().flush();
-            }
+            bar.set_message(format!("{} on class {k}", info.tag));
+            bar.inc(1);
             let fixed: Vec<_> = tris.iter().map(|t| golden::frontend::FixedTriangle::from_triangle(t, info.cfg.frac)).collect();
             let run = run_chain(info, args.seed, Traffic::FULL, &fixed);
             if !run.report.ok() {
@@ -244,10 +242,8 @@ fn main() -> ExitCode {
         }
         let mut cells = Vec::new();
         for (k, spans) in span_sets.iter().enumerate() {
-            if show {
-                eprint!("\rsweep: {} on workload {k}   ", info.tag);
-                let _ = std::io::stderr().flush();
-            }
+            bar.set_message(format!("{} on workload {k}", info.tag));
+            bar.inc(1);
             let run = run_writer(info, args.seed, Traffic::FULL, Stress::NONE, spans);
             if !run.report.ok() {
                 failures.push(format!(
@@ -269,9 +265,7 @@ fn main() -> ExitCode {
         };
         writer_rows.push((name, "RTL", cells));
     }
-    if show {
-        eprintln!();
-    }
+    bar.finish_and_clear();
 
     // Best p per class and alignment: the smallest p within 10% of the widest model's rate.
     let best = |align: Align, k: usize| -> Option<u32> {
@@ -358,9 +352,7 @@ fn main() -> ExitCode {
 
     match &args.out {
         Some(path) => {
-            let tmp = PathBuf::from(format!("{}.tmp{}", path.display(), std::process::id()));
-            if let Err(e) = std::fs::write(&tmp, &md).and_then(|_| std::fs::rename(&tmp, path)) {
-                let _ = std::fs::remove_file(&tmp);
+            if let Err(e) = hdl_gen::output::write_one(path, md.as_bytes()) {
                 eprintln!("error: --out {}: {e}", path.display());
                 return ExitCode::from(2);
             }
