@@ -11,13 +11,13 @@
 //! - bad triangle input is rejected with its line number, never a panic or garbage pixels.
 
 use golden::setup::{parse_triangles, triangle_spans, Screen, Triangle, Vertex, COORD_LIMIT};
-use golden::specular::{SpecularSpan, SpecularUnit, N_BITS};
+use golden::specular::{SpecularSpan, N_BITS};
 use golden::{Config, Span};
 use rand::rngs::StdRng;
 use rand::{Rng, SeedableRng};
 use verilator_harness::cosim::{assert_clean, Report, SegmentCosim, Stim, Stress, Traffic};
 use verilator_harness::ffi::{
-    require_models, require_specular_model, to_port, ModelInfo, Rtl, SegIn, SegOut, SpecIn, SpecOut, RTL_DIR, SEGMENT_MODELS,
+    require_models, require_specular_model, specular_unit, to_port, ModelInfo, Rtl, SegIn, SegOut, SpecIn, SpecOut, RTL_DIR, SEGMENT_MODELS,
 };
 use verilator_harness::specular::{random_span, SpecularCosim};
 use verilator_harness::stimulus::{directed, random_triangle};
@@ -102,7 +102,7 @@ fn specular_unit_survives_resets_stalls_and_gaps() {
     let seed = verilator_harness::seed("specular_unit_survives_resets_stalls_and_gaps");
     let Some(info) = spec_model("the specular unit under stress") else { return };
     let mut rng = StdRng::seed_from_u64(seed);
-    let mut sim = SpecularCosim::new(info, SpecularUnit::default(), seed, Traffic::RANDOM);
+    let mut sim = SpecularCosim::new(info, specular_unit(), seed, Traffic::RANDOM);
     sim.set_stress(SPEC_STRESS);
     let mut report = Report::default();
     for _ in 0..8 {
@@ -179,7 +179,7 @@ fn out_valid_does_not_wait_for_out_ready() {
         rtl.step_into(&input, &mut out);
         assert_eq!(out.out_valid, 0, "specular: valid {k} clocks after the transfer");
     }
-    let want = SpecularUnit::default().pixel(200 << 8, 20, 0, 1 << 18, 0).0;
+    let want = specular_unit().pixel(200 << 8, 20, 0, 1 << 18, 0).0;
     for k in 0..20 {
         rtl.step_into(&input, &mut out);
         assert_eq!((out.out_valid, out.out_spec, out.out_last), (1, want, 0), "specular: first pixel held with out_ready low (clock +{k})");
@@ -193,7 +193,7 @@ fn out_valid_does_not_wait_for_out_ready() {
 fn specular_sweep_reaches_every_rom_word() {
     let seed = verilator_harness::seed("specular_sweep_reaches_every_rom_word");
     let Some(info) = spec_model("the specular ROM sweep") else { return };
-    let unit = SpecularUnit::default();
+    let unit = specular_unit();
     let plan = unit.plan().clone();
     let len = 1024u32.min(info.cfg.max_len());
     let spans: Vec<SpecularSpan> = (0..1u32 << N_BITS)
@@ -290,7 +290,7 @@ fn harness_rejects_spans_the_rtl_cannot_take() {
     for (span, needle) in
         [(SpecularSpan { len: port_max + 1, ..good }, "in_len port"), (SpecularSpan { n: 1 << N_BITS, ..good }, "in_n port")]
     {
-        let mut sim = SpecularCosim::new(info, SpecularUnit::default(), 1, Traffic::FULL);
+        let mut sim = SpecularCosim::new(info, specular_unit(), 1, Traffic::FULL);
         let mut report = Report::default();
         let e = sim.try_stream(&[good, span], &mut report).expect_err("accepted");
         assert!(e.contains("span 1") && e.contains(needle), "{e}");
@@ -298,7 +298,7 @@ fn harness_rejects_spans_the_rtl_cannot_take() {
     }
     // What the ports carry is valid input, an n outside 1..1000 included (out_err = 1), and the
     // longest length the port carries.
-    let mut sim = SpecularCosim::new(info, SpecularUnit::default(), 1, Traffic::RANDOM);
+    let mut sim = SpecularCosim::new(info, specular_unit(), 1, Traffic::RANDOM);
     let mut report = Report::default();
     let spans = [SpecularSpan { n: 1023, ..good }, SpecularSpan { n: 0, ..good }, SpecularSpan { len: port_max, dtheta: 1, ..good }];
     sim.try_stream(&spans, &mut report).unwrap();

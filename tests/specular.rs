@@ -3,11 +3,11 @@
 //! random gaps and backpressure. Every pixel bit-exact, within SPEC §4, monotone along a span.
 
 use golden::specular::reference::epicentre;
-use golden::specular::{n_valid, theta_at, SpecularSpan, SpecularUnit, THETA_FRAC};
+use golden::specular::{n_valid, theta_at, SpecularSpan, THETA_FRAC};
 use rand::rngs::StdRng;
 use rand::{Rng, SeedableRng};
 use verilator_harness::cosim::{assert_clean, Report, Traffic, DRAIN_CLOCKS};
-use verilator_harness::ffi::{require_specular_model, ModelInfo, SpecIn, SpecOut};
+use verilator_harness::ffi::{require_specular_model, specular_unit, ModelInfo, SpecIn, SpecOut};
 use verilator_harness::specular::{random_span, SpecularCosim};
 
 const PIXELS: u64 = 200_000;
@@ -21,7 +21,7 @@ fn random_spans_bit_exact_accurate_and_monotone() {
     let seed = verilator_harness::seed("random_spans_bit_exact_accurate_and_monotone");
     let Some(info) = model("random spans") else { return };
     let mut rng = StdRng::seed_from_u64(seed);
-    let mut sim = SpecularCosim::new(info, SpecularUnit::default(), seed, Traffic::RANDOM);
+    let mut sim = SpecularCosim::new(info, specular_unit(), seed, Traffic::RANDOM);
     let mut report = Report::default();
     let mut seen_n = [false; 1024];
     // The SPEC §4 checks only bite where there is light: count pixels inside the epicentre.
@@ -67,9 +67,28 @@ fn one_pixel_per_clock_at_full_rate() {
             s
         })
         .collect();
-    let mut sim = SpecularCosim::new(info, SpecularUnit::default(), seed, Traffic::FULL);
+    let mut sim = SpecularCosim::new(info, specular_unit(), seed, Traffic::FULL);
     let mut report = Report::default();
     sim.stream(&spans, &mut report);
     assert_clean(info.tag, seed, &report);
     assert_eq!(report.cycles, report.pixels + info.latency as u64 + DRAIN_CLOCKS, "bubbles at full rate");
+}
+
+/// The negative control of the table set build.rs takes from the manifest: the same model
+/// checked against golden's unit for another `--brdf-k` set must fail, so a checker left on
+/// the default plan would not pass RTL generated with other tables.
+#[test]
+fn a_golden_unit_of_another_table_set_is_caught() {
+    use golden::specular::{SpecularPlan, SpecularUnit};
+    let seed = verilator_harness::seed("a_golden_unit_of_another_table_set_is_caught");
+    let Some(info) = model("another table set") else { return };
+    let built = specular_unit();
+    let other_ks: &[u32] = if built.plan().decoder.ks() == [1, 2, 3, 9] { &[1, 2, 4, 16] } else { &[1, 2, 3, 9] };
+    let wrong = SpecularUnit::new(SpecularPlan::from_k_set(other_ks).expect("a valid set"));
+    let mut rng = StdRng::seed_from_u64(seed);
+    let spans: Vec<SpecularSpan> = (0..400).map(|_| random_span(&mut rng, info.cfg.max_len())).collect();
+    let mut sim = SpecularCosim::new(info, wrong, seed, Traffic::FULL);
+    let mut report = Report::default();
+    let _ = sim.try_stream(&spans, &mut report);
+    assert!(report.mismatch_count > 0, "the model passed against golden's k = {other_ks:?} unit (seed {seed})");
 }

@@ -3,8 +3,10 @@
 //! another, so a clock costs one FFI call whatever the port count.
 
 use crate::driver::{Control, Handshake};
+use golden::specular::{Decoder, DecoderRepr, KRange, SpecularPlan, SpecularUnit};
 use golden::{Align, Config};
 use std::ffi::c_void;
+use std::sync::OnceLock;
 
 /// Inputs of `segment_shader_p<P>` for one clock.
 #[repr(C)]
@@ -258,7 +260,32 @@ pub struct ModelInfo<I: 'static, O: 'static> {
     pub step: unsafe extern "C" fn(*mut c_void, *const I, *mut O),
 }
 
+/// The table set the specular model was generated with (`--brdf-k`): build.rs takes it from
+/// the generator's default or from COSIM_RTL_DIR's manifest, where it checks that golden
+/// rebuilds from it the very plan the manifest states.
+pub struct SpecularTables {
+    pub ks: &'static [u32],
+    /// The decoder: which n uses which table.
+    pub k_ranges: &'static [KRange],
+    /// The BRDF word width, when not the plan builder's own choice (some `--brdf-k auto` plans).
+    pub word_bits: Option<u32>,
+}
+
+impl SpecularTables {
+    pub fn plan(&self) -> Result<SpecularPlan, String> {
+        let decoder = Decoder::try_from(DecoderRepr { ks: self.ks.to_vec(), ranges: self.k_ranges.to_vec() })?;
+        SpecularPlan::build(decoder, self.word_bits)
+    }
+}
+
 include!(concat!(env!("OUT_DIR"), "/models.rs"));
+
+/// The golden specular unit the built specular model is checked against: [`SPECULAR_TABLES`]'
+/// plan (built once), not `SpecularUnit::default()`, which is right only for the default set.
+pub fn specular_unit() -> SpecularUnit {
+    static UNIT: OnceLock<SpecularUnit> = OnceLock::new();
+    UNIT.get_or_init(|| SpecularUnit::new(SPECULAR_TABLES.plan().expect("build.rs rebuilt this plan"))).clone()
+}
 
 impl<I, O> ModelInfo<I, O> {
     /// Golden's front-end for a front-end model (`tri_frontend`, `tri_shader_p<P>`, `tri_fb_p<P>`).

@@ -16,14 +16,14 @@
 //! triangles are drawn over earlier ones, so a pixel belongs to the last triangle covering it.
 
 use crate::cosim::{Report, SegView, SegmentCosim, Stim, Stress, Traffic, DRAIN_CLOCKS};
-use crate::ffi::{ModelInfo, SegIn, SegOut, SpecIn, SpecOut, TriIn, TriSegOut, WrIn, WrOut};
+use crate::ffi::{specular_unit, ModelInfo, SegIn, SegOut, SpecIn, SpecOut, TriIn, TriSegOut, WrIn, WrOut};
 use crate::frontend::{stream_chain, Expected};
 use crate::specular::SpecularCosim;
 use crate::writer::{run_segments, stream_fb, SegStim};
 use golden::frontend::{FixedTriangle, FrontEnd};
 use golden::setup::{parse_triangles, triangle_spans, Screen, Triangle, Vertex};
 use golden::specular::setup::{cross, dot, normalize, setup_span, SpanEnds, Vec3};
-use golden::specular::{SpecularSpan, SpecularUnit, C_FRAC};
+use golden::specular::{SpecularSpan, C_FRAC};
 use golden::writer::Writer;
 use golden::{Config, Span};
 use std::f64::consts::{PI, TAU};
@@ -645,7 +645,7 @@ pub fn run_with(
             let done = &done;
             s.spawn(move || {
                 let mut out = vec![0u16; npix];
-                let mut sim = SpecularCosim::new(info, SpecularUnit::default(), SEED, Traffic::FULL);
+                let mut sim = SpecularCosim::new(info, specular_unit(), SEED, Traffic::FULL);
                 let mut report = Report { triangles: job.drawn, ..Report::default() };
                 let stims = &job.stims[0];
                 sim.stream_with(&job.specular, &mut report, |k, j, o| {
@@ -713,7 +713,7 @@ pub fn run_with(
         None => host_diffuse.clone(),
     };
     let gold_spec = with_spec.then(|| {
-        let unit = SpecularUnit::default();
+        let unit = specular_unit();
         let mut out = vec![0u16; npix];
         for (st, sp) in job.stims[0].iter().zip(&job.specular) {
             for (j, px) in unit.span(sp).enumerate() {

@@ -28,7 +28,7 @@
 use clap::{Parser, Subcommand, ValueEnum};
 use golden::segment::segments;
 use golden::setup::{triangle_spans, Screen};
-use golden::specular::{SpecularSpan, SpecularUnit};
+use golden::specular::SpecularSpan;
 use golden::{Align, Span};
 use rand::rngs::StdRng;
 use rand::SeedableRng;
@@ -38,7 +38,7 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 use std::time::Instant;
 use verilator_harness::cosim::{Report, SegmentCosim, Stim};
-use verilator_harness::ffi::{segment_model, to_port, SPECULAR_MODELS};
+use verilator_harness::ffi::{segment_model, specular_unit, to_port, SPECULAR_MODELS};
 use verilator_harness::specular::{random_span, SpecularCosim};
 use verilator_harness::stimulus::random_triangle;
 use verilator_harness::traffic::{state_of, Traffic};
@@ -287,7 +287,7 @@ fn gen_specular(count: usize, seed: u64, traffic: Traffic, out: &std::path::Path
         eprintln!("error: this build has no specular unit");
         return ExitCode::from(2);
     };
-    let unit = SpecularUnit::default();
+    let unit = specular_unit();
     let mut rng = StdRng::seed_from_u64(seed);
     let spans: Vec<SpecularSpan> = (0..count).map(|_| random_span(&mut rng, info.cfg.max_len())).collect();
     let outputs: u64 = spans.iter().map(|s| s.len as u64).sum();
@@ -389,7 +389,7 @@ fn harness(path: &std::path::Path, limit: usize) -> ExitCode {
                 .iter()
                 .map(|r| SpecularSpan { c: r[0] as u16, n: r[1] as u16, theta0: r[2] as i32, dtheta: r[3] as i32, len: r[4] })
                 .collect();
-            let mut sim = SpecularCosim::new(info, SpecularUnit::default(), h.seed, traffic);
+            let mut sim = SpecularCosim::new(info, specular_unit(), h.seed, traffic);
             (info.tag, timed(|| sim.stream(&spans, &mut report)))
         }
         d => panic!("unknown design {d}"),

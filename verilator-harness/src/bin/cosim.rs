@@ -4,14 +4,13 @@
 
 use clap::{Parser, ValueEnum};
 use golden::setup::Screen;
-use golden::specular::SpecularUnit;
 use golden::Align;
 use rand::rngs::StdRng;
 use rand::SeedableRng;
 use std::process::ExitCode;
 use std::time::Instant;
 use verilator_harness::cosim::{Report, SegmentCosim, Traffic};
-use verilator_harness::ffi::{segment_model, SEGMENT_MODELS, SPECULAR_MODELS, TRISHADER_MODELS};
+use verilator_harness::ffi::{segment_model, specular_unit, SEGMENT_MODELS, SPECULAR_MODELS, TRISHADER_MODELS};
 use verilator_harness::frontend::{random_triangles, run_chain_at};
 use verilator_harness::specular::{random_span, SpecularCosim};
 use verilator_harness::stimulus::random_triangle;
@@ -200,7 +199,7 @@ fn specular(args: &Args) -> ExitCode {
     let traffic = args.traffic.traffic();
     println!("model {} ({}), seed {seed}, traffic {}", info.tag, info.top, args.traffic.name());
     let mut rng = StdRng::seed_from_u64(seed);
-    let mut sim = SpecularCosim::new(info, SpecularUnit::default(), seed, traffic);
+    let mut sim = SpecularCosim::new(info, specular_unit(), seed, traffic);
     let mut report = Report::default();
     let start = Instant::now();
     while report.pixels < args.pixels {
