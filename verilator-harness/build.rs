@@ -140,7 +140,15 @@ fn tables_from_dir(dir: &Path) -> SpecTables {
                 if built == stated {
                     return SpecTables::of(&plan, w);
                 }
-                last = format!("golden rebuilds {built:?}");
+                let rebuilt = serde_json::to_value(&built).expect("a plan serializes");
+                let differ: Vec<String> = rebuilt
+                    .as_object()
+                    .into_iter()
+                    .flatten()
+                    .filter(|(k, v)| m["specular"].get(k.as_str()) != Some(*v))
+                    .map(|(k, v)| format!("{k}: manifest {}, golden {v}", m["specular"][k.as_str()]))
+                    .collect();
+                last = format!("with word_bits {w:?}, {}", differ.join("; "));
             }
             Err(e) => last = e,
         }
