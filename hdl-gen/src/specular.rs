@@ -77,7 +77,7 @@ fn module(cfg: &Config, unit: &SpecularUnit, names: &SpecNames) -> Module {
     let (lw, w, mw, sb) = (cfg.xbits + 1, p.word_bits, p.nk_mant_bits, p.sel_bits);
     let (mag, prod, ab, ib) = (p.mag_bits, p.prod_bits(), p.brdf_addr_bits(), p.index_bits());
     let tables = &p.tables;
-    let lo = tables.iter().map(|t| t.shift).min().expect("a plan has tables");
+    let lo = p.prod_drop();
 
     let mut header = vec![
         format!("{} — specular term of patent UA 71489, one pixel per clock.", names.unit),

@@ -370,6 +370,11 @@ impl SpecularPlan {
     pub fn prod_bits(&self) -> u32 {
         self.mag_bits + self.nk_mant_bits
     }
+    /// Low product bits no table's index reaches (the smallest table shift): stage 2 registers
+    /// only the `prod_bits() - prod_drop()` bits above them.
+    pub fn prod_drop(&self) -> u32 {
+        self.tables.iter().map(|t| t.shift).min().unwrap_or(0)
+    }
 
     /// A span transferred in clock t has its first pixel valid in clock t + latency: one clock
     /// per register stage (the same convention as the segment shader's).
@@ -398,7 +403,11 @@ impl SpecularPlan {
             (
                 "arg_mul",
                 "prod = mag * M (unsigned); err = (M == 0)".to_string(),
-                vec![reg("prod", self.prod_bits(), "uint"), reg("sel", self.sel_bits, "uint"), reg("err", 1, "flag")],
+                vec![
+                    reg("prod", self.prod_bits() - self.prod_drop(), &format!("uint, prod >> {}", self.prod_drop())),
+                    reg("sel", self.sel_bits, "uint"),
+                    reg("err", 1, "flag"),
+                ],
             ),
             (
                 "brdf",
