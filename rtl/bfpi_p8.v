@@ -33,3 +33,24 @@ module bfpi_p8 (
 endmodule
 
 `default_nettype wire
+
+`ifdef FORMAL
+
+`default_nettype none
+
+module bfpi_p8_ref (
+  input  wire signed [20:0] di, // increment
+  output wire [191:0] inc       // lane i = (i+1)*di, by multiplication
+);
+  genvar k;
+  generate
+    for (k = 0; k < 8; k = k + 1) begin : lane
+      localparam [23:0] K = k + 1;
+      assign inc[k*24 +: 24] = {{3{di[20]}}, di} * K;
+    end
+  endgenerate
+
+endmodule
+
+`default_nettype wire
+`endif

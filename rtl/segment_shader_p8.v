@@ -108,6 +108,178 @@ module segment_shader_p8 (
     end
   end
 
+`ifdef FORMAL
+  // Clocks since the start: $past is meaningful once f_past is set.
+  reg f_past = 1'b0;
+  reg f_past2 = 1'b0;
+  always @(posedge clk) begin
+    f_past <= 1'b1;
+    f_past2 <= f_past;
+  end
+  // The one rule the environment keeps: reset in the first clock.
+  always @(*) begin
+    if (!f_past) begin
+      assume(rst);
+    end
+  end
+  // Reset: no segment out of reset.
+  always @(posedge clk) begin
+    if (f_past && $past(rst)) begin
+      assert(!out_valid);
+    end
+  end
+  // Stability: a segment offered and not taken stays, unchanged.
+  always @(posedge clk) begin
+    if (f_past && !$past(rst) && $past(out_valid && !out_ready)) begin
+      assert(out_valid);
+      assert(out_x == $past(out_x));
+      assert(out_pix == $past(out_pix));
+      assert(out_mask == $past(out_mask));
+      assert(out_last == $past(out_last));
+    end
+  end
+  // The shadow: spans accepted whose segments have not all appeared. Span h's next
+  // segment starts f_h_off pixels after its first block's x (f_h_b); t waits behind it.
+  // A span is first lead (x0 mod P in screen alignment) masked lanes, then m pixels: tot = lead + m.
+  reg f_h_v;
+  reg [11:0] f_h_b;
+  reg [2:0] f_h_lead;
+  reg [12:0] f_h_tot;
+  reg f_t_v;
+  reg [11:0] f_t_b;
+  reg [2:0] f_t_lead;
+  reg [12:0] f_t_tot;
+  reg [12:0] f_h_off;
+  wire [11:0] f_in_b = in_x;
+  wire [2:0] f_in_lead = 3'd0;
+  wire [12:0] f_in_tot = in_len + {10'd0, f_in_lead};
+  // A new segment is on the output when it is valid and the register could load.
+  reg f_free;
+  always @(posedge clk) begin
+    f_free <= rst || !out_valid || out_ready;
+  end
+  wire f_fresh = f_past && out_valid && f_free;
+  wire [12:0] f_left = f_h_tot - f_h_off;
+  wire f_exp_last = f_left <= 13'd8;
+  wire [11:0] f_exp_x = f_h_b + f_h_off[11:0];
+  wire [7:0] f_exp_mask;
+  genvar fk;
+  generate
+    for (fk = 0; fk < 8; fk = fk + 1) begin : f_lane
+      localparam [13:0] FK = fk;
+      assign f_exp_mask[fk] = ({1'b0, f_h_off} + FK >= {11'd0, f_h_lead}) && ({1'b0, f_h_off} + FK < {1'b0, f_h_tot});
+    end
+  endgenerate
+  wire f_push = in_valid && in_ready && in_len != 0;
+  wire f_pop = f_fresh && f_exp_last;
+  // Each new segment is the one SPEC §3 says comes next; none comes unowed.
+  always @(*) begin
+    if (f_fresh) begin
+      assert(f_h_v);
+      assert(out_x == f_exp_x);
+      assert(out_last == f_exp_last);
+      assert(out_mask == f_exp_mask);
+    end
+  end
+  always @(posedge clk) begin
+    if (rst) begin
+      f_h_v <= 1'b0;
+      f_t_v <= 1'b0;
+    end else begin
+      if (f_fresh && !f_exp_last) begin
+        f_h_off <= f_h_off + 13'd8;
+      end
+      if (f_pop) begin
+        f_h_v <= f_t_v || f_push;
+        f_h_off <= 13'd0;
+        f_t_v <= f_t_v && f_push;
+        if (f_t_v) begin
+          f_h_b <= f_t_b;
+          f_h_lead <= f_t_lead;
+          f_h_tot <= f_t_tot;
+        end else begin
+          f_h_b <= f_in_b;
+          f_h_lead <= f_in_lead;
+          f_h_tot <= f_in_tot;
+        end
+        f_t_b <= f_in_b;
+        f_t_lead <= f_in_lead;
+        f_t_tot <= f_in_tot;
+      end else if (f_push) begin
+        if (!f_h_v) begin
+          f_h_v <= 1'b1;
+          f_h_off <= 13'd0;
+          f_h_b <= f_in_b;
+          f_h_lead <= f_in_lead;
+          f_h_tot <= f_in_tot;
+        end else begin
+          f_t_v <= 1'b1;
+          f_t_b <= f_in_b;
+          f_t_lead <= f_in_lead;
+          f_t_tot <= f_in_tot;
+        end
+      end
+    end
+  end
+  // Nothing lost: a span is accepted only when at most one is owed besides it.
+  always @(*) begin
+    if (f_past && f_push) begin
+      assert(!(f_h_v && f_t_v && !f_pop));
+    end
+  end
+  // Throughput with out_ready high: no bubble inside a span, nor between spans when the
+  // next non-empty span was offered by the time the last segment left the shader.
+  always @(posedge clk) begin
+    if (f_past && !$past(rst) && $past(out_valid && out_ready && !out_last)) begin
+      assert(out_valid);
+    end
+    if (f_past2 && !$past(rst) && !$past(rst, 2) && $past(out_valid && out_ready && out_last) && $past(in_valid && in_len != 0, 2)) begin
+      assert(out_valid);
+    end
+  end
+  // Linking invariants: the current-span registers hold what the shadow owes next.
+  always @(*) begin
+    if (f_past) begin
+      if (!f_h_v) begin
+        assert(!cur_valid);
+        assert(!f_t_v);
+        assert(!f_fresh);
+      end else if (f_fresh && !f_exp_last) begin
+        assert(cur_valid);
+        assert(!f_t_v);
+        assert(cur_x == f_exp_x + 12'd8);
+        assert(cur_rem == f_left - 13'd8);
+      end else if (f_fresh) begin
+        assert(cur_valid == f_t_v);
+        if (f_t_v) begin
+          assert(cur_x == f_t_b);
+          assert(cur_rem == f_t_tot);
+        end
+      end else begin
+        assert(cur_valid);
+        assert(!f_t_v);
+        assert(cur_x == f_exp_x);
+        assert(cur_rem == f_left);
+      end
+      if (f_h_v) begin
+        assert(f_h_tot != 13'd0);
+        assert(f_h_off < f_h_tot);
+        assert(f_h_tot <= 13'd8191);
+        assert(f_h_off[2:0] == 3'd0);
+        assert(f_h_lead == 3'd0);
+      end
+      if (f_t_v) begin
+        assert(f_t_tot != 13'd0);
+        assert(f_t_tot <= 13'd8191);
+        assert(f_t_lead == 3'd0);
+      end
+      if (out_valid && !out_last) begin
+        assert(cur_valid);
+      end
+    end
+  end
+`endif
+
 endmodule
 
 `default_nettype wire

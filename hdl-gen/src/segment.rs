@@ -226,6 +226,8 @@ pub fn module_with(cfg: &Config, names: &Names, arch: BfpiArch) -> Module {
             vec![],
         )],
     )]));
+    body.push(Item::Blank);
+    body.push(crate::formal::segment_properties(cfg, rw));
 
     Module { name: names.segment.clone(), header, params: vec![], ports: ports(cfg), body }
 }

@@ -62,6 +62,10 @@ pub enum Stmt {
     Delay(u32),
     /// Testbench only: `forever begin ... end`.
     Forever(Vec<Stmt>),
+    /// Formal only (inside [`Item::Formal`]): an immediate `assert(cond);`.
+    Assert(String),
+    /// Formal only: an immediate `assume(cond);`, a rule the environment is held to.
+    Assume(String),
 }
 
 pub fn set(lhs: impl Into<String>, rhs: impl Into<String>) -> Stmt {
@@ -130,6 +134,18 @@ pub enum Item {
     },
     /// Testbench only (SPEC §3 allows no `initial` in the modules): `initial begin ... end`.
     Initial(Vec<Stmt>),
+    /// `always @(*) begin ... end`: combinational checks of the formal properties.
+    Comb(Vec<Stmt>),
+    /// Formal only: `reg [w-1:0] name = value;`, a register whose first value the solver
+    /// knows (the `f_past` flags; the product RTL has no initial values).
+    RegInit {
+        name: String,
+        width: u32,
+        value: String,
+    },
+    /// `` `ifdef FORMAL `` ... `` `endif ``: properties read by `read_verilog -formal` (Yosys
+    /// defines FORMAL), invisible to every other tool, so the product stays Verilog-2005.
+    Formal(Vec<Item>),
 }
 
 pub fn wire(name: &str, width: u32, value: impl Into<String>) -> Item {
@@ -234,6 +250,12 @@ pub fn lit(width: u32, value: u64) -> String {
 }
 
 impl Module {
+    /// A formal-only module (a proof's reference), for appending to a product file: inside
+    /// `` `ifdef FORMAL ``, so no other tool sees it.
+    pub fn render_formal(&self) -> String {
+        format!("\n`ifdef FORMAL\n{}`endif\n", self.render())
+    }
+
     pub fn render(&self) -> String {
         let mut o = String::new();
         for line in &self.header {
@@ -361,6 +383,20 @@ fn render_items(o: &mut String, items: &[Item], level: usize) {
                 indent(o, level);
                 o.push_str("end\n");
             }
+            Item::Comb(stmts) => {
+                o.push_str("always @(*) begin\n");
+                render_stmts(o, stmts, level + 1);
+                indent(o, level);
+                o.push_str("end\n");
+            }
+            Item::RegInit { name, width, value } => writeln!(o, "reg {}{name} = {value};", range(*width)).unwrap(),
+            Item::Formal(items) => {
+                // Preprocessor lines start at column 0, like the file's `default_nettype.
+                o.truncate(o.trim_end_matches(' ').len());
+                o.push_str("`ifdef FORMAL\n");
+                render_items(o, items, level);
+                o.push_str("`endif\n");
+            }
         }
     }
 }
@@ -374,6 +410,8 @@ fn render_stmts(o: &mut String, stmts: &[Stmt], level: usize) {
             Stmt::Blocking(l, r) => writeln!(o, "{l} = {r};").unwrap(),
             Stmt::Call(c) => writeln!(o, "{c};").unwrap(),
             Stmt::Delay(n) => writeln!(o, "#{n};").unwrap(),
+            Stmt::Assert(c) => writeln!(o, "assert({c});").unwrap(),
+            Stmt::Assume(c) => writeln!(o, "assume({c});").unwrap(),
             Stmt::Forever(body) => {
                 o.push_str("forever begin\n");
                 render_stmts(o, body, level + 1);

@@ -1,0 +1,214 @@
+//! The formal properties each streaming module carries under `` `ifdef FORMAL ``: SPEC §3's
+//! stream contract as assertions, and the invariants that make it provable by k-induction.
+//!
+//! The contract is checked at the ports against a *shadow* of the accepted spans, kept in the
+//! property block: the spans whose segments have not all appeared yet (at most two: the one
+//! at the output and the one loaded behind it). Every segment that appears is compared with
+//! the one SPEC §3 says comes next (x, mask, last), so a segment lost, repeated, invented or
+//! out of order fails, and a third span accepted while two are owed means one was dropped.
+//!
+//! Port properties alone are not inductive: a solver can start from a state in which the
+//! shader's registers disagree with the shadow and stall forever. The generator knows its
+//! stage structure, so it also states how the current-span registers relate to the shadow
+//! (the linking invariants); with them every property is 1- or 2-inductive. They are
+//! assertions too, so a wrong invariant fails rather than proves something false.
+//!
+//! The environment is held to one rule only: reset in the first clock. Sources need not keep
+//! `in_valid` or the span steady (SPEC asks them to), so the proof covers any input sequence.
+//! Pixel values are left to co-simulation and to the BFPI proof (`bfpi_reference`): each
+//! lane is the accumulator plus a proven multiple of dI.
+
+use crate::verilog::{assign, comment, lit, net, reg, set, sext, wire, zext, Item, Module, Port, Stmt};
+use golden::{Align, Config};
+
+fn assert(c: impl Into<String>) -> Stmt {
+    Stmt::Assert(c.into())
+}
+fn when(cond: impl Into<String>, then: Vec<Stmt>) -> Stmt {
+    Stmt::If(cond.into(), then, vec![])
+}
+
+/// `f_past` (one clock since the solver's start) and `f_past2` (two), and the reset rule.
+fn past_flags() -> Vec<Item> {
+    vec![
+        comment("Clocks since the start: $past is meaningful once f_past is set."),
+        Item::RegInit { name: "f_past".into(), width: 1, value: "1'b0".into() },
+        Item::RegInit { name: "f_past2".into(), width: 1, value: "1'b0".into() },
+        Item::Always(vec![set("f_past", "1'b1"), set("f_past2", "f_past")]),
+        comment("The one rule the environment keeps: reset in the first clock."),
+        Item::Comb(vec![when("!f_past", vec![Stmt::Assume("rst".into())])]),
+    ]
+}
+
+/// Properties of `segment_shader_p<P>` (names as `segment::module_with` declares them).
+pub fn segment_properties(cfg: &Config, rw: u32) -> Item {
+    let (p, xw, log2p) = (cfg.p, cfg.xbits, cfg.log2p());
+    let screen = cfg.align == Align::Screen && p > 1;
+    let lw = log2p.max(1);
+    // Largest lead + m: the pixels-left counter's range.
+    let max_tot = (1u64 << (xw + 1)) - 1 + if screen { p as u64 - 1 } else { 0 };
+    let pr = lit(rw, p as u64);
+    let mut b = past_flags();
+
+    b.push(comment("Reset: no segment out of reset."));
+    b.push(Item::Always(vec![when("f_past && $past(rst)", vec![assert("!out_valid")])]));
+    b.push(comment("Stability: a segment offered and not taken stays, unchanged."));
+    b.push(Item::Always(vec![when(
+        "f_past && !$past(rst) && $past(out_valid && !out_ready)",
+        vec![
+            assert("out_valid"),
+            assert("out_x == $past(out_x)"),
+            assert("out_pix == $past(out_pix)"),
+            assert("out_mask == $past(out_mask)"),
+            assert("out_last == $past(out_last)"),
+        ],
+    )]));
+
+    b.push(comment("The shadow: spans accepted whose segments have not all appeared. Span h's next"));
+    b.push(comment("segment starts f_h_off pixels after its first block's x (f_h_b); t waits behind it."));
+    b.push(comment("A span is first lead (x0 mod P in screen alignment) masked lanes, then m pixels: tot = lead + m."));
+    for s in ["h", "t"] {
+        b.push(reg(&format!("f_{s}_v"), 1));
+        b.push(reg(&format!("f_{s}_b"), xw));
+        b.push(reg(&format!("f_{s}_lead"), lw));
+        b.push(reg(&format!("f_{s}_tot"), rw));
+    }
+    b.push(reg("f_h_off", rw));
+    let (in_b, in_lead) = if screen {
+        let blk = if log2p == xw { lit(xw, 0) } else { format!("{{in_x[{}:{log2p}], {}}}", xw - 1, lit(log2p, 0)) };
+        (blk, format!("in_x[{}:0]", log2p - 1))
+    } else {
+        ("in_x".to_string(), lit(lw, 0))
+    };
+    b.push(wire("f_in_b", xw, in_b));
+    b.push(wire("f_in_lead", lw, in_lead));
+    b.push(wire("f_in_tot", rw, format!("{} + {}", zext("in_len", xw + 1, rw), zext("f_in_lead", lw, rw))));
+    b.push(comment("A new segment is on the output when it is valid and the register could load."));
+    b.push(reg("f_free", 1));
+    b.push(Item::Always(vec![set("f_free", "rst || !out_valid || out_ready")]));
+    b.push(wire("f_fresh", 1, "f_past && out_valid && f_free"));
+    b.push(wire("f_left", rw, "f_h_tot - f_h_off"));
+    b.push(wire("f_exp_last", 1, format!("f_left <= {pr}")));
+    b.push(wire("f_exp_x", xw, format!("f_h_b + f_h_off[{}:0]", xw - 1)));
+    b.push(net("f_exp_mask", p));
+    b.push(Item::ForGenerate {
+        var: "fk".into(),
+        count: p,
+        label: "f_lane".into(),
+        body: vec![
+            Item::Localparam { name: "FK".into(), width: rw + 1, value: "fk".into() },
+            assign(
+                "f_exp_mask[fk]",
+                format!("({{1'b0, f_h_off}} + FK >= {}) && ({{1'b0, f_h_off}} + FK < {{1'b0, f_h_tot}})", zext("f_h_lead", lw, rw + 1)),
+            ),
+        ],
+    });
+    b.push(wire("f_push", 1, "in_valid && in_ready && in_len != 0"));
+    b.push(wire("f_pop", 1, "f_fresh && f_exp_last"));
+    b.push(comment("Each new segment is the one SPEC §3 says comes next; none comes unowed."));
+    b.push(Item::Comb(vec![when(
+        "f_fresh",
+        vec![assert("f_h_v"), assert("out_x == f_exp_x"), assert("out_last == f_exp_last"), assert("out_mask == f_exp_mask")],
+    )]));
+    let take = |dst: &str, src: &str| -> Vec<Stmt> {
+        ["b", "lead", "tot"].iter().map(|f| set(format!("f_{dst}_{f}"), format!("f_{src}_{f}"))).collect()
+    };
+    let mut pop = vec![set("f_h_v", "f_t_v || f_push"), set("f_h_off", lit(rw, 0)), set("f_t_v", "f_t_v && f_push")];
+    pop.push(Stmt::If("f_t_v".into(), take("h", "t"), take("h", "in")));
+    pop.extend(take("t", "in"));
+    let mut push_h = vec![set("f_h_v", "1'b1"), set("f_h_off", lit(rw, 0))];
+    push_h.extend(take("h", "in"));
+    let mut push_t = vec![set("f_t_v", "1'b1")];
+    push_t.extend(take("t", "in"));
+    b.push(Item::Always(vec![Stmt::If(
+        "rst".into(),
+        vec![set("f_h_v", "1'b0"), set("f_t_v", "1'b0")],
+        vec![
+            when("f_fresh && !f_exp_last", vec![set("f_h_off", format!("f_h_off + {pr}"))]),
+            Stmt::If("f_pop".into(), pop, vec![when("f_push", vec![Stmt::If("!f_h_v".into(), push_h, push_t)])]),
+        ],
+    )]));
+    b.push(comment("Nothing lost: a span is accepted only when at most one is owed besides it."));
+    b.push(Item::Comb(vec![when("f_past && f_push", vec![assert("!(f_h_v && f_t_v && !f_pop)")])]));
+
+    b.push(comment("Throughput with out_ready high: no bubble inside a span, nor between spans when the"));
+    b.push(comment("next non-empty span was offered by the time the last segment left the shader."));
+    b.push(Item::Always(vec![
+        when("f_past && !$past(rst) && $past(out_valid && out_ready && !out_last)", vec![assert("out_valid")]),
+        when(
+            "f_past2 && !$past(rst) && !$past(rst, 2) && $past(out_valid && out_ready && out_last) && $past(in_valid && in_len != 0, 2)",
+            vec![assert("out_valid")],
+        ),
+    ]));
+
+    b.push(comment("Linking invariants: the current-span registers hold what the shadow owes next."));
+    let lead_is = |v: &str| if screen { vec![assert(format!("cur_lead == {v}"))] } else { vec![] };
+    let mut fresh_more = vec![
+        assert("cur_valid"),
+        assert("!f_t_v"),
+        assert(format!("cur_x == f_exp_x + {}", lit(xw, p as u64 % (1u64 << xw)))),
+        assert(format!("cur_rem == f_left - {pr}")),
+    ];
+    fresh_more.extend(lead_is(&lit(log2p.max(1), 0)));
+    let mut next_t = vec![assert("cur_x == f_t_b"), assert("cur_rem == f_t_tot")];
+    next_t.extend(lead_is("f_t_lead"));
+    let mut held = vec![assert("cur_valid"), assert("!f_t_v"), assert("cur_x == f_exp_x"), assert("cur_rem == f_left")];
+    held.extend(lead_is(&format!("(f_h_off == {} ? f_h_lead : {})", lit(rw, 0), lit(lw, 0))));
+    let mut range =
+        vec![assert(format!("f_h_tot != {}", lit(rw, 0))), assert("f_h_off < f_h_tot"), assert(format!("f_h_tot <= {}", lit(rw, max_tot)))];
+    let mut trange = vec![assert(format!("f_t_tot != {}", lit(rw, 0))), assert(format!("f_t_tot <= {}", lit(rw, max_tot)))];
+    if log2p > 0 {
+        range.push(assert(format!("f_h_off[{}:0] == {}", log2p - 1, lit(log2p, 0))));
+    }
+    if screen {
+        range.push(assert(format!("f_h_b[{}:0] == {}", log2p - 1, lit(log2p, 0))));
+        trange.push(assert(format!("f_t_b[{}:0] == {}", log2p - 1, lit(log2p, 0))));
+    } else {
+        range.push(assert(format!("f_h_lead == {}", lit(lw, 0))));
+        trange.push(assert(format!("f_t_lead == {}", lit(lw, 0))));
+    }
+    b.push(Item::Comb(vec![when(
+        "f_past",
+        vec![
+            Stmt::If(
+                "!f_h_v".into(),
+                vec![assert("!cur_valid"), assert("!f_t_v"), assert("!f_fresh")],
+                vec![Stmt::If(
+                    "f_fresh && !f_exp_last".into(),
+                    fresh_more,
+                    vec![Stmt::If("f_fresh".into(), vec![assert("cur_valid == f_t_v"), when("f_t_v", next_t)], held)],
+                )],
+            ),
+            when("f_h_v", range),
+            when("f_t_v", trange),
+            when("out_valid && !out_last", vec![assert("cur_valid")]),
+        ],
+    )]));
+    Item::Formal(b)
+}
+
+/// The reference `bfpi_p<P>` is proven equal to (Yosys `equiv_*`, lane by lane, for all di):
+/// `<bfpi>_ref`, each lane `(i+1) * di` written with `*`. A second module rather than an
+/// assertion, because SAT on `x * constant` against a shift-and-add graph takes minutes at
+/// P = 64 where structural equivalence takes seconds.
+pub fn bfpi_reference(cfg: &Config, bfpi: &str) -> Module {
+    let (p, dw, mw) = (cfg.p, cfg.dw(), cfg.mw());
+    Module {
+        name: format!("{bfpi}_ref"),
+        header: vec![],
+        params: vec![],
+        ports: vec![
+            Port::input("di", dw, "", "increment").signed(),
+            Port::output("inc", p * mw, "", "lane i = (i+1)*di, by multiplication"),
+        ],
+        body: vec![Item::ForGenerate {
+            var: "k".into(),
+            count: p,
+            label: "lane".into(),
+            body: vec![
+                Item::Localparam { name: "K".into(), width: mw, value: "k + 1".into() },
+                assign(format!("inc[k*{mw} +: {mw}]"), format!("{} * K", sext("di", dw, mw))),
+            ],
+        }],
+    }
+}
