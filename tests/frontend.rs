@@ -2,7 +2,7 @@
 //! `tri_shader_p<P>` segment by segment and frame by frame, with random gaps and backpressure.
 
 use golden::frontend::{FixedTriangle, FrontEnd, Outcome};
-use rand::rngs::StdRng;
+use golden::rng::SeedRng;
 use rand::SeedableRng;
 use verilator_harness::cosim::{assert_clean, Stress, Traffic};
 use verilator_harness::ffi::{require, require_models, FRONTEND_MODELS, TRISHADER_MODELS};
@@ -18,7 +18,7 @@ fn spans_equal_golden_for_every_kind_of_triangle() {
     let Some(models) = require_models(FRONTEND_MODELS, "tri_frontend", "frontend spans") else { return };
     for m in models {
         let fe = frontend(m);
-        let tris = random_triangles(&mut StdRng::seed_from_u64(seed), &fe, 3000);
+        let tris = random_triangles(&mut SeedRng::seed_from_u64(seed), &fe, 3000);
         let exp = Expected::new(fe, &tris);
         // The stimulus reaches every outcome.
         for o in [Outcome::Guard, Outcome::Culled, Outcome::Walked] {
@@ -41,7 +41,7 @@ fn resets_in_the_middle_of_triangles_drop_them_cleanly() {
     let Some(models) = require_models(FRONTEND_MODELS, "tri_frontend", "frontend resets") else { return };
     for m in models {
         let fe = frontend(m);
-        let tris = random_triangles(&mut StdRng::seed_from_u64(seed ^ 1), &fe, 1500);
+        let tris = random_triangles(&mut SeedRng::seed_from_u64(seed ^ 1), &fe, 1500);
         let report = run_frontend(m, seed, Traffic::RANDOM, Stress::HARSH, &tris);
         assert!(report.resets > 0, "the stress made no reset");
         assert_clean(m.tag, seed, &report);
@@ -54,7 +54,7 @@ fn segments_and_frames_through_the_chain() {
     let Some(models) = require_models(TRISHADER_MODELS, "tri_shader", "tri_shader segments") else { return };
     for m in models {
         let fe = frontend(m);
-        let mut rng = StdRng::seed_from_u64(seed ^ m.cfg.p as u64);
+        let mut rng = SeedRng::seed_from_u64(seed ^ m.cfg.p as u64);
         // Few enough per frame that the frame comparison stays meaningful where they overlap:
         // the last writer wins in both the RTL frame and golden's.
         for round in 0..4 {
@@ -72,7 +72,7 @@ fn a_shared_edge_mesh_writes_every_covered_pixel_exactly_once() {
     let Some(models) = require_models(TRISHADER_MODELS, "tri_shader", "tri_shader mesh") else { return };
     for m in models {
         let fe = frontend(m);
-        let tris: Vec<FixedTriangle> = mesh(&mut StdRng::seed_from_u64(seed), &fe, 17, 11);
+        let tris: Vec<FixedTriangle> = mesh(&mut SeedRng::seed_from_u64(seed), &fe, 17, 11);
         let run = run_chain(m, seed, Traffic::RANDOM, &tris);
         assert_clean(m.tag, seed, &run.report);
         // The mesh covers the screen [0, W) x [0, H) exactly: every pixel, once.
@@ -91,7 +91,7 @@ fn the_scoreboard_catches_a_wrong_span() {
     let seed = verilator_harness::seed("frontend negative control");
     let Some(m) = require(FRONTEND_MODELS.first(), "tri_frontend", "frontend negative control") else { return };
     let fe = frontend(m);
-    let tris = random_triangles(&mut StdRng::seed_from_u64(seed), &fe, 200);
+    let tris = random_triangles(&mut SeedRng::seed_from_u64(seed), &fe, 200);
     let mut bad = tris.clone();
     // A vertex intensity changed by one LSB changes golden's spans but not the RTL's input.
     let k = Expected::new(fe, &tris).stims.iter().position(|s| s.count > 0).unwrap();

@@ -10,10 +10,10 @@
 //! - the harness API rejects spans the ports cannot carry before they reach a model;
 //! - bad triangle input is rejected with its line number, never a panic or garbage pixels.
 
+use golden::rng::SeedRng;
 use golden::setup::{parse_triangles, triangle_spans, Screen, Triangle, Vertex, COORD_LIMIT};
 use golden::specular::{SpecularSpan, N_BITS};
 use golden::{Config, Span};
-use rand::rngs::StdRng;
 use rand::{Rng, SeedableRng};
 use verilator_harness::cosim::{assert_clean, Report, SegmentCosim, Stim, Stress, Traffic};
 use verilator_harness::ffi::{
@@ -32,7 +32,7 @@ fn spec_model(what: &str) -> Option<&'static ModelInfo<SpecIn, SpecOut>> {
 }
 
 /// Spans of random triangles with raw short spans and zero-length spans mixed in.
-fn stress_stims(rng: &mut StdRng, cfg: &Config, screen: &Screen, triangles: usize) -> Vec<Stim> {
+fn stress_stims(rng: &mut SeedRng, cfg: &Config, screen: &Screen, triangles: usize) -> Vec<Stim> {
     let mut stims = Vec::new();
     for k in 0..triangles {
         let t = random_triangle(rng, screen);
@@ -55,7 +55,7 @@ fn segment_shaders_survive_resets_stalls_and_gaps() {
     let screen = Screen::default();
     for (m, info) in models.iter().enumerate() {
         let model_seed = seed.wrapping_add(m as u64);
-        let mut rng = StdRng::seed_from_u64(model_seed);
+        let mut rng = SeedRng::seed_from_u64(model_seed);
         let mut sim = SegmentCosim::new(info, model_seed, Traffic::RANDOM);
         sim.set_stress(STRESS);
         let mut report = Report::default();
@@ -86,7 +86,7 @@ fn segment_frames_exact_under_bursts() {
     let screen = Screen::default();
     for (m, info) in SEGMENT_MODELS.iter().enumerate() {
         let model_seed = seed.wrapping_add(m as u64);
-        let mut rng = StdRng::seed_from_u64(model_seed);
+        let mut rng = SeedRng::seed_from_u64(model_seed);
         let mut sim = SegmentCosim::new(info, model_seed, Traffic::RANDOM);
         sim.set_stress(Stress::BURSTS);
         let mut report = Report::default();
@@ -101,7 +101,7 @@ fn segment_frames_exact_under_bursts() {
 fn specular_unit_survives_resets_stalls_and_gaps() {
     let seed = verilator_harness::seed("specular_unit_survives_resets_stalls_and_gaps");
     let Some(info) = spec_model("the specular unit under stress") else { return };
-    let mut rng = StdRng::seed_from_u64(seed);
+    let mut rng = SeedRng::seed_from_u64(seed);
     let mut sim = SpecularCosim::new(info, specular_unit(), seed, Traffic::RANDOM);
     sim.set_stress(SPEC_STRESS);
     let mut report = Report::default();
@@ -334,7 +334,7 @@ fn bad_triangle_input_is_rejected_with_its_line() {
         assert!(e.message.contains(want), "{bad}: '{}' should contain '{want}'", e.message);
     }
     // Fuzz: lines of random tokens, numbers and junk.
-    let mut rng = StdRng::seed_from_u64(6);
+    let mut rng = SeedRng::seed_from_u64(6);
     let tokens = ["0", "-1", "1e9", "nan", "inf", "-0", "255", "3.5", "#", "x", "", "1e-400", "32768", "-32768", "\t", "1e308"];
     for _ in 0..5000 {
         let line: Vec<&str> = (0..rng.gen_range(0..12)).map(|_| tokens[rng.gen_range(0..tokens.len())]).collect();
@@ -362,7 +362,7 @@ fn bad_triangle_input_is_rejected_with_its_line() {
 #[test]
 fn extreme_triangles_are_clipped_not_garbled() {
     let seed = verilator_harness::seed("extreme_triangles_are_clipped_not_garbled");
-    let mut rng = StdRng::seed_from_u64(seed);
+    let mut rng = SeedRng::seed_from_u64(seed);
     let l = COORD_LIMIT;
     // Three widths bound a default build's time; a COSIM_RTL_DIR build runs what it has.
     for info in SEGMENT_MODELS.iter().filter(|m| m.cfg.p == 8 || m.cfg.p == 1 || m.cfg.p == 64 || RTL_DIR.is_some()) {

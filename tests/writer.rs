@@ -4,10 +4,10 @@
 //! enable or write a pixel twice within a span, and the memory is compared as a frame.
 
 use golden::frontend::{FixedTriangle, FrontEnd};
+use golden::rng::SeedRng;
 use golden::setup::Screen;
 use golden::writer::Writer;
 use golden::Span;
-use rand::rngs::StdRng;
 use rand::{Rng, SeedableRng};
 use verilator_harness::cosim::{assert_clean, Stress, Traffic};
 use verilator_harness::ffi::{require_models, Rtl, WrIn, WrOut, TRIWRITER_MODELS, WRITER_MODELS};
@@ -16,7 +16,7 @@ use verilator_harness::writer::{run_fb, run_writer, run_writer_against};
 
 /// Spans of every shape the glue has a corner for: one pixel, shorter than a block, starting or
 /// ending on a block edge, the whole row, the row's last pixels, and anything at random.
-fn random_spans(rng: &mut StdRng, w: &Writer, n: usize) -> Vec<(u32, Span)> {
+fn random_spans(rng: &mut SeedRng, w: &Writer, n: usize) -> Vec<(u32, Span)> {
     let (width, height, p) = (w.screen.width, w.screen.height, w.cfg.p);
     let imax = (255u32 << w.cfg.frac) as i64;
     (0..n)
@@ -65,7 +65,7 @@ fn writes_equal_golden_under_memory_stalls() {
     let Some(models) = require_models(WRITER_MODELS, "fb_writer", "writer writes") else { return };
     for m in models {
         let w = writer_of(m);
-        let spans = random_spans(&mut StdRng::seed_from_u64(seed ^ m.cfg.p as u64), &w, 4000);
+        let spans = random_spans(&mut SeedRng::seed_from_u64(seed ^ m.cfg.p as u64), &w, 4000);
         for (traffic, stress) in [(Traffic::RANDOM, Stress::BURSTS), (Traffic::FULL, Stress::NONE)] {
             let mut run = run_writer(m, seed, traffic, stress, &spans);
             run.check_frame(&spans);
@@ -86,7 +86,7 @@ fn one_write_per_clock_at_full_rate() {
     let Some(models) = require_models(WRITER_MODELS, "fb_writer", "writer rate") else { return };
     for m in models {
         let w = writer_of(m);
-        let spans = random_spans(&mut StdRng::seed_from_u64(seed), &w, 2000);
+        let spans = random_spans(&mut SeedRng::seed_from_u64(seed), &w, 2000);
         let run = run_writer(m, seed, Traffic::FULL, Stress::NONE, &spans);
         assert_clean(m.tag, seed, &run.report);
         let writes: u64 = spans.iter().map(|(_, s)| w.write_count(s) as u64).sum();
@@ -104,7 +104,7 @@ fn the_scoreboard_catches_a_wrong_writer() {
     let Some(models) = require_models(WRITER_MODELS, "fb_writer", "writer negative control") else { return };
     for m in models {
         let w = writer_of(m);
-        let spans = random_spans(&mut StdRng::seed_from_u64(seed), &w, 300);
+        let spans = random_spans(&mut SeedRng::seed_from_u64(seed), &w, 300);
         let narrow = Writer::new(m.cfg, Screen { width: w.screen.width - m.cfg.p, ..w.screen }).unwrap();
         let spans_narrow: Vec<(u32, Span)> = spans.iter().filter(|(_, s)| s.x0 + s.len <= narrow.screen.width).cloned().collect();
         let run = run_writer_against(m, seed, Traffic::RANDOM, Stress::NONE, &spans_narrow, narrow);
@@ -185,7 +185,7 @@ fn triangles_to_memory_equal_golden_and_the_f64_reference() {
     let Some(models) = require_models(TRIWRITER_MODELS, "tri_fb", "tri_fb frames") else { return };
     for m in models {
         let fe = frontend(m);
-        let mut rng = StdRng::seed_from_u64(seed ^ m.cfg.p as u64);
+        let mut rng = SeedRng::seed_from_u64(seed ^ m.cfg.p as u64);
         for round in 0..3 {
             let tris = random_triangles(&mut rng, &fe, 150);
             let run = run_fb(m, seed + round, Traffic::RANDOM, &tris);
@@ -201,7 +201,7 @@ fn a_shared_edge_mesh_lands_in_memory_once_per_pixel() {
     let Some(models) = require_models(TRIWRITER_MODELS, "tri_fb", "tri_fb mesh") else { return };
     for m in models {
         let fe = frontend(m);
-        let tris: Vec<FixedTriangle> = mesh(&mut StdRng::seed_from_u64(seed), &fe, 13, 9);
+        let tris: Vec<FixedTriangle> = mesh(&mut SeedRng::seed_from_u64(seed), &fe, 13, 9);
         let run = run_fb(m, seed, Traffic::RANDOM, &tris);
         assert_clean(m.tag, seed, &run.report);
         let writes = run.mem.screen_writes();

@@ -6,6 +6,7 @@ pub mod bfpi;
 pub mod format;
 pub mod frontend;
 pub mod raster;
+pub mod rng;
 pub mod rom;
 pub mod schemes;
 pub mod segment;

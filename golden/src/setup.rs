@@ -538,9 +538,9 @@ mod tests {
         use rand::{Rng, SeedableRng};
         let cfg = Config::default();
         let screen = Screen { width: 40, height: 30 };
-        let mut rng = rand::rngs::StdRng::seed_from_u64(7);
+        let mut rng = crate::rng::SeedRng::seed_from_u64(7);
         for _ in 0..3000 {
-            let c = |rng: &mut rand::rngs::StdRng, hi: f64| {
+            let c = |rng: &mut crate::rng::SeedRng, hi: f64| {
                 let v: f64 = rng.gen_range(-5.0..hi);
                 if rng.gen_bool(0.5) {
                     (v * 2.0).round() / 2.0

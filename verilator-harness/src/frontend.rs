@@ -14,9 +14,9 @@ use crate::ffi::{to_port, FeOut, ModelInfo, Rtl, TriIn, TriSegOut};
 use crate::traffic::{Traffic, TrafficGen};
 use golden::frontend::{FixedTriangle, FrontEnd, Outcome};
 use golden::raster::{compare, reference_triangle, Frame, RefFrame};
+use golden::rng::SeedRng;
 use golden::segment::segment;
 use golden::Span;
-use rand::rngs::StdRng;
 use rand::Rng;
 
 /// A triangle with golden's verdict: its spans are `spans[first..first + count]`.
@@ -409,7 +409,7 @@ pub(crate) fn check_frame(exp: &Expected, frame: &Frame, writes: &[u8], report: 
 /// Random port-level triangles of every kind: anywhere in the guard band (huge), tiny, slivers
 /// both ways, vertices on pixel centres, horizontal edges, on the band's edges, outside it,
 /// zero-area, entirely off-screen.
-pub fn random_triangles(rng: &mut StdRng, fe: &FrontEnd, n: usize) -> Vec<FixedTriangle> {
+pub fn random_triangles(rng: &mut SeedRng, fe: &FrontEnd, n: usize) -> Vec<FixedTriangle> {
     let (w, h) = (fe.screen.width as i64 * 256, fe.screen.height as i64 * 256);
     let wd = fe.widths();
     // SPEC §5's intensities 0..255 (the port takes up to 2^IW - 1; the f64 reference does not).
@@ -450,7 +450,7 @@ pub fn random_triangles(rng: &mut StdRng, fe: &FrontEnd, n: usize) -> Vec<FixedT
 
 /// A mesh of triangles sharing edges: a jittered grid over the screen, each cell cut on a
 /// random diagonal, vertices sometimes exactly on pixel centres.
-pub fn mesh(rng: &mut StdRng, fe: &FrontEnd, cols: i64, rows: i64) -> Vec<FixedTriangle> {
+pub fn mesh(rng: &mut SeedRng, fe: &FrontEnd, cols: i64, rows: i64) -> Vec<FixedTriangle> {
     let (w, h) = (fe.screen.width as i64 * 256, fe.screen.height as i64 * 256);
     let imax = 255i64 << fe.cfg.frac;
     let mut pts = vec![(0i64, 0i64, 0u32); ((cols + 1) * (rows + 1)) as usize];

@@ -86,7 +86,7 @@ pub fn accuracy_table(unit: &SpecularUnit, c: u16) -> Vec<NAccuracy> {
 mod tests {
     use super::super::{ABS_TOL, INSIDE_REL, OUTSIDE_REL};
     use super::*;
-    use rand::rngs::StdRng;
+    use crate::rng::SeedRng;
     use rand::{Rng, SeedableRng};
 
     /// Every output of n with input c against SPEC §4, over every theta code; also that the
@@ -117,7 +117,7 @@ mod tests {
     #[test]
     fn specular_accuracy_every_output_meets_spec_4() {
         let unit = SpecularUnit::default();
-        let mut r = StdRng::seed_from_u64(0x5bec);
+        let mut r = SeedRng::seed_from_u64(0x5bec);
         for n in N_MIN..=N_MAX {
             // The largest C (relative bounds bind), C = 1.0, and one arbitrary C per n.
             for c in [u16::MAX, 256, r.gen_range(1..u16::MAX)] {
@@ -135,7 +135,7 @@ mod tests {
     fn specular_accuracy_segments_cover_every_code() {
         // The runs the checks rely on really are where the output is constant.
         let unit = SpecularUnit::default();
-        let mut r = StdRng::seed_from_u64(7);
+        let mut r = SeedRng::seed_from_u64(7);
         for n in [1u32, 2, 4, 6, 7, 500, 1000] {
             let seg = unit.plan().segments(n);
             assert_eq!(seg[0].0, 0);

@@ -245,17 +245,17 @@ mod tests {
     use super::super::reference::{approx_error, blinn_phong_slerp, epicentre_code};
     use super::super::{span_overflows, SpecularUnit, THETA_FRAC};
     use super::*;
-    use rand::rngs::StdRng;
+    use crate::rng::SeedRng;
     use rand::{Rng, SeedableRng};
 
     /// Seeded from GOLDEN_SEED if set, else fresh; the seed is printed so a failure replays.
-    fn rng() -> StdRng {
+    fn rng() -> SeedRng {
         let seed = std::env::var("GOLDEN_SEED").ok().and_then(|s| s.parse().ok()).unwrap_or_else(rand::random::<u64>);
         eprintln!("GOLDEN_SEED={seed}");
-        StdRng::seed_from_u64(seed)
+        SeedRng::seed_from_u64(seed)
     }
 
-    fn unit(r: &mut StdRng) -> Vec3 {
+    fn unit(r: &mut SeedRng) -> Vec3 {
         loop {
             let v = [r.gen_range(-1.0..1.0), r.gen_range(-1.0..1.0), r.gen_range(-1.0..1.0)];
             if let Some(u) = normalize(v).filter(|_| norm(v) <= 1.0) {
@@ -264,13 +264,13 @@ mod tests {
         }
     }
 
-    fn nudge(r: &mut StdRng, v: Vec3) -> Vec3 {
+    fn nudge(r: &mut SeedRng, v: Vec3) -> Vec3 {
         let e = [0.0, 1e-15, 1e-9, 1e-6][r.gen_range(0..4)];
         add(v, scale(unit(r), e))
     }
 
     /// Random ends with the degenerate configurations over-represented.
-    fn ends(r: &mut StdRng) -> SpanEnds {
+    fn ends(r: &mut SeedRng) -> SpanEnds {
         let (n1, h1) = (unit(r), unit(r));
         let mut e = SpanEnds { n1, h1, n2: unit(r), h2: unit(r) };
         match r.gen_range(0..12) {
@@ -348,7 +348,7 @@ mod tests {
         let mut checked = 0;
         for _ in 0..400 {
             let n1 = unit(&mut r);
-            let near = |r: &mut StdRng| normalize(add(n1, scale(unit(r), r.gen_range(0.0..0.6)))).unwrap();
+            let near = |r: &mut SeedRng| normalize(add(n1, scale(unit(r), r.gen_range(0.0..0.6)))).unwrap();
             let (h1, h2) = (near(&mut r), near(&mut r));
             let e = SpanEnds { n1, h1, n2: n1, h2 };
             let (n, l) = (r.gen_range(1..=1000u32), r.gen_range(1..=600u32));

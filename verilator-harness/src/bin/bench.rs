@@ -26,11 +26,11 @@
 //! and thresholds.
 
 use clap::{Parser, Subcommand, ValueEnum};
+use golden::rng::SeedRng;
 use golden::segment::segments;
 use golden::setup::{triangle_spans, Screen};
 use golden::specular::SpecularSpan;
 use golden::{Align, Span};
-use rand::rngs::StdRng;
 use rand::SeedableRng;
 use std::fs::File;
 use std::io::{BufReader, BufWriter, Read, Write};
@@ -231,7 +231,7 @@ fn gen_segment(p: u32, count: usize, seed: u64, traffic: Traffic, out: &std::pat
     };
     let cfg = info.cfg;
     let screen = Screen::default();
-    let mut rng = StdRng::seed_from_u64(seed);
+    let mut rng = SeedRng::seed_from_u64(seed);
     let mut stims: Vec<Stim> = Vec::with_capacity(count);
     let mut triangle = 0;
     while stims.len() < count {
@@ -288,7 +288,7 @@ fn gen_specular(count: usize, seed: u64, traffic: Traffic, out: &std::path::Path
         return ExitCode::from(2);
     };
     let unit = specular_unit();
-    let mut rng = StdRng::seed_from_u64(seed);
+    let mut rng = SeedRng::seed_from_u64(seed);
     let spans: Vec<SpecularSpan> = (0..count).map(|_| random_span(&mut rng, info.cfg.max_len())).collect();
     let outputs: u64 = spans.iter().map(|s| s.len as u64).sum();
     let header = Header {

@@ -3,9 +3,9 @@
 //! With `--specular`, the same for the specular unit, pixel by pixel (spans).
 
 use clap::{Parser, ValueEnum};
+use golden::rng::SeedRng;
 use golden::setup::Screen;
 use golden::Align;
-use rand::rngs::StdRng;
 use rand::SeedableRng;
 use std::process::ExitCode;
 use std::time::Instant;
@@ -105,7 +105,7 @@ fn main() -> ExitCode {
     let traffic = args.traffic.traffic();
     println!("model {} ({}), screen {}x{}, seed {seed}, traffic {}", info.tag, info.top, screen.width, screen.height, args.traffic.name());
 
-    let mut rng = StdRng::seed_from_u64(seed);
+    let mut rng = SeedRng::seed_from_u64(seed);
     let mut sim = SegmentCosim::new(info, seed, traffic);
     let mut report = Report::default();
     let start = Instant::now();
@@ -166,7 +166,7 @@ fn rtl_frontend(args: &Args) -> ExitCode {
         args.traffic.name()
     );
     let fe = info.frontend();
-    let mut rng = StdRng::seed_from_u64(seed);
+    let mut rng = SeedRng::seed_from_u64(seed);
     let mut report = Report::default();
     let start = Instant::now();
     let mut done = 0;
@@ -198,7 +198,7 @@ fn specular(args: &Args) -> ExitCode {
     let seed = args.seed.unwrap_or_else(|| verilator_harness::seed("cosim --specular"));
     let traffic = args.traffic.traffic();
     println!("model {} ({}), seed {seed}, traffic {}", info.tag, info.top, args.traffic.name());
-    let mut rng = StdRng::seed_from_u64(seed);
+    let mut rng = SeedRng::seed_from_u64(seed);
     let mut sim = SpecularCosim::new(info, specular_unit(), seed, traffic);
     let mut report = Report::default();
     let start = Instant::now();

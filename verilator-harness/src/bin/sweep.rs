@@ -7,10 +7,10 @@
 //! equal the analytical one (`Σ segments + latency`). Either failing gives exit status 1.
 
 use clap::Parser;
+use golden::rng::SeedRng;
 use golden::schemes::{workload_count, Scheme, FILL};
 use golden::setup::{Screen, Triangle, Vertex};
 use golden::Align;
-use rand::rngs::StdRng;
 use rand::{Rng, SeedableRng};
 use std::fmt::Write as _;
 use std::path::PathBuf;
@@ -48,7 +48,7 @@ const CLASSES: [f64; 3] = [10.0, 100.0, 1000.0];
 /// vertices on the 1/128-pixel grid (so the midline split tiles it exactly), random intensities.
 /// The shape: three points uniform in a disk, scaled to the area; very thin ones (under 5% of
 /// the disk's largest triangle) are drawn again, so the class is not dominated by slivers.
-fn sized_triangle(rng: &mut StdRng, screen: &Screen, area: f64) -> Triangle {
+fn sized_triangle(rng: &mut SeedRng, screen: &Screen, area: f64) -> Triangle {
     let target = area * rng.gen_range(0.8f64.ln()..1.25f64.ln()).exp();
     loop {
         let mut p = [[0.0f64; 2]; 3];
@@ -105,7 +105,7 @@ fn main() -> ExitCode {
         return ExitCode::from(2);
     }
     let cfg = models[0].cfg;
-    let mut rng = StdRng::seed_from_u64(args.seed);
+    let mut rng = SeedRng::seed_from_u64(args.seed);
     let workloads: Vec<Vec<Triangle>> =
         CLASSES.iter().map(|&a| (0..args.triangles).map(|_| sized_triangle(&mut rng, &screen, a)).collect()).collect();
     // One bar over every RTL run; indicatif hides it when stderr is not a terminal.
