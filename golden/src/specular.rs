@@ -64,6 +64,17 @@ pub const INSIDE_REL: f64 = 0.0025;
 pub const OUTSIDE_REL: f64 = 0.005;
 pub const ABS_TOL: f64 = 2.0 / 256.0;
 
+/// SPEC §4's allowance for `|out - approx|`, in output units (UQ8.8 as a real): `approx` is the
+/// table approximation `C * a`, `c` the input C, `inside` whether the pixel is in the epicentre.
+/// Every checker takes its bound from here.
+pub fn tolerance(inside: bool, approx: f64, c: f64) -> f64 {
+    if inside {
+        INSIDE_REL * approx + ABS_TOL
+    } else {
+        OUTSIDE_REL * c + ABS_TOL
+    }
+}
+
 /// Whether `n` is one the unit computes; the others give `out_err = 1`, `out_spec = 0`.
 pub fn n_valid(n: u32) -> bool {
     (N_MIN..=N_MAX).contains(&n)

@@ -8,7 +8,7 @@ use crate::ffi::{to_port, ModelInfo, Rtl, SpecIn, SpecOut};
 use crate::traffic::TrafficGen;
 use golden::specular::reference::{approx, cos_k, epicentre};
 use golden::specular::setup::{norm, normalize, setup_span, SpanEnds, Vec3};
-use golden::specular::{n_valid, theta_at, SpecularSpan, SpecularUnit, ABS_TOL, C_FRAC, INSIDE_REL, N_MAX, OUTSIDE_REL, THETA_FRAC};
+use golden::specular::{n_valid, theta_at, tolerance, SpecularSpan, SpecularUnit, C_FRAC, N_MAX, THETA_FRAC};
 use rand::Rng;
 use std::f64::consts::FRAC_PI_2;
 
@@ -215,7 +215,7 @@ impl Judge {
                 let inside = delta <= self.shine.edge;
                 self.cos_k[table].surely_within(a * delta, c, got, inside) || {
                     let want = approx(c, s.n as u32, k_n, delta);
-                    let tol = if inside { INSIDE_REL * want } else { OUTSIDE_REL * c } + ABS_TOL;
+                    let tol = tolerance(inside, want, c);
                     (got - want).abs() <= tol
                 }
             }
@@ -264,7 +264,7 @@ impl Judge {
             let delta = theta.unsigned_abs() as f64 / (1u64 << THETA_FRAC) as f64;
             let want = approx(c, s.n as u32, k_n, delta);
             let inside = delta <= self.shine.edge;
-            let tol = if inside { INSIDE_REL * want } else { OUTSIDE_REL * c } + ABS_TOL;
+            let tol = tolerance(inside, want, c);
             if (got - want).abs() > tol {
                 let place = if inside { "inside" } else { "outside" };
                 problems
@@ -320,9 +320,9 @@ impl CosK {
         let (lo, hi) = (c * (est - self.err), c * (est + self.err));
         let m = 1e-9 * (1.0 + c);
         if inside {
-            got >= hi - (INSIDE_REL * hi + ABS_TOL) + m && got <= lo + (INSIDE_REL * lo + ABS_TOL) - m
+            got >= hi - tolerance(true, hi, c) + m && got <= lo + tolerance(true, lo, c) - m
         } else {
-            let tol = OUTSIDE_REL * c + ABS_TOL;
+            let tol = tolerance(false, 0.0, c);
             got >= hi - tol + m && got <= lo + tol - m
         }
     }
@@ -430,7 +430,7 @@ mod tests {
     use super::{monotone, CosK};
     use golden::rng::SeedRng;
     use golden::specular::reference::cos_k;
-    use golden::specular::{ABS_TOL, INSIDE_REL, OUTSIDE_REL};
+    use golden::specular::tolerance;
     use rand::{Rng, SeedableRng};
     use std::f64::consts::FRAC_PI_2;
 
@@ -482,7 +482,7 @@ mod tests {
                 let c = rng.gen_range(0.0..256.0);
                 let want = c * cos_k(k, x);
                 let inside = rng.gen_bool(0.5);
-                let tol = if inside { INSIDE_REL * want } else { OUTSIDE_REL * c } + ABS_TOL;
+                let tol = tolerance(inside, want, c);
                 // Outputs around both edges of the bound, and inside it.
                 let got = want + tol * rng.gen_range(-1.02..1.02);
                 if table.surely_within(x, c, got, inside) {

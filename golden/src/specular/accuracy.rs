@@ -84,7 +84,7 @@ pub fn accuracy_table(unit: &SpecularUnit, c: u16) -> Vec<NAccuracy> {
 
 #[cfg(test)]
 mod tests {
-    use super::super::{ABS_TOL, INSIDE_REL, OUTSIDE_REL};
+    use super::super::{tolerance, INSIDE_REL};
     use super::*;
     use crate::rng::SeedRng;
     use rand::{Rng, SeedableRng};
@@ -107,7 +107,7 @@ mod tests {
             }
             for code in points {
                 let a = approx(cf, n, k, rad(code));
-                let tol = if code <= edge { INSIDE_REL * a } else { OUTSIDE_REL * cf } + ABS_TOL;
+                let tol = tolerance(code <= edge, a, cf);
                 let o = out as f64 / 256.0;
                 assert!((o - a).abs() <= tol, "n={n} c={c} code={code}: out {o} approx {a} tol {tol}");
             }
@@ -163,7 +163,7 @@ mod tests {
             for (j, p) in unit.span(&s).enumerate() {
                 let code = (s.theta0 as i64 + j as i64 * s.dtheta as i64).abs();
                 let a = approx(s.c as f64 / 256.0, n, k, rad(code as u64));
-                let tol = if code <= edge { INSIDE_REL * a } else { OUTSIDE_REL * 255.996 } + ABS_TOL;
+                let tol = tolerance(code <= edge, a, 255.996);
                 assert!((p.spec as f64 / 256.0 - a).abs() <= tol, "n={n} j={j}");
                 if let Some((pc, ps)) = prev {
                     assert!(code < pc && p.spec >= ps || code > pc && p.spec <= ps || code == pc);
