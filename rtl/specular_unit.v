@@ -168,6 +168,119 @@ module specular_unit #(
     end
   end
 
+`ifdef FORMAL
+  // Clocks since the start: $past is meaningful once f_past is set.
+  reg f_past = 1'b0;
+  reg f_past2 = 1'b0;
+  always @(posedge clk) begin
+    f_past <= 1'b1;
+    f_past2 <= f_past;
+  end
+  // The one rule the environment keeps: reset in the first clock.
+  always @(*) begin
+    if (!f_past) begin
+      assume(rst);
+    end
+  end
+  // Reset: no pixel out of reset.
+  always @(posedge clk) begin
+    if (f_past && $past(rst)) begin
+      assert(!out_valid);
+    end
+  end
+  // Stability: a pixel offered and not taken stays, unchanged.
+  always @(posedge clk) begin
+    if (f_past && !$past(rst) && $past(out_valid && !out_ready)) begin
+      assert(out_valid);
+      assert(out_spec == $past(out_spec));
+      assert(out_last == $past(out_last));
+      assert(out_err == $past(out_err));
+    end
+  end
+  // The reference: the span being issued (f_len pixels, f_k issued) and the pipe.
+  reg f_busy;
+  reg [12:0] f_len;
+  reg [12:0] f_k;
+  wire f_adv = !out_valid || out_ready;
+  wire f_last0 = f_k + 13'd1 == f_len;
+  reg f_v1;
+  reg f_l1;
+  reg f_v2;
+  reg f_l2;
+  reg f_v3;
+  reg f_l3;
+  reg f_v4;
+  reg f_l4;
+  always @(posedge clk) begin
+    if (rst) begin
+      f_busy <= 1'b0;
+      f_v1 <= 1'b0;
+      f_v2 <= 1'b0;
+      f_v3 <= 1'b0;
+      f_v4 <= 1'b0;
+    end else begin
+      if (f_adv) begin
+        f_v1 <= f_busy;
+        f_l1 <= f_last0;
+        f_v2 <= f_v1;
+        f_l2 <= f_l1;
+        f_v3 <= f_v2;
+        f_l3 <= f_l2;
+        f_v4 <= f_v3;
+        f_l4 <= f_l3;
+      end
+      if (in_valid && in_ready) begin
+        f_busy <= in_len != 13'd0;
+        f_len <= in_len;
+        f_k <= 13'd0;
+      end else if (f_adv && f_busy) begin
+        if (f_last0) begin
+          f_busy <= 1'b0;
+        end else begin
+          f_k <= f_k + 13'd1;
+        end
+      end
+    end
+  end
+  // Ports against the reference: accept exactly when idle or finishing into a free pipe;
+  // the output's valid and last are the reference's.
+  always @(*) begin
+    if (f_past) begin
+      assert(in_ready == (!f_busy || (f_adv && f_last0)));
+      assert(out_valid == f_v4);
+      if (out_valid) begin
+        assert(out_last == f_l4);
+      end
+    end
+  end
+  // Linking invariants: the unit's stage registers are the reference's.
+  always @(*) begin
+    if (f_past) begin
+      assert(busy == f_busy);
+      if (f_busy) begin
+        assert(f_k < f_len);
+        assert(cnt == f_len - f_k);
+      end
+      assert(v1 == f_v1);
+      if (v1) begin
+        assert(last1 == f_l1);
+      end
+      assert(v2 == f_v2);
+      if (v2) begin
+        assert(last2 == f_l2);
+      end
+      assert(v3 == f_v3);
+      if (v3) begin
+        assert(last3 == f_l3);
+      end
+      assert(out_valid == f_v4);
+      if (out_valid) begin
+        assert(out_last == f_l4);
+      end
+    end
+  end
+`endif
+
 endmodule
 
 `default_nettype wire

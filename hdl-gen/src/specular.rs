@@ -263,6 +263,8 @@ fn module(cfg: &Config, unit: &SpecularUnit, names: &SpecNames) -> Module {
         )],
     )]));
 
+    body.push(Item::Blank);
+    body.push(crate::formal::specular_properties(lw, &[("v1", "last1"), ("v2", "last2"), ("v3", "last3"), ("out_valid", "out_last")]));
     Module {
         name: names.unit.clone(),
         header,
