@@ -237,6 +237,13 @@ module segment_shader_p8 (
       assert(out_valid);
     end
   end
+  // Valid never waits for ready: a segment owed to an empty output is offered the next
+  // clock, whatever out_ready was (a sink may wait for valid before raising ready).
+  always @(posedge clk) begin
+    if (f_past && !$past(rst) && $past(f_h_v && !out_valid)) begin
+      assert(out_valid);
+    end
+  end
   // Linking invariants: the current-span registers hold what the shadow owes next.
   always @(*) begin
     if (f_past) begin

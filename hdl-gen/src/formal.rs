@@ -142,6 +142,10 @@ pub fn segment_properties(cfg: &Config, rw: u32) -> Item {
         ),
     ]));
 
+    b.push(comment("Valid never waits for ready: a segment owed to an empty output is offered the next"));
+    b.push(comment("clock, whatever out_ready was (a sink may wait for valid before raising ready)."));
+    b.push(Item::Always(vec![when("f_past && !$past(rst) && $past(f_h_v && !out_valid)", vec![assert("out_valid")])]));
+
     b.push(comment("Linking invariants: the current-span registers hold what the shadow owes next."));
     let lead_is = |v: &str| if screen { vec![assert(format!("cur_lead == {v}"))] } else { vec![] };
     let mut fresh_more = vec![
