@@ -8,10 +8,10 @@
 //! level where two earlier values make it, so every value sits at its minimal depth and the
 //! graph depth is the minimum possible: 1 for p <= 8, 2 for 16..=128, 3 for 256.
 
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 /// Add or subtract.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum Op {
     Add,
@@ -20,7 +20,7 @@ pub enum Op {
 
 /// One adder: `value = (a << a_shift) op (b << b_shift)`, where `a` and `b` are the input
 /// (1) or earlier adders' values, always odd.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 pub struct Adder {
     pub value: u32,
     pub a: u32,

@@ -134,7 +134,7 @@ pub fn generate(opts: &Options) -> Vec<GeneratedFile> {
     for (name, rom) in [(golden::rom::BRDF_HEX, unit.brdf_rom()), (golden::rom::NK_HEX, unit.nk_rom())] {
         files.push(GeneratedFile { name: name.into(), contents: rom.to_hex() });
     }
-    files.push(GeneratedFile { name: "manifest.json".into(), contents: manifest::render(opts, &names, &modules, &unit) });
+    files.push(GeneratedFile { name: manifest::MANIFEST_FILE.into(), contents: manifest::render(opts, &names, &modules, &unit) });
     files.push(GeneratedFile { name: manifest::CORE_FILE.into(), contents: manifest::core_file(opts, &names, &modules) });
     files
 }

@@ -1,5 +1,9 @@
 //! `manifest.json` and the FuseSoC CAPI2 core: machine-readable descriptions of what
 //! `generate` wrote, derived from the same module descriptions that print the Verilog.
+//!
+//! [`Manifest`] is the file's one schema: `generate` serializes it, and every reader
+//! (`hdl-gen synth-wrapper`, the harness's build script for `COSIM_RTL_DIR`, the tests)
+//! deserializes it with [`Manifest::parse`], so a field renamed here is renamed for all of them.
 
 use crate::specular::SpecNames;
 use crate::verilog::{Dir, Module};
@@ -7,148 +11,193 @@ use crate::{segment, BfpiArch, Names, Options, VERSION};
 use golden::bfpi::{Adder, BfpiPlan};
 use golden::rom::{Rom, BRDF_HEX, NK_HEX};
 use golden::specular::{SpecularGeometry, SpecularUnit};
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 pub const CORE_FILE: &str = "segshade.core";
+/// The manifest's file name in a folder `generate` wrote.
+pub const MANIFEST_FILE: &str = "manifest.json";
 
-#[derive(Serialize)]
-struct Manifest<'a> {
-    generator: Generator,
-    parameters: Parameters<'a>,
-    formats: Formats,
-    modules: Vec<ModuleEntry>,
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Manifest {
+    pub generator: Generator,
+    pub parameters: Parameters,
+    pub formats: Formats,
+    pub modules: Vec<ModuleEntry>,
     /// The shift-and-add graph; absent for the comparison forms (`--bfpi-arch naive|tree`).
-    #[serde(skip_serializing_if = "Option::is_none")]
-    bfpi: Option<Bfpi>,
-    specular: Specular,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub bfpi: Option<Bfpi>,
+    pub specular: Specular,
     /// SPEC §6's front-end; absent when the configuration cannot host the screen.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    frontend: Option<Frontend>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub frontend: Option<Frontend>,
     /// SPEC §7's segment writer and block memory; present with the front-end.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    writer: Option<WriterEntry>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub writer: Option<WriterEntry>,
+}
+
+/// What a module is in the chain; readers find modules by role, not by name (names take a prefix).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Role {
+    Bfpi,
+    SegmentShader,
+    Frontend,
+    TriangleShader,
+    Writer,
+    TriangleWriter,
+    SpecularUnit,
+    Rom,
 }
 
 /// The block memory the writer addresses, and its timing.
-#[derive(Serialize)]
-struct WriterEntry {
-    module: String,
-    top: String,
-    screen: golden::setup::Screen,
-    blocks_per_row: u32,
-    blocks: u32,
-    addr_bits: u32,
-    address: &'static str,
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct WriterEntry {
+    pub module: String,
+    pub top: String,
+    pub screen: golden::setup::Screen,
+    pub blocks_per_row: u32,
+    pub blocks: u32,
+    pub addr_bits: u32,
+    pub address: String,
     /// Clocks from a segment's transfer to its write.
-    latency: u32,
-    writes: &'static str,
+    pub latency: u32,
+    pub writes: String,
 }
 
 /// The front-end's screen, guard band, widths and timing.
-#[derive(Serialize)]
-struct Frontend {
-    module: String,
-    top: String,
-    screen: golden::setup::Screen,
-    guard_band: String,
-    widths: golden::frontend::Widths,
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Frontend {
+    pub module: String,
+    pub top: String,
+    pub screen: golden::setup::Screen,
+    pub guard_band: String,
+    pub widths: golden::frontend::Widths,
     /// Quotient bits per clock of the set-up dividers (`--fe-div-bits`).
-    div_bits: u32,
+    pub div_bits: u32,
     /// Where `dI` comes from (`--fe-di`): `triangle` (once per triangle) or `scanline`.
-    di: golden::frontend::DiMode,
+    pub di: golden::frontend::DiMode,
     /// Per-scanline dI only: clocks the span divider runs for a span of two pixels or more.
-    span_div_clocks: u32,
+    pub span_div_clocks: u32,
     /// Clocks from a triangle's transfer to its first span when the walker is idle.
-    latency: u32,
+    pub latency: u32,
     /// Set-up clocks per walked triangle (its rate limit) and per dropped triangle.
-    setup_clocks_walked: u32,
-    setup_clocks_dropped: u32,
+    pub setup_clocks_walked: u32,
+    pub setup_clocks_dropped: u32,
     /// Walker clocks per triangle: one per row from its first to its last covered row.
-    walker: &'static str,
+    pub walker: String,
 }
 
 /// The specular unit's configuration: k-set, n ranges, tables, ROM geometry, pipeline.
-#[derive(Serialize)]
-struct Specular {
-    module: String,
-    brdf_rom: RomEntry,
-    nk_rom: RomEntry,
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Specular {
+    pub module: String,
+    pub brdf_rom: RomEntry,
+    pub nk_rom: RomEntry,
     #[serde(flatten)]
-    geometry: SpecularGeometry,
+    pub geometry: SpecularGeometry,
 }
 
-#[derive(Serialize)]
-struct RomEntry {
-    module: String,
-    file: &'static str,
-    depth: usize,
-    width: u32,
-    bits: u64,
+#[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub struct RomEntry {
+    pub module: String,
+    pub file: String,
+    pub depth: usize,
+    pub width: u32,
+    pub bits: u64,
 }
 
 impl RomEntry {
-    fn new(module: &str, file: &'static str, rom: &Rom) -> RomEntry {
-        RomEntry { module: module.to_string(), file, depth: rom.depth(), width: rom.width, bits: rom.bits() }
+    fn new(module: &str, file: &str, rom: &Rom) -> RomEntry {
+        RomEntry { module: module.to_string(), file: file.to_string(), depth: rom.depth(), width: rom.width, bits: rom.bits() }
     }
 }
 
-#[derive(Serialize)]
-struct Generator {
-    name: &'static str,
-    version: &'static str,
+#[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub struct Generator {
+    pub name: String,
+    pub version: String,
 }
 
-#[derive(Serialize)]
-struct Parameters<'a> {
-    p: u32,
-    frac: u32,
-    xbits: u32,
-    align: &'static str,
-    prefix: &'a str,
+#[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub struct Parameters {
+    pub p: u32,
+    pub frac: u32,
+    pub xbits: u32,
+    pub align: golden::Align,
+    pub prefix: String,
     /// Only written for the comparison forms, so the default output stays as it was.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    bfpi_arch: Option<&'static str>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub bfpi_arch: Option<String>,
 }
 
-#[derive(Serialize)]
-struct Formats {
-    intensity: String,
-    increment: String,
-    pixel: &'static str,
-    iw: u32,
-    dw: u32,
-    mw: u32,
-    accumulator_bits: u32,
+#[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub struct Formats {
+    pub intensity: String,
+    pub increment: String,
+    pub pixel: String,
+    pub iw: u32,
+    pub dw: u32,
+    pub mw: u32,
+    pub accumulator_bits: u32,
 }
 
-#[derive(Serialize)]
-struct ModuleEntry {
-    name: String,
-    file: String,
-    role: &'static str,
+#[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub struct ModuleEntry {
+    pub name: String,
+    pub file: String,
+    pub role: Role,
     /// Clocks from input to output; 0 for combinational blocks.
-    latency: u32,
-    throughput: &'static str,
-    ports: Vec<PortEntry>,
+    pub latency: u32,
+    pub throughput: String,
+    pub ports: Vec<PortEntry>,
 }
 
-#[derive(Serialize)]
+#[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
 pub struct PortEntry {
     pub name: String,
-    pub direction: &'static str,
+    pub direction: Dir,
     pub width: u32,
     pub signed: bool,
     pub format: String,
     pub description: String,
 }
 
-#[derive(Serialize)]
-struct Bfpi {
-    module: String,
-    adder_count: usize,
-    depth: u32,
-    lower_bound: u32,
-    adders: Vec<Adder>,
+#[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub struct Bfpi {
+    pub module: String,
+    pub adder_count: usize,
+    pub depth: u32,
+    pub lower_bound: u32,
+    pub adders: Vec<Adder>,
+}
+
+/// A `manifest.json` that does not read as [`Manifest`].
+#[derive(Debug, thiserror::Error)]
+pub enum ManifestError {
+    #[error("manifest.json: {0}")]
+    Json(#[from] serde_json::Error),
+    #[error("manifest.json lists no module '{module}' (it lists {listed})")]
+    NoModule { module: String, listed: String },
+}
+
+impl Manifest {
+    /// Reads a `manifest.json` text.
+    pub fn parse(text: &str) -> Result<Manifest, ManifestError> {
+        Ok(serde_json::from_str(text)?)
+    }
+
+    /// The entry of the module named `name`.
+    pub fn module(&self, name: &str) -> Result<&ModuleEntry, ManifestError> {
+        self.modules.iter().find(|m| m.name == name).ok_or_else(|| ManifestError::NoModule {
+            module: name.to_string(),
+            listed: self.modules.iter().map(|m| m.name.as_str()).collect::<Vec<_>>().join(", "),
+        })
+    }
+
+    /// The first module with `role`, if the configuration has one.
+    pub fn by_role(&self, role: Role) -> Option<&ModuleEntry> {
+        self.modules.iter().find(|m| m.role == role)
+    }
 }
 
 fn ports(m: &Module) -> Vec<PortEntry> {
@@ -156,10 +205,7 @@ fn ports(m: &Module) -> Vec<PortEntry> {
         .iter()
         .map(|p| PortEntry {
             name: p.name.clone(),
-            direction: match p.dir {
-                Dir::Input => "input",
-                Dir::Output => "output",
-            },
+            direction: p.dir,
             width: p.width,
             signed: p.signed,
             format: p.format.clone(),
@@ -177,38 +223,38 @@ pub fn render(opts: &Options, names: &Names, modules: &[Module], unit: &Specular
     let wr = opts.writer().ok().filter(|_| fe.is_some());
     let entry = |m: &Module| {
         let (role, latency, throughput) = if m.name == names.bfpi {
-            ("bfpi", 0, "combinational")
+            (Role::Bfpi, 0, "combinational")
         } else if m.name == names.segment {
-            ("segment_shader", segment::LATENCY, "one segment per clock")
+            (Role::SegmentShader, segment::LATENCY, "one segment per clock")
         } else if m.name == names.frontend {
-            ("frontend", fe_latency, "one span per clock; set-up per walked triangle as in frontend.setup_clocks")
+            (Role::Frontend, fe_latency, "one span per clock; set-up per walked triangle as in frontend.setup_clocks")
         } else if m.name == names.top {
-            ("triangle_shader", fe_latency + segment::LATENCY, "one segment per clock")
+            (Role::TriangleShader, fe_latency + segment::LATENCY, "one segment per clock")
         } else if m.name == names.writer {
-            ("writer", golden::writer::LATENCY, "one block write per clock")
+            (Role::Writer, golden::writer::LATENCY, "one block write per clock")
         } else if m.name == names.fb_top {
-            ("triangle_writer", fe_latency + segment::LATENCY + golden::writer::LATENCY, "one block write per clock")
+            (Role::TriangleWriter, fe_latency + segment::LATENCY + golden::writer::LATENCY, "one block write per clock")
         } else if m.name == spec.unit {
-            ("specular_unit", unit.plan().latency(), "one pixel per clock")
+            (Role::SpecularUnit, unit.plan().latency(), "one pixel per clock")
         } else {
-            ("rom", 1, "one word per clock")
+            (Role::Rom, 1, "one word per clock")
         };
-        ModuleEntry { name: m.name.clone(), file: format!("{}.v", m.name), role, latency, throughput, ports: ports(m) }
+        ModuleEntry { name: m.name.clone(), file: format!("{}.v", m.name), role, latency, throughput: throughput.into(), ports: ports(m) }
     };
     let manifest = Manifest {
-        generator: Generator { name: "segshade hdl-gen", version: VERSION },
+        generator: Generator { name: "segshade hdl-gen".into(), version: VERSION.into() },
         parameters: Parameters {
             p: cfg.p,
             frac: cfg.frac,
             xbits: cfg.xbits,
-            align: cfg.align.name(),
-            prefix: &opts.prefix,
-            bfpi_arch: (opts.bfpi_arch != BfpiArch::ShiftAdd).then(|| opts.bfpi_arch.name()),
+            align: cfg.align,
+            prefix: opts.prefix.clone(),
+            bfpi_arch: (opts.bfpi_arch != BfpiArch::ShiftAdd).then(|| opts.bfpi_arch.name().into()),
         },
         formats: Formats {
             intensity: format!("UQ8.{}", cfg.frac),
             increment: format!("signed Q8.{}", cfg.frac),
-            pixel: "UQ8.0",
+            pixel: "UQ8.0".into(),
             iw: cfg.iw(),
             dw: cfg.dw(),
             mw: cfg.mw(),
@@ -246,7 +292,7 @@ pub fn render(opts: &Options, names: &Names, modules: &[Module], unit: &Specular
             latency: hw.latency(),
             setup_clocks_walked: hw.setup_clocks().0,
             setup_clocks_dropped: hw.setup_clocks().1,
-            walker: "one clock per row from the first to the last row of the bounding box on screen",
+            walker: "one clock per row from the first to the last row of the bounding box on screen".into(),
         }),
         writer: wr.map(|w| WriterEntry {
             module: names.writer.clone(),
@@ -255,12 +301,13 @@ pub fn render(opts: &Options, names: &Names, modules: &[Module], unit: &Specular
             blocks_per_row: w.blocks_per_row(),
             blocks: w.blocks(),
             addr_bits: w.addr_bits(),
-            address: "y * blocks_per_row + x div P; pixel x mod P in mem_data[8i +: 8], enable mem_we[i]",
+            address: "y * blocks_per_row + x div P; pixel x mod P in mem_data[8i +: 8], enable mem_we[i]".into(),
             latency: golden::writer::LATENCY,
             writes: match opts.cfg.align {
                 golden::Align::Span => "ceil((x0 mod P + m) / P) per span: each block the span touches, once, ascending (glue)",
                 golden::Align::Screen => "one per segment: each block the span touches, once, ascending",
-            },
+            }
+            .into(),
         }),
     };
     serde_json::to_string_pretty(&manifest).expect("manifest serializes") + "\n"
@@ -319,4 +366,38 @@ pub fn core_file(opts: &Options, names: &Names, modules: &[Module]) -> String {
         xw = cfg.xbits,
         align = cfg.align,
     )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use golden::{Align, Config};
+
+    /// The reader is the writer's schema: every configuration's manifest reads back into
+    /// [`Manifest`] and prints again byte for byte, so no field is dropped or misread.
+    #[test]
+    fn manifests_read_back_exactly() {
+        let configs = [
+            Options::default(),
+            Options { cfg: Config { p: 64, align: Align::Screen, ..Config::default() }, prefix: "x_".into(), ..Default::default() },
+            Options { cfg: Config::new(2, 20, 16, Align::Span).unwrap(), bfpi_arch: BfpiArch::Tree, ..Default::default() },
+        ];
+        for opts in configs {
+            let files = crate::generate(&opts);
+            let text = &files.iter().find(|f| f.name == MANIFEST_FILE).unwrap().contents;
+            let m = Manifest::parse(text).unwrap();
+            assert_eq!(&(serde_json::to_string_pretty(&m).unwrap() + "\n"), text);
+            assert_eq!(m.parameters.align, opts.cfg.align);
+            assert!(m.by_role(Role::SegmentShader).is_some());
+        }
+    }
+
+    #[test]
+    fn a_missing_module_is_named_with_the_ones_listed() {
+        let files = crate::generate(&Options::default());
+        let m = Manifest::parse(&files.iter().find(|f| f.name == MANIFEST_FILE).unwrap().contents).unwrap();
+        let e = m.module("nope").unwrap_err().to_string();
+        assert!(e.contains("'nope'") && e.contains("segment_shader_p8"), "{e}");
+        assert!(Manifest::parse("{}").is_err());
+    }
 }

@@ -14,6 +14,7 @@
 //! The ports come from the module's entry in `manifest.json`, so any module `generate` lists is
 //! covered, whatever it is.
 
+use crate::manifest::Manifest;
 use crate::verilog::{bit, reg, set, Dir, Item, Module, Port, Stmt};
 
 /// One port of the wrapped block, as the manifest lists it.
@@ -26,26 +27,9 @@ pub struct BlockPort {
 
 /// The ports of `module` in a `manifest.json` text.
 pub fn ports_from_manifest(manifest: &str, module: &str) -> Result<Vec<BlockPort>, String> {
-    let m: serde_json::Value = serde_json::from_str(manifest).map_err(|e| format!("manifest.json: {e}"))?;
-    let modules = m["modules"].as_array().ok_or("manifest.json has no modules list")?;
-    let entry = modules.iter().find(|e| e["name"] == module).ok_or_else(|| {
-        let names: Vec<&str> = modules.iter().filter_map(|e| e["name"].as_str()).collect();
-        format!("manifest.json lists no module '{module}' (it lists {})", names.join(", "))
-    })?;
-    let ports = entry["ports"].as_array().ok_or_else(|| format!("module '{module}' has no ports list"))?;
-    ports
-        .iter()
-        .map(|p| {
-            let name = p["name"].as_str().ok_or("a port has no name")?.to_string();
-            let dir = match p["direction"].as_str() {
-                Some("input") => Dir::Input,
-                Some("output") => Dir::Output,
-                other => return Err(format!("port {name}: direction {other:?} is not input or output")),
-            };
-            let width = p["width"].as_u64().filter(|&w| (1..=1 << 20).contains(&w)).ok_or(format!("port {name}: bad width"))? as u32;
-            Ok(BlockPort { name, dir, width })
-        })
-        .collect()
+    let m = Manifest::parse(manifest).map_err(|e| e.to_string())?;
+    let entry = m.module(module).map_err(|e| e.to_string())?;
+    Ok(entry.ports.iter().map(|p| BlockPort { name: p.name.clone(), dir: p.direction, width: p.width }).collect())
 }
 
 /// The harness module `<block>_synth` around `block`, which must have an input `clk`.

@@ -48,8 +48,7 @@ fn lint(sources: &[String], top: &str) {
 }
 
 fn module_names(manifest: &str) -> Vec<String> {
-    let m: serde_json::Value = serde_json::from_str(manifest).unwrap();
-    m["modules"].as_array().unwrap().iter().map(|e| e["name"].as_str().unwrap().to_string()).collect()
+    hdl_gen::manifest::Manifest::parse(manifest).unwrap().modules.into_iter().map(|e| e.name).collect()
 }
 
 #[test]
