@@ -169,6 +169,8 @@ module specular_unit #(
   end
 
 `ifdef FORMAL
+  // scripts/prove: cutpoint t:$mul t:$mem_v2
+  // (the multipliers and ROMs: their outputs become free, values are left to co-simulation)
   // Clocks since the start: $past is meaningful once f_past is set.
   reg f_past = 1'b0;
   reg f_past2 = 1'b0;

@@ -21,6 +21,14 @@
 use crate::verilog::{assign, comment, lit, net, reg, set, sext, wire, zext, Item, Module, Port, Stmt};
 use golden::{Align, Config};
 
+/// A comment `scripts/prove` reads: the Yosys command, if any, that cuts what the solver cannot
+/// manage out of this module's proof. The generator knows which blocks those are; the script
+/// applies only what the module asks for.
+pub const CUT_TAG: &str = "scripts/prove: ";
+
+/// The output stream of the shader and the specular unit (SPEC §3).
+const OUT: (&str, &str) = ("out_valid", "out_ready");
+
 fn assert(c: impl Into<String>) -> Stmt {
     Stmt::Assert(c.into())
 }
@@ -40,16 +48,17 @@ fn past_flags() -> Vec<Item> {
     ]
 }
 
-/// Reset (nothing out the clock after `rst`) and stability (an output offered and not taken
-/// stays valid with every `held` port unchanged): the stream contract's first two rules.
-fn reset_and_stability(what: &str, held: &[&str]) -> Vec<Item> {
-    let mut hold = vec![assert("out_valid")];
+/// Reset (nothing out the clock after `rst`) and stability (an output offered on `valid` and
+/// not taken by `ready` stays valid with every `held` port unchanged): the stream contract's
+/// first two rules.
+fn reset_and_stability(what: &str, (valid, ready): (&str, &str), held: &[&str]) -> Vec<Item> {
+    let mut hold = vec![assert(valid)];
     hold.extend(held.iter().map(|q| assert(format!("{q} == $past({q})"))));
     vec![
         comment(format!("Reset: no {what} out of reset.")),
-        Item::Always(vec![when("f_past && $past(rst)", vec![assert("!out_valid")])]),
+        Item::Always(vec![when("f_past && $past(rst)", vec![assert(format!("!{valid}"))])]),
         comment(format!("Stability: a {what} offered and not taken stays, unchanged.")),
-        Item::Always(vec![when("f_past && !$past(rst) && $past(out_valid && !out_ready)", hold)]),
+        Item::Always(vec![when(format!("f_past && !$past(rst) && $past({valid} && !{ready})"), hold)]),
     ]
 }
 
@@ -63,7 +72,7 @@ pub fn segment_properties(cfg: &Config, rw: u32) -> Item {
     let pr = lit(rw, p as u64);
     let mut b = past_flags();
 
-    b.extend(reset_and_stability("segment", &["out_x", "out_pix", "out_mask", "out_last"]));
+    b.extend(reset_and_stability("segment", OUT, &["out_x", "out_pix", "out_mask", "out_last"]));
 
     b.push(comment("The shadow: spans accepted whose segments have not all appeared. Span h's next"));
     b.push(comment("segment starts f_h_off pixels after its first block's x (f_h_b); t waits behind it."));
@@ -230,8 +239,12 @@ pub fn bfpi_reference(cfg: &Config, bfpi: &str) -> Module {
 /// manage; `scripts/prove` cuts them (their outputs become free), so the proof holds for any
 /// value they produce, and the values are left to co-simulation.
 pub fn specular_properties(lw: u32, stages: &[(&str, &str)]) -> Item {
-    let mut b = past_flags();
-    b.extend(reset_and_stability("pixel", &["out_spec", "out_last", "out_err"]));
+    let mut b = vec![
+        comment(format!("{CUT_TAG}cutpoint t:$mul t:$mem_v2")),
+        comment("(the multipliers and ROMs: their outputs become free, values are left to co-simulation)"),
+    ];
+    b.extend(past_flags());
+    b.extend(reset_and_stability("pixel", OUT, &["out_spec", "out_last", "out_err"]));
     b.push(comment("The reference: the span being issued (f_len pixels, f_k issued) and the pipe."));
     b.push(reg("f_busy", 1));
     b.push(reg("f_len", lw));
@@ -282,6 +295,180 @@ pub fn specular_properties(lw: u32, stages: &[(&str, &str)]) -> Item {
         link.push(assert(format!("{v} == f_v{}", k + 1)));
         link.push(when(*v, vec![assert(format!("{l} == f_l{}", k + 1))]));
     }
+    b.push(Item::Comb(vec![when("f_past", link)]));
+    Item::Formal(b)
+}
+
+/// Properties of `fb_writer_p<P>` (SPEC §7) against a reference writer kept beside it.
+///
+/// The reference places each accepted segment's pixels by their screen x, without the
+/// rotation the writer uses: lane j of a segment at x goes to block `x div P + (r + j) div P`,
+/// lane `(r + j) mod P` (r = x mod P), so lanes r.. of the rotated mask are the head block and
+/// the rest the tail, written with the next segment's head or, after the span's last segment,
+/// on its own. Asserted: every write the writer issues is the reference's (valid, address and
+/// enables, and the pixels under the enables; what a disabled lane carries is free), `in_ready`
+/// holds only for the tail's own write, reset, stability, no write without an enable, and a
+/// pixel count: the pixels accepted and not yet taken by memory are exactly those in the write
+/// register and the pending tail, so none is lost or written twice.
+///
+/// The environment is held to what the shader's own proof guarantees (assume-guarantee):
+/// the segments of a span follow each other at x + P on one scanline.
+pub fn writer_properties(w: &golden::writer::Writer) -> Item {
+    let cfg = &w.cfg;
+    let (p, l, xw, yw) = (cfg.p, cfg.log2p(), cfg.xbits, w.y_bits());
+    let aw = w.addr_bits();
+    let glued = cfg.align == Align::Span && p > 1;
+    let cw = 32 - (2 * p).leading_zeros() + 1; // pixel counts up to 2P, with a spare bit
+    let mut b = past_flags();
+    b.extend(reset_and_stability("write", ("mem_valid", "mem_ready"), &["mem_addr", "mem_data", "mem_we"]));
+    b.push(comment("No write without an enable."));
+    b.push(Item::Comb(vec![when("f_past && mem_valid", vec![assert(format!("mem_we != {}", lit(p, 0)))])]));
+
+    b.push(comment("The reference: each pixel placed by its screen x."));
+    b.push(wire("f_free", 1, "!mem_valid || mem_ready"));
+    b.push(wire("f_take", 1, "in_valid && in_ready"));
+    let blk = if xw > l { zext(&format!("in_x[{}:{l}]", xw - 1), xw - l, aw) } else { lit(aw, 0) };
+    b.push(wire("f_addr", aw, format!("{} * {} + {blk}", zext("in_y", yw, aw), lit(aw, w.blocks_per_row() as u64))));
+    // The expected write; its pixels are all P lanes without the glue, the tracked lane with it.
+    for (n, wd) in [("f_mv", 1), ("f_ma", aw), ("f_md", 8), ("f_mwe", p)] {
+        b.push(reg(n, wd));
+    }
+    b.push(comment("Pixels are checked on one lane of the block, f_lane, that the solver picks freely, so the"));
+    b.push(comment("proof holds for every lane; tracking one lane keeps the reference free of wide shifters."));
+    let (lane, at) = match p > 1 {
+        true => {
+            b.push(wire("f_lane", l, "$anyconst"));
+            ("f_lane", "{f_lane, 3'b000}")
+        }
+        false => ("0", "0"),
+    };
+    let mut link = vec![];
+    if glued {
+        let lp = lit(l + 1, p as u64);
+        b.extend([
+            wire("f_r", l, format!("in_x[{}:0]", l - 1)),
+            comment("Head: input lane j lands on block lane r + j; tail: lanes beyond P, on lane r + j - P of the next block."),
+            wire("f_hwe", p, "in_mask << f_r"),
+            wire("f_twe", p, format!("in_mask >> ({lp} - {})", zext("f_r", l, l + 1))),
+            comment("f_lane's pixel comes from input lane f_lane - r (mod P): in the head block when f_lane >= r, else the tail."),
+            wire("f_src", l, "f_lane - f_r"),
+            wire("f_pix", 8, "in_pix[{f_src, 3'b000} +: 8]"),
+            comment("The pending tail (f_pwe lanes of block f_pa, f_pp on f_lane) and whether it waits for a merge or its own write."),
+            reg("f_cont", 1),
+            reg("f_flush", 1),
+            reg("f_pa", aw),
+            reg("f_pp", 8),
+            reg("f_pwe", p),
+            reg("f_px", xw),
+            reg("f_py", yw),
+        ]);
+        b.push(comment("What the shader guarantees: a span's next segment is P pixels on, on its scanline."));
+        b.push(Item::Comb(vec![when(
+            "f_past && f_take && f_cont",
+            vec![Stmt::Assume(format!("in_x == f_px + {} && in_y == f_py", lit(xw, p as u64)))],
+        )]));
+        b.push(Item::Always(vec![Stmt::If(
+            "rst".into(),
+            vec![set("f_mv", "1'b0"), set("f_cont", "1'b0"), set("f_flush", "1'b0")],
+            vec![when(
+                "f_free",
+                vec![Stmt::If(
+                    "f_flush".into(),
+                    vec![set("f_mv", "1'b1"), set("f_ma", "f_pa"), set("f_md", "f_pp"), set("f_mwe", "f_pwe"), set("f_flush", "1'b0")],
+                    vec![Stmt::If(
+                        "in_valid".into(),
+                        vec![
+                            set("f_mv", format!("(f_hwe | (f_cont ? f_pwe : {z})) != {z}", z = lit(p, 0))),
+                            set("f_ma", "f_addr"),
+                            set("f_md", "f_hwe[f_lane] ? f_pix : f_pp"),
+                            set("f_mwe", format!("f_hwe | (f_cont ? f_pwe : {})", lit(p, 0))),
+                            set("f_pa", format!("f_addr + {}", lit(aw, 1))),
+                            set("f_pp", "f_pix"),
+                            set("f_pwe", "f_twe"),
+                            set("f_px", "in_x"),
+                            set("f_py", "in_y"),
+                            set("f_cont", "!in_last"),
+                            set("f_flush", format!("in_last && f_twe != {}", lit(p, 0))),
+                        ],
+                        vec![set("f_mv", "1'b0")],
+                    )],
+                )],
+            )],
+        )]));
+        b.push(comment("The writer takes a segment exactly when its write register is free and no tail owes its own write."));
+        b.push(Item::Comb(vec![when("f_past", vec![assert("in_ready == (f_free && !f_flush)")])]));
+        link.extend([
+            assert("cont == f_cont"),
+            assert("flush == f_flush"),
+            when(
+                "f_cont || f_flush",
+                vec![
+                    assert("pend_addr == f_pa"),
+                    assert("pend_we == f_pwe"),
+                    when("f_pwe[f_lane]", vec![assert("pend_pix[{f_lane, 3'b000} +: 8] == f_pp")]),
+                ],
+            ),
+            when("f_flush", vec![assert(format!("f_pwe != {}", lit(p, 0))), assert("!f_cont")]),
+            // The reference's own: a pending tail lies below the span's lane offset, in the block after
+            // the last segment's.
+            when(
+                "f_cont || f_flush",
+                vec![
+                    assert(format!("(f_pwe >> f_px[{}:0]) == {}", l - 1, lit(p, 0))),
+                    assert(format!(
+                        "f_pa == {} * {} + {} + {}",
+                        zext("f_py", yw, aw),
+                        lit(aw, w.blocks_per_row() as u64),
+                        if xw > l { zext(&format!("f_px[{}:{l}]", xw - 1), xw - l, aw) } else { lit(aw, 0) },
+                        lit(aw, 1)
+                    )),
+                ],
+            ),
+        ]);
+    } else {
+        b.push(comment("One write per segment: its block, its lanes as they come."));
+        b.push(Item::Always(vec![Stmt::If(
+            "rst".into(),
+            vec![set("f_mv", "1'b0")],
+            vec![when(
+                "f_free",
+                vec![
+                    set("f_mv", format!("in_valid && in_mask != {}", lit(p, 0))),
+                    set("f_ma", "f_addr"),
+                    set("f_md", format!("in_pix[{at} +: 8]")),
+                    set("f_mwe", "in_mask"),
+                ],
+            )],
+        )]));
+        b.push(comment("Valid never waits for ready, and nothing makes the writer refuse a segment but a full register."));
+        b.push(Item::Comb(vec![when("f_past", vec![assert("in_ready == f_free")])]));
+    }
+    b.push(comment("Every write is the reference's: address, enables, and the pixels under the enables."));
+    b.push(Item::Comb(vec![when(
+        "f_past",
+        vec![
+            assert("mem_valid == f_mv"),
+            when(
+                "mem_valid",
+                vec![
+                    assert("mem_addr == f_ma"),
+                    assert("mem_we == f_mwe"),
+                    when(format!("mem_we[{lane}]"), vec![assert(format!("mem_data[{at} +: 8] == f_md"))]),
+                ],
+            ),
+        ],
+    )]));
+    b.push(comment("Pixels owed: accepted, not yet taken by memory. They are exactly the write register's"));
+    b.push(comment("and the pending tail's, so no pixel is lost, invented or written twice."));
+    b.push(reg("f_owed", cw));
+    let held = if glued { "((f_cont || f_flush) ? $countones(f_pwe) : 0)" } else { "0" };
+    b.push(Item::Always(vec![Stmt::If(
+        "rst".into(),
+        vec![set("f_owed", lit(cw, 0))],
+        vec![set("f_owed", "f_owed + (f_take ? $countones(in_mask) : 0) - ((mem_valid && mem_ready) ? $countones(mem_we) : 0)")],
+    )]));
+    link.push(assert(format!("f_owed == (mem_valid ? $countones(mem_we) : 0) + {held}")));
+    b.push(comment("Linking invariants: the writer's registers are the reference's."));
     b.push(Item::Comb(vec![when("f_past", link)]));
     Item::Formal(b)
 }

@@ -168,6 +168,7 @@ pub fn module(w: &Writer, names: &Names) -> Module {
             )],
         )]));
     }
+    body.push(crate::formal::writer_properties(w));
     Module { name: names.writer.clone(), header, params: vec![], ports: ports(w), body }
 }
 
