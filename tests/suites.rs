@@ -1,7 +1,7 @@
 //! Every co-simulation suite of the harness in one test binary, so the verilated models are
 //! linked once. One module per suite; run one with `cargo test -p verilator-harness --test
 //! suites segment::` (or `bfpi::`, `specular::`, `render::`, `reliability::`, `cli_harness::`,
-//! `frontend::`, `writer::`).
+//! `frontend::`, `writer::`, `waveforms::`).
 
 mod bfpi;
 mod cli_harness;
@@ -10,4 +10,5 @@ mod reliability;
 mod render;
 mod segment;
 mod specular;
+mod waveforms;
 mod writer;

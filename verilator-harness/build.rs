@@ -8,6 +8,12 @@
 //! other and into the shim's `step`, which is what a native testbench gets. Models are built on
 //! as many threads as cargo gives jobs, and each records its build time in
 //! `OUT_DIR/obj/<tag>/build.time` (read by the `bench` binary).
+//!
+//! Traced twins (`verilator --trace-fst`, symbols `<tag>_tr_*`, see `csrc/trace.h` and
+//! `verilator_harness::waveform`): with COSIM_TRACE set, every streaming model gets one; without
+//! it, only [`ALWAYS_TRACED`], so the suite's waveform test has one to run. The untraced models
+//! are built exactly as without twins (same flags, same keys): twins are models of their own,
+//! with a runtime of their own for the FST writer (`libverilated_fst_rt.a`, linked with zlib).
 
 use golden::frontend::DiMode;
 use golden::setup::Screen;
@@ -21,6 +27,14 @@ use std::time::Instant;
 
 /// How a model is compiled; part of every model's key, so a change here rebuilds the models.
 const LAYOUT: &str = "one translation unit per model: class files, then the shim; -O2 -fPIE";
+
+/// Traced twins' (see the module comment) difference from [`LAYOUT`]; part of their keys.
+const TRACE_LAYOUT: &str = "verilator --trace-fst; -DVM_TRACE=1 -DVM_TRACE_FST=1";
+/// The model that has a traced twin in every default build (no COSIM_RTL_DIR): a small one, cheap
+/// to compile, for the suite's waveform test.
+const ALWAYS_TRACED: &str = "seg_p2_span";
+/// The suffix of a twin's tag (and symbols) after its model's.
+const TRACED_SUFFIX: &str = "_tr";
 
 /// The segment widths built by default, each in both alignments; each p's BFPI is built too.
 const BUILT_P: [u32; 7] = [1, 2, 4, 8, 16, 32, 64];
@@ -48,6 +62,7 @@ enum Kind {
     TriWriter,
 }
 
+#[derive(Clone)]
 struct Model {
     /// Symbol prefix of the shim and suffix of the Verilator class (`V<tag>`).
     tag: String,
@@ -67,8 +82,11 @@ struct Model {
 fn main() {
     println!("cargo:rerun-if-changed=build.rs");
     println!("cargo:rerun-if-changed=csrc/shim.h");
+    println!("cargo:rerun-if-changed=csrc/trace.h");
     println!("cargo:rerun-if-env-changed=COSIM_RTL_DIR");
     println!("cargo:rerun-if-env-changed=SEGSHADE_ALL_CHAINS");
+    // Only whether it is set matters here (its folder is read at run time).
+    println!("cargo:rerun-if-env-changed=COSIM_TRACE");
     let out = PathBuf::from(std::env::var("OUT_DIR").unwrap());
     let rtl_dir = std::env::var_os("COSIM_RTL_DIR").map(PathBuf::from);
     let models = match &rtl_dir {
@@ -78,22 +96,54 @@ fn main() {
         }
         None => generated_models(),
     };
+    let trace_all = std::env::var_os("COSIM_TRACE").is_some();
+    let twins: Vec<Model> = models
+        .iter()
+        .filter(|m| m.kind != Kind::Bfpi && (trace_all || (rtl_dir.is_none() && m.tag == ALWAYS_TRACED)))
+        .map(|m| Model { tag: format!("{}{TRACED_SUFFIX}", m.tag), ..m.clone() })
+        .collect();
     let verilator = Verilator::find();
-    let globals = build_models(&verilator, &out, &models);
-    build_runtime(&verilator, &out, &globals);
+    let jobs: Vec<(&Model, bool)> = models.iter().map(|m| (m, false)).chain(twins.iter().map(|m| (m, true))).collect();
+    let globals = build_models(&verilator, &out, &jobs);
+    let plain: Vec<String> = union(globals.iter().filter(|(traced, _)| !traced).map(|(_, g)| g));
+    build_runtime(&verilator, &out, Runtime::PLAIN, &plain);
+    // The twins' runtime files beyond the plain models' (the FST writer), with their defines.
+    let fst: Vec<String> = union(globals.iter().filter(|(traced, _)| *traced).map(|(_, g)| g));
+    let fst: Vec<String> = fst.into_iter().filter(|g| !plain.contains(g)).collect();
+    if !twins.is_empty() {
+        build_runtime(&verilator, &out, Runtime::FST, &fst);
+    }
     println!("cargo:rustc-link-search=native={}", out.display());
-    for m in &models {
+    for m in models.iter().chain(&twins) {
         println!("cargo:rustc-link-lib=static={}", m.tag);
     }
-    println!("cargo:rustc-link-lib=static=verilated_rt");
+    if !twins.is_empty() {
+        println!("cargo:rustc-link-lib=static={}", Runtime::FST.lib);
+    }
+    println!("cargo:rustc-link-lib=static={}", Runtime::PLAIN.lib);
     println!("cargo:rustc-link-lib=stdc++");
+    if !twins.is_empty() {
+        // The FST writer compresses its hierarchy with zlib.
+        println!("cargo:rustc-link-lib=z");
+    }
     println!("cargo:rustc-link-lib=pthread");
     println!("cargo:rustc-link-lib=atomic");
     let tables = match &rtl_dir {
         Some(dir) => tables_from_dir(dir),
         None => SpecTables::of(hdl_gen::Options::default().specular_unit().plan(), None),
     };
-    fs::write(out.join("models.rs"), models_rs(&models, rtl_dir.as_deref(), &tables)).unwrap();
+    fs::write(out.join("models.rs"), models_rs(&models, &twins, trace_all, rtl_dir.as_deref(), &tables)).unwrap();
+}
+
+/// The runtime files the lists ask for, each once, in the order first asked.
+fn union<'a>(lists: impl Iterator<Item = &'a Vec<String>>) -> Vec<String> {
+    let mut all: Vec<String> = Vec::new();
+    for g in lists.flatten() {
+        if !all.contains(g) {
+            all.push(g.clone());
+        }
+    }
+    all
 }
 
 /// The specular unit's table set, as models.rs hands it to the checkers (`ffi::SPECULAR_TABLES`),
@@ -496,7 +546,10 @@ impl Verilator {
 /// a shared library (`-fPIC`): the models only ever link into executables, and under `-fPIC`
 /// every global function may be interposed, so GCC would not inline the model's evaluation
 /// functions into each other.
-fn cc_build(v: &Verilator) -> cc::Build {
+///
+/// `traced`: for a traced twin and the FST writer, `VM_TRACE` and `VM_TRACE_FST` are 1, as
+/// Verilator's makefile sets them for a `--trace-fst` model; everything else is the same.
+fn cc_build(v: &Verilator, traced: bool) -> cc::Build {
     let mut b = cc::Build::new();
     b.cpp(true)
         .opt_level(2)
@@ -509,7 +562,8 @@ fn cc_build(v: &Verilator) -> cc::Build {
         .flag("-faligned-new")
         .flag("-fcf-protection=none");
     for d in ["VM_COVERAGE", "VM_SC", "VM_TRACE", "VM_TRACE_FST", "VM_TRACE_VCD"] {
-        b.define(d, "0");
+        let on = traced && (d == "VM_TRACE" || d == "VM_TRACE_FST");
+        b.define(d, if on { "1" } else { "0" });
     }
     for i in v.include() {
         b.include(i);
@@ -517,33 +571,38 @@ fn cc_build(v: &Verilator) -> cc::Build {
     b
 }
 
-/// Builds every model, as many at once as cargo allows jobs (each model is one verilator run and
-/// one compiler run). Returns the runtime files their makefiles ask for.
-fn build_models(v: &Verilator, out: &Path, models: &[Model]) -> Vec<String> {
+/// Builds every model, (model, traced twin or not), as many at once as cargo allows jobs (each
+/// model is one verilator run and one compiler run). Returns, for each, whether it is traced and
+/// the runtime files its makefile asks for.
+fn build_models(v: &Verilator, out: &Path, models: &[(&Model, bool)]) -> Vec<(bool, Vec<String>)> {
     let jobs = std::env::var("NUM_JOBS").ok().and_then(|j| j.parse().ok()).unwrap_or(1usize).clamp(1, models.len().max(1));
     let next = std::sync::atomic::AtomicUsize::new(0);
-    let globals = std::sync::Mutex::new(Vec::new());
+    let globals = std::sync::Mutex::new(vec![(false, Vec::new()); models.len()]);
     std::thread::scope(|s| {
         for _ in 0..jobs {
             s.spawn(|| loop {
                 let k = next.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-                let Some(m) = models.get(k) else { break };
-                let g = build_model(v, out, m);
-                *globals.lock().unwrap() = g;
+                let Some(&(m, traced)) = models.get(k) else { break };
+                let g = build_model(v, out, m, traced);
+                globals.lock().unwrap()[k] = (traced, g);
             });
         }
     });
     globals.into_inner().unwrap()
 }
 
-/// Verilates and compiles one model unless its key (everything the result depends on) is the
-/// one recorded by the last build. Returns the runtime files its makefile asks for.
-fn build_model(v: &Verilator, out: &Path, m: &Model) -> Vec<String> {
+/// Verilates and compiles one model (`traced`: a traced twin) unless its key (everything the
+/// result depends on) is the one recorded by the last build. Returns the runtime files its
+/// makefile asks for.
+fn build_model(v: &Verilator, out: &Path, m: &Model, traced: bool) -> Vec<String> {
     let class = format!("V{}", m.tag);
-    let shim = shim_cpp(m, &class);
+    let shim = shim_cpp(m, &class, traced);
     let mut key = format!("{}\n{LAYOUT}\n{}\n{}\n{}\n", v.version, m.top, include_str!("csrc/shim.h"), shim);
     for (name, text) in &m.sources {
         write!(key, "== {name}\n{text}").unwrap();
+    }
+    if traced {
+        write!(key, "== {TRACE_LAYOUT}\n{}", include_str!("csrc/trace.h")).unwrap();
     }
     let cache = cache_dir(out, &m.tag, &key);
     let (obj, rtl) = (cache.join("obj"), cache.join("rtl"));
@@ -575,6 +634,7 @@ fn build_model(v: &Verilator, out: &Path, m: &Model) -> Vec<String> {
         };
         let status = Command::new("verilator")
             .args(["--cc", "-O3", "--x-assign", "fast", "--x-initial", "unique", "-Wno-fatal"])
+            .args(traced.then_some("--trace-fst"))
             .args(["--prefix", &class, "--top-module", &m.top])
             .args(&images)
             .arg("-Mdir")
@@ -595,7 +655,7 @@ fn build_model(v: &Verilator, out: &Path, m: &Model) -> Vec<String> {
         all.push_str(&shim);
         let all_path = obj.join(format!("{class}__all.cpp"));
         fs::write(&all_path, &all).unwrap();
-        let mut b = cc_build(v);
+        let mut b = cc_build(v, traced);
         b.include(&obj).include(Path::new(env!("CARGO_MANIFEST_DIR")).join("csrc")).out_dir(&obj).file(&all_path);
         b.compile(&m.tag);
         let total = start.elapsed().as_secs_f64();
@@ -628,25 +688,49 @@ fn cache_dir(out: &Path, tag: &str, key: &str) -> PathBuf {
     root.join(format!("{tag}-{:016x}", h.finish()))
 }
 
-/// Verilator's runtime (`verilated.cpp`, `verilated_threads.cpp`, as the makefile lists them),
-/// compiled once for every model.
-fn build_runtime(v: &Verilator, out: &Path, globals: &[String]) {
-    let key = format!("{}\n{LAYOUT}\n{}\n", v.version, globals.join(" "));
-    let obj = cache_dir(out, "runtime", &key);
-    let lib = obj.join("libverilated_rt.a");
-    let linked = out.join("libverilated_rt.a");
+/// One of Verilator's runtime libraries.
+struct Runtime {
+    /// Its cache folder's tag (`cache_dir`).
+    tag: &'static str,
+    /// The static library's name.
+    lib: &'static str,
+    traced: bool,
+}
+
+impl Runtime {
+    /// Verilator's runtime (`verilated.cpp`, `verilated_threads.cpp`, as the makefile lists them),
+    /// compiled once for every model.
+    const PLAIN: Runtime = Runtime { tag: "runtime", lib: "verilated_rt", traced: false };
+    /// What traced twins need beyond it: the FST writer (`verilated_fst_c.cpp`, which includes
+    /// GTKWave's `fstapi.c` and its compressors).
+    const FST: Runtime = Runtime { tag: "fst-runtime", lib: "verilated_fst_rt", traced: true };
+}
+
+/// Compiles `globals`, runtime files the models' makefiles ask for, into `rt`'s library, once for
+/// every model.
+fn build_runtime(v: &Verilator, out: &Path, rt: Runtime, globals: &[String]) {
+    let mut key = format!("{}\n{LAYOUT}\n{}\n", v.version, globals.join(" "));
+    if rt.traced {
+        key.push_str(TRACE_LAYOUT);
+    }
+    let obj = cache_dir(out, rt.tag, &key);
+    let lib = obj.join(format!("lib{}.a", rt.lib));
+    let linked = out.join(format!("lib{}.a", rt.lib));
     if fs::read_to_string(obj.join("build.key")).is_ok_and(|k| k == key) && lib.exists() {
         fs::copy(&lib, &linked).unwrap();
         return;
     }
     fs::create_dir_all(&obj).unwrap();
     let start = Instant::now();
-    let mut b = cc_build(v);
+    let mut b = cc_build(v, rt.traced);
     b.out_dir(&obj);
+    if rt.traced {
+        require_zlib(v, &obj);
+    }
     for g in globals {
         b.file(v.root.join("include").join(format!("{g}.cpp")));
     }
-    b.compile("verilated_rt");
+    b.compile(rt.lib);
     fs::copy(&lib, &linked).unwrap();
     fs::write(
         obj.join("build.time"),
@@ -687,23 +771,66 @@ impl Classes {
     }
 }
 
-fn shim_cpp(m: &Model, class: &str) -> String {
-    let expand = match m.kind {
-        Kind::Segment => format!("SEGSHADE_SEGMENT_SHIM({class}, {}, {})", m.tag, m.cfg.p),
-        Kind::Bfpi => format!("SEGSHADE_BFPI_SHIM({class}, {}, {})", m.tag, (m.cfg.p * m.cfg.mw()).div_ceil(8)),
-        Kind::Specular => format!("SEGSHADE_SPECULAR_SHIM({class}, {})", m.tag),
-        Kind::Frontend => format!("SEGSHADE_FRONTEND_SHIM({class}, {})", m.tag),
-        Kind::TriShader => format!("SEGSHADE_TRISHADER_SHIM({class}, {}, {})", m.tag, m.cfg.p),
-        Kind::Writer => format!("SEGSHADE_WRITER_SHIM({class}, {}, {})", m.tag, m.cfg.p),
-        Kind::TriWriter => format!("SEGSHADE_TRIWRITER_SHIM({class}, {}, {})", m.tag, m.cfg.p),
+/// The model's shim: shim.h's macro for its kind. A traced twin expands it on the traced class
+/// under the symbol prefix `<tag>_raw`, and `trace.h`'s wrappers give the `<tag>_*` symbols.
+fn shim_cpp(m: &Model, class: &str, traced: bool) -> String {
+    let (model, sym) = match traced {
+        false => (class.to_string(), m.tag.clone()),
+        true => (format!("SegshadeTraced<{class}>"), format!("{}_raw", m.tag)),
     };
-    format!("// Generated by build.rs.\n#include \"{class}.h\"\n#include \"shim.h\"\n{expand}\n")
+    let expand = match m.kind {
+        Kind::Segment => format!("SEGSHADE_SEGMENT_SHIM({model}, {sym}, {})", m.cfg.p),
+        Kind::Bfpi => format!("SEGSHADE_BFPI_SHIM({model}, {sym}, {})", (m.cfg.p * m.cfg.mw()).div_ceil(8)),
+        Kind::Specular => format!("SEGSHADE_SPECULAR_SHIM({model}, {sym})"),
+        Kind::Frontend => format!("SEGSHADE_FRONTEND_SHIM({model}, {sym})"),
+        Kind::TriShader => format!("SEGSHADE_TRISHADER_SHIM({model}, {sym}, {})", m.cfg.p),
+        Kind::Writer => format!("SEGSHADE_WRITER_SHIM({model}, {sym}, {})", m.cfg.p),
+        Kind::TriWriter => format!("SEGSHADE_TRIWRITER_SHIM({model}, {sym}, {})", m.cfg.p),
+    };
+    if !traced {
+        return format!("// Generated by build.rs.\n#include \"{class}.h\"\n#include \"shim.h\"\n{expand}\n");
+    }
+    let (inp, outp) = ports(m.kind);
+    format!(
+        "// Generated by build.rs: a traced twin.\n#include \"{class}.h\"\n#include \"shim.h\"\n#include \"trace.h\"\n{expand}\n\
+         SEGSHADE_TRACE_SHIM({class}, {}, {inp}, {outp})\n",
+        m.tag
+    )
 }
 
-fn models_rs(models: &[Model], rtl_dir: Option<&Path>, tables: &SpecTables) -> String {
+/// The per-clock input and output structs of a kind's shim (the same names in shim.h and ffi.rs).
+fn ports(kind: Kind) -> (&'static str, &'static str) {
+    match kind {
+        Kind::Segment => ("SegIn", "SegOut"),
+        Kind::Bfpi => ("BfpiIn", "BfpiOut"),
+        Kind::Specular => ("SpecIn", "SpecOut"),
+        Kind::Frontend => ("TriIn", "FeOut"),
+        Kind::TriShader => ("TriIn", "TriSegOut"),
+        Kind::Writer => ("WrIn", "WrOut"),
+        Kind::TriWriter => ("TriIn", "WrOut"),
+    }
+}
+
+/// Stops the build with the package to install when the compiler finds no `zlib.h` (the FST
+/// writer's), rather than with a compiler error deep in GTKWave's code.
+fn require_zlib(v: &Verilator, obj: &Path) {
+    let probe = obj.join("zlib-probe.cpp");
+    fs::write(&probe, "#include <zlib.h>\n").unwrap();
+    if cc_build(v, true).file(&probe).try_expand().is_err() {
+        panic!(
+            "\n\nzlib's header (zlib.h) was not found. The traced models' FST writer needs it.\n\
+             Install Debian's package:   apt-get install -y zlib1g-dev\n\
+             (or run ./scripts/test, which installs it when missing)\n\n"
+        );
+    }
+}
+
+fn models_rs(models: &[Model], twins: &[Model], trace_all: bool, rtl_dir: Option<&Path>, tables: &SpecTables) -> String {
     let mut s = String::from("// Generated by build.rs: the models linked into this crate.\n");
     let dir = rtl_dir.map_or("None".to_string(), |d| format!("Some({:?})", d.display().to_string()));
     writeln!(s, "/// The COSIM_RTL_DIR the models came from; `None`: all generated.\npub const RTL_DIR: Option<&str> = {dir};").unwrap();
+    writeln!(s, "/// Whether COSIM_TRACE was set when these models were built (every streaming model traced).\npub const TRACED_BUILD: bool = {trace_all};")
+        .unwrap();
     let mut seg = String::new();
     let mut bfpi = String::new();
     let mut spec = String::new();
@@ -712,14 +839,15 @@ fn models_rs(models: &[Model], rtl_dir: Option<&Path>, tables: &SpecTables) -> S
     let mut wr = String::new();
     let mut trw = String::new();
     for m in models {
-        let (inp, outp, list) = match m.kind {
-            Kind::Segment => ("SegIn", "SegOut", &mut seg),
-            Kind::Bfpi => ("BfpiIn", "BfpiOut", &mut bfpi),
-            Kind::Specular => ("SpecIn", "SpecOut", &mut spec),
-            Kind::Frontend => ("TriIn", "FeOut", &mut fe),
-            Kind::TriShader => ("TriIn", "TriSegOut", &mut tris),
-            Kind::Writer => ("WrIn", "WrOut", &mut wr),
-            Kind::TriWriter => ("TriIn", "WrOut", &mut trw),
+        let (inp, outp) = ports(m.kind);
+        let list = match m.kind {
+            Kind::Segment => &mut seg,
+            Kind::Bfpi => &mut bfpi,
+            Kind::Specular => &mut spec,
+            Kind::Frontend => &mut fe,
+            Kind::TriShader => &mut tris,
+            Kind::Writer => &mut wr,
+            Kind::TriWriter => &mut trw,
         };
         let t = &m.tag;
         writeln!(
@@ -728,6 +856,24 @@ fn models_rs(models: &[Model], rtl_dir: Option<&Path>, tables: &SpecTables) -> S
              fn {t}_step(h: *mut c_void, i: *const {inp}, o: *mut {outp});\n}}"
         )
         .unwrap();
+        let traced = match twins.iter().find(|w| w.tag == format!("{t}{TRACED_SUFFIX}")) {
+            None => "None".to_string(),
+            Some(w) => {
+                let w = &w.tag;
+                writeln!(
+                    s,
+                    "extern \"C\" {{\n    fn {w}_new(seed: u64) -> *mut c_void;\n    fn {w}_free(h: *mut c_void);\n    \
+                     fn {w}_step(h: *mut c_void, i: *const {inp}, o: *mut {outp});\n    \
+                     fn {w}_trace_open(h: *mut c_void, path: *const c_char, clock: u64) -> c_int;\n    \
+                     fn {w}_trace_close(h: *mut c_void) -> c_int;\n}}"
+                )
+                .unwrap();
+                format!(
+                    "Some(TracedModel {{ tag: \"{w}\", new: {w}_new, free: {w}_free, step: {w}_step, \
+                     trace_open: {w}_trace_open, trace_close: {w}_trace_close }})"
+                )
+            }
+        };
         let c = &m.cfg;
         let align = match c.align {
             Align::Span => "Span",
@@ -737,7 +883,7 @@ fn models_rs(models: &[Model], rtl_dir: Option<&Path>, tables: &SpecTables) -> S
             list,
             "    ModelInfo {{ tag: \"{t}\", top: \"{}\", latency: {}, cfg: Config {{ p: {}, frac: {}, xbits: {}, align: Align::{align} }}, \
              screen: golden::setup::Screen {{ width: {}, height: {} }}, di: golden::frontend::DiMode::{:?}, \
-             new: {t}_new, free: {t}_free, step: {t}_step }},",
+             new: {t}_new, free: {t}_free, step: {t}_step, traced: {traced} }},",
             m.top, m.latency, c.p, c.frac, c.xbits, m.screen.width, m.screen.height, m.di
         )
         .unwrap();

@@ -64,6 +64,9 @@ pub struct Report {
     pub cut_spans: u64,
     /// Side pulses the unit raised (the front-end's guard-band `err`).
     pub pulses: u64,
+    /// The waveforms written for failures (COSIM_TRACE, `--trace`: [`crate::waveform`]), each
+    /// also named in its mismatch's message.
+    pub waveforms: Vec<crate::waveform::Waveform>,
 }
 
 const KEEP_MISMATCHES: usize = 20;
@@ -84,6 +87,7 @@ impl Report {
         self.resets += other.resets;
         self.cut_spans += other.cut_spans;
         self.pulses += other.pulses;
+        self.waveforms.extend(other.waveforms);
     }
 
     pub fn mismatch(&mut self, m: Mismatch) {
@@ -324,6 +328,12 @@ impl SegmentCosim {
     /// Adds [`Stress`] to the traffic of every following [`SegmentCosim::stream`].
     pub fn set_stress(&mut self, stress: Stress) {
         self.driver.stress = stress;
+    }
+
+    /// Writes the first failure's waveform into `dir` (`None`: none), whatever COSIM_TRACE says
+    /// ([`crate::waveform`]). The model gets two clocks of reset, where the replay will start.
+    pub fn set_waveforms(&mut self, dir: Option<std::path::PathBuf>) {
+        self.driver.set_waveforms(dir);
     }
 
     pub fn info(&self) -> &'static ModelInfo<SegIn, SegOut> {

@@ -9,12 +9,17 @@
 //! (the expensive part: golden's segments and rows, the f64 references). On two cores the
 //! model then runs at 0.8 to 0.9 of its speed in a bare C++ testbench (`scripts/bench-cosim`);
 //! the order of checks, and therefore every report, is the same as in one thread.
+//!
+//! With waveforms on ([`crate::waveform`]), the driver also keeps a tape of its model's inputs,
+//! and the first mismatch of the run names the FST file of its clocks and its clock.
 
 use crate::cosim::{Mismatch, Report};
 use crate::ffi::Rtl;
 use crate::traffic::TrafficGen;
+use crate::waveform::{NoTape, Recorder, Tape, Waveform, AFTER, BEFORE};
 use rand::Rng;
 use std::collections::VecDeque;
+use std::path::PathBuf;
 use std::sync::mpsc::{sync_channel, Receiver, SyncSender};
 
 /// Stress on top of [`crate::traffic::Traffic`], off by default: `rst` at random clocks, long
@@ -123,6 +128,8 @@ pub trait Control: Copy + Default + 'static {
     fn set_control(&mut self, rst: bool, in_valid: bool, out_ready: bool);
     /// Whether the next step may leave the data ports as the last one wrote them.
     fn keep_data(&mut self, keep: bool);
+    /// What the two above set: `rst | in_valid << 1 | out_ready << 2 | keep << 3`.
+    fn control(&self) -> u8;
 }
 
 /// The handshake outputs of a streaming unit.
@@ -210,50 +217,204 @@ pub(crate) struct Driver<U: Unit> {
     pub stress: Stress,
     input: U::In,
     output: U::Out,
+    /// Clocks the model has run since it was built, reset clocks included: the clock numbers of
+    /// mismatch messages and waveforms. Brought up to date when a stream ends (the clock loop
+    /// counts in `Report::cycles`).
+    clock: u64,
+    /// Where the first failure's waveform goes ([`crate::waveform`]).
+    waves: Waves,
+    /// The inputs since the last reset, while a waveform may still be needed.
+    tape: Option<Box<Tape<U::In>>>,
+}
+
+/// What a driver does about waveforms.
+enum Waves {
+    Off,
+    /// On a failure, replay the tape into the model's traced twin and write the window to this
+    /// folder (COSIM_TRACE).
+    OnFailure(PathBuf),
+    /// The model is the traced twin, writing every clock (`--trace`): name its file.
+    Live,
+    /// The first failure has been described (one waveform per model).
+    Done,
 }
 
 impl<U: Unit> Driver<U> {
-    /// The model in reset for two clocks.
+    /// The model in reset for two clocks. Waveforms are on when the model is traced
+    /// (`--trace`) or COSIM_TRACE is set ([`crate::waveform::failure_dir`]).
     pub fn new(rtl: Rtl<U::In, U::Out>, rng: TrafficGen) -> Self {
-        let mut d = Driver { rtl, rng, stress: Stress::NONE, input: U::In::default(), output: U::Out::default() };
+        let waves = match (rtl.waves(), crate::waveform::failure_dir()) {
+            (Some(_), _) => Waves::Live,
+            (None, Some(dir)) => Waves::OnFailure(dir.to_path_buf()),
+            (None, None) => Waves::Off,
+        };
+        let mut d =
+            Driver { rtl, rng, stress: Stress::NONE, input: U::In::default(), output: U::Out::default(), clock: 0, waves, tape: None };
+        d.start_tape();
         d.reset();
         d
     }
 
+    /// Failure waveforms into `dir` (`None`: off) from now on, whatever COSIM_TRACE says; two
+    /// clocks of reset start the tape. No effect on a traced model (`--trace`).
+    pub fn set_waveforms(&mut self, dir: Option<PathBuf>) {
+        if matches!(self.waves, Waves::Live) {
+            return;
+        }
+        self.waves = dir.map_or(Waves::Off, Waves::OnFailure);
+        self.start_tape();
+        self.reset();
+    }
+
+    /// A new tape, starting with the next clock, when waveforms need one: a traced model's file
+    /// needs the output clocks, a failure's replay every input (if the model has a twin to
+    /// replay into: else there is nothing to tape for).
+    fn start_tape(&mut self) {
+        let needed = match self.waves {
+            Waves::Live => true,
+            Waves::OnFailure(_) => self.rtl.info().traced.is_some(),
+            Waves::Off | Waves::Done => false,
+        };
+        self.tape = needed.then(|| Box::new(Tape::new(self.clock)));
+    }
+
     /// Two clocks of reset with the inputs idle.
     pub fn reset(&mut self) {
+        match self.tape.take() {
+            Some(mut tape) => {
+                self.reset_with(&mut *tape);
+                self.tape = Some(tape);
+            }
+            None => self.reset_with(&mut NoTape),
+        }
+    }
+
+    fn reset_with(&mut self, rec: &mut impl Recorder<U::In>) {
         self.input = U::In::default();
         self.input.set_control(true, false, false);
+        rec.reset(self.clock);
         for _ in 0..2 {
             self.rtl.step_into(&self.input, &mut self.output);
+            rec.clock(self.clock, &self.input);
+            self.clock += 1;
         }
     }
 
     /// Streams `spans` through the model, `check` judging every output on a second thread;
     /// the driver's counts, protocol findings and the checker's verdicts all land in `report`.
+    /// With waveforms on, the run's first mismatch names its waveform ([`Driver::waveform`]).
     pub fn stream(&mut self, unit: &U, spans: &[U::Span], report: &mut Report, check: impl Check) {
         let (tx, rx) = sync_channel::<Batch>(IN_FLIGHT);
         // Checked batches come back empty, to be filled again.
         let (back_tx, back_rx) = sync_channel::<Batch>(IN_FLIGHT + 2);
-        let checked = std::thread::scope(|s| {
+        // Mismatches the driver finds are added to `report` after these.
+        let (kept, before) = (report.mismatches.len(), report.mismatch_count);
+        let mut tape = self.tape.take();
+        if let Some(t) = tape.as_deref_mut() {
+            t.new_stream();
+        }
+        let (mut checked, first_bad) = std::thread::scope(|s| {
             // The checker's state (its checker, its report) lives on its own thread: written
             // for every output, it must share no cache line with the driver's.
             let checker = s.spawn(move || consume(rx, back_tx, unit.record_bytes(), check));
             let (recycled, send) = (|| back_rx.try_recv().ok(), |batch| tx.send(batch).is_ok());
-            if self.stress == Stress::NONE {
-                self.drive(Pacer::<false>::new(self.stress, self.rng.clone()), unit, spans, report, recycled, send);
-            } else {
-                self.drive(Pacer::<true>::new(self.stress, self.rng.clone()), unit, spans, report, recycled, send);
+            let rng = self.rng.clone();
+            // The clock loop for each case, so none pays for what it does not do.
+            match (self.stress == Stress::NONE, tape.as_deref_mut()) {
+                (true, None) => self.drive(Pacer::<false>::new(self.stress, rng), unit, spans, report, recycled, send, &mut NoTape),
+                (false, None) => self.drive(Pacer::<true>::new(self.stress, rng), unit, spans, report, recycled, send, &mut NoTape),
+                (true, Some(t)) => self.drive(Pacer::<false>::new(self.stress, rng), unit, spans, report, recycled, send, t),
+                (false, Some(t)) => self.drive(Pacer::<true>::new(self.stress, rng), unit, spans, report, recycled, send, t),
             }
             drop(tx);
             checker.join().unwrap_or_else(|panic| std::panic::resume_unwind(panic))
         });
+        if report.mismatch_count > before || !checked.ok() {
+            self.describe_failure(tape.as_deref(), first_bad, kept, report, &mut checked);
+        }
+        self.tape = match self.waves {
+            Waves::Done => None,
+            _ => tape.map(|mut t| {
+                t.end_stream();
+                t
+            }),
+        };
         report.absorb(checked);
+    }
+
+    /// The run's first failure (this stream's first mismatch, in clock order, if the run had none
+    /// before) names its waveform, or why there is none. `first_bad`: the checker's first failing
+    /// output; `kept`: where this stream's driver mismatches start in `report.mismatches`.
+    #[cold]
+    fn describe_failure(
+        &mut self,
+        tape: Option<&Tape<U::In>>,
+        first_bad: Option<usize>,
+        kept: usize,
+        report: &mut Report,
+        checked: &mut Report,
+    ) {
+        let tape = match (&self.waves, tape) {
+            (Waves::Off | Waves::Done, _) => return,
+            (_, Some(tape)) => tape,
+            // Nothing was taped: the model has no twin to replay into (a traced model always
+            // has a tape). The note goes on this stream's first mismatch.
+            (_, None) => {
+                let tag = self.rtl.info().tag;
+                let note = format!("COSIM_TRACE: no waveform: this build has no traced model of {tag} (build with COSIM_TRACE set)");
+                annotate(report.mismatches.get_mut(kept).or(checked.mismatches.first_mut()), &note);
+                self.waves = Waves::Done;
+                return;
+            }
+        };
+        let by_driver = tape.found;
+        let by_checker = first_bad.and_then(|n| tape.transfers.get(n).copied());
+        let Some(clock) = by_driver.into_iter().chain(by_checker).min() else { return };
+        let waveform = self.waveform(tape, clock);
+        let note = match &waveform {
+            Ok(w) => w.to_string(),
+            Err(e) => format!("clock {clock}; COSIM_TRACE: no waveform: {e}"),
+        };
+        match by_driver == Some(clock) {
+            true => annotate(report.mismatches.get_mut(kept), &note),
+            false => annotate(checked.mismatches.first_mut(), &note),
+        }
+        report.waveforms.extend(waveform.ok());
+        self.waves = Waves::Done;
+    }
+
+    /// The waveform of a failure in clock `clock`: the traced model's own file, or the tape's
+    /// window around `clock` replayed into the model's twin, written and read back.
+    #[cold]
+    fn waveform(&self, tape: &Tape<U::In>, clock: u64) -> Result<Waveform, String> {
+        let dir = match &self.waves {
+            Waves::Live => {
+                let path = self.rtl.waves().expect("a traced model has a file").to_path_buf();
+                return Ok(Waveform { path, clock, window: None });
+            }
+            Waves::OnFailure(dir) => dir,
+            Waves::Off | Waves::Done => return Err("waveforms are off".into()),
+        };
+        let (first, last) = tape.clocks();
+        let (from, to) = (clock.saturating_sub(BEFORE).max(first), (clock + AFTER).min(last));
+        let info = self.rtl.info();
+        std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+        let path = dir.join(format!("{}-seed{}-clock{clock}.fst", info.tag, self.rtl.seed()));
+        let mut twin = Rtl::traced(info, self.rtl.seed())?;
+        tape.replay(&mut twin, from, to, &path)?;
+        drop(twin);
+        let ports = crate::waveform::Ports::read(&path).map_err(|e| format!("written but unreadable: {e}"))?;
+        if ports.first > clock || ports.last < clock {
+            return Err(format!("{} holds clocks {} to {}, not {clock}", path.display(), ports.first, ports.last));
+        }
+        Ok(Waveform { path, clock, window: Some((ports.first, ports.last)) })
     }
 
     /// The clock loop; `send` hands a full batch to the checker (false: the checker is gone,
     /// having panicked; stop and let `stream` pass its panic on), `recycled` returns an empty
-    /// batch the checker is done with, if there is one.
+    /// batch the checker is done with, if there is one. `rec` is told every clock's inputs,
+    /// output transfers, resets and the driver's mismatches (nothing with waveforms off).
+    #[allow(clippy::too_many_arguments)]
     fn drive<const STRESSED: bool>(
         &mut self,
         mut pacer: Pacer<STRESSED>,
@@ -262,10 +423,19 @@ impl<U: Unit> Driver<U> {
         report: &mut Report,
         mut recycled: impl FnMut() -> Option<Batch>,
         mut send: impl FnMut(Batch) -> bool,
+        rec: &mut impl Recorder<U::In>,
     ) {
         let (rb, full) = (unit.record_bytes(), Batch::records(unit.record_bytes()));
         let mut new_batch = || recycled().unwrap_or_else(|| Batch::new(rb));
         let mut batch = new_batch();
+        // The model's clock is `first_clock` plus the clocks this loop has counted in
+        // `report.cycles` since it began: `clock!()` is the clock being stepped.
+        let (mut first_clock, first_cycle) = (self.clock, report.cycles);
+        macro_rules! clock {
+            () => {
+                first_clock + (report.cycles - first_cycle)
+            };
+        }
         // Every accepted span with outputs still owed, oldest first, as (span, next output,
         // owed): the oldest in `front` (in registers: every output transfer updates it), the
         // rest queued behind it.
@@ -291,12 +461,14 @@ impl<U: Unit> Driver<U> {
                     report.cut_spans += front.is_some() as u64 + behind.len() as u64;
                     front = None;
                     behind.clear();
+                    rec.reset(clock!());
                 }
                 in_reset = true;
                 holding = false;
                 let ready = pacer.ready();
                 self.input.set_control(true, offering, ready);
                 self.rtl.step_into(&self.input, &mut self.output);
+                rec.clock(clock!(), &self.input);
                 report.cycles += 1;
                 idle = 0;
                 continue;
@@ -311,6 +483,7 @@ impl<U: Unit> Driver<U> {
             let ready = pacer.ready();
             self.input.set_control(false, offering, ready);
             self.rtl.step_into(&self.input, &mut self.output);
+            rec.clock(clock!(), &self.input);
             // The ports now hold this span's data: until the next span, the shim need not
             // write them again.
             self.input.keep_data(true);
@@ -318,9 +491,10 @@ impl<U: Unit> Driver<U> {
             let out = &self.output;
             report.pulses += unit.pulse(out) as u64;
             if std::mem::take(&mut in_reset) && out.out_valid() {
+                rec.found(clock!() - 1);
                 report.mismatch(Mismatch {
                     triangle: None,
-                    context: format!("clock {}", report.cycles),
+                    context: format!("clock {}", clock!() - 1),
                     what: "out_valid high in the first clock after a reset".into(),
                 });
             }
@@ -328,7 +502,8 @@ impl<U: Unit> Driver<U> {
             if out.out_valid() {
                 if std::mem::take(&mut holding) && !unit.same(&held, out) {
                     let what = unit.describe_change(&held, out);
-                    report.mismatch(Mismatch { triangle: None, context: format!("clock {}", report.cycles), what });
+                    rec.found(clock!() - 1);
+                    report.mismatch(Mismatch { triangle: None, context: format!("clock {}", clock!() - 1), what });
                 }
                 if ready {
                     match &mut front {
@@ -337,6 +512,7 @@ impl<U: Unit> Driver<U> {
                             let n = batch.at.len();
                             unit.record(out, &mut batch.data[n * rb..(n + 1) * rb]);
                             batch.at.push((*k as u32, *j));
+                            rec.transfer(clock!() - 1);
                             *j += 1;
                             if *j == *owed {
                                 front = behind.pop_front();
@@ -347,20 +523,24 @@ impl<U: Unit> Driver<U> {
                         }
                         // Output nobody asked for is no progress: a model that streams garbage
                         // while refusing input is declared hung, not followed forever.
-                        None => report.mismatch(Mismatch {
-                            triangle: None,
-                            context: format!("clock {}", report.cycles),
-                            what: "output with no span outstanding".into(),
-                        }),
+                        None => {
+                            rec.found(clock!() - 1);
+                            report.mismatch(Mismatch {
+                                triangle: None,
+                                context: format!("clock {}", clock!() - 1),
+                                what: "output with no span outstanding".into(),
+                            })
+                        }
                     }
                 } else {
                     holding = true;
                     unit.record(out, &mut held);
                 }
             } else if std::mem::take(&mut holding) {
+                rec.found(clock!() - 1);
                 report.mismatch(Mismatch {
                     triangle: None,
-                    context: format!("clock {}", report.cycles),
+                    context: format!("clock {}", clock!() - 1),
                     what: "out_valid dropped before the output offered was taken".into(),
                 });
             }
@@ -386,15 +566,19 @@ impl<U: Unit> Driver<U> {
                     None => (None, "idle".into()),
                 };
                 let left: u64 = front.iter().chain(&behind).map(|&(_, j, owed)| (owed - j) as u64).sum();
+                rec.found(clock!() - 1);
                 report.mismatch(Mismatch {
                     triangle,
                     context,
-                    what: format!("no transfer for {STALL_LIMIT} clocks; {left} outputs still expected"),
+                    what: format!("no transfer for {STALL_LIMIT} clocks (clock {}); {left} outputs still expected", clock!() - 1),
                 });
-                self.reset();
+                self.clock = clock!();
+                self.reset_with(rec);
+                first_clock += 2;
                 break;
             }
         }
+        self.clock = clock!();
         // The next stream goes on with the traffic where this one left it.
         self.rng = pacer.rng;
         if !batch.at.is_empty() {
@@ -403,16 +587,30 @@ impl<U: Unit> Driver<U> {
     }
 }
 
+/// Adds `note` to a mismatch's message, in brackets.
+fn annotate(m: Option<&mut Mismatch>, note: &str) {
+    if let Some(m) = m {
+        m.what = format!("{} [{note}]", m.what);
+    }
+}
+
 /// The checking thread: every record of every batch, in order; each batch then goes back.
-fn consume(rx: Receiver<Batch>, back: SyncSender<Batch>, rb: usize, mut check: impl Check) -> Report {
+/// Returns the report and the index (in transfer order) of the first output that failed.
+fn consume(rx: Receiver<Batch>, back: SyncSender<Batch>, rb: usize, mut check: impl Check) -> (Report, Option<usize>) {
     let mut report = Report::default();
+    let (mut n, mut first_bad) = (0, None);
     for mut batch in rx {
         for (&(k, j), rec) in batch.at.iter().zip(batch.data.chunks_exact(rb)) {
+            let before = report.mismatch_count;
             check.check(k as usize, j, rec, &mut report);
+            if report.mismatch_count != before && first_bad.is_none() {
+                first_bad = Some(n);
+            }
+            n += 1;
         }
         batch.at.clear();
         // The driver may have finished, or hold enough spares already: then it is dropped.
         let _ = back.try_send(batch);
     }
-    report
+    (report, first_bad)
 }

@@ -5,7 +5,8 @@
 use crate::driver::{Control, Handshake};
 use golden::specular::{Decoder, DecoderRepr, KRange, SpecularPlan, SpecularUnit};
 use golden::{Align, Config};
-use std::ffi::c_void;
+use std::ffi::{c_char, c_int, c_void, CString};
+use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
 
 /// Inputs of `segment_shader_p<P>` for one clock.
@@ -224,6 +225,10 @@ macro_rules! streaming_ports {
             fn keep_data(&mut self, keep: bool) {
                 self.keep = keep as u8;
             }
+            #[inline(always)]
+            fn control(&self) -> u8 {
+                self.rst | self.in_valid << 1 | self.out_ready << 2 | self.keep << 3
+            }
         }
         $(impl Handshake for $out {
             #[inline(always)]
@@ -258,6 +263,25 @@ pub struct ModelInfo<I: 'static, O: 'static> {
     pub new: unsafe extern "C" fn(u64) -> *mut c_void,
     pub free: unsafe extern "C" fn(*mut c_void),
     pub step: unsafe extern "C" fn(*mut c_void, *const I, *mut O),
+    /// Its traced twin, when this build has one (see [`crate::waveform`]).
+    pub traced: Option<TracedModel<I, O>>,
+}
+
+/// A model's traced twin (`verilator --trace-fst`, `csrc/trace.h`): the same RTL and the same
+/// per-clock structs, and an FST file it dumps every clock into while one is open. build.rs
+/// builds one for every streaming model when COSIM_TRACE is set, and for `seg_p2_span` always.
+#[derive(Clone, Copy)]
+pub struct TracedModel<I: 'static, O: 'static> {
+    /// `<tag>_tr`: its symbol prefix and the suffix of its Verilator class.
+    pub tag: &'static str,
+    pub new: unsafe extern "C" fn(u64) -> *mut c_void,
+    pub free: unsafe extern "C" fn(*mut c_void),
+    pub step: unsafe extern "C" fn(*mut c_void, *const I, *mut O),
+    /// (handle, path, clock): the next step is clock `clock`; every clock from then on goes into
+    /// the FST file at `path`. 0, or 1 when the file cannot be created, 2 on another error.
+    pub trace_open: unsafe extern "C" fn(*mut c_void, *const c_char, u64) -> c_int,
+    /// Flushes and closes the file (dropping the model does too). 0, or 2 on an error.
+    pub trace_close: unsafe extern "C" fn(*mut c_void) -> c_int,
 }
 
 /// The table set the specular model was generated with (`--brdf-k`): build.rs takes it from
@@ -370,10 +394,19 @@ pub fn require<T>(found: Option<T>, model: &str, what: &str) -> Option<T> {
     }
 }
 
-/// One instance of a verilated model with its own VerilatedContext.
+/// One instance of a verilated model with its own VerilatedContext: the model, or its traced
+/// twin ([`Rtl::traced`]).
 pub struct Rtl<I: 'static, O: 'static> {
     handle: *mut c_void,
     info: &'static ModelInfo<I, O>,
+    /// The model's or the twin's.
+    step: unsafe extern "C" fn(*mut c_void, *const I, *mut O),
+    free: unsafe extern "C" fn(*mut c_void),
+    seed: u64,
+    /// The twin's functions, when this is the twin.
+    twin: Option<&'static TracedModel<I, O>>,
+    /// The FST file open on the twin.
+    waves: Option<PathBuf>,
 }
 
 // Each instance owns its context and is only touched through &mut self.
@@ -381,25 +414,85 @@ unsafe impl<I, O> Send for Rtl<I, O> {}
 
 impl<I, O: Default> Rtl<I, O> {
     /// `seed` randomizes the registers' power-up values, so only a real reset makes them known.
+    ///
+    /// Under [`crate::waveform::trace_everything`] (`--trace DIR`) this is the traced twin with
+    /// a file of its own in DIR open from its first clock; it panics when the build has no twin
+    /// (the binaries check first, [`crate::waveform::require_traced`]).
     pub fn new(info: &'static ModelInfo<I, O>, seed: u64) -> Self {
-        let handle = unsafe { (info.new)(seed) };
-        assert!(!handle.is_null(), "model {} failed to construct", info.tag);
-        Rtl { handle, info }
+        let Some(dir) = crate::waveform::everything() else {
+            let handle = unsafe { (info.new)(seed) };
+            assert!(!handle.is_null(), "model {} failed to construct", info.tag);
+            return Rtl { handle, info, step: info.step, free: info.free, seed, twin: None, waves: None };
+        };
+        let mut rtl = Rtl::traced(info, seed).unwrap_or_else(|e| panic!("--trace: {e}"));
+        let path = crate::waveform::full_trace_path(dir, info.tag, seed);
+        rtl.open_waves(&path, 0).unwrap_or_else(|e| panic!("--trace: {e}"));
+        rtl
+    }
+
+    /// The traced twin of `info` (no file open yet), or why there is none.
+    pub fn traced(info: &'static ModelInfo<I, O>, seed: u64) -> Result<Self, String> {
+        let Some(twin) = &info.traced else {
+            return Err(format!("this build has no traced twin of {} (build with COSIM_TRACE set)", info.tag));
+        };
+        let handle = unsafe { (twin.new)(seed) };
+        if handle.is_null() {
+            return Err(format!("the traced model {} failed to construct", twin.tag));
+        }
+        Ok(Rtl { handle, info, step: twin.step, free: twin.free, seed, twin: Some(twin), waves: None })
     }
 
     pub fn info(&self) -> &'static ModelInfo<I, O> {
         self.info
     }
 
+    /// The seed of the registers' power-up values.
+    pub fn seed(&self) -> u64 {
+        self.seed
+    }
+
+    /// The FST file this instance writes, if any.
+    pub fn waves(&self) -> Option<&Path> {
+        self.waves.as_deref()
+    }
+
     /// One clock: apply `input` with the clock low, sample the outputs, raise the clock.
     pub fn step_into(&mut self, input: &I, output: &mut O) {
-        unsafe { (self.info.step)(self.handle, input, output) }
+        unsafe { (self.step)(self.handle, input, output) }
+    }
+
+    /// The twin only: from the next step on, which is clock `clock` of the run (the file's time
+    /// is 10 `clock`), every clock goes into a new FST file at `path`.
+    pub fn open_waves(&mut self, path: &Path, clock: u64) -> Result<(), String> {
+        let Some(twin) = self.twin else { return Err(format!("{} is not a traced model", self.info.tag)) };
+        use std::os::unix::ffi::OsStrExt;
+        let c = CString::new(path.as_os_str().as_bytes()).map_err(|_| format!("{}: a NUL in the path", path.display()))?;
+        // The FST writer cannot say why it fails to create a file: find out first.
+        std::fs::File::create(path).map_err(|e| format!("{}: {e}", path.display()))?;
+        match unsafe { (twin.trace_open)(self.handle, c.as_ptr(), clock) } {
+            0 => {
+                self.waves = Some(path.to_path_buf());
+                Ok(())
+            }
+            1 => Err(format!("{}: the FST writer cannot create it", path.display())),
+            _ => Err(format!("{}: the FST writer failed", path.display())),
+        }
+    }
+
+    /// Flushes and closes the FST file, if one is open.
+    pub fn close_waves(&mut self) -> Result<(), String> {
+        let (Some(twin), Some(path)) = (self.twin, self.waves.take()) else { return Ok(()) };
+        match unsafe { (twin.trace_close)(self.handle) } {
+            0 => Ok(()),
+            _ => Err(format!("{}: the FST writer failed to close it", path.display())),
+        }
     }
 }
 
 impl<I, O> Drop for Rtl<I, O> {
     fn drop(&mut self) {
-        unsafe { (self.info.free)(self.handle) }
+        // The twin's destructor closes its file.
+        unsafe { (self.free)(self.handle) }
     }
 }
 

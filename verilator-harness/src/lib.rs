@@ -6,7 +6,8 @@
 //! checks every segment of a segment shader and the final frames; [`specular`] does the same
 //! for the specular unit, pixel by pixel; [`render`] draws whole scenes through them;
 //! [`traffic`] makes the driver's and the sink's per-clock decisions (shared, bit for bit,
-//! with the native and cocotb benches of `scripts/bench-cosim`).
+//! with the native and cocotb benches of `scripts/bench-cosim`); [`waveform`] writes FST files of
+//! failures (COSIM_TRACE) and of whole runs (`--trace`).
 
 pub mod cosim;
 pub mod driver;
@@ -16,6 +17,7 @@ pub mod render;
 pub mod specular;
 pub mod stimulus;
 pub mod traffic;
+pub mod waveform;
 pub mod writer;
 
 /// The seed of a random test: `COSIM_SEED` when set (to replay a failure), else a fresh one.

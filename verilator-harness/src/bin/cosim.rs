@@ -7,13 +7,15 @@ use golden::rng::SeedRng;
 use golden::setup::Screen;
 use golden::Align;
 use rand::SeedableRng;
+use std::path::PathBuf;
 use std::process::ExitCode;
 use std::time::Instant;
 use verilator_harness::cosim::{Report, SegmentCosim, Traffic};
-use verilator_harness::ffi::{segment_model, specular_unit, SEGMENT_MODELS, SPECULAR_MODELS, TRISHADER_MODELS};
+use verilator_harness::ffi::{segment_model, specular_unit, ModelInfo, SEGMENT_MODELS, SPECULAR_MODELS, TRISHADER_MODELS};
 use verilator_harness::frontend::{random_triangles, run_chain_at};
 use verilator_harness::specular::{random_span, SpecularCosim};
 use verilator_harness::stimulus::random_triangle;
+use verilator_harness::waveform;
 
 /// `--traffic`: the valid/ready pattern at both ends.
 #[derive(Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
@@ -74,6 +76,28 @@ struct Args {
     /// With --specular: pixels to stream.
     #[arg(long, default_value_t = 1_000_000, requires = "specular")]
     pixels: u64,
+    /// Write every clock of the run into FST files in DIR (`<model>-seed<seed>.fst`, one per model
+    /// instance), for GTKWave or Surfer. For small runs: a few hundred bytes per clock. Needs
+    /// traced models (built when COSIM_TRACE is set at build time).
+    #[arg(long, value_name = "DIR")]
+    trace: Option<PathBuf>,
+}
+
+/// With `--trace DIR`: every model instance from now on writes its waveform into DIR. Exit
+/// status 2 when `info` has no traced twin in this build or DIR cannot be made.
+fn start_trace<I, O>(args: &Args, info: &ModelInfo<I, O>) -> Result<(), ExitCode> {
+    let Some(dir) = &args.trace else { return Ok(()) };
+    waveform::require_traced(info).and_then(|()| waveform::trace_everything(dir)).map_err(|e| {
+        eprintln!("error: {e}");
+        ExitCode::from(2)
+    })
+}
+
+/// The `waveform:` lines of a run: the files `--trace` wrote.
+fn print_waveforms() {
+    for path in waveform::written() {
+        println!("waveform:   {}", path.display());
+    }
 }
 
 #[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
@@ -100,6 +124,9 @@ fn main() -> ExitCode {
     if let Err(e) = screen.check_for(&info.cfg) {
         eprintln!("error: --width/--height: {e}");
         return ExitCode::from(2);
+    }
+    if let Err(code) = start_trace(&args, info) {
+        return code;
     }
     let seed = args.seed.unwrap_or_else(|| verilator_harness::seed("cosim"));
     let traffic = args.traffic.traffic();
@@ -139,6 +166,7 @@ fn finish(seed: u64, report: &Report, triangles: &str, spans: Option<u64>, speed
     println!("pixels per clock: {:.3}", report.pixels_per_clock());
     println!("worst |pixel - exact|: {:.3}", report.max_error);
     println!("wall: {secs:.2} s, {speed}, {:.0} clocks/s", report.cycles as f64 / secs);
+    print_waveforms();
     println!("{} passed, {} failed", report.passed_count(), report.failed_count());
     exit_code(report)
 }
@@ -154,6 +182,9 @@ fn rtl_frontend(args: &Args) -> ExitCode {
     if (args.width, args.height) != (info.screen.width, info.screen.height) {
         eprintln!("error: --width/--height: the front-end model draws on {}x{}", info.screen.width, info.screen.height);
         return ExitCode::from(2);
+    }
+    if let Err(code) = start_trace(args, info) {
+        return code;
     }
     let seed = args.seed.unwrap_or_else(|| verilator_harness::seed("cosim --frontend rtl"));
     let traffic = args.traffic.traffic();
@@ -195,6 +226,9 @@ fn specular(args: &Args) -> ExitCode {
         eprintln!("error: --specular: this build has no specular unit");
         return ExitCode::from(2);
     };
+    if let Err(code) = start_trace(args, info) {
+        return code;
+    }
     let seed = args.seed.unwrap_or_else(|| verilator_harness::seed("cosim --specular"));
     let traffic = args.traffic.traffic();
     println!("model {} ({}), seed {seed}, traffic {}", info.tag, info.top, args.traffic.name());
@@ -217,6 +251,7 @@ fn specular(args: &Args) -> ExitCode {
     println!("cycles per pixel: {:.3} (latency {} clocks)", report.cycles as f64 / report.pixels.max(1) as f64, info.latency);
     println!("wall: {secs:.2} s, {:.0} pixels/s, {:.0} clocks/s", report.pixels as f64 / secs, report.cycles as f64 / secs);
     let failed = report.failed_count();
+    print_waveforms();
     println!("{} passed, {failed} failed", report.spans as usize - report.failed.len().min(report.spans as usize));
     exit_code(&report)
 }

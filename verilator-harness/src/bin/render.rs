@@ -18,6 +18,7 @@ use verilator_harness::ffi::{
     segment_model, ModelInfo, SEGMENT_MODELS, SPECULAR_MODELS, TRISHADER_MODELS, TRIWRITER_MODELS, WRITER_MODELS,
 };
 use verilator_harness::render::{busy_cycles, difference_image, obj_job, run_with, scene_job, triangles_job, Chain, Job, SceneKind};
+use verilator_harness::waveform::{require_traced, trace_everything};
 
 #[derive(Parser)]
 #[command(about = "Render a scene or a triangle file through the generated RTL to PNG, checked against golden")]
@@ -68,6 +69,11 @@ struct Args {
     /// No progress line.
     #[arg(long)]
     quiet: bool,
+    /// Write every clock of every model instance into FST files in DIR (`<model>-seed<seed>.fst`),
+    /// for GTKWave or Surfer. For small renders (try --width 64 --height 48): a few hundred bytes
+    /// per clock. Needs traced models (built when COSIM_TRACE is set at build time).
+    #[arg(long, value_name = "DIR")]
+    trace: Option<PathBuf>,
 }
 
 fn fail(msg: impl std::fmt::Display) -> ExitCode {
@@ -173,6 +179,21 @@ fn main() -> ExitCode {
         Ok(j) => j,
         Err(e) => return fail(e),
     };
+    if let Some(trace) = &args.trace {
+        // The models this run builds instances of must have traced twins.
+        let mut need = match chain {
+            Chain::Host => vec![require_traced(info)],
+            Chain::HostToMemory(w) => vec![require_traced(info), require_traced(w)],
+            Chain::Rtl(m) => vec![require_traced(m)],
+            Chain::RtlToMemory(m) => vec![require_traced(m)],
+        };
+        if args.scene.is_some() || args.obj.is_some() {
+            need.extend(SPECULAR_MODELS.first().map(require_traced));
+        }
+        if let Err(e) = need.into_iter().collect::<Result<Vec<()>, String>>().and_then(|_| trace_everything(trace)) {
+            return fail(e);
+        }
+    }
 
     // indicatif hides the bar by itself when stderr is not a terminal.
     let bar = match args.quiet {
@@ -199,7 +220,7 @@ fn main() -> ExitCode {
 
     let differing = outcome.differing_pixels(channels);
     summary(&args, &job, &outcome, info.tag, chain, secs);
-    for (path, _) in &files {
+    for path in files.iter().map(|(p, _)| p.clone()).chain(verilator_harness::waveform::written()) {
         println!("wrote       {}", path.display());
     }
     for r in outcome.segment.iter().chain(&outcome.writer).chain(&outcome.specular) {
