@@ -11,6 +11,7 @@ use golden::rng::SeedRng;
 use golden::setup::{triangle_spans, Screen};
 use golden::Align;
 use rand::SeedableRng;
+use std::collections::HashMap;
 use std::ffi::c_void;
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -19,7 +20,7 @@ use std::sync::OnceLock;
 use verilator_harness::cosim::{Report, SegmentCosim, Stim, Stress, Traffic};
 use verilator_harness::ffi::{require, require_segment_model, ModelInfo, SegIn, SegOut, SEGMENT_MODELS};
 use verilator_harness::stimulus::random_triangle;
-use verilator_harness::waveform::{Ports, AFTER, BEFORE};
+use verilator_harness::waveform::{check_fst, AFTER, BEFORE, TIME_PER_CLOCK};
 
 /// The transfer whose lane-0 pixel the mutant flips (counted from its construction).
 const FLIP_AT: u32 = 1500;
@@ -53,6 +54,62 @@ fn scratch(name: &str) -> PathBuf {
     dir
 }
 
+/// A waveform file as GTKWave's `fst2vcd` reads it (Debian's gtkwave; `./scripts/test` installs
+/// it): the top-level ports (the variables of the outermost scope) and their values over time.
+struct Ports {
+    /// Name and VCD identifier.
+    ports: Vec<(String, String)>,
+    /// Each identifier's changes: (time, value bits).
+    changes: HashMap<String, Vec<(u64, String)>>,
+    /// The first and last clock in the file.
+    first: u64,
+    last: u64,
+}
+
+impl Ports {
+    fn read(path: &Path) -> Ports {
+        let out = Command::new("fst2vcd").arg(path).output().unwrap_or_else(|e| {
+            panic!("fst2vcd: {e} (it comes with Debian's gtkwave: apt-get install -y gtkwave; ./scripts/test installs it)")
+        });
+        assert!(out.status.success(), "fst2vcd {}: {}", path.display(), String::from_utf8_lossy(&out.stderr));
+        let text = String::from_utf8(out.stdout).expect("VCD is text");
+        let (mut depth, mut ports, mut changes, mut times) = (0, Vec::new(), HashMap::<String, Vec<(u64, String)>>::new(), Vec::new());
+        let mut t = 0;
+        for line in text.lines() {
+            let words: Vec<&str> = line.split_whitespace().collect();
+            match words.as_slice() {
+                ["$scope", ..] => depth += 1,
+                ["$upscope", ..] => depth -= 1,
+                ["$var", _, _, id, name, ..] if depth == 1 => ports.push((name.to_string(), id.to_string())),
+                [w] if w.starts_with('#') => {
+                    t = w[1..].parse().expect("a time");
+                    times.push(t);
+                }
+                [v, id] if v.starts_with('b') => changes.entry(id.to_string()).or_default().push((t, v[1..].to_string())),
+                [v] if !v.starts_with('$') && v.len() > 1 => {
+                    let (bit, id) = v.split_at(1);
+                    changes.entry(id.to_string()).or_default().push((t, bit.to_string()));
+                }
+                _ => {}
+            }
+        }
+        let (first, last) = (times.first().copied().unwrap_or(0), times.last().copied().unwrap_or(0));
+        Ports { ports, changes, first: first / TIME_PER_CLOCK, last: last / TIME_PER_CLOCK }
+    }
+
+    /// The value of `port` in clock `clock`, as its rising edge sees it (t = 10 `clock`).
+    fn at(&self, port: &str, clock: u64) -> Option<&str> {
+        let id = &self.ports.iter().find(|(name, _)| name == port)?.1;
+        let t = clock * TIME_PER_CLOCK;
+        self.changes.get(id)?.iter().take_while(|(time, _)| *time <= t).last().map(|(_, v)| v.as_str())
+    }
+
+    /// [`Ports::at`] as a number.
+    fn value(&self, port: &str, clock: u64) -> Option<u64> {
+        u64::from_str_radix(self.at(port, clock)?, 2).ok()
+    }
+}
+
 /// The ports SPEC §3 gives `segment_shader_p<P>`.
 const PORTS: [&str; 14] = [
     "clk",
@@ -72,7 +129,7 @@ const PORTS: [&str; 14] = [
 ];
 
 fn assert_ports(ports: &Ports, path: &Path) {
-    let names: Vec<&str> = ports.ports.iter().map(|(n, _)| n.as_str()).collect();
+    let names: Vec<&str> = ports.ports.iter().map(|(name, _)| name.as_str()).collect();
     for p in PORTS {
         assert!(names.contains(&p), "{}: no top-level port {p} (has {names:?})", path.display());
     }
@@ -128,9 +185,11 @@ fn planted_fault(mutant: &'static ModelInfo<SegIn, SegOut>, seed: u64, stress: S
     let lane = all.iter().find(|m| m.contains("lane 0 (pixel")).unwrap_or_else(|| panic!("{all:#?}"));
     let expected: u64 = lane.split("expected ").nth(1).and_then(|s| s.split(',').next()).and_then(|s| s.parse().ok()).expect(lane);
 
-    let ports = Ports::read(path).unwrap_or_else(|e| panic!("{e}"));
+    let ports = Ports::read(path);
     assert_ports(&ports, path);
     assert_eq!(w.window, Some((ports.first, ports.last)));
+    let summary = check_fst(path).unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!((summary.first, summary.last), (ports.first, ports.last), "the harness's check and fst2vcd agree");
     assert!(clock > BEFORE + 2, "clock {clock}: the fault should come later");
     if stress == Stress::NONE {
         assert_eq!((ports.first, ports.last), (clock - BEFORE, clock + AFTER), "the window");
@@ -164,7 +223,7 @@ fn cosim_trace_writes_the_whole_run() {
     let path = dir.join(format!("{}-seed7.fst", info.tag));
     assert!(stdout.contains(&format!("waveform:   {}", path.display())), "{stdout}");
     let cycles: u64 = stdout.lines().find_map(|l| l.strip_prefix("cycles:")).and_then(|c| c.trim().parse().ok()).expect(&stdout);
-    let ports = Ports::read(&path).unwrap_or_else(|e| panic!("{e}"));
+    let ports = Ports::read(&path);
     assert_ports(&ports, &path);
     // The reset's two clocks, the run's, and its last clock's edge.
     assert_eq!((ports.first, ports.last), (0, cycles + 2 - 1), "every clock of the run");

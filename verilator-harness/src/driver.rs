@@ -208,6 +208,28 @@ impl Batch {
     }
 }
 
+/// The driver's ends of the channels to the checking thread.
+struct Link {
+    tx: SyncSender<Batch>,
+    /// Checked batches, empty, to be filled again.
+    back: Receiver<Batch>,
+}
+
+impl Link {
+    /// Hands a full batch to the checker; false when the checker is gone, having panicked (the
+    /// driver then stops and `stream` passes the panic on).
+    #[inline]
+    fn send(&self, batch: Batch) -> bool {
+        self.tx.send(batch).is_ok()
+    }
+
+    /// An empty batch the checker is done with, if there is one.
+    #[inline]
+    fn recycled(&self) -> Option<Batch> {
+        self.back.try_recv().ok()
+    }
+}
+
 /// A unit under test: the model, its traffic and its stress. Written every clock, so aligned
 /// to whole cache lines: nothing the checking thread writes may sit beside it.
 #[repr(align(128))]
@@ -317,16 +339,17 @@ impl<U: Unit> Driver<U> {
             // The checker's state (its checker, its report) lives on its own thread: written
             // for every output, it must share no cache line with the driver's.
             let checker = s.spawn(move || consume(rx, back_tx, unit.record_bytes(), check));
-            let (recycled, send) = (|| back_rx.try_recv().ok(), |batch| tx.send(batch).is_ok());
+            let link = Link { tx, back: back_rx };
             let rng = self.rng.clone();
             // The clock loop for each case, so none pays for what it does not do.
             match (self.stress == Stress::NONE, tape.as_deref_mut()) {
-                (true, None) => self.drive(Pacer::<false>::new(self.stress, rng), unit, spans, report, recycled, send, &mut NoTape),
-                (false, None) => self.drive(Pacer::<true>::new(self.stress, rng), unit, spans, report, recycled, send, &mut NoTape),
-                (true, Some(t)) => self.drive(Pacer::<false>::new(self.stress, rng), unit, spans, report, recycled, send, t),
-                (false, Some(t)) => self.drive(Pacer::<true>::new(self.stress, rng), unit, spans, report, recycled, send, t),
+                (true, None) => self.drive(Pacer::<false>::new(self.stress, rng), unit, spans, report, &link, &mut NoTape),
+                (false, None) => self.drive(Pacer::<true>::new(self.stress, rng), unit, spans, report, &link, &mut NoTape),
+                (true, Some(t)) => self.drive(Pacer::<false>::new(self.stress, rng), unit, spans, report, &link, t),
+                (false, Some(t)) => self.drive(Pacer::<true>::new(self.stress, rng), unit, spans, report, &link, t),
             }
-            drop(tx);
+            // The checker's loop ends when its channel closes.
+            drop(link);
             checker.join().unwrap_or_else(|panic| std::panic::resume_unwind(panic))
         });
         if report.mismatch_count > before || !checked.ok() {
@@ -384,7 +407,7 @@ impl<U: Unit> Driver<U> {
     }
 
     /// The waveform of a failure in clock `clock`: the traced model's own file, or the tape's
-    /// window around `clock` replayed into the model's twin, written and read back.
+    /// window around `clock` replayed into the model's twin, written and checked whole.
     #[cold]
     fn waveform(&self, tape: &Tape<U::In>, clock: u64) -> Result<Waveform, String> {
         let dir = match &self.waves {
@@ -403,30 +426,26 @@ impl<U: Unit> Driver<U> {
         let mut twin = Rtl::traced(info, self.rtl.seed())?;
         tape.replay(&mut twin, from, to, &path)?;
         drop(twin);
-        let ports = crate::waveform::Ports::read(&path).map_err(|e| format!("written but unreadable: {e}"))?;
-        if ports.first > clock || ports.last < clock {
-            return Err(format!("{} holds clocks {} to {}, not {clock}", path.display(), ports.first, ports.last));
+        let file = crate::waveform::check_fst(&path).map_err(|e| format!("written but unreadable: {e}"))?;
+        if (file.first, file.last) != (from, to) {
+            return Err(format!("{} holds clocks {} to {}, not {from} to {to}", path.display(), file.first, file.last));
         }
-        Ok(Waveform { path, clock, window: Some((ports.first, ports.last)) })
+        Ok(Waveform { path, clock, window: Some((from, to)) })
     }
 
-    /// The clock loop; `send` hands a full batch to the checker (false: the checker is gone,
-    /// having panicked; stop and let `stream` pass its panic on), `recycled` returns an empty
-    /// batch the checker is done with, if there is one. `rec` is told every clock's inputs,
-    /// output transfers, resets and the driver's mismatches (nothing with waveforms off).
-    #[allow(clippy::too_many_arguments)]
+    /// The clock loop; full batches go to the checker over `link`. `rec` is told every clock's
+    /// inputs, output transfers, resets and the driver's mismatches (nothing with waveforms off).
     fn drive<const STRESSED: bool>(
         &mut self,
         mut pacer: Pacer<STRESSED>,
         unit: &U,
         spans: &[U::Span],
         report: &mut Report,
-        mut recycled: impl FnMut() -> Option<Batch>,
-        mut send: impl FnMut(Batch) -> bool,
+        link: &Link,
         rec: &mut impl Recorder<U::In>,
     ) {
         let (rb, full) = (unit.record_bytes(), Batch::records(unit.record_bytes()));
-        let mut new_batch = || recycled().unwrap_or_else(|| Batch::new(rb));
+        let new_batch = || link.recycled().unwrap_or_else(|| Batch::new(rb));
         let mut batch = new_batch();
         // The model's clock is `first_clock` plus the clocks this loop has counted in
         // `report.cycles` since it began: `clock!()` is the clock being stepped.
@@ -517,7 +536,7 @@ impl<U: Unit> Driver<U> {
                             if *j == *owed {
                                 front = behind.pop_front();
                             }
-                            if batch.at.len() == full && !send(std::mem::replace(&mut batch, new_batch())) {
+                            if batch.at.len() == full && !link.send(std::mem::replace(&mut batch, new_batch())) {
                                 return;
                             }
                         }
@@ -582,7 +601,7 @@ impl<U: Unit> Driver<U> {
         // The next stream goes on with the traffic where this one left it.
         self.rng = pacer.rng;
         if !batch.at.is_empty() {
-            send(batch);
+            link.send(batch);
         }
     }
 }

@@ -21,7 +21,7 @@
 //! that reset) to [`AFTER`] clocks after it (or the stream's end). Failures the driver sees (the
 //! protocol) carry their clock; for the scoreboard's, on the other thread, the tape notes the
 //! clock of every output transfer and the checker the index of its first failing output. The
-//! file is read back ([`Ports::read`]) before it is named. With waveforms off nothing is taped
+//! file is checked whole ([`check_fst`]) before it is named. With waveforms off nothing is taped
 //! and the clock loop is the code it was: the recorder is a type parameter ([`NoTape`]).
 //!
 //! **Everything (`--trace DIR`).** [`trace_everything`] makes every model instance of the process
@@ -248,67 +248,49 @@ impl<I: Control> Recorder<I> for Tape<I> {
     }
 }
 
-/// The top-level ports of a waveform file, read back with an independent reader (`fst-reader`,
-/// not GTKWave's library that wrote it).
-pub struct Ports {
-    /// Name and width in bits, in the file's order.
-    pub ports: Vec<(String, u32)>,
-    /// The first and last clock in the file.
+/// What [`check_fst`] found in a waveform file.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FstSummary {
+    /// The first and last clock the file holds.
     pub first: u64,
     pub last: u64,
-    /// Each port's changes: (time, bits most significant first).
-    changes: Vec<Vec<(u64, String)>>,
+    /// Variables in its hierarchy.
+    pub vars: u64,
+    /// Value-change blocks.
+    pub blocks: u64,
 }
 
-impl Ports {
-    /// Reads the file's hierarchy and every change of its top-level ports (the variables of its
-    /// outermost scope).
-    pub fn read(path: &Path) -> Result<Ports, String> {
-        let fail = |e: &dyn fmt::Display| format!("{}: {e}", path.display());
-        let file = std::fs::File::open(path).map_err(|e| fail(&e))?;
-        let mut reader = fst_reader::FstReader::open(std::io::BufReader::new(file)).map_err(|e| fail(&e))?;
-        let header = reader.get_header();
-        let (mut depth, mut ports, mut handles) = (0, Vec::new(), Vec::new());
-        reader
-            .read_hierarchy(|entry| match entry {
-                fst_reader::FstHierarchyEntry::Scope { .. } => depth += 1,
-                fst_reader::FstHierarchyEntry::UpScope => depth -= 1,
-                fst_reader::FstHierarchyEntry::Var { name, length, handle, .. } if depth == 1 => {
-                    // Vectors are named with their range: `out_pix [15:0]`.
-                    let name = name.split(' ').next().unwrap_or_default().to_string();
-                    ports.push((name, length));
-                    handles.push(handle.get_index());
-                }
-                _ => {}
-            })
-            .map_err(|e| fail(&e))?;
-        if ports.is_empty() {
-            return Err(fail(&"no top-level ports"));
+/// Checks that `path` is a whole FST file: its header block, then blocks (a type byte and a
+/// big-endian length) that end exactly at the end of the file, with a hierarchy, a geometry and
+/// value changes among them, as GTKWave's `fstapi.c` writes them. No decompression: `fst2vcd`
+/// (Debian's gtkwave) reads the values (`tests/waveforms.rs`, `scripts/check-rtl-dir --trace`).
+pub fn check_fst(path: &Path) -> Result<FstSummary, String> {
+    let fail = |what: &str| format!("{}: {what}", path.display());
+    let bytes = std::fs::read(path).map_err(|e| fail(&e.to_string()))?;
+    let u64_at = |at: usize| bytes.get(at..at + 8).map(|b| u64::from_be_bytes(b.try_into().expect("8 bytes")));
+    // fstapi.h: FST_BL_HDR 0, VCDATA 1, GEOM 3, HIER 4, VCDATA_DYN_ALIAS 5, HIER_LZ4 6,
+    // HIER_LZ4DUO 7, VCDATA_DYN_ALIAS2 8, BLACKOUT 2, SKIP 255.
+    if bytes.first() != Some(&0) {
+        return Err(fail("not an FST file (no header block)"));
+    }
+    // The header's fields after its type and length: start and end time, an endianness test,
+    // memory used, scopes, variables.
+    let (Some(start), Some(end), Some(vars)) = (u64_at(9), u64_at(17), u64_at(49)) else { return Err(fail("header cut short")) };
+    let (mut at, mut kinds, mut blocks) = (0usize, [0u64; 256], 0);
+    while at < bytes.len() {
+        let kind = bytes[at] as usize;
+        let len = u64_at(at + 1).ok_or_else(|| fail(&format!("block at byte {at} cut short")))? as usize;
+        if len < 8 || at + 1 + len > bytes.len() {
+            return Err(fail(&format!("block {kind} at byte {at} runs past the end")));
         }
-        let mut changes = vec![Vec::new(); ports.len()];
-        let filter = fst_reader::FstFilter::filter_signals(handles.iter().map(|&h| fst_reader::FstSignalHandle::from_index(h)).collect());
-        reader
-            .read_signals(&filter, |time, handle, value| {
-                let k = handles.iter().position(|&h| h == handle.get_index());
-                if let (Some(k), fst_reader::FstSignalValue::String(bits)) = (k, value) {
-                    changes[k].push((time, String::from_utf8_lossy(bits).into_owned()));
-                }
-                Ok::<(), std::convert::Infallible>(())
-            })
-            .map_err(|e| fail(&e))?;
-        Ok(Ports { ports, first: header.start_time / TIME_PER_CLOCK, last: header.end_time / TIME_PER_CLOCK, changes })
+        kinds[kind] += 1;
+        blocks += 1;
+        at += 1 + len;
     }
-
-    /// The value of `port` in clock `clock`, as its rising edge sees it (t = 10 `clock`): bits,
-    /// most significant first. `None` for a port the file does not have or a clock before it.
-    pub fn at(&self, port: &str, clock: u64) -> Option<&str> {
-        let k = self.ports.iter().position(|(name, _)| name == port)?;
-        let t = clock * TIME_PER_CLOCK;
-        self.changes[k].iter().take_while(|(time, _)| *time <= t).last().map(|(_, v)| v.as_str())
+    let hier = kinds[4] + kinds[6] + kinds[7];
+    let vc = kinds[1] + kinds[5] + kinds[8];
+    if kinds[3] != 1 || hier != 1 || vc == 0 {
+        return Err(fail(&format!("{blocks} blocks: {vc} of value changes, {} geometry, {hier} hierarchy (unfinished?)", kinds[3])));
     }
-
-    /// [`Ports::at`] as a number (ports of at most 64 bits with no x or z bits).
-    pub fn value(&self, port: &str, clock: u64) -> Option<u64> {
-        u64::from_str_radix(self.at(port, clock)?, 2).ok()
-    }
+    Ok(FstSummary { first: start / TIME_PER_CLOCK, last: end / TIME_PER_CLOCK, vars, blocks: vc })
 }
