@@ -109,7 +109,7 @@ fn set_up_costs_what_the_manifest_says() {
     let Some(m) = require(FRONTEND_MODELS.iter().find(|m| m.tag == "fe"), "fe", "frontend set-up clocks") else { return };
     // The model's divider rate, from the latency the build recorded for it.
     let hw = hdl_gen::frontend::DIV_BITS
-        .map(|div_bits| hdl_gen::frontend::Hw { fe: frontend(m), div_bits })
+        .map(|div_bits| hdl_gen::frontend::Hw { fe: frontend(m), div_bits, pipeline: m.pipeline })
         .into_iter()
         .find(|hw| hw.latency() == m.latency)
         .expect("a divider rate with the model's latency");

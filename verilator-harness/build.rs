@@ -16,6 +16,7 @@
 //! with a runtime of their own for the FST writer (`libverilated_fst_rt.a`, linked with zlib).
 
 use golden::frontend::DiMode;
+use golden::pipeline::Pipeline;
 use golden::setup::Screen;
 use golden::specular::{Decoder, DecoderRepr, KRange, SpecularGeometry, SpecularPlan};
 use golden::{Align, Config};
@@ -46,6 +47,9 @@ const BUILT_TRI: [(u32, Align); 4] = [(1, Align::Span), (8, Align::Span), (8, Al
 const BUILT_WR: [(u32, Align); 6] =
     [(1, Align::Span), (2, Align::Span), (8, Align::Span), (8, Align::Screen), (64, Align::Span), (64, Align::Screen)];
 const BUILT_FB: [(u32, Align); 2] = [(8, Align::Span), (64, Align::Screen)];
+/// Pipelined shaders (`--pipeline`) built by default, each in both alignments: every level at
+/// P = 8, the deepest at the smallest and largest P (its stages' corners: P = 1 has no BFPI).
+const BUILT_PIPE: [(u32, u32); 4] = [(8, 1), (1, 2), (8, 2), (64, 2)];
 
 #[derive(Clone, Copy, PartialEq)]
 enum Kind {
@@ -75,6 +79,8 @@ struct Model {
     top: String,
     /// Clocks from input transfer to first output valid (0: combinational).
     latency: u32,
+    /// The shader's register stages (`--pipeline`).
+    pipeline: Pipeline,
     /// Verilog sources and ROM images: (file name, text).
     sources: Vec<(String, String)>,
 }
@@ -218,6 +224,7 @@ fn generated_models() -> Vec<Model> {
         screen: Screen::default(),
         top: spec_names.unit.clone(),
         latency: hdl_gen::Options::default().specular_unit().plan().latency(),
+        pipeline: Pipeline::NONE,
         sources: spec
             .into_iter()
             .filter(|f| f.name.ends_with(".hex") || f.name.starts_with("specular_"))
@@ -241,10 +248,11 @@ fn generated_models() -> Vec<Model> {
                     screen: Screen::default(),
                     top: names.bfpi.clone(),
                     latency: 0,
+                    pipeline: Pipeline::NONE,
                     sources: bfpi,
                 });
             }
-            let latency = hdl_gen::segment::LATENCY;
+            let latency = golden::segment::latency(&cfg, Pipeline::NONE);
             // The chain at every P and alignment only on request (`sweep`'s front-end table):
             // each is a few seconds of compiling that the test suite does not need.
             if BUILT_TRI.contains(&(p, align)) || std::env::var_os("SEGSHADE_ALL_CHAINS").is_some() {
@@ -262,6 +270,7 @@ fn generated_models() -> Vec<Model> {
                         screen: fe.screen,
                         top: names.frontend.clone(),
                         latency: fe_lat,
+                        pipeline: Pipeline::NONE,
                         sources: src,
                     });
                     // The classical per-scanline dI (`--fe-di scanline`), the comparison option.
@@ -275,6 +284,7 @@ fn generated_models() -> Vec<Model> {
                         screen: fe.screen,
                         top: m.name.clone(),
                         latency: scan.latency(),
+                        pipeline: Pipeline::NONE,
                         sources: vec![(format!("{}.v", m.name), m.render())],
                     });
                     // The other divider rates (`--fe-div-bits`), so co-simulation covers every option.
@@ -290,6 +300,7 @@ fn generated_models() -> Vec<Model> {
                             screen: fe.screen,
                             top: m.name,
                             latency: hw.latency(),
+                            pipeline: Pipeline::NONE,
                             sources: src,
                         });
                     }
@@ -311,6 +322,7 @@ fn generated_models() -> Vec<Model> {
                         screen: fe.screen,
                         top: names.top.clone(),
                         latency: scan.latency() + latency,
+                        pipeline: Pipeline::NONE,
                         sources: src,
                     });
                 }
@@ -322,6 +334,7 @@ fn generated_models() -> Vec<Model> {
                     screen: fe.screen,
                     top: names.top.clone(),
                     latency: top_lat,
+                    pipeline: Pipeline::NONE,
                     sources: src,
                 });
             }
@@ -338,6 +351,7 @@ fn generated_models() -> Vec<Model> {
                     screen: Screen::default(),
                     top,
                     latency,
+                    pipeline: Pipeline::NONE,
                     sources: src,
                 });
             }
@@ -356,11 +370,30 @@ fn generated_models() -> Vec<Model> {
                     screen: Screen::default(),
                     top,
                     latency,
+                    pipeline: Pipeline::NONE,
                     sources: src,
                 });
             }
-            let sources =
+            let sources: Vec<(String, String)> =
                 sources.into_iter().filter(|(n, _)| *n == format!("{}.v", names.segment) || *n == format!("{}.v", names.bfpi)).collect();
+            for level in BUILT_PIPE.iter().filter(|(bp, _)| *bp == p).map(|&(_, l)| l) {
+                let pipeline = Pipeline::new(level).expect("a built level exists");
+                let m = hdl_gen::segment::module_with(&cfg, &names, hdl_gen::BfpiArch::ShiftAdd, pipeline);
+                let mut src: Vec<(String, String)> =
+                    sources.iter().filter(|(n, _)| *n != format!("{}.v", names.segment)).cloned().collect();
+                src.push((format!("{}.v", m.name), m.render()));
+                models.push(Model {
+                    tag: format!("seg_p{p}_{align}_pl{level}"),
+                    kind: Kind::Segment,
+                    cfg,
+                    di: DiMode::Triangle,
+                    screen: Screen::default(),
+                    top: names.segment.clone(),
+                    latency: golden::segment::latency(&cfg, pipeline),
+                    pipeline,
+                    sources: src,
+                });
+            }
             models.push(Model {
                 tag: format!("seg_p{p}_{align}"),
                 kind: Kind::Segment,
@@ -369,6 +402,7 @@ fn generated_models() -> Vec<Model> {
                 screen: Screen::default(),
                 top: names.segment,
                 latency,
+                pipeline: Pipeline::NONE,
                 sources,
             });
         }
@@ -385,6 +419,8 @@ fn models_from_dir(dir: &Path) -> Vec<Model> {
     let param = |k: &str| m["parameters"][k].as_u64().unwrap_or_else(|| fail(format!("manifest has no parameters.{k}"))) as u32;
     let align: Align = m["parameters"]["align"].as_str().unwrap_or("span").parse().unwrap_or_else(|e| fail(e));
     let cfg = Config::new(param("p"), param("frac"), param("xbits"), align).unwrap_or_else(|e| fail(e));
+    let level = m["parameters"]["pipeline"].as_u64().unwrap_or(0) as u32;
+    let pipeline = Pipeline::new(level).unwrap_or_else(|| fail(format!("parameters.pipeline {level} is above {}", Pipeline::MAX)));
     let modules = m["modules"].as_array().unwrap_or_else(|| fail("manifest has no modules".into()));
     let read = |file: &str| {
         let text = fs::read_to_string(dir.join(file)).unwrap_or_else(|e| fail(format!("cannot read {file}: {e}")));
@@ -413,6 +449,7 @@ fn models_from_dir(dir: &Path) -> Vec<Model> {
             screen: Screen::default(),
             top,
             latency: 0,
+            pipeline: Pipeline::NONE,
             sources: src,
         });
     }
@@ -426,6 +463,7 @@ fn models_from_dir(dir: &Path) -> Vec<Model> {
             screen: Screen::default(),
             top,
             latency,
+            pipeline,
             sources: sources.clone(),
         });
     }
@@ -446,6 +484,7 @@ fn models_from_dir(dir: &Path) -> Vec<Model> {
             screen,
             top: fe_top,
             latency: latency_of("frontend"),
+            pipeline: Pipeline::NONE,
             sources: fe_src,
         });
         let tag = format!("tris_p{}_{}", cfg.p, cfg.align);
@@ -457,6 +496,7 @@ fn models_from_dir(dir: &Path) -> Vec<Model> {
             screen,
             top: tri_top,
             latency: latency_of("triangle_shader"),
+            pipeline: Pipeline::NONE,
             sources: all.clone(),
         });
         if let (Some(wr_top), Some(fb_top)) = (top_of("writer"), top_of("triangle_writer")) {
@@ -470,6 +510,7 @@ fn models_from_dir(dir: &Path) -> Vec<Model> {
                 screen,
                 top: wr_top,
                 latency: latency_of("writer"),
+                pipeline: Pipeline::NONE,
                 sources: wr_src.clone(),
             });
             all.extend(wr_src);
@@ -483,6 +524,7 @@ fn models_from_dir(dir: &Path) -> Vec<Model> {
                 screen,
                 top: fb_top,
                 latency: latency_of("triangle_writer"),
+                pipeline: Pipeline::NONE,
                 sources: all,
             });
         }
@@ -502,6 +544,7 @@ fn models_from_dir(dir: &Path) -> Vec<Model> {
             screen: Screen::default(),
             top,
             latency,
+            pipeline: Pipeline::NONE,
             sources: src,
         });
     }
@@ -881,10 +924,10 @@ fn models_rs(models: &[Model], twins: &[Model], trace_all: bool, rtl_dir: Option
         };
         writeln!(
             list,
-            "    ModelInfo {{ tag: \"{t}\", top: \"{}\", latency: {}, cfg: Config {{ p: {}, frac: {}, xbits: {}, align: Align::{align} }}, \
+            "    ModelInfo {{ tag: \"{t}\", top: \"{}\", latency: {}, pipeline: golden::pipeline::Pipeline::at({}), cfg: Config {{ p: {}, frac: {}, xbits: {}, align: Align::{align} }}, \
              screen: golden::setup::Screen {{ width: {}, height: {} }}, di: golden::frontend::DiMode::{:?}, \
              new: {t}_new, free: {t}_free, step: {t}_step, traced: {traced} }},",
-            m.top, m.latency, c.p, c.frac, c.xbits, m.screen.width, m.screen.height, m.di
+            m.top, m.latency, m.pipeline, c.p, c.frac, c.xbits, m.screen.width, m.screen.height, m.di
         )
         .unwrap();
     }

@@ -5,6 +5,7 @@
 pub mod bfpi;
 pub mod format;
 pub mod frontend;
+pub mod pipeline;
 pub mod raster;
 pub mod rng;
 pub mod rom;

@@ -3,6 +3,7 @@
 //! says nothing about them.
 
 use crate::format::{Align, Config, Span};
+use crate::pipeline::{numbered, PipeReg, PipeStage, Pipeline};
 
 /// One output segment of a span.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -61,6 +62,79 @@ pub fn segment(cfg: &Config, span: &Span, s: u32) -> Segment {
         len: span.len,
         p,
     }
+}
+
+/// Width of the shader's pixels-left counter: holds `lead + m` for any port value, and P.
+pub fn rem_bits(cfg: &Config) -> u32 {
+    let lead = (cfg.align == Align::Screen && cfg.p > 1) as u32;
+    (cfg.xbits + 1 + lead).max(cfg.log2p() + 1)
+}
+
+/// The shader's register stages at `pipe`, input first; a span transferred in clock t has its
+/// first segment valid in clock t + `stages().len()`. Every stage moves when the output
+/// register is free, so one segment leaves per clock at every level.
+pub fn stages(cfg: &Config, pipe: Pipeline) -> Vec<PipeStage> {
+    let (p, f, xw) = (cfg.p, cfg.frac, cfg.xbits);
+    let (aw, rw, qw) = (cfg.aw(), rem_bits(cfg), cfg.aw() - cfg.frac);
+    let screen = cfg.align == Align::Screen && p > 1;
+    let acc = PipeReg::new("acc", aw, &format!("signed Q{}.{f}, lane 0 + 2^-{}", aw - f, f + 1));
+    let pos = [PipeReg::new("x", xw, "uint"), PipeReg::new("rem", rw, "uint, pixels left"), PipeReg::new("valid", 1, "flag")];
+    let lead = screen.then(|| PipeReg::new("lead", cfg.log2p(), "uint, masked leading lanes"));
+    let start = if screen { format!("I0 + 2^{} - (x0 mod {p})*dI", f - 1) } else { format!("I0 + 2^{}", f - 1) };
+    let lanes = "lane i = clamp((acc + inc_i) >> F, 0, 255), inc_i = i*dI (BFPI lane i - 1); \
+                 mask_i = i < rem (and i >= lead)";
+    let out = vec![
+        PipeReg::new("out_pix", 8 * p, "P x UQ8.0"),
+        PipeReg::new("out_mask", p, "bit per lane"),
+        PipeReg::new("out_x", xw, "uint"),
+        PipeReg::new("out_last", 1, "flag"),
+        PipeReg::new("out_valid", 1, "flag"),
+    ];
+    let mut body = Vec::new();
+    if pipe.span_stage() {
+        let regs = vec![
+            PipeReg::new("x0", xw, "uint"),
+            PipeReg::new("m", xw + 1, "uint"),
+            PipeReg::new("i0", cfg.iw(), &format!("UQ8.{f}")),
+            PipeReg::new("di", cfg.dw(), &format!("signed Q8.{f}")),
+            PipeReg::new("valid", 1, "flag (m != 0)"),
+        ];
+        body.push(("span", "the accepted span; m = 0 is dropped here".to_string(), regs));
+    }
+    let mut cur = vec![acc];
+    if pipe.span_stage() {
+        cur.push(PipeReg::new("inc", p * cfg.mw(), &format!("{p} x signed Q{}.{f}, (i+1)*dI", cfg.mw() - f)));
+        cur.push(PipeReg::new("last", 1, "flag, rem <= P"));
+    } else {
+        cur.push(PipeReg::new("di", cfg.dw(), &format!("signed Q8.{f}")));
+    }
+    cur.extend(pos.clone());
+    cur.extend(lead);
+    let cur_logic = if pipe.span_stage() {
+        format!("acc <= start ? {start} : acc + P*dI; inc <= (i+1)*dI, the BFPI of the waiting span's dI")
+    } else {
+        format!("acc <= accept ? {start} : acc + P*dI")
+    };
+    body.push(("current", cur_logic, cur));
+    if pipe.sum_stage() {
+        let regs = vec![
+            PipeReg::new("q", p * qw, &format!("{p} x signed {qw}-bit integer part of acc + inc_i")),
+            PipeReg::new("mask", p, "bit per lane"),
+            PipeReg::new("x", xw, "uint"),
+            PipeReg::new("last", 1, "flag"),
+            PipeReg::new("valid", 1, "flag"),
+        ];
+        body.push(("sum", "q_i = (acc + inc_i) >> F; mask_i = i < rem (and i >= lead)".to_string(), regs));
+        body.push(("output", "lane i = clamp(q_i, 0, 255)".to_string(), out));
+    } else {
+        body.push(("output", lanes.to_string(), out));
+    }
+    numbered(body)
+}
+
+/// Clocks from a span's transfer to its first segment's `out_valid` at `pipe`.
+pub fn latency(cfg: &Config, pipe: Pipeline) -> u32 {
+    stages(cfg, pipe).len() as u32
 }
 
 #[cfg(test)]
@@ -128,5 +202,20 @@ mod tests {
         let span = Span { x0: 70, len: 100, i0: 0, di: 0 };
         let first = segments(&c, &span).next().unwrap();
         assert_eq!(first.mask(), [0, !0 << 6, 0, 0]);
+    }
+
+    #[test]
+    fn each_pipeline_level_adds_stages_and_level_0_is_the_seed() {
+        for align in Align::ALL {
+            let c = cfg(8, align);
+            assert_eq!(latency(&c, Pipeline::NONE), 2, "SPEC's seed: current span and output registers");
+            let lat: Vec<u32> = Pipeline::all().map(|pipe| latency(&c, pipe)).collect();
+            assert!(lat.windows(2).all(|w| w[0] < w[1]), "{lat:?}");
+            for pipe in Pipeline::all() {
+                let st = stages(&c, pipe);
+                assert!(st.iter().enumerate().all(|(i, s)| s.stage == i as u32));
+                assert_eq!(st.last().unwrap().name, "output");
+            }
+        }
     }
 }

@@ -30,6 +30,8 @@ pub struct Hw {
     pub fe: FrontEnd,
     /// Quotient bits per clock of every set-up divider (one of [`DIV_BITS`]).
     pub div_bits: u32,
+    /// The chain's register stages (`--pipeline`): the shader's; the front-end has none yet.
+    pub pipeline: golden::pipeline::Pipeline,
 }
 
 impl Hw {
@@ -52,6 +54,12 @@ impl Hw {
     /// scanline, the span's division when it has two pixels or more).
     pub fn latency(&self) -> u32 {
         self.div_clocks() + 5 + self.span_div_clocks()
+    }
+
+    /// Clocks from a triangle's transfer to the first segment out of `tri_shader_p<P>` when idle:
+    /// the front-end's latency, then the shader's at the chain's pipeline level.
+    pub fn shader_latency(&self) -> u32 {
+        self.latency() + golden::segment::latency(&self.fe.cfg, self.pipeline)
     }
 
     /// Set-up clocks per triangle that is walked (the rate limit for tiny triangles: the
@@ -750,7 +758,7 @@ pub fn top_module(hw: &Hw, names: &Names) -> Module {
             "Configuration: P = {p}, F = {}, XW = {xw}, align = {}, screen {}x{}.",
             cfg.frac, cfg.align, fe.screen.width, fe.screen.height
         ),
-        format!("Latency: first segment {} clocks after the triangle's transfer when idle.", hw.latency() + crate::segment::LATENCY),
+        format!("Latency: first segment {} clocks after the triangle's transfer when idle.", hw.shader_latency()),
     ];
     let mut ports: Vec<Port> = ports(fe, &wd)
         .into_iter()

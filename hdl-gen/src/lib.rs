@@ -74,6 +74,8 @@ pub struct Options {
     pub fe_div_bits: Option<u32>,
     /// Where the front-end's `dI` comes from (`--fe-di`); the default is once per triangle.
     pub fe_di: golden::frontend::DiMode,
+    /// Register stages added for clock rate (`--pipeline`); level 0 is SPEC's seed structure.
+    pub pipeline: golden::pipeline::Pipeline,
 }
 
 impl Options {
@@ -87,7 +89,7 @@ impl Options {
     pub fn frontend(&self) -> Result<frontend::Hw, golden::frontend::FrontEndError> {
         let fe = golden::frontend::FrontEnd::new(self.cfg, self.screen.unwrap_or_else(|| Options::default_screen(&self.cfg)))?
             .with_di(self.fe_di);
-        Ok(frontend::Hw { fe, div_bits: self.fe_div_bits.unwrap_or(frontend::DEFAULT_DIV_BITS) })
+        Ok(frontend::Hw { fe, div_bits: self.fe_div_bits.unwrap_or(frontend::DEFAULT_DIV_BITS), pipeline: self.pipeline })
     }
 
     /// The segment writer of the front-end's screen (the same screen: the chain shares it).
@@ -115,7 +117,7 @@ pub struct GeneratedFile {
 pub fn generate(opts: &Options) -> Vec<GeneratedFile> {
     let names = Names::new(&opts.prefix, &opts.cfg);
     let mut modules: Vec<verilog::Module> = bfpi::module_for(&opts.cfg, &names, opts.bfpi_arch).into_iter().collect();
-    modules.push(segment::module_with(&opts.cfg, &names, opts.bfpi_arch));
+    modules.push(segment::module_with(&opts.cfg, &names, opts.bfpi_arch, opts.pipeline));
     // The CLI validates the screen; a library caller with a bad one gets no front-end.
     if let (Ok(fe), Ok(w)) = (opts.frontend(), opts.writer()) {
         modules.push(frontend::module(&fe, &names));

@@ -45,6 +45,12 @@ enum Command {
         /// intensities with the same divider: a comparison option, slower and larger).
         #[arg(long = "fe-di", value_enum, default_value_t = DiMode::Triangle)]
         fe_di: DiMode,
+        /// Register stages added for clock rate, 0..2 (golden::pipeline): 1 registers the span and
+        /// the shader's increments, 2 also its lane sums. Values and throughput are the same at
+        /// every level; latency grows (manifest.json). 0, the default: SPEC's seed structure,
+        /// smallest and shortest (docs/fpga.md compares the levels).
+        #[arg(long, default_value_t = 0, value_parser = clap::value_parser!(u32).range(0..=golden::pipeline::Pipeline::MAX as i64))]
+        pipeline: u32,
         /// Output folder (created if missing).
         #[arg(long)]
         out: PathBuf,
@@ -219,12 +225,16 @@ enum RomTable {
 fn main() -> ExitCode {
     let cli = parse_cli();
     let result = match cli.command {
-        Command::Generate { config, bfpi_arch, brdf, width, height, fe_div_bits, fe_di, out } => config
+        Command::Generate { config, bfpi_arch, brdf, width, height, fe_div_bits, fe_di, pipeline, out } => config
             .options(&brdf)
             .and_then(|opts| {
                 let default = Options::default_screen(&opts.cfg);
                 let screen = golden::setup::Screen { width: width.unwrap_or(default.width), height: height.unwrap_or(default.height) };
-                let opts = Options { bfpi_arch, screen: Some(screen), fe_div_bits, fe_di, ..opts };
+                let pipeline = golden::pipeline::Pipeline::new(pipeline).expect("clap checked the range");
+                if pipeline.span_stage() && bfpi_arch == BfpiArch::Tree {
+                    return Err(hdl_gen::segment::TREE_UNPIPELINED.to_string());
+                }
+                let opts = Options { bfpi_arch, screen: Some(screen), fe_div_bits, fe_di, pipeline, ..opts };
                 opts.frontend().map_err(|e| format!("--width/--height: {e}"))?;
                 Ok(opts)
             })

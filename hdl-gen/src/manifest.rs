@@ -7,7 +7,7 @@
 
 use crate::specular::SpecNames;
 use crate::verilog::{Dir, Module};
-use crate::{segment, BfpiArch, Names, Options, VERSION};
+use crate::{BfpiArch, Names, Options, VERSION};
 use golden::bfpi::{Adder, BfpiPlan};
 use golden::rom::{Rom, BRDF_HEX, NK_HEX};
 use golden::specular::{SpecularGeometry, SpecularUnit};
@@ -128,6 +128,13 @@ pub struct Parameters {
     /// Only written for the comparison forms, so the default output stays as it was.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub bfpi_arch: Option<String>,
+    /// `--pipeline`; only written above level 0, so the default output stays as it was.
+    #[serde(default, skip_serializing_if = "is_seed_pipeline")]
+    pub pipeline: golden::pipeline::Pipeline,
+}
+
+fn is_seed_pipeline(p: &golden::pipeline::Pipeline) -> bool {
+    *p == golden::pipeline::Pipeline::NONE
 }
 
 #[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
@@ -150,6 +157,10 @@ pub struct ModuleEntry {
     pub latency: u32,
     pub throughput: String,
     pub ports: Vec<PortEntry>,
+    /// The register stages (`golden::segment::stages`) of a pipelined segment shader; absent at
+    /// level 0, whose two stages SPEC's seed fixes (the specular unit's are in `specular`).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub stages: Vec<golden::pipeline::PipeStage>,
 }
 
 #[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
@@ -220,26 +231,40 @@ pub fn render(opts: &Options, names: &Names, modules: &[Module], unit: &Specular
     let spec = SpecNames::new(&opts.prefix);
     let fe = opts.frontend().ok();
     let fe_latency = fe.as_ref().map_or(0, |hw| hw.latency());
+    let seg_latency = golden::segment::latency(cfg, opts.pipeline);
     let wr = opts.writer().ok().filter(|_| fe.is_some());
     let entry = |m: &Module| {
         let (role, latency, throughput) = if m.name == names.bfpi {
             (Role::Bfpi, 0, "combinational")
         } else if m.name == names.segment {
-            (Role::SegmentShader, segment::LATENCY, "one segment per clock")
+            (Role::SegmentShader, seg_latency, "one segment per clock")
         } else if m.name == names.frontend {
             (Role::Frontend, fe_latency, "one span per clock; set-up per walked triangle as in frontend.setup_clocks")
         } else if m.name == names.top {
-            (Role::TriangleShader, fe_latency + segment::LATENCY, "one segment per clock")
+            (Role::TriangleShader, fe_latency + seg_latency, "one segment per clock")
         } else if m.name == names.writer {
             (Role::Writer, golden::writer::LATENCY, "one block write per clock")
         } else if m.name == names.fb_top {
-            (Role::TriangleWriter, fe_latency + segment::LATENCY + golden::writer::LATENCY, "one block write per clock")
+            (Role::TriangleWriter, fe_latency + seg_latency + golden::writer::LATENCY, "one block write per clock")
         } else if m.name == spec.unit {
             (Role::SpecularUnit, unit.plan().latency(), "one pixel per clock")
         } else {
             (Role::Rom, 1, "one word per clock")
         };
-        ModuleEntry { name: m.name.clone(), file: format!("{}.v", m.name), role, latency, throughput: throughput.into(), ports: ports(m) }
+        let stages = if role == Role::SegmentShader && opts.pipeline != golden::pipeline::Pipeline::NONE {
+            golden::segment::stages(cfg, opts.pipeline)
+        } else {
+            Vec::new()
+        };
+        ModuleEntry {
+            name: m.name.clone(),
+            file: format!("{}.v", m.name),
+            role,
+            latency,
+            throughput: throughput.into(),
+            ports: ports(m),
+            stages,
+        }
     };
     let manifest = Manifest {
         generator: Generator { name: "segshade hdl-gen".into(), version: VERSION.into() },
@@ -250,6 +275,7 @@ pub fn render(opts: &Options, names: &Names, modules: &[Module], unit: &Specular
             align: cfg.align,
             prefix: opts.prefix.clone(),
             bfpi_arch: (opts.bfpi_arch != BfpiArch::ShiftAdd).then(|| opts.bfpi_arch.name().into()),
+            pipeline: opts.pipeline,
         },
         formats: Formats {
             intensity: format!("UQ8.{}", cfg.frac),

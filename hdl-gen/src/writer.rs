@@ -193,10 +193,7 @@ pub fn top_module(hw: &crate::frontend::Hw, w: &Writer, names: &Names) -> Module
             fe.screen.height,
             w.blocks()
         ),
-        format!(
-            "Latency: first write {} clocks after the triangle's transfer when idle.",
-            hw.latency() + crate::segment::LATENCY + LATENCY
-        ),
+        format!("Latency: first write {} clocks after the triangle's transfer when idle.", hw.shader_latency() + LATENCY),
     ];
     let fe_ports: Vec<Port> = crate::frontend::ports(fe, &fe.widths())
         .into_iter()

@@ -7,6 +7,7 @@
 //! The full sweep (every P, both alignments, every form, plus Yosys) is `scripts/lint-all`.
 
 use golden::frontend::DiMode;
+use golden::pipeline::Pipeline;
 use golden::{Align, Config};
 use hdl_gen::{generate, output, wrapper, BfpiArch, Options};
 use std::path::Path;
@@ -21,22 +22,34 @@ fn run(tool: &str, args: &[String]) -> String {
     text
 }
 
-fn configs() -> Vec<(Config, &'static str, BfpiArch)> {
+fn configs() -> Vec<(Config, &'static str, BfpiArch, Pipeline)> {
+    let seed = Pipeline::NONE;
     let mut v = Vec::new();
     for p in [1, 2, 4, 8, 16, 64, 256] {
         for align in Align::ALL {
-            v.push((Config { p, align, ..Config::default() }, "", BfpiArch::ShiftAdd));
+            v.push((Config { p, align, ..Config::default() }, "", BfpiArch::ShiftAdd, seed));
         }
     }
-    v.push((Config::new(16, 4, 4, Align::Screen).unwrap(), "edge_", BfpiArch::ShiftAdd));
-    v.push((Config::new(2, 20, 16, Align::Screen).unwrap(), "", BfpiArch::ShiftAdd));
-    v.push((Config::new(128, 7, 9, Align::Span).unwrap(), "x_", BfpiArch::ShiftAdd));
+    v.push((Config::new(16, 4, 4, Align::Screen).unwrap(), "edge_", BfpiArch::ShiftAdd, seed));
+    v.push((Config::new(2, 20, 16, Align::Screen).unwrap(), "", BfpiArch::ShiftAdd, seed));
+    v.push((Config::new(128, 7, 9, Align::Span).unwrap(), "x_", BfpiArch::ShiftAdd, seed));
     for arch in [BfpiArch::Naive, BfpiArch::Tree] {
         for (p, align) in [(1, Align::Span), (2, Align::Screen), (8, Align::Span), (64, Align::Screen), (256, Align::Span)] {
-            v.push((Config { p, align, ..Config::default() }, "", arch));
+            v.push((Config { p, align, ..Config::default() }, "", arch, seed));
         }
-        v.push((Config::new(16, 4, 4, Align::Screen).unwrap(), "edge_", arch));
+        v.push((Config::new(16, 4, 4, Align::Screen).unwrap(), "edge_", arch, seed));
     }
+    // `--pipeline`: every level at P = 8, the deepest at the corners (P = 1 has no BFPI; P = 2^XW
+    // and the narrowest formats) and with the naive increments.
+    let deepest = Pipeline::new(Pipeline::MAX).unwrap();
+    for pipe in Pipeline::all().skip(1) {
+        v.push((Config { p: 8, align: Align::Screen, ..Config::default() }, "", BfpiArch::ShiftAdd, pipe));
+    }
+    for (p, align) in [(1, Align::Span), (64, Align::Span), (256, Align::Screen)] {
+        v.push((Config { p, align, ..Config::default() }, "", BfpiArch::ShiftAdd, deepest));
+    }
+    v.push((Config::new(16, 4, 4, Align::Screen).unwrap(), "edge_", BfpiArch::ShiftAdd, deepest));
+    v.push((Config { p: 8, align: Align::Span, ..Config::default() }, "", BfpiArch::Naive, deepest));
     v
 }
 
@@ -57,13 +70,14 @@ fn verilator_lint_and_icarus_are_clean() {
     // alignment or the increment form: it is linted once per front-end configuration, and the
     // chain there and at the extreme P values (scripts/lint-all lints every configuration).
     let mut fe_seen = std::collections::HashSet::new();
-    let mut runs = configs().into_iter().map(|(cfg, prefix, arch)| (cfg, prefix, arch, None, DiMode::Triangle)).collect::<Vec<_>>();
+    let mut runs =
+        configs().into_iter().map(|(cfg, prefix, arch, pipe)| (cfg, prefix, arch, None, DiMode::Triangle, pipe)).collect::<Vec<_>>();
     for bits in hdl_gen::frontend::DIV_BITS {
-        runs.push((Config::default(), "", BfpiArch::ShiftAdd, Some(bits), DiMode::Triangle));
+        runs.push((Config::default(), "", BfpiArch::ShiftAdd, Some(bits), DiMode::Triangle, Pipeline::NONE));
     }
     // The per-scanline dI (`--fe-di scanline`) at the slowest and the fastest divider.
     for bits in [1, 4] {
-        runs.push((Config::default(), "", BfpiArch::ShiftAdd, Some(bits), DiMode::Scanline));
+        runs.push((Config::default(), "", BfpiArch::ShiftAdd, Some(bits), DiMode::Scanline, Pipeline::NONE));
     }
     // The work is external processes (Verilator, Icarus): two at a time, one per core.
     let runs: Vec<_> = runs.into_iter().enumerate().map(|(k, r)| (k, r, fe_seen.insert((r.0.frac, r.0.xbits, r.1, r.3, r.4)))).collect();
@@ -71,22 +85,32 @@ fn verilator_lint_and_icarus_are_clean() {
     std::thread::scope(|s| {
         for _ in 0..2 {
             s.spawn(|| {
-                while let Some(&(k, (cfg, prefix, arch, fe_div_bits, fe_di), fe_first)) =
+                while let Some(&(k, (cfg, prefix, arch, fe_div_bits, fe_di, pipe), fe_first)) =
                     runs.get(next.fetch_add(1, std::sync::atomic::Ordering::Relaxed))
                 {
-                    lint_one(k, cfg, prefix, arch, fe_div_bits, fe_di, fe_first);
+                    lint_one(k, cfg, prefix, arch, (fe_div_bits, fe_di), pipe, fe_first);
                 }
             });
         }
     });
 }
 
-fn lint_one(k: usize, cfg: Config, prefix: &str, arch: BfpiArch, fe_div_bits: Option<u32>, fe_di: DiMode, fe_first: bool) {
+fn lint_one(
+    k: usize,
+    cfg: Config,
+    prefix: &str,
+    arch: BfpiArch,
+    (fe_div_bits, fe_di): (Option<u32>, DiMode),
+    pipeline: Pipeline,
+    fe_first: bool,
+) {
     {
-        let what = format!("{cfg:?}, prefix '{prefix}', --bfpi-arch {arch}, --fe-div-bits {fe_div_bits:?}, --fe-di {fe_di:?}");
+        let what = format!(
+            "{cfg:?}, prefix '{prefix}', --bfpi-arch {arch}, --fe-div-bits {fe_div_bits:?}, --fe-di {fe_di:?}, --pipeline {pipeline}"
+        );
         let dir = std::env::temp_dir().join(format!("hdl-gen-lint-{}-{k}", std::process::id()));
         let _ = std::fs::remove_dir_all(&dir);
-        let opts = Options { cfg, prefix: prefix.into(), bfpi_arch: arch, fe_div_bits, fe_di, ..Default::default() };
+        let opts = Options { cfg, prefix: prefix.into(), bfpi_arch: arch, fe_div_bits, fe_di, pipeline, ..Default::default() };
         let names = hdl_gen::Names::new(prefix, &cfg);
         let chain = fe_first || (arch == BfpiArch::ShiftAdd && [1, 256].contains(&cfg.p));
         let skip = |module: &str| (module == names.frontend && !fe_first) || ((module == names.top || module == names.fb_top) && !chain);

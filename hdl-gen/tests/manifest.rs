@@ -17,6 +17,10 @@ fn configs() -> Vec<Options> {
     }
     v.push(Options { cfg: Config::new(16, 4, 4, Align::Screen).unwrap(), prefix: "acme_".into(), ..Default::default() });
     v.push(Options { cfg: Config::new(2, 20, 16, Align::Span).unwrap(), ..Default::default() });
+    for level in 1..=golden::pipeline::Pipeline::MAX {
+        let pipeline = golden::pipeline::Pipeline::new(level).unwrap();
+        v.push(Options { cfg: Config { p: 8, align: Align::Screen, ..Config::default() }, pipeline, ..Default::default() });
+    }
     v
 }
 

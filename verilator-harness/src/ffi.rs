@@ -255,6 +255,8 @@ pub struct ModelInfo<I: 'static, O: 'static> {
     pub top: &'static str,
     /// Clocks from an input transfer to the first output valid, as the generator states it.
     pub latency: u32,
+    /// The shader's register stages (`--pipeline`); level 0 for every other kind of model.
+    pub pipeline: golden::pipeline::Pipeline,
     pub cfg: Config,
     /// The screen of a front-end model (`tri_frontend`, `tri_shader_p<P>`); 640x480 elsewhere.
     pub screen: golden::setup::Screen,
@@ -318,9 +320,12 @@ impl<I, O> ModelInfo<I, O> {
     }
 }
 
-/// The segment-shader model built for `p` and `align`, if this build has one.
+/// The segment-shader model built for `p` and `align` with SPEC's seed structure (or, from
+/// `COSIM_RTL_DIR`, whatever pipeline level the folder has), if this build has one.
 pub fn segment_model(p: u32, align: Align) -> Option<&'static ModelInfo<SegIn, SegOut>> {
-    SEGMENT_MODELS.iter().find(|m| m.cfg.p == p && m.cfg.align == align)
+    let seed = |m: &&ModelInfo<SegIn, SegOut>| m.pipeline == golden::pipeline::Pipeline::NONE;
+    let matching = || SEGMENT_MODELS.iter().filter(|m| m.cfg.p == p && m.cfg.align == align);
+    matching().find(seed).or_else(|| matching().next())
 }
 
 /// The segment-shader model for `p` and `align`, for a test that needs it (`what` names that

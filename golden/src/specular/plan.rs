@@ -25,6 +25,7 @@
 use super::decoder::{BrdfK, Decoder, KRange};
 use super::reference::{cos_k, epicentre_arg, epicentre_code};
 use super::{INSIDE_REL, NK_DEPTH, N_MIN, OUTSIDE_REL, THETA_FRAC};
+use crate::pipeline::{PipeReg, PipeStage};
 use crate::rom::addr_bits;
 use serde::{Deserialize, Serialize};
 use std::ops::RangeInclusive;
@@ -70,23 +71,6 @@ impl TablePlan {
     pub fn end_arg(&self) -> f64 {
         self.len as f64 * self.step
     }
-}
-
-/// One register of a pipeline stage.
-#[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
-pub struct PipeReg {
-    pub name: String,
-    pub bits: u32,
-    pub format: String,
-}
-
-/// One register stage: the logic in front of it and what it holds.
-#[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
-pub struct PipeStage {
-    pub stage: u32,
-    pub name: String,
-    pub logic: String,
-    pub regs: Vec<PipeReg>,
 }
 
 /// Where an exhaustive check found a table short of SPEC §4.

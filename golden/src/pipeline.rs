@@ -1,0 +1,123 @@
+//! Register stages for clock rate (`hdl-gen generate --pipeline N`).
+//!
+//! Pipelining changes no value: at every level each block computes what its golden model says.
+//! It changes when a value appears (the latency) and which registers exist. This module states
+//! the stage structure once, as data: the generator prints it into each module's header and the
+//! manifest, the harness and the throughput models take their latencies from it, and the
+//! blocks' plans ([`crate::segment::stages`]) are built from it.
+//!
+//! Every stage of every block moves on one stall signal (the output register is free), so a
+//! stall holds every stage and the throughput is the same at every level: one segment or pixel
+//! per clock, no bubble between spans.
+
+use serde::{Deserialize, Serialize};
+
+/// One register of a pipeline stage.
+#[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub struct PipeReg {
+    pub name: String,
+    pub bits: u32,
+    pub format: String,
+}
+
+impl PipeReg {
+    pub fn new(name: &str, bits: u32, format: &str) -> PipeReg {
+        PipeReg { name: name.into(), bits, format: format.into() }
+    }
+}
+
+/// One register stage: the logic in front of it and what it holds.
+#[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub struct PipeStage {
+    pub stage: u32,
+    pub name: String,
+    pub logic: String,
+    pub regs: Vec<PipeReg>,
+}
+
+/// Numbers `(name, logic, regs)` in order: stage i is register stage i from the input.
+pub fn numbered(body: Vec<(&str, String, Vec<PipeReg>)>) -> Vec<PipeStage> {
+    body.into_iter().enumerate().map(|(i, (name, logic, regs))| PipeStage { stage: i as u32, name: name.into(), logic, regs }).collect()
+}
+
+/// How many register stages the generator adds for clock rate, the same level for every block:
+///
+/// | level | segment shader |
+/// |--:|---|
+/// | 0 | as SPEC's seed: 2 stages |
+/// | 1 | + a span register; the BFPI's multiples and the last-segment flag registered |
+/// | 2 | + the lane sums registered before round and clamp |
+///
+/// Level 0 is the default: the smallest circuit and the shortest latency, byte for byte the
+/// RTL every earlier release generated. `docs/fpga.md` gives each level's area and Fmax.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize, Deserialize)]
+#[serde(transparent)]
+pub struct Pipeline(u32);
+
+impl Pipeline {
+    /// The deepest level.
+    pub const MAX: u32 = 2;
+    /// SPEC's seed structure, no added stage.
+    pub const NONE: Pipeline = Pipeline(0);
+
+    /// Level `level`; panics above [`Pipeline::MAX`] (for constants and generated tables).
+    pub const fn at(level: u32) -> Pipeline {
+        assert!(level <= Self::MAX, "pipeline level above Pipeline::MAX");
+        Pipeline(level)
+    }
+
+    /// Level `level`, or `None` above [`Pipeline::MAX`].
+    pub fn new(level: u32) -> Option<Pipeline> {
+        (level <= Self::MAX).then_some(Pipeline(level))
+    }
+
+    pub fn level(self) -> u32 {
+        self.0
+    }
+
+    /// Every level, shallowest first.
+    pub fn all() -> impl Iterator<Item = Pipeline> {
+        (0..=Self::MAX).map(Pipeline)
+    }
+
+    /// Segment shader: the span waits in its own register, and the increments (the BFPI's
+    /// multiples of dI) and the last-segment flag are registered when the span starts, so the
+    /// lanes' path begins at a register instead of behind the BFPI's adders.
+    pub fn span_stage(self) -> bool {
+        self.0 >= 1
+    }
+
+    /// Segment shader: the lane sums are registered between the add and the round/clamp.
+    pub fn sum_stage(self) -> bool {
+        self.0 >= 2
+    }
+}
+
+impl std::fmt::Display for Pipeline {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{}", self.0)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn levels_above_the_deepest_are_refused() {
+        assert_eq!(Pipeline::new(Pipeline::MAX).map(Pipeline::level), Some(Pipeline::MAX));
+        assert_eq!(Pipeline::new(Pipeline::MAX + 1), None);
+        assert_eq!(Pipeline::default(), Pipeline::NONE);
+    }
+
+    #[test]
+    fn each_level_adds_to_the_one_before() {
+        let flags = |p: Pipeline| [p.span_stage(), p.sum_stage()];
+        let levels: Vec<_> = Pipeline::all().collect();
+        for w in levels.windows(2) {
+            let (a, b) = (flags(w[0]), flags(w[1]));
+            assert!(a.iter().zip(&b).all(|(x, y)| !x || *y), "level {} drops a stage of level {}", w[1], w[0]);
+            assert_ne!(a, b, "level {} adds nothing to level {}", w[1], w[0]);
+        }
+    }
+}
