@@ -214,23 +214,28 @@ fn tables_from_dir(dir: &Path) -> SpecTables {
 
 fn generated_models() -> Vec<Model> {
     let mut models = Vec::new();
-    let spec = hdl_gen::generate(&hdl_gen::Options::default());
     let spec_names = hdl_gen::specular::SpecNames::new("");
-    models.push(Model {
-        tag: "spec".into(),
-        kind: Kind::Specular,
-        cfg: Config::default(),
-        di: DiMode::Triangle,
-        screen: Screen::default(),
-        top: spec_names.unit.clone(),
-        latency: hdl_gen::Options::default().specular_unit().plan().latency(),
-        pipeline: Pipeline::NONE,
-        sources: spec
-            .into_iter()
-            .filter(|f| f.name.ends_with(".hex") || f.name.starts_with("specular_"))
-            .map(|f| (f.name, f.contents))
-            .collect(),
-    });
+    // The specular unit as SPEC's seed builds it, then split for clock rate (`--pipeline 1`;
+    // level 2 adds nothing to the unit).
+    for pipeline in [Pipeline::NONE, Pipeline::at(1)] {
+        let opts = hdl_gen::Options { pipeline, ..Default::default() };
+        let tag = if pipeline == Pipeline::NONE { "spec".to_string() } else { format!("spec_pl{pipeline}") };
+        models.push(Model {
+            tag,
+            kind: Kind::Specular,
+            cfg: Config::default(),
+            di: DiMode::Triangle,
+            screen: Screen::default(),
+            top: spec_names.unit.clone(),
+            latency: opts.specular_unit().plan().latency(),
+            pipeline,
+            sources: hdl_gen::generate(&opts)
+                .into_iter()
+                .filter(|f| f.name.ends_with(".hex") || f.name.starts_with("specular_"))
+                .map(|f| (f.name, f.contents))
+                .collect(),
+        });
+    }
     for p in BUILT_P {
         for align in Align::ALL {
             let cfg = Config { p, align, ..Config::default() };

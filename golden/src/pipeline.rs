@@ -4,7 +4,8 @@
 //! It changes when a value appears (the latency) and which registers exist. This module states
 //! the stage structure once, as data: the generator prints it into each module's header and the
 //! manifest, the harness and the throughput models take their latencies from it, and the
-//! blocks' plans ([`crate::segment::stages`]) are built from it.
+//! blocks' plans ([`crate::segment::stages`], [`crate::specular::SpecularPlan::stages`]) are built
+//! from it.
 //!
 //! Every stage of every block moves on one stall signal (the output register is free), so a
 //! stall holds every stage and the throughput is the same at every level: one segment or pixel
@@ -42,11 +43,11 @@ pub fn numbered(body: Vec<(&str, String, Vec<PipeReg>)>) -> Vec<PipeStage> {
 
 /// How many register stages the generator adds for clock rate, the same level for every block:
 ///
-/// | level | segment shader |
-/// |--:|---|
-/// | 0 | as SPEC's seed: 2 stages |
-/// | 1 | + a span register; the BFPI's multiples and the last-segment flag registered |
-/// | 2 | + the lane sums registered before round and clamp |
+/// | level | segment shader | specular unit |
+/// |--:|---|---|
+/// | 0 | as SPEC's seed: 2 stages | 5 stages |
+/// | 1 | + a span register; the BFPI's multiples and the last-segment flag registered | + both multiplies split into registered 4-bit partial products and their sum; the BRDF address registered before the ROM: 8 stages |
+/// | 2 | + the lane sums registered before round and clamp | as level 1 |
 ///
 /// Level 0 is the default: the smallest circuit and the shortest latency, byte for byte the
 /// RTL every earlier release generated. `docs/fpga.md` gives each level's area and Fmax.
@@ -91,6 +92,13 @@ impl Pipeline {
     pub fn sum_stage(self) -> bool {
         self.0 >= 2
     }
+
+    /// Specular unit: the argument and C multiplies each become registered partial products
+    /// (small multiplies by 4-bit slices) and a registered sum, and the BRDF address (the table
+    /// select's mux after the per-table index arithmetic) is registered before the ROM read.
+    pub fn split_multiplies(self) -> bool {
+        self.0 >= 1
+    }
 }
 
 impl std::fmt::Display for Pipeline {
@@ -112,7 +120,7 @@ mod tests {
 
     #[test]
     fn each_level_adds_to_the_one_before() {
-        let flags = |p: Pipeline| [p.span_stage(), p.sum_stage()];
+        let flags = |p: Pipeline| [p.span_stage(), p.sum_stage(), p.split_multiplies()];
         let levels: Vec<_> = Pipeline::all().collect();
         for w in levels.windows(2) {
             let (a, b) = (flags(w[0]), flags(w[1]));

@@ -99,10 +99,8 @@ impl Options {
 
     /// The specular unit these options describe, with its ROM images.
     pub fn specular_unit(&self) -> golden::specular::SpecularUnit {
-        match &self.brdf {
-            Some(plan) => golden::specular::SpecularUnit::new(plan.clone()),
-            None => golden::specular::SpecularUnit::default(),
-        }
+        let plan = self.brdf.clone().unwrap_or_else(golden::specular::SpecularPlan::patent);
+        golden::specular::SpecularUnit::new(plan.with_pipeline(self.pipeline))
     }
 }
 

@@ -1,14 +1,16 @@
 //! `specular_unit`: the specular term of patent UA 71489, one pixel per clock, printed from
 //! golden's [`SpecularPlan`] (widths, tables, pipeline) and ROM images.
 //!
-//! Five register stages with one stall signal: every stage moves when the output register is
-//! free (`adv`), so the latency is fixed and a stalled pipe keeps every pixel. The ROMs read on
-//! the same `adv`, which makes them ordinary enable-gated block RAM reads.
+//! Five register stages (eight with `--pipeline`, which splits both multiplies into registered
+//! partial products and their sum and registers the BRDF address) with one stall signal: every
+//! stage moves when the output register is free (`adv`), so the latency is fixed and a stalled
+//! pipe keeps every pixel. The ROMs read on the same `adv`, which makes them ordinary
+//! enable-gated block RAM reads.
 
 use crate::rom;
 use crate::verilog::{assign, comment, lit, reg, set, wire, zext, Item, Module, Param, Port, Stmt};
 use golden::rom::{BRDF_HEX, NK_HEX};
-use golden::specular::{SpecularUnit, C_FRAC, N_BITS, THETA_FRAC};
+use golden::specular::{SpecularPlan, SpecularUnit, C_FRAC, N_BITS, THETA_FRAC};
 use golden::Config;
 
 pub const THETA_BITS: u32 = 32;
@@ -59,6 +61,20 @@ fn rom_read(module: &str, name: &str, file_param: &str, addr: &str, data: &str) 
         name: name.into(),
         params: vec![conn("INIT_FILE", file_param)],
         conns: vec![conn("clk", "clk"), conn("en", "adv"), conn("addr", addr), conn("data", data)],
+    }
+}
+
+/// `a + b + ...` as a balanced tree of two-input adds, so a sum of partial products is log2(n)
+/// adders deep however Yosys maps it.
+fn tree(terms: &[String]) -> String {
+    match terms {
+        [] => "0".into(),
+        [one] => one.clone(),
+        _ => {
+            let (l, r) = terms.split_at(terms.len().div_ceil(2));
+            let paren = |t: &[String]| if t.len() > 1 { format!("({})", tree(t)) } else { tree(t) };
+            format!("{} + {}", paren(l), paren(r))
+        }
     }
 }
 
@@ -167,25 +183,71 @@ fn module(cfg: &Config, unit: &SpecularUnit, names: &SpecNames) -> Module {
         Item::Bus { name: "nk1".into(), width: g.nk_width },
         rom_read(&names.nk, "u_nk", "NK_FILE", "n0", "nk1"),
         Item::Blank,
-        comment("Stage 2: the argument multiplier; M = 0 marks an invalid n."),
-        wire("m1", mw, format!("nk1[{}:0]", mw - 1)),
+    ];
+    let split = p.pipeline.split_multiplies();
+    let k = SpecularPlan::MUL_CHUNK;
+    if split {
+        // Partial products by k-bit slices of M, registered; their sum is the next stage.
+        let mc = mw.div_ceil(k);
+        body.push(comment(format!("Stage 2a: |theta| times each {k}-bit slice of M; M = 0 marks an invalid n.")));
+        body.push(wire("m1", mw, format!("nk1[{}:0]", mw - 1)));
+        body.extend([reg("v2a", 1), reg("c2a", C_BITS), reg("last2a", 1), reg("err2a", 1)]);
+        if sb > 0 && tables.len() > 1 {
+            body.push(reg("sel2a", sb));
+        }
+        for j in 0..mc {
+            let bits = k.min(mw - j * k);
+            body.push(reg(&format!("pp2a_{j}"), mag + k));
+            body.push(wire(
+                &format!("pp1_{j}"),
+                mag + k,
+                format!("{} * {}", zext("mag1", mag, mag + k), zext(&format!("m1[{}:{}]", j * k + bits - 1, j * k), bits, mag + k)),
+            ));
+        }
+        body.push(Item::Blank);
+        body.push(comment("Stage 2: the argument, the partial products summed in a balanced tree."));
+    } else {
+        body.push(comment("Stage 2: the argument multiplier; M = 0 marks an invalid n."));
+        body.push(wire("m1", mw, format!("nk1[{}:0]", mw - 1)));
+    }
+    let prod_expr = if split {
+        let terms: Vec<String> = (0..mw.div_ceil(k))
+            .map(|j| {
+                let t = zext(&format!("pp2a_{j}"), mag + k, prod);
+                if j == 0 {
+                    t
+                } else {
+                    format!("({t} << {})", j * k)
+                }
+            })
+            .collect();
+        tree(&terms)
+    } else {
+        format!("{} * {}", zext("mag1", mag, prod), zext("m1", mw, prod))
+    };
+    body.extend([
         comment(format!("Bits below the smallest table shift ({lo}) never reach an index: not registered.")),
         comment("verilator lint_off UNUSEDSIGNAL"),
-        wire("prod1", prod, format!("{} * {}", zext("mag1", mag, prod), zext("m1", mw, prod))),
+        wire("prod1", prod, prod_expr),
         comment("verilator lint_on UNUSEDSIGNAL"),
         reg("v2", 1),
         reg("prod2", prod - lo),
         reg("err2", 1),
         reg("c2", C_BITS),
         reg("last2", 1),
-    ];
-    if sb > 0 && tables.len() > 1 {
+    ]);
+    let multi_table = sb > 0 && tables.len() > 1;
+    if multi_table {
         body.push(reg("sel2", sb));
     }
     body.push(Item::Blank);
 
     // Stage 3: each table's index is a fixed shift of the product; the select picks one.
-    body.push(comment("Stage 3: index = prod >> shift[sel]; past the table's end the output is 0; BRDF read."));
+    if split {
+        body.push(comment("Stage 3a: index = prod >> shift[sel]; past the table's end the output is 0; the BRDF address."));
+    } else {
+        body.push(comment("Stage 3: index = prod >> shift[sel]; past the table's end the output is 0; BRDF read."));
+    }
     body.push(comment("Each table uses the product bits above its own shift; no table uses them all."));
     body.push(comment("verilator lint_off UNUSEDSIGNAL"));
     for (t, tb) in tables.iter().enumerate() {
@@ -206,6 +268,21 @@ fn module(cfg: &Config, unit: &SpecularUnit, names: &SpecNames) -> Module {
     };
     body.push(wire("in_table", 1, pick("in")));
     body.push(wire("addr2", ab, pick("addr")));
+    let rom_addr = if split {
+        body.extend([
+            reg("v3a", 1),
+            reg("cut3a", 1),
+            reg("err3a", 1),
+            reg("c3a", C_BITS),
+            reg("last3a", 1),
+            reg("addr3a", ab),
+            Item::Blank,
+        ]);
+        body.push(comment("Stage 3: the BRDF read."));
+        "addr3a"
+    } else {
+        "addr2"
+    };
     body.extend([
         reg("v3", 1),
         reg("cut3", 1),
@@ -213,58 +290,115 @@ fn module(cfg: &Config, unit: &SpecularUnit, names: &SpecNames) -> Module {
         reg("c3", C_BITS),
         reg("last3", 1),
         Item::Bus { name: "w3".into(), width: w },
-        rom_read(&names.brdf, "u_brdf", "BRDF_FILE", "addr2", "w3"),
+        rom_read(&names.brdf, "u_brdf", "BRDF_FILE", rom_addr, "w3"),
         Item::Blank,
-        comment(format!("Stage 4: out = C * (w + 1) / 2^{w}, rounded half up; never above C.")),
+    ]);
+    let sw = C_BITS + w + 1;
+    let wp = format!("({} + {})", zext("w3", w, w + 1), lit(w + 1, 1));
+    let scaled = if split {
+        // C times each k-bit slice of w + 1, registered; their sum is the last stage.
+        let cc = (w + 1).div_ceil(k);
+        body.push(comment(format!("Stage 4a: C times each {k}-bit slice of w + 1.")));
+        body.push(wire("wp3", w + 1, wp));
+        body.extend([reg("v4a", 1), reg("cut4a", 1), reg("err4a", 1), reg("last4a", 1)]);
+        for j in 0..cc {
+            let bits = k.min(w + 1 - j * k);
+            body.push(reg(&format!("cp4a_{j}"), C_BITS + k));
+            body.push(wire(
+                &format!("cp3_{j}"),
+                C_BITS + k,
+                format!("{} * {}", zext("c3", C_BITS, C_BITS + k), zext(&format!("wp3[{}:{}]", j * k + bits - 1, j * k), bits, C_BITS + k)),
+            ));
+        }
+        body.push(Item::Blank);
+        let terms: Vec<String> = (0..cc)
+            .map(|j| {
+                let t = zext(&format!("cp4a_{j}"), C_BITS + k, sw);
+                if j == 0 {
+                    t
+                } else {
+                    format!("({t} << {})", j * k)
+                }
+            })
+            .collect();
+        body.push(comment(format!("Stage 4: out = C * (w + 1) / 2^{w}, the slices summed, rounded half up; never above C.")));
+        format!("{} + {}", tree(&terms), lit(sw, 1 << (w - 1)))
+    } else {
+        body.push(comment(format!("Stage 4: out = C * (w + 1) / 2^{w}, rounded half up; never above C.")));
+        format!("{} * {} + {}", zext("c3", C_BITS, sw), zext(&wp, w + 1, sw), lit(sw, 1 << (w - 1)))
+    };
+    body.extend([
         comment("verilator lint_off UNUSEDSIGNAL"),
-        wire(
-            "scaled",
-            C_BITS + w + 1,
-            format!(
-                "{} * {} + {}",
-                zext("c3", C_BITS, C_BITS + w + 1),
-                zext(&format!("({} + {})", zext("w3", w, w + 1), lit(w + 1, 1)), w + 1, C_BITS + w + 1),
-                lit(C_BITS + w + 1, 1 << (w - 1))
-            ),
-        ),
+        wire("scaled", sw, scaled),
         comment("verilator lint_on UNUSEDSIGNAL"),
         Item::Blank,
     ]);
 
-    let mut stage2 = vec![
-        set("v2", "v1"),
-        set("prod2", format!("prod1[{}:{lo}]", prod - 1)),
-        set("err2", format!("m1 == {}", lit(mw, 0))),
-        set("c2", "c1"),
-        set("last2", "last1"),
-    ];
-    if sb > 0 && tables.len() > 1 {
-        stage2.push(set("sel2", format!("nk1[{}:{mw}]", mw + sb - 1)));
+    let sel_of_nk = format!("nk1[{}:{mw}]", mw + sb - 1);
+    let err_of_m = format!("m1 == {}", lit(mw, 0));
+    let mut stages: Vec<Vec<Stmt>> = vec![vec![set("v1", "busy"), set("mag1", "mag0"), set("c1", "c0"), set("last1", "last0")]];
+    let mut resets = vec![set("v1", "1'b0")];
+    let mut order = vec![("v1", "last1")];
+    if split {
+        let mut part = vec![set("v2a", "v1"), set("c2a", "c1"), set("last2a", "last1"), set("err2a", err_of_m.clone())];
+        part.extend((0..mw.div_ceil(k)).map(|j| set(format!("pp2a_{j}"), format!("pp1_{j}"))));
+        if multi_table {
+            part.push(set("sel2a", sel_of_nk.clone()));
+        }
+        stages.push(part);
+        resets.push(set("v2a", "1'b0"));
+        order.push(("v2a", "last2a"));
     }
+    let from2 = |r: &str| if split { format!("{r}2a") } else { format!("{r}1") };
+    let mut stage2 = vec![
+        set("v2", from2("v")),
+        set("prod2", format!("prod1[{}:{lo}]", prod - 1)),
+        set("err2", if split { "err2a".to_string() } else { err_of_m }),
+        set("c2", from2("c")),
+        set("last2", from2("last")),
+    ];
+    if multi_table {
+        stage2.push(set("sel2", if split { "sel2a".to_string() } else { sel_of_nk }));
+    }
+    stages.push(stage2);
+    resets.push(set("v2", "1'b0"));
+    order.push(("v2", "last2"));
+    if split {
+        stages.push(vec![
+            set("v3a", "v2"),
+            set("cut3a", "err2 || !in_table"),
+            set("err3a", "err2"),
+            set("c3a", "c2"),
+            set("last3a", "last2"),
+            set("addr3a", "addr2"),
+        ]);
+        resets.push(set("v3a", "1'b0"));
+        order.push(("v3a", "last3a"));
+        stages.push(vec![set("v3", "v3a"), set("cut3", "cut3a"), set("err3", "err3a"), set("c3", "c3a"), set("last3", "last3a")]);
+        let mut part = vec![set("v4a", "v3"), set("cut4a", "cut3"), set("err4a", "err3"), set("last4a", "last3")];
+        part.extend((0..(w + 1).div_ceil(k)).map(|j| set(format!("cp4a_{j}"), format!("cp3_{j}"))));
+        stages.push(part);
+        resets.extend([set("v3", "1'b0"), set("v4a", "1'b0")]);
+        order.extend([("v3", "last3"), ("v4a", "last4a")]);
+    } else {
+        stages.push(vec![set("v3", "v2"), set("cut3", "err2 || !in_table"), set("err3", "err2"), set("c3", "c2"), set("last3", "last2")]);
+        resets.push(set("v3", "1'b0"));
+        order.push(("v3", "last3"));
+    }
+    let fin = if split { "4a" } else { "3" };
+    stages.push(vec![
+        set("out_valid", format!("v{fin}")),
+        set("out_spec", format!("cut{fin} ? {} : scaled[{}:{w}]", lit(C_BITS, 0), C_BITS + w - 1)),
+        set("out_err", format!("err{fin}")),
+        set("out_last", format!("last{fin}")),
+    ]);
+    resets.push(set("out_valid", "1'b0"));
+    order.push(("out_valid", "out_last"));
     body.push(comment("Stages 1 to 4 move together; only the valid bits are reset."));
-    body.push(Item::Always(vec![Stmt::If(
-        "rst".into(),
-        vec![set("v1", "1'b0"), set("v2", "1'b0"), set("v3", "1'b0"), set("out_valid", "1'b0")],
-        vec![Stmt::If(
-            adv.into(),
-            [
-                vec![set("v1", "busy"), set("mag1", "mag0"), set("c1", "c0"), set("last1", "last0")],
-                stage2,
-                vec![set("v3", "v2"), set("cut3", "err2 || !in_table"), set("err3", "err2"), set("c3", "c2"), set("last3", "last2")],
-                vec![
-                    set("out_valid", "v3"),
-                    set("out_spec", format!("cut3 ? {} : scaled[{}:{w}]", lit(C_BITS, 0), C_BITS + w - 1)),
-                    set("out_err", "err3"),
-                    set("out_last", "last3"),
-                ],
-            ]
-            .concat(),
-            vec![],
-        )],
-    )]));
+    body.push(Item::Always(vec![Stmt::If("rst".into(), resets, vec![Stmt::If(adv.into(), stages.concat(), vec![])])]));
 
     body.push(Item::Blank);
-    body.push(crate::formal::specular_properties(lw, &[("v1", "last1"), ("v2", "last2"), ("v3", "last3"), ("out_valid", "out_last")]));
+    body.push(crate::formal::specular_properties(lw, &order));
     Module {
         name: names.unit.clone(),
         header,

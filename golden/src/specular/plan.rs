@@ -25,7 +25,7 @@
 use super::decoder::{BrdfK, Decoder, KRange};
 use super::reference::{cos_k, epicentre_arg, epicentre_code};
 use super::{INSIDE_REL, NK_DEPTH, N_MIN, OUTSIDE_REL, THETA_FRAC};
-use crate::pipeline::{PipeReg, PipeStage};
+use crate::pipeline::{PipeReg, PipeStage, Pipeline};
 use crate::rom::addr_bits;
 use serde::{Deserialize, Serialize};
 use std::ops::RangeInclusive;
@@ -101,6 +101,9 @@ pub struct SpecularPlan {
     pub nk_mant_bits: u32,
     /// Width of the table select in the n-table word.
     pub sel_bits: u32,
+    /// Register stages added for clock rate (`--pipeline`): they change when, not what.
+    #[serde(default)]
+    pub pipeline: Pipeline,
 }
 
 /// Everything a generator or manifest needs about a plan, derived values included, flat.
@@ -245,6 +248,7 @@ impl SpecularPlan {
             mag_bits: 32 - THETA_DROP,
             nk_mant_bits: nw,
             sel_bits: addr_bits(decoder.tables()),
+            pipeline: Pipeline::NONE,
         };
         // An index, not an iterator: the loop resizes `plan`'s tables as it goes.
         #[allow(clippy::needless_range_loop)]
@@ -360,6 +364,15 @@ impl SpecularPlan {
         self.tables.iter().map(|t| t.shift).min().unwrap_or(0)
     }
 
+    /// This plan with the register stages of `pipeline`.
+    pub fn with_pipeline(self, pipeline: Pipeline) -> SpecularPlan {
+        SpecularPlan { pipeline, ..self }
+    }
+
+    /// Multiplier operand bits per partial product when the multiplies are split in two stages
+    /// (`Pipeline::split_multiplies`): each partial is a small multiply, their sum a short tree.
+    pub const MUL_CHUNK: u32 = 4;
+
     /// A span transferred in clock t has its first pixel valid in clock t + latency: one clock
     /// per register stage (the same convention as the segment shader's).
     pub fn latency(&self) -> u32 {
@@ -371,7 +384,9 @@ impl SpecularPlan {
     pub fn stages(&self) -> Vec<PipeStage> {
         let reg = |name: &str, bits: u32, format: &str| PipeReg { name: name.into(), bits, format: format.into() };
         let (w, drop) = (self.word_bits, self.theta_drop);
-        let body = [
+        let split = self.pipeline.split_multiplies();
+        let chunks = |bits: u32| bits.div_ceil(Self::MUL_CHUNK);
+        let mut body = vec![
             (
                 "issue",
                 "theta <= accept ? in_theta0 : theta + dtheta (32-bit wrap); \
@@ -384,28 +399,65 @@ impl SpecularPlan {
                 format!("mag = |theta| >> {drop} (|-2^31| = 2^31 exact); n-table ROM registered read at n"),
                 vec![reg("mag", self.mag_bits, &format!("UQ3.{}", self.mag_frac())), reg("nk", self.nk_width(), "{sel, M}")],
             ),
-            (
-                "arg_mul",
-                "prod = mag * M (unsigned); err = (M == 0)".to_string(),
+        ];
+        let (mc, cc) = (chunks(self.nk_mant_bits), chunks(w + 1));
+        if split {
+            body.push((
+                "arg_part",
+                format!("pp_k = mag * M[4k +: 4], k < {mc}; err = (M == 0)"),
                 vec![
-                    reg("prod", self.prod_bits() - self.prod_drop(), &format!("uint, prod >> {}", self.prod_drop())),
+                    reg("pp", mc * (self.mag_bits + Self::MUL_CHUNK), &format!("{mc} x uint")),
                     reg("sel", self.sel_bits, "uint"),
                     reg("err", 1, "flag"),
                 ],
-            ),
-            (
+            ));
+        }
+        body.push((
+            "arg_mul",
+            if split {
+                "prod = sum_k pp_k << 4k (a balanced tree)".to_string()
+            } else {
+                "prod = mag * M (unsigned); err = (M == 0)".to_string()
+            },
+            vec![
+                reg("prod", self.prod_bits() - self.prod_drop(), &format!("uint, prod >> {}", self.prod_drop())),
+                reg("sel", self.sel_bits, "uint"),
+                reg("err", 1, "flag"),
+            ],
+        ));
+        let index = "idx = prod >> shift[sel]; cut = err | (idx >= len[sel])";
+        if split {
+            body.push((
+                "brdf_addr",
+                format!("{index}; addr = base[sel] + idx"),
+                vec![reg("addr", self.brdf_addr_bits(), "uint"), reg("cut", 1, "flag"), reg("err", 1, "flag")],
+            ));
+            body.push((
                 "brdf",
-                "idx = prod >> shift[sel]; cut = err | (idx >= len[sel]); \
-                 BRDF ROM registered read at base[sel] + idx"
-                    .to_string(),
+                "BRDF ROM registered read at addr".to_string(),
                 vec![reg("w", w, &format!("(w+1)/2^{w}")), reg("cut", 1, "flag"), reg("err", 1, "flag")],
-            ),
-            (
-                "c_mul",
-                format!("out_spec = cut ? 0 : (C * (w + 1) + 2^{}) >> {w}", w - 1),
-                vec![reg("out_spec", 16, "UQ8.8"), reg("out_err", 1, "flag")],
-            ),
-        ];
+            ));
+            body.push((
+                "c_part",
+                format!("cp_k = C * (w + 1)[4k +: 4], k < {cc}"),
+                vec![reg("cp", cc * (16 + Self::MUL_CHUNK), &format!("{cc} x uint")), reg("cut", 1, "flag"), reg("err", 1, "flag")],
+            ));
+        } else {
+            body.push((
+                "brdf",
+                format!("{index}; BRDF ROM registered read at base[sel] + idx"),
+                vec![reg("w", w, &format!("(w+1)/2^{w}")), reg("cut", 1, "flag"), reg("err", 1, "flag")],
+            ));
+        }
+        body.push((
+            "c_mul",
+            if split {
+                format!("out_spec = cut ? 0 : (sum_k cp_k << 4k + 2^{}) >> {w}", w - 1)
+            } else {
+                format!("out_spec = cut ? 0 : (C * (w + 1) + 2^{}) >> {w}", w - 1)
+            },
+            vec![reg("out_spec", 16, "UQ8.8"), reg("out_err", 1, "flag")],
+        ));
         let last = body.len() - 1;
         body.into_iter()
             .enumerate()
@@ -525,6 +577,12 @@ mod tests {
         let nw = p.nk_mant_bits;
         assert_eq!(p.latency(), 5);
         assert_eq!(p.stages().len(), 5);
+        // `--pipeline 1`: both multiplies split in two stages, the BRDF address registered.
+        let split = p.clone().with_pipeline(crate::pipeline::Pipeline::at(1));
+        let names: Vec<String> = split.stages().into_iter().map(|s| s.name).collect();
+        assert_eq!(names, ["issue", "abs_nk", "arg_part", "arg_mul", "brdf_addr", "brdf", "c_part", "c_mul"]);
+        assert_eq!(split.latency(), 8);
+        assert_eq!(split.clone().with_pipeline(crate::pipeline::Pipeline::at(2)).latency(), 8, "level 2 adds nothing to the unit");
         for (t, tb) in p.tables.iter().enumerate() {
             assert!(tb.end_arg() < std::f64::consts::FRAC_PI_2);
             assert!(cos_k(tb.k, tb.end_arg()) <= TABLE_END * 1.0001);
