@@ -10,7 +10,7 @@
 //!   and a new span loads in the clock the last pixels of the current one leave, as in the
 //!   segment shader's RTL (which shows it: a full-rate stream has no bubble). A span with `m`
 //!   pixels therefore costs exactly the clocks its pixels need.
-//! * **One pipeline fill per stream**, [`FILL`] = 2 clocks, the segment shader's latency, charged
+//! * **One pipeline fill per stream**, [`fill`] = 2 clocks, the segment shader's latency, charged
 //!   to every scheme (it is negligible for any real workload).
 //! * **Only covered pixels are visited.** Spans come from the exact set-up of `setup`, clipped
 //!   to the screen; a triangle that covers no pixel centre costs nothing.
@@ -19,14 +19,17 @@
 //!   four sub-triangles).
 //!
 //! Under these assumptions the RTL's clock count for `segment_shader_p<P>` is exactly
-//! `Σ segments + FILL` ([`Scheme::Segment`]); the co-simulation sweep checks it clock for clock.
+//! `Σ segments + fill()` ([`Scheme::Segment`]); the co-simulation sweep checks it clock for clock.
 
 use crate::format::{Align, Config, Span};
 use crate::setup::{triangle_spans, Screen, Triangle, Vertex};
 use std::fmt;
 
-/// Pipeline fill charged once per stream: the segment shader's two register stages.
-pub const FILL: u64 = 2;
+/// Pipeline fill charged once per stream: the latency of the segment shader as SPEC's seed builds it
+/// (two register stages; `--pipeline` only adds fill).
+pub fn fill() -> u64 {
+    crate::segment::latency(&Config::default(), crate::pipeline::Pipeline::NONE) as u64
+}
 
 /// A span-interpolation scheme.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -116,12 +119,12 @@ pub struct Count {
 }
 
 impl Count {
-    /// Clocks with the one pipeline fill of a stream ([`FILL`]); 0 for an empty workload.
+    /// Clocks with the one pipeline fill of a stream ([`fill`]); 0 for an empty workload.
     pub fn total_clocks(&self) -> u64 {
         if self.clocks == 0 {
             0
         } else {
-            self.clocks + FILL
+            self.clocks + fill()
         }
     }
 
