@@ -357,7 +357,9 @@ pub fn module_with(cfg: &Config, names: &Names, arch: BfpiArch, pipe: Pipeline) 
         )],
     )]));
     body.push(Item::Blank);
-    if !pipe.span_stage() {
+    if pipe.span_stage() {
+        body.push(crate::formal::segment_pipelined_properties(cfg, rw, pipe));
+    } else {
         body.push(crate::formal::segment_properties(cfg, rw));
     }
 
