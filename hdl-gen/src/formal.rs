@@ -62,6 +62,26 @@ fn reset_and_stability(what: &str, (valid, ready): (&str, &str), held: &[&str]) 
     ]
 }
 
+/// `name`: SPEC §3's mask of the segment `off` pixels into a span of `tot` = lead + m pixels,
+/// lane i inside when `lead <= off + i < tot` (widths: `rw` for off and tot, `lw` for lead).
+fn spec_mask(name: &str, (off, lead, tot): (&str, &str, &str), p: u32, (rw, lw): (u32, u32)) -> Vec<Item> {
+    vec![
+        net(name, p),
+        Item::ForGenerate {
+            var: "fk".into(),
+            count: p,
+            label: "f_lane".into(),
+            body: vec![
+                Item::Localparam { name: "FK".into(), width: rw + 1, value: "fk".into() },
+                assign(
+                    format!("{name}[fk]"),
+                    format!("({{1'b0, {off}}} + FK >= {}) && ({{1'b0, {off}}} + FK < {{1'b0, {tot}}})", zext(lead, lw, rw + 1)),
+                ),
+            ],
+        },
+    ]
+}
+
 /// Properties of `segment_shader_p<P>` (names as `segment::module_with` declares them).
 pub fn segment_properties(cfg: &Config, rw: u32) -> Item {
     let (p, xw, log2p) = (cfg.p, cfg.xbits, cfg.log2p());
@@ -100,19 +120,7 @@ pub fn segment_properties(cfg: &Config, rw: u32) -> Item {
     b.push(wire("f_left", rw, "f_h_tot - f_h_off"));
     b.push(wire("f_exp_last", 1, format!("f_left <= {pr}")));
     b.push(wire("f_exp_x", xw, format!("f_h_b + f_h_off[{}:0]", xw - 1)));
-    b.push(net("f_exp_mask", p));
-    b.push(Item::ForGenerate {
-        var: "fk".into(),
-        count: p,
-        label: "f_lane".into(),
-        body: vec![
-            Item::Localparam { name: "FK".into(), width: rw + 1, value: "fk".into() },
-            assign(
-                "f_exp_mask[fk]",
-                format!("({{1'b0, f_h_off}} + FK >= {}) && ({{1'b0, f_h_off}} + FK < {{1'b0, f_h_tot}})", zext("f_h_lead", lw, rw + 1)),
-            ),
-        ],
-    });
+    b.extend(spec_mask("f_exp_mask", ("f_h_off", "f_h_lead", "f_h_tot"), p, (rw, lw)));
     b.push(wire("f_push", 1, "in_valid && in_ready && in_len != 0"));
     b.push(wire("f_pop", 1, "f_fresh && f_exp_last"));
     b.push(comment("Each new segment is the one SPEC §3 says comes next; none comes unowed."));
@@ -537,19 +545,7 @@ pub fn segment_pipelined_properties(cfg: &Config, rw: u32, pipe: golden::pipelin
     b.push(wire("f_src_x", xw, src_x));
     b.push(wire("f_src_lead", lw, lead));
     b.push(wire("f_cx", xw, format!("f_cb + f_coff[{}:0]", xw - 1)));
-    b.push(net("f_cmask", p));
-    b.push(Item::ForGenerate {
-        var: "fk".into(),
-        count: p,
-        label: "f_lane".into(),
-        body: vec![
-            Item::Localparam { name: "FK".into(), width: rw + 1, value: "fk".into() },
-            assign(
-                "f_cmask[fk]",
-                format!("({{1'b0, f_coff}} + FK >= {}) && ({{1'b0, f_coff}} + FK < {{1'b0, f_ctot}})", zext("f_clead", lw, rw + 1)),
-            ),
-        ],
-    });
+    b.extend(spec_mask("f_cmask", ("f_coff", "f_clead", "f_ctot"), p, (rw, lw)));
     let start = vec![
         set("f_cv", if pipe.span_stage() { "1'b1".to_string() } else { format!("{src_len} != 0") }),
         set("f_cb", blk),
