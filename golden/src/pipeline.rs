@@ -46,7 +46,7 @@ pub fn numbered(body: Vec<(&str, String, Vec<PipeReg>)>) -> Vec<PipeStage> {
 /// | level | segment shader | specular unit |
 /// |--:|---|---|
 /// | 0 | as SPEC's seed: 2 stages | 5 stages |
-/// | 1 | + a span register; the BFPI's multiples and the last-segment flag registered | + both multiplies split into registered 4-bit partial products and their sum; the BRDF address registered before the ROM: 8 stages |
+/// | 1 | + a span register; the BFPI's multiples and the last-segment flag registered | + both multiplies split into registered 4-bit partial products and their sum; the BRDF address registered before the ROM, both ROMs' words registered before any arithmetic: 10 stages |
 /// | 2 | + the lane sums registered before round and clamp | as level 1 |
 ///
 /// Level 0 is the default: the smallest circuit and the shortest latency, byte for byte the
@@ -94,8 +94,10 @@ impl Pipeline {
     }
 
     /// Specular unit: the argument and C multiplies each become registered partial products
-    /// (small multiplies by 4-bit slices) and a registered sum, and the BRDF address (the table
-    /// select's mux after the per-table index arithmetic) is registered before the ROM read.
+    /// (small multiplies by 4-bit slices) and a registered sum, the BRDF address (the table
+    /// select's mux after the per-table index arithmetic) is registered before the ROM read,
+    /// and each ROM's word is registered before any arithmetic (a block RAM's clock-to-out is
+    /// long).
     pub fn split_multiplies(self) -> bool {
         self.0 >= 1
     }

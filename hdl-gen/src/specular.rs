@@ -1,8 +1,9 @@
 //! `specular_unit`: the specular term of patent UA 71489, one pixel per clock, printed from
 //! golden's [`SpecularPlan`] (widths, tables, pipeline) and ROM images.
 //!
-//! Five register stages (eight with `--pipeline`, which splits both multiplies into registered
-//! partial products and their sum and registers the BRDF address) with one stall signal: every
+//! Five register stages (ten with `--pipeline`, which splits both multiplies into registered
+//! partial products and their sum, registers the BRDF address, and takes both ROMs' words into
+//! plain registers before any arithmetic: a block RAM's clock-to-out is long) with one stall signal: every
 //! stage moves when the output register is free (`adv`), so the latency is fixed and a stalled
 //! pipe keeps every pixel. The ROMs read on the same `adv`, which makes them ordinary
 //! enable-gated block RAM reads.
@@ -189,8 +190,10 @@ fn module(cfg: &Config, unit: &SpecularUnit, names: &SpecNames) -> Module {
     if split {
         // Partial products by k-bit slices of M, registered; their sum is the next stage.
         let mc = mw.div_ceil(k);
+        body.push(comment("Stage 1q: |theta| and the n-table word registered off the ROM's output."));
+        body.extend([reg("v1q", 1), reg("mag1q", mag), reg("c1q", C_BITS), reg("last1q", 1), reg("nk1q", g.nk_width), Item::Blank]);
         body.push(comment(format!("Stage 2a: |theta| times each {k}-bit slice of M; M = 0 marks an invalid n.")));
-        body.push(wire("m1", mw, format!("nk1[{}:0]", mw - 1)));
+        body.push(wire("m1", mw, format!("nk1q[{}:0]", mw - 1)));
         body.extend([reg("v2a", 1), reg("c2a", C_BITS), reg("last2a", 1), reg("err2a", 1)]);
         if sb > 0 && tables.len() > 1 {
             body.push(reg("sel2a", sb));
@@ -201,7 +204,7 @@ fn module(cfg: &Config, unit: &SpecularUnit, names: &SpecNames) -> Module {
             body.push(wire(
                 &format!("pp1_{j}"),
                 mag + k,
-                format!("{} * {}", zext("mag1", mag, mag + k), zext(&format!("m1[{}:{}]", j * k + bits - 1, j * k), bits, mag + k)),
+                format!("{} * {}", zext("mag1q", mag, mag + k), zext(&format!("m1[{}:{}]", j * k + bits - 1, j * k), bits, mag + k)),
             ));
         }
         body.push(Item::Blank);
@@ -296,18 +299,24 @@ fn module(cfg: &Config, unit: &SpecularUnit, names: &SpecNames) -> Module {
     let sw = C_BITS + w + 1;
     let wp = format!("({} + {})", zext("w3", w, w + 1), lit(w + 1, 1));
     let scaled = if split {
-        // C times each k-bit slice of w + 1, registered; their sum is the last stage.
-        let cc = (w + 1).div_ceil(k);
-        body.push(comment(format!("Stage 4a: C times each {k}-bit slice of w + 1.")));
-        body.push(wire("wp3", w + 1, wp));
-        body.extend([reg("v4a", 1), reg("cut4a", 1), reg("err4a", 1), reg("last4a", 1)]);
+        // The word off the ROM into a plain register first; then C times each k-bit slice of
+        // it, registered; their sum, with C (C * (w + 1) = C * w + C), is the last stage.
+        let cc = w.div_ceil(k);
+        body.push(comment("Stage 3q: the BRDF word registered off the ROM's output."));
+        body.extend([reg("v3q", 1), reg("cut3q", 1), reg("err3q", 1), reg("c3q", C_BITS), reg("last3q", 1), reg("w3q", w), Item::Blank]);
+        body.push(comment(format!("Stage 4a: C times each {k}-bit slice of w.")));
+        body.extend([reg("v4a", 1), reg("cut4a", 1), reg("err4a", 1), reg("c4a", C_BITS), reg("last4a", 1)]);
         for j in 0..cc {
-            let bits = k.min(w + 1 - j * k);
+            let bits = k.min(w - j * k);
             body.push(reg(&format!("cp4a_{j}"), C_BITS + k));
             body.push(wire(
                 &format!("cp3_{j}"),
                 C_BITS + k,
-                format!("{} * {}", zext("c3", C_BITS, C_BITS + k), zext(&format!("wp3[{}:{}]", j * k + bits - 1, j * k), bits, C_BITS + k)),
+                format!(
+                    "{} * {}",
+                    zext("c3q", C_BITS, C_BITS + k),
+                    zext(&format!("w3q[{}:{}]", j * k + bits - 1, j * k), bits, C_BITS + k)
+                ),
             ));
         }
         body.push(Item::Blank);
@@ -321,8 +330,8 @@ fn module(cfg: &Config, unit: &SpecularUnit, names: &SpecNames) -> Module {
                 }
             })
             .collect();
-        body.push(comment(format!("Stage 4: out = C * (w + 1) / 2^{w}, the slices summed, rounded half up; never above C.")));
-        format!("{} + {}", tree(&terms), lit(sw, 1 << (w - 1)))
+        body.push(comment(format!("Stage 4: out = C * (w + 1) / 2^{w}, the slices and C summed, rounded half up; never above C.")));
+        format!("{} + {} + {}", tree(&terms), zext("c4a", C_BITS, sw), lit(sw, 1 << (w - 1)))
     } else {
         body.push(comment(format!("Stage 4: out = C * (w + 1) / 2^{w}, rounded half up; never above C.")));
         format!("{} * {} + {}", zext("c3", C_BITS, sw), zext(&wp, w + 1, sw), lit(sw, 1 << (w - 1)))
@@ -334,13 +343,16 @@ fn module(cfg: &Config, unit: &SpecularUnit, names: &SpecNames) -> Module {
         Item::Blank,
     ]);
 
-    let sel_of_nk = format!("nk1[{}:{mw}]", mw + sb - 1);
+    let sel_of_nk = format!("{}[{}:{mw}]", if split { "nk1q" } else { "nk1" }, mw + sb - 1);
     let err_of_m = format!("m1 == {}", lit(mw, 0));
     let mut stages: Vec<Vec<Stmt>> = vec![vec![set("v1", "busy"), set("mag1", "mag0"), set("c1", "c0"), set("last1", "last0")]];
     let mut resets = vec![set("v1", "1'b0")];
     let mut order = vec![("v1", "last1")];
     if split {
-        let mut part = vec![set("v2a", "v1"), set("c2a", "c1"), set("last2a", "last1"), set("err2a", err_of_m.clone())];
+        stages.push(vec![set("v1q", "v1"), set("mag1q", "mag1"), set("c1q", "c1"), set("last1q", "last1"), set("nk1q", "nk1")]);
+        resets.push(set("v1q", "1'b0"));
+        order.push(("v1q", "last1q"));
+        let mut part = vec![set("v2a", "v1q"), set("c2a", "c1q"), set("last2a", "last1q"), set("err2a", err_of_m.clone())];
         part.extend((0..mw.div_ceil(k)).map(|j| set(format!("pp2a_{j}"), format!("pp1_{j}"))));
         if multi_table {
             part.push(set("sel2a", sel_of_nk.clone()));
@@ -375,11 +387,19 @@ fn module(cfg: &Config, unit: &SpecularUnit, names: &SpecNames) -> Module {
         resets.push(set("v3a", "1'b0"));
         order.push(("v3a", "last3a"));
         stages.push(vec![set("v3", "v3a"), set("cut3", "cut3a"), set("err3", "err3a"), set("c3", "c3a"), set("last3", "last3a")]);
-        let mut part = vec![set("v4a", "v3"), set("cut4a", "cut3"), set("err4a", "err3"), set("last4a", "last3")];
-        part.extend((0..(w + 1).div_ceil(k)).map(|j| set(format!("cp4a_{j}"), format!("cp3_{j}"))));
+        stages.push(vec![
+            set("v3q", "v3"),
+            set("cut3q", "cut3"),
+            set("err3q", "err3"),
+            set("c3q", "c3"),
+            set("last3q", "last3"),
+            set("w3q", "w3"),
+        ]);
+        let mut part = vec![set("v4a", "v3q"), set("cut4a", "cut3q"), set("err4a", "err3q"), set("c4a", "c3q"), set("last4a", "last3q")];
+        part.extend((0..w.div_ceil(k)).map(|j| set(format!("cp4a_{j}"), format!("cp3_{j}"))));
         stages.push(part);
-        resets.extend([set("v3", "1'b0"), set("v4a", "1'b0")]);
-        order.extend([("v3", "last3"), ("v4a", "last4a")]);
+        resets.extend([set("v3", "1'b0"), set("v3q", "1'b0"), set("v4a", "1'b0")]);
+        order.extend([("v3", "last3"), ("v3q", "last3q"), ("v4a", "last4a")]);
     } else {
         stages.push(vec![set("v3", "v2"), set("cut3", "err2 || !in_table"), set("err3", "err2"), set("c3", "c2"), set("last3", "last2")]);
         resets.push(set("v3", "1'b0"));

@@ -400,8 +400,13 @@ impl SpecularPlan {
                 vec![reg("mag", self.mag_bits, &format!("UQ3.{}", self.mag_frac())), reg("nk", self.nk_width(), "{sel, M}")],
             ),
         ];
-        let (mc, cc) = (chunks(self.nk_mant_bits), chunks(w + 1));
+        let (mc, cc) = (chunks(self.nk_mant_bits), chunks(w));
         if split {
+            body.push((
+                "nk_q",
+                "mag and the n-table word registered off the ROM's output".to_string(),
+                vec![reg("mag", self.mag_bits, &format!("UQ3.{}", self.mag_frac())), reg("nk", self.nk_width(), "{sel, M}")],
+            ));
             body.push((
                 "arg_part",
                 format!("pp_k = mag * M[4k +: 4], k < {mc}; err = (M == 0)"),
@@ -438,8 +443,13 @@ impl SpecularPlan {
                 vec![reg("w", w, &format!("(w+1)/2^{w}")), reg("cut", 1, "flag"), reg("err", 1, "flag")],
             ));
             body.push((
+                "brdf_q",
+                "w registered off the ROM's output, whose clock-to-out then stays out of the multiply".to_string(),
+                vec![reg("w", w, &format!("(w+1)/2^{w}")), reg("cut", 1, "flag"), reg("err", 1, "flag")],
+            ));
+            body.push((
                 "c_part",
-                format!("cp_k = C * (w + 1)[4k +: 4], k < {cc}"),
+                format!("cp_k = C * w[4k +: 4], k < {cc} (C * (w + 1) = C * w + C)"),
                 vec![reg("cp", cc * (16 + Self::MUL_CHUNK), &format!("{cc} x uint")), reg("cut", 1, "flag"), reg("err", 1, "flag")],
             ));
         } else {
@@ -452,7 +462,7 @@ impl SpecularPlan {
         body.push((
             "c_mul",
             if split {
-                format!("out_spec = cut ? 0 : (sum_k cp_k << 4k + 2^{}) >> {w}", w - 1)
+                format!("out_spec = cut ? 0 : (sum_k cp_k << 4k + C + 2^{}) >> {w}", w - 1)
             } else {
                 format!("out_spec = cut ? 0 : (C * (w + 1) + 2^{}) >> {w}", w - 1)
             },
@@ -577,12 +587,12 @@ mod tests {
         let nw = p.nk_mant_bits;
         assert_eq!(p.latency(), 5);
         assert_eq!(p.stages().len(), 5);
-        // `--pipeline 1`: both multiplies split in two stages, the BRDF address registered.
+        // `--pipeline 1`: both multiplies split in two stages, the BRDF address and word registered.
         let split = p.clone().with_pipeline(crate::pipeline::Pipeline::at(1));
         let names: Vec<String> = split.stages().into_iter().map(|s| s.name).collect();
-        assert_eq!(names, ["issue", "abs_nk", "arg_part", "arg_mul", "brdf_addr", "brdf", "c_part", "c_mul"]);
-        assert_eq!(split.latency(), 8);
-        assert_eq!(split.clone().with_pipeline(crate::pipeline::Pipeline::at(2)).latency(), 8, "level 2 adds nothing to the unit");
+        assert_eq!(names, ["issue", "abs_nk", "nk_q", "arg_part", "arg_mul", "brdf_addr", "brdf", "brdf_q", "c_part", "c_mul"]);
+        assert_eq!(split.latency(), 10);
+        assert_eq!(split.clone().with_pipeline(crate::pipeline::Pipeline::at(2)).latency(), 10, "level 2 adds nothing to the unit");
         for (t, tb) in p.tables.iter().enumerate() {
             assert!(tb.end_arg() < std::f64::consts::FRAC_PI_2);
             assert!(cos_k(tb.k, tb.end_arg()) <= TABLE_END * 1.0001);
