@@ -7,11 +7,13 @@
 //!   `out_valid` is low right after a reset and that an offered output holds until taken);
 //! - `out_valid` rises without waiting for `out_ready`, at the stated latency;
 //! - every word of both specular ROMs is reached (so a changed word cannot hide);
-//! - the harness API rejects spans the ports cannot carry before they reach a model;
-//! - bad triangle input is rejected with its line number, never a panic or garbage pixels.
+//! - the harness API rejects spans the ports cannot carry before they reach a model.
+//!
+//! Bad triangle input (rejected with its line number, never a panic or garbage pixels) is
+//! golden's alone: `golden::setup`'s tests.
 
 use golden::rng::SeedRng;
-use golden::setup::{parse_triangles, triangle_spans, Screen, Triangle, Vertex, COORD_LIMIT};
+use golden::setup::{triangle_spans, Screen, Triangle, Vertex, COORD_LIMIT};
 use golden::specular::{SpecularSpan, N_BITS};
 use golden::{Config, Span};
 use rand::{Rng, SeedableRng};
@@ -304,56 +306,6 @@ fn harness_rejects_spans_the_rtl_cannot_take() {
     sim.try_stream(&spans, &mut report).unwrap();
     assert_clean("specular port extremes", 1, &report);
     assert_eq!(report.pixels, 6 + port_max as u64);
-}
-
-/// Bad triangle text is rejected with its line number; NaN, infinities and coordinates beyond
-/// the set-up's limits never reach a span. Random garbage never panics the parser.
-#[test]
-fn bad_triangle_input_is_rejected_with_its_line() {
-    let good = "0 0 0 10 0 128 0 10 255";
-    let cases = [
-        ("nan 0 0 1 0 0 0 1 0", "x0 = 'nan' is not finite"),
-        ("0 NaN 0 1 0 0 0 1 0", "y0 = 'NaN' is not finite"),
-        ("0 0 0 inf 0 0 0 1 0", "x1 = 'inf' is not finite"),
-        ("0 0 0 1 -inf 0 0 1 0", "y1 = '-inf' is not finite"),
-        ("0 0 0 1 0 0 1e400 1 0", "x2 = '1e400' is not finite"),
-        ("0 0 0 1 0 0 0 1 infinity", "i2 = 'infinity' is not finite"),
-        ("1e300 0 0 1 0 0 0 1 0", "vertex 0: x = 1000000000000000"),
-        ("0 0 0 32768.004 0 0 0 1 0", "vertex 1: x = 32768.004"),
-        ("0 0 0 1 0 0 0 -32769 0", "vertex 2: y = -32769"),
-        ("0 0 0 1 0 0 0 1 255.5", "vertex 2: intensity 255.5"),
-        ("0 0 0 1 0 0 0 1", "expected 9 numbers"),
-        ("0 0 0 1 0 0 0 1 0 0", "expected 9 numbers"),
-        ("0 0 0 1 0 0 0 1 0x10", "i2 = '0x10' is not a number"),
-        ("0,0,0 1 0 0 0 1 0", "expected 9 numbers"),
-    ];
-    for (bad, want) in cases {
-        let text = format!("# scene\n{good}\n\n{bad}\n{good}\n");
-        let e = parse_triangles(&text).expect_err(bad);
-        assert_eq!(e.line, 4, "{bad}");
-        assert!(e.message.contains(want), "{bad}: '{}' should contain '{want}'", e.message);
-    }
-    // Fuzz: lines of random tokens, numbers and junk.
-    let mut rng = SeedRng::seed_from_u64(6);
-    let tokens = ["0", "-1", "1e9", "nan", "inf", "-0", "255", "3.5", "#", "x", "", "1e-400", "32768", "-32768", "\t", "1e308"];
-    for _ in 0..5000 {
-        let line: Vec<&str> = (0..rng.gen_range(0..12)).map(|_| tokens[rng.gen_range(0..tokens.len())]).collect();
-        if let Ok(tris) = parse_triangles(&line.join(" ")) {
-            for t in tris {
-                t.check().expect("the parser returns only valid triangles");
-            }
-        }
-    }
-    // Built in code, the same triangles are rejected by the set-up, not turned into spans.
-    let cfg = Config::default();
-    let screen = Screen::default();
-    for bad in [f64::NAN, f64::INFINITY, f64::NEG_INFINITY, 1e300, COORD_LIMIT + 0.01] {
-        let t = Triangle { v: [Vertex { x: 0.0, y: 0.0, i: 0.0 }, Vertex { x: bad, y: 5.0, i: 9.0 }, Vertex { x: 3.0, y: 9.0, i: 1.0 }] };
-        let mut spans = 0;
-        let e = triangle_spans(&cfg, &screen, &t, |_, _| spans += 1).expect_err("accepted");
-        assert!(e.contains("vertex 1"), "{e}");
-        assert_eq!(spans, 0);
-    }
 }
 
 /// Triangles at the coordinate limits are clipped to the screen: every span fits the ports, and

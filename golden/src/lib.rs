@@ -15,4 +15,4 @@ pub mod setup;
 pub mod specular;
 pub mod writer;
 
-pub use format::{Align, Config, Span};
+pub use format::{Align, Config, ConfigError, Span, SpanError};

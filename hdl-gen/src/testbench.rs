@@ -55,10 +55,15 @@ impl BenchNames {
     }
 }
 
+/// A vector count [`testbench`] refuses: outside `1..=MAX_VECTORS`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, thiserror::Error)]
+#[error("--vectors {0} is outside 1..{MAX_VECTORS}")]
+pub struct VectorCountError(pub u32);
+
 /// Everything `generate` writes for `opts`, then both benches and their vector files.
-pub fn testbench(opts: &Options, vectors: u32, seed: u64) -> Result<Vec<GeneratedFile>, String> {
+pub fn testbench(opts: &Options, vectors: u32, seed: u64) -> Result<Vec<GeneratedFile>, VectorCountError> {
     if !(1..=MAX_VECTORS).contains(&vectors) {
-        return Err(format!("--vectors {vectors} is outside 1..{MAX_VECTORS}"));
+        return Err(VectorCountError(vectors));
     }
     let mut files = generate(opts);
     let bench = BenchNames::new(opts);
@@ -725,7 +730,8 @@ mod tests {
         let opts = Options::default();
         assert_eq!(testbench(&opts, 50, 7).unwrap(), testbench(&opts, 50, 7).unwrap());
         assert_ne!(testbench(&opts, 50, 7).unwrap(), testbench(&opts, 50, 8).unwrap());
-        assert!(testbench(&opts, 0, 7).is_err());
+        assert_eq!(testbench(&opts, 0, 7), Err(VectorCountError(0)));
+        assert_eq!(testbench(&opts, MAX_VECTORS + 1, 7), Err(VectorCountError(MAX_VECTORS + 1)));
     }
 
     #[test]

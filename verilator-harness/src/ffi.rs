@@ -3,7 +3,7 @@
 //! another, so a clock costs one FFI call whatever the port count.
 
 use crate::driver::{Control, Handshake};
-use golden::specular::{Decoder, DecoderRepr, KRange, SpecularPlan, SpecularUnit};
+use golden::specular::{Decoder, DecoderRepr, KRange, PlanError, SpecularPlan, SpecularUnit};
 use golden::{Align, Config};
 use std::ffi::{c_char, c_int, c_void, CString};
 use std::path::{Path, PathBuf};
@@ -298,7 +298,7 @@ pub struct SpecularTables {
 }
 
 impl SpecularTables {
-    pub fn plan(&self) -> Result<SpecularPlan, String> {
+    pub fn plan(&self) -> Result<SpecularPlan, PlanError> {
         let decoder = Decoder::try_from(DecoderRepr { ks: self.ks.to_vec(), ranges: self.k_ranges.to_vec() })?;
         SpecularPlan::build(decoder, self.word_bits)
     }

@@ -387,7 +387,7 @@ pub(crate) fn check_frame(exp: &Expected, frame: &Frame, writes: &[u8], report: 
         }
         if st.outcome != Outcome::Guard {
             if let Err(e) = reference_triangle(&screen, &st.tri.to_triangle(cfg.frac), &mut reference) {
-                report.mismatch(Mismatch { triangle: Some(st.triangle), context: "f64 reference".into(), what: e });
+                report.mismatch(Mismatch { triangle: Some(st.triangle), context: "f64 reference".into(), what: e.to_string() });
             }
         }
     }

@@ -340,7 +340,7 @@ pub fn mesh_job(mesh: &Mesh, light: &Lighting, radius: f64, cfg: &Config, screen
         let first = job.stims[0].len();
         for (c, stims) in job.stims.iter_mut().enumerate() {
             let t = Triangle { v: [0, 1, 2].map(|k| Vertex { x: v[k].0, y: v[k].1, i: lit[f[k] as usize][c] }) };
-            triangle_spans(cfg, screen, &t, |y, span| stims.push(Stim { triangle: tri as usize, y, span }))?;
+            triangle_spans(cfg, screen, &t, |y, span| stims.push(Stim { triangle: tri as usize, y, span })).map_err(|e| e.to_string())?;
             job.tris[c].push(FixedTriangle::from_triangle(&t, cfg.frac));
         }
         let interp = Interp::new(v);
@@ -427,7 +427,7 @@ pub fn triangles_job(text: &str, cfg: &Config, screen: &Screen) -> Result<Job, S
 
 /// As [`triangles_job`], for triangles already parsed.
 pub fn triangles_job_of(tris: &[Triangle], cfg: &Config, screen: &Screen) -> Result<Job, String> {
-    screen.check_for(cfg)?;
+    screen.check_for(cfg).map_err(|e| e.to_string())?;
     let mut job = Job {
         screen: *screen,
         stims: vec![Vec::new()],

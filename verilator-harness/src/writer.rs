@@ -182,7 +182,7 @@ impl MemoryCheck {
             }
         }
         if let Err(e) = self.memory.apply(&kept) {
-            report.mismatch(Mismatch { triangle, context: context(), what: e });
+            report.mismatch(Mismatch { triangle, context: context(), what: e.to_string() });
             return;
         }
         let twice: Vec<u32> = (0..p)
