@@ -15,13 +15,13 @@
 use golden::rng::SeedRng;
 use golden::setup::{triangle_spans, Screen, Triangle, Vertex, COORD_LIMIT};
 use golden::specular::{SpecularSpan, N_BITS};
-use golden::{Config, Span};
+use golden::{Config, Span, SpanError};
 use rand::{Rng, SeedableRng};
-use verilator_harness::cosim::{assert_clean, Report, SegmentCosim, Stim, Stress, Traffic};
+use verilator_harness::cosim::{assert_clean, Report, SegmentCosim, SpanRejected, Stim, Stress, Traffic};
 use verilator_harness::ffi::{
     require_models, require_specular_model, specular_unit, to_port, ModelInfo, Rtl, SegIn, SegOut, SpecIn, SpecOut, RTL_DIR, SEGMENT_MODELS,
 };
-use verilator_harness::specular::{random_span, SpecularCosim};
+use verilator_harness::specular::{random_span, SpecSpanRejected, SpecularCosim};
 use verilator_harness::stimulus::{directed, random_triangle};
 
 /// Backpressure bursts, input gaps and a reset about every 700 clocks.
@@ -255,20 +255,21 @@ fn harness_rejects_spans_the_rtl_cannot_take() {
         let max = cfg.max_len();
         let good = Span { x0: 0, len: 4, i0: 0, di: 0 };
         let half = 1i32 << (cfg.dw() - 1);
+        let (iw, dw, frac) = (cfg.iw(), cfg.dw(), cfg.frac);
         let bad = [
-            (Span { x0: max - 3, len: 4, ..good }, "beyond the screen width"),
-            (Span { x0: 0, len: max + 1, ..good }, "exceeds 2^XW"),
-            (Span { x0: max, len: 0, ..good }, "beyond the screen width"),
-            (Span { i0: 1 << cfg.iw(), ..good }, "does not fit UQ8"),
-            (Span { di: half, ..good }, "signed bits"),
-            (Span { di: -half - 1, ..good }, "signed bits"),
+            (Span { x0: max - 3, len: 4, ..good }, SpanError::Beyond { x0: max - 3, len: 4, max }),
+            (Span { x0: 0, len: max + 1, ..good }, SpanError::Len { len: max + 1, max }),
+            (Span { x0: max, len: 0, ..good }, SpanError::Beyond { x0: max, len: 0, max }),
+            (Span { i0: 1 << iw, ..good }, SpanError::I0 { i0: 1 << iw, frac }),
+            (Span { di: half, ..good }, SpanError::Di { di: half, bits: dw }),
+            (Span { di: -half - 1, ..good }, SpanError::Di { di: -half - 1, bits: dw }),
         ];
-        for (span, needle) in bad {
+        for (span, error) in bad {
             let stims = [Stim { triangle: 0, y: 0, span: good }, Stim { triangle: 7, y: 9, span }];
             let mut sim = SegmentCosim::new(info, 1, Traffic::FULL);
             let mut report = Report::default();
             let e = sim.try_stream(&stims, &mut report, |_, _| {}).expect_err(&format!("{}: {span:?} accepted", info.tag));
-            assert!(e.contains("span 1 (triangle 7, y = 9)") && e.contains(needle), "{}: {e}", info.tag);
+            assert_eq!(e, SpanRejected { index: 1, triangle: 7, y: 9, error }, "{}", info.tag);
             assert_eq!((report.cycles, report.spans), (0, 0), "{}: the model saw a clock", info.tag);
         }
         if info.tag == SEGMENT_MODELS[0].tag {
@@ -289,13 +290,14 @@ fn harness_rejects_spans_the_rtl_cannot_take() {
     let Some(info) = spec_model("the specular unit's port limits") else { return };
     let port_max = (1u32 << (info.cfg.xbits + 1)) - 1;
     let good = SpecularSpan { c: 100, n: 10, theta0: 0, dtheta: 1000, len: 3 };
-    for (span, needle) in
-        [(SpecularSpan { len: port_max + 1, ..good }, "in_len port"), (SpecularSpan { n: 1 << N_BITS, ..good }, "in_n port")]
-    {
+    let bits = info.cfg.xbits + 1;
+    for (span, error) in [
+        (SpecularSpan { len: port_max + 1, ..good }, SpecSpanRejected::Len { index: 1, len: port_max + 1, bits }),
+        (SpecularSpan { n: 1 << N_BITS, ..good }, SpecSpanRejected::N { index: 1, n: 1 << N_BITS, bits: N_BITS }),
+    ] {
         let mut sim = SpecularCosim::new(info, specular_unit(), 1, Traffic::FULL);
         let mut report = Report::default();
-        let e = sim.try_stream(&[good, span], &mut report).expect_err("accepted");
-        assert!(e.contains("span 1") && e.contains(needle), "{e}");
+        assert_eq!(sim.try_stream(&[good, span], &mut report), Err(error));
         assert_eq!(report.cycles, 0);
     }
     // What the ports carry is valid input, an n outside 1..1000 included (out_err = 1), and the

@@ -13,10 +13,11 @@
 //! With waveforms on ([`crate::waveform`]), the driver also keeps a tape of its model's inputs,
 //! and the first mismatch of the run names the FST file of its clocks and its clock.
 
-use crate::cosim::{Mismatch, Report};
-use crate::ffi::Rtl;
+use crate::ffi::{Control, Handshake, Rtl};
+use crate::report::{Mismatch, Report};
+use crate::tape::{NoTape, Recorder, Tape};
 use crate::traffic::TrafficGen;
-use crate::waveform::{NoTape, Recorder, Tape, Waveform, AFTER, BEFORE};
+use crate::waveform::{TraceError, Waveform, AFTER, BEFORE};
 use rand::Rng;
 use std::collections::VecDeque;
 use std::path::PathBuf;
@@ -121,21 +122,6 @@ impl<const ON: bool> Pacer<ON> {
             self.gap_left = self.rng.gen_range(1..=self.stress.gap_max.max(1));
         }
     }
-}
-
-/// The control inputs of a streaming unit.
-pub trait Control: Copy + Default + 'static {
-    fn set_control(&mut self, rst: bool, in_valid: bool, out_ready: bool);
-    /// Whether the next step may leave the data ports as the last one wrote them.
-    fn keep_data(&mut self, keep: bool);
-    /// What the two above set: `rst | in_valid << 1 | out_ready << 2 | keep << 3`.
-    fn control(&self) -> u8;
-}
-
-/// The handshake outputs of a streaming unit.
-pub trait Handshake: Copy + Default + 'static {
-    fn in_ready(&self) -> bool;
-    fn out_valid(&self) -> bool;
 }
 
 /// What the driving thread knows of a unit: how a span goes onto its ports, how many outputs
@@ -383,8 +369,7 @@ impl<U: Unit> Driver<U> {
             // Nothing was taped: the model has no twin to replay into (a traced model always
             // has a tape). The note goes on this stream's first mismatch.
             (_, None) => {
-                let tag = self.rtl.info().tag;
-                let note = format!("COSIM_TRACE: no waveform: this build has no traced model of {tag} (build with COSIM_TRACE set)");
+                let note = format!("COSIM_TRACE: no waveform: {}", TraceError::NoTwin(self.rtl.info().tag));
                 annotate(report.mismatches.get_mut(kept).or(checked.mismatches.first_mut()), &note);
                 self.waves = Waves::Done;
                 return;
@@ -409,26 +394,26 @@ impl<U: Unit> Driver<U> {
     /// The waveform of a failure in clock `clock`: the traced model's own file, or the tape's
     /// window around `clock` replayed into the model's twin, written and checked whole.
     #[cold]
-    fn waveform(&self, tape: &Tape<U::In>, clock: u64) -> Result<Waveform, String> {
+    fn waveform(&self, tape: &Tape<U::In>, clock: u64) -> Result<Waveform, TraceError> {
         let dir = match &self.waves {
             Waves::Live => {
                 let path = self.rtl.waves().expect("a traced model has a file").to_path_buf();
                 return Ok(Waveform { path, clock, window: None });
             }
             Waves::OnFailure(dir) => dir,
-            Waves::Off | Waves::Done => return Err("waveforms are off".into()),
+            Waves::Off | Waves::Done => return Err(TraceError::Off),
         };
         let (first, last) = tape.clocks();
         let (from, to) = (clock.saturating_sub(BEFORE).max(first), (clock + AFTER).min(last));
         let info = self.rtl.info();
-        std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+        std::fs::create_dir_all(dir).map_err(|error| TraceError::Io { path: dir.clone(), error })?;
         let path = dir.join(format!("{}-seed{}-clock{clock}.fst", info.tag, self.rtl.seed()));
         let mut twin = Rtl::traced(info, self.rtl.seed())?;
         tape.replay(&mut twin, from, to, &path)?;
         drop(twin);
-        let file = crate::waveform::check_fst(&path).map_err(|e| format!("written but unreadable: {e}"))?;
+        let file = crate::waveform::check_fst(&path).map_err(TraceError::Unreadable)?;
         if (file.first, file.last) != (from, to) {
-            return Err(format!("{} holds clocks {} to {}, not {from} to {to}", path.display(), file.first, file.last));
+            return Err(TraceError::Window { path, held: (file.first, file.last), wanted: (from, to) });
         }
         Ok(Waveform { path, clock, window: Some((from, to)) })
     }

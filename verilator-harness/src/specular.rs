@@ -2,10 +2,10 @@
 //! against golden, within SPEC §4 of the f64 approximation `C cos^k(sqrt(n/k) delta)`, and,
 //! along each span, never brighter where |theta| is larger.
 
-use crate::cosim::{Mismatch, Report, Stress, Traffic};
-use crate::driver::{Check, Driver, Unit};
+use crate::driver::{Check, Driver, Stress, Unit};
 use crate::ffi::{to_port, ModelInfo, Rtl, SpecIn, SpecOut};
-use crate::traffic::TrafficGen;
+use crate::report::{Mismatch, Report};
+use crate::traffic::{Traffic, TrafficGen};
 use golden::specular::reference::{approx, cos_k, epicentre};
 use golden::specular::setup::{norm, normalize, setup_span, SpanEnds, Vec3};
 use golden::specular::{n_valid, theta_at, tolerance, SpecularSpan, SpecularUnit, C_FRAC, N_MAX, THETA_FRAC};
@@ -133,7 +133,7 @@ impl SpecularCosim {
     /// With [`Stress`] resets, a span cut by a reset owes no more pixels; a protocol monitor
     /// checks that a pixel offered and not taken stays, unchanged, and that `out_valid` is low
     /// in the first clock after a reset.
-    pub fn try_stream(&mut self, spans: &[SpecularSpan], report: &mut Report) -> Result<(), String> {
+    pub fn try_stream(&mut self, spans: &[SpecularSpan], report: &mut Report) -> Result<(), SpecSpanRejected> {
         self.try_stream_with(spans, report, |_, _, _| {})
     }
 
@@ -152,14 +152,14 @@ impl SpecularCosim {
         spans: &[SpecularSpan],
         report: &mut Report,
         pixel: impl FnMut(usize, u32, &SpecOut) + Send,
-    ) -> Result<(), String> {
-        let len_max = (1u32 << (self.info.cfg.xbits + 1)) - 1;
-        for (k, s) in spans.iter().enumerate() {
-            if s.len > len_max {
-                return Err(format!("span {k} rejected: len = {} does not fit the {}-bit in_len port", s.len, self.info.cfg.xbits + 1));
+    ) -> Result<(), SpecSpanRejected> {
+        let bits = self.info.cfg.xbits + 1;
+        for (index, s) in spans.iter().enumerate() {
+            if s.len >= 1 << bits {
+                return Err(SpecSpanRejected::Len { index, len: s.len, bits });
             }
             if s.n as u32 >= 1 << golden::specular::N_BITS {
-                return Err(format!("span {k} rejected: n = {} does not fit the {}-bit in_n port", s.n, golden::specular::N_BITS));
+                return Err(SpecSpanRejected::N { index, n: s.n, bits: golden::specular::N_BITS });
             }
         }
         self.judge.along.clear();
@@ -167,6 +167,16 @@ impl SpecularCosim {
         self.driver.stream(&SpecPorts, spans, report, check);
         Ok(())
     }
+}
+
+/// A span the specular unit's ports cannot carry ([`SpecularCosim::try_stream`]); nothing was
+/// streamed.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, thiserror::Error)]
+pub enum SpecSpanRejected {
+    #[error("span {index} rejected: len = {len} does not fit the {bits}-bit in_len port")]
+    Len { index: usize, len: u32, bits: u32 },
+    #[error("span {index} rejected: n = {n} does not fit the {bits}-bit in_n port")]
+    N { index: usize, n: u16, bits: u32 },
 }
 
 /// The scoreboard of the specular unit, on the checking thread.
