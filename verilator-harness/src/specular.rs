@@ -7,9 +7,7 @@ use crate::ffi::{to_port, ModelInfo, Rtl, SpecIn, SpecOut};
 use crate::report::{Mismatch, Report};
 use crate::traffic::{Traffic, TrafficGen};
 use golden::specular::reference::{approx, cos_k, epicentre};
-use golden::specular::setup::{norm, normalize, setup_span, SpanEnds, Vec3};
-use golden::specular::{n_valid, theta_at, tolerance, SpecularSpan, SpecularUnit, C_FRAC, N_MAX, THETA_FRAC};
-use rand::Rng;
+use golden::specular::{n_valid, theta_at, tolerance, SpecularSpan, SpecularUnit, C_FRAC, THETA_FRAC};
 use std::f64::consts::FRAC_PI_2;
 
 /// The specular unit under test: its driver and the checker's golden twin and caches.
@@ -388,52 +386,8 @@ fn monotone(along: &[(u32, u16)]) -> bool {
     }
 }
 
-/// The shininess of a random span: all four default k ranges, their boundaries, and invalid n.
-pub fn random_n(rng: &mut impl Rng) -> u16 {
-    match rng.gen_range(0..20) {
-        0..=7 => rng.gen_range(7..=N_MAX as u16),
-        8..=10 => rng.gen_range(3..=6),
-        11 => 1,
-        12 => 2,
-        13..=16 => [1, 2, 3, 6, 7, 1000][rng.gen_range(0..6)],
-        17 => [0, 1001, 1023][rng.gen_range(0..3)],
-        _ => rng.gen_range(1001..=1023),
-    }
-}
-
-/// Uniform on the sphere: rejection from the cube, away from the centre.
-fn unit_vector(rng: &mut impl Rng) -> Vec3 {
-    loop {
-        let v: Vec3 = [rng.gen_range(-1.0..1.0), rng.gen_range(-1.0..1.0), rng.gen_range(-1.0..1.0)];
-        if (0.1..=1.0).contains(&norm(v)) {
-            return normalize(v).expect("not near zero");
-        }
-    }
-}
-
-fn near(rng: &mut impl Rng, v: Vec3, spread: f64) -> Vec3 {
-    let u = unit_vector(rng);
-    [v[0] + spread * u[0], v[1] + spread * u[1], v[2] + spread * u[2]]
-}
-
-/// A random span as the host would set it up: normals and half-vectors at both ends (mostly a
-/// highlight crossing the span, sometimes anything at all, including degenerate pairs).
-pub fn random_span(rng: &mut impl Rng, max_len: u32) -> SpecularSpan {
-    let n = random_n(rng);
-    let n1 = unit_vector(rng);
-    let ends = match rng.gen_range(0..10) {
-        0 => SpanEnds { n1, h1: unit_vector(rng), n2: unit_vector(rng), h2: unit_vector(rng) },
-        1 => SpanEnds { n1, h1: n1, n2: n1, h2: n1 },
-        2 => SpanEnds { n1, h1: near(rng, n1, 0.3), n2: [-n1[0], -n1[1], -n1[2]], h2: near(rng, n1, 0.3) },
-        _ => {
-            let spread = rng.gen_range(0.01..0.8);
-            SpanEnds { n1, h1: near(rng, n1, spread), n2: near(rng, n1, spread), h2: near(rng, n1, spread) }
-        }
-    };
-    let l = rng.gen_range(0..max_len.min(400));
-    let il_ks = rng.gen_range(0.5..300.0);
-    setup_span(&ends, il_ks, 1.0, n, l).port
-}
+// Golden's generator (golden::stimulus), where the suites and binaries import it.
+pub use golden::stimulus::random_span;
 
 #[cfg(test)]
 mod tests {
