@@ -618,3 +618,175 @@ fn consume(rx: Receiver<Batch>, back: SyncSender<Batch>, rb: usize, mut check: i
     }
     (report, first_bad)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::ffi::{require_segment_model, to_port, SegIn, SegOut};
+    use crate::traffic::Traffic;
+    use golden::{Align, Config, Span};
+    use std::sync::{Arc, Mutex};
+
+    /// The driver's view of a segment shader, as little as the driver needs: a record is
+    /// `out_x | out_last << 31`, and `extra` segments are claimed beyond what golden says each
+    /// span owes (a negative control: a unit that miscounts).
+    struct Segments {
+        cfg: Config,
+        extra: i32,
+    }
+
+    impl Unit for Segments {
+        type In = SegIn;
+        type Out = SegOut;
+        type Span = Span;
+        fn record_bytes(&self) -> usize {
+            4
+        }
+        fn load(&self, input: &mut SegIn, s: &Span) {
+            (input.in_x, input.in_len, input.in_i0, input.in_di) = (s.x0, s.len, s.i0, to_port(s.di as i64, self.cfg.dw()));
+        }
+        fn owed(&self, s: &Span) -> u32 {
+            (self.cfg.segment_count(s.x0, s.len) as i32 + self.extra).max(0) as u32
+        }
+        fn record(&self, out: &SegOut, rec: &mut [u8]) {
+            rec.copy_from_slice(&(out.out_x | (out.out_last as u32) << 31).to_le_bytes());
+        }
+        fn same(&self, held: &[u8], out: &SegOut) -> bool {
+            let mut now = [0; 4];
+            self.record(out, &mut now);
+            held == now
+        }
+        fn describe_change(&self, _held: &[u8], _out: &SegOut) -> String {
+            "changed".into()
+        }
+        fn blame(&self, k: usize, _s: &Span) -> (Option<usize>, String) {
+            (Some(k), format!("span {k}"))
+        }
+    }
+
+    /// (span, output, record) of one output the checker got.
+    type Got = (usize, u32, u32);
+
+    /// Every output the checker got, in order.
+    #[derive(Clone, Default)]
+    struct Seen(Arc<Mutex<Vec<Got>>>);
+
+    impl Check for Seen {
+        fn check(&mut self, k: usize, j: u32, rec: &[u8], _report: &mut Report) {
+            self.0.lock().unwrap().push((k, j, u32::from_le_bytes(rec.try_into().unwrap())));
+        }
+    }
+
+    fn spans(n: u32) -> Vec<Span> {
+        (0..n).map(|k| Span { x0: (k * 7) % 200, len: k % 23, i0: 100 << 12, di: 1 << 10 }).collect()
+    }
+
+    /// Runs `spans` through `seg_p2_span` with `unit` under `traffic` and `stress`; `None` when
+    /// this build has no such model (COSIM_RTL_DIR).
+    fn run(unit: &Segments, spans: &[Span], traffic: Traffic, stress: Stress) -> Option<(Report, Vec<Got>)> {
+        let info = require_segment_model(2, Align::Span, "driver: its own tests")?;
+        let mut d = Driver::<Segments>::new(Rtl::new(info, 3), TrafficGen::new(traffic, 3));
+        d.set_waveforms(None);
+        d.stress = stress;
+        let (mut report, seen) = (Report::default(), Seen::default());
+        d.stream(unit, spans, &mut report, seen.clone());
+        let got = seen.0.lock().unwrap().clone();
+        Some((report, got))
+    }
+
+    /// Every output golden owes reaches the checker once, in order (span by span, each span's
+    /// outputs numbered from 0), with golden's x and last flag; the counts add up.
+    #[test]
+    fn every_owed_output_reaches_the_checker_in_order() {
+        let cfg = Config { p: 2, ..Config::default() };
+        let unit = Segments { cfg, extra: 0 };
+        let s = spans(300);
+        for traffic in [Traffic::FULL, Traffic::RANDOM] {
+            let Some((report, got)) = run(&unit, &s, traffic, Stress::BURSTS) else { return };
+            assert!(report.ok(), "{:?}", report.mismatches);
+            assert_eq!(report.spans, s.len() as u64);
+            let want: Vec<Got> = s
+                .iter()
+                .enumerate()
+                .flat_map(|(k, sp)| golden::segment::segments(&cfg, sp).map(move |g| (k, g.index, g.x | (g.last as u32) << 31)))
+                .collect();
+            assert_eq!(got, want);
+        }
+    }
+
+    /// With resets, a span cut short stops early and nothing of it comes later: per span the
+    /// output numbers run 0, 1, 2, ... and spans come in order; resets and cuts are counted.
+    #[test]
+    fn resets_cut_spans_and_nothing_stale_follows() {
+        let unit = Segments { cfg: Config { p: 2, ..Config::default() }, extra: 0 };
+        let Some((report, got)) = run(&unit, &spans(2000), Traffic::RANDOM, Stress::HARSH) else { return };
+        assert!(report.ok(), "{:?}", report.mismatches);
+        assert!(report.resets > 0 && report.cut_spans > 0, "{report:?}");
+        for w in got.windows(2) {
+            let ((k0, j0, _), (k1, j1, _)) = (w[0], w[1]);
+            assert!((k1 == k0 && j1 == j0 + 1) || (k1 > k0 && j1 == 0), "{:?} then {:?}", w[0], w[1]);
+        }
+    }
+
+    /// Negative controls of the protocol monitor: a unit that owes one output too few sees
+    /// output with no span outstanding; one that owes one too many sees the model stop, and the
+    /// driver declares it hung instead of waiting forever.
+    #[test]
+    fn miscounted_outputs_are_mismatches() {
+        let cfg = Config { p: 2, ..Config::default() };
+        let s: Vec<Span> = spans(40).into_iter().filter(|s| s.len > 0).collect();
+        let Some((few, _)) = run(&Segments { cfg, extra: -1 }, &s, Traffic::RANDOM, Stress::NONE) else { return };
+        assert!(few.mismatches.iter().any(|m| m.what == "output with no span outstanding"), "{:?}", few.mismatches);
+        let Some((many, _)) = run(&Segments { cfg, extra: 1 }, &s, Traffic::RANDOM, Stress::NONE) else { return };
+        assert!(
+            many.mismatches.iter().any(|m| m.what.starts_with(&format!("no transfer for {STALL_LIMIT} clocks"))),
+            "{:?}",
+            many.mismatches
+        );
+    }
+
+    /// The checking thread hands back the index, in transfer order, of the first output that
+    /// failed, over batches; the driver names the waveform after it.
+    #[test]
+    fn the_checker_names_its_first_failing_output() {
+        struct FailFrom(usize, usize);
+        impl Check for FailFrom {
+            fn check(&mut self, _k: usize, _j: u32, _rec: &[u8], report: &mut Report) {
+                if self.1 >= self.0 {
+                    report.mismatch(Mismatch { triangle: None, context: String::new(), what: "planted".into() });
+                }
+                self.1 += 1;
+            }
+        }
+        let (tx, rx) = sync_channel(IN_FLIGHT);
+        let (back, _back_rx) = sync_channel(IN_FLIGHT + 2);
+        let rb = 4;
+        let per = Batch::records(rb);
+        let sender = std::thread::spawn(move || {
+            for b in 0..3 {
+                let mut batch = Batch::new(rb);
+                for r in 0..per {
+                    batch.at.push((b, r as u32));
+                }
+                tx.send(batch).unwrap();
+            }
+        });
+        let (report, first_bad) = consume(rx, back, rb, FailFrom(per + 5, 0));
+        sender.join().unwrap();
+        assert_eq!(first_bad, Some(per + 5));
+        assert_eq!(report.mismatch_count, (3 * per - per - 5) as u64);
+    }
+
+    /// Without stress the pacer is the plain traffic, draw for draw (the benches' stream).
+    #[test]
+    fn an_unstressed_pacer_is_the_plain_traffic() {
+        let (mut plain, mut pacer) =
+            (TrafficGen::new(Traffic::RANDOM, 9), Pacer::<false>::new(Stress::NONE, TrafficGen::new(Traffic::RANDOM, 9)));
+        for _ in 0..10_000 {
+            plain.clock();
+            pacer.clock();
+            assert!(!pacer.reset());
+            assert_eq!((pacer.offer(), pacer.ready()), (plain.offer(), plain.ready()));
+        }
+    }
+}
