@@ -114,9 +114,9 @@ enum Report {
     Accuracy {
         #[command(flatten)]
         brdf: BrdfArgs,
-        /// Also draw the error against n into this PNG file.
+        /// Also draw the error against n into this SVG file.
         #[arg(long)]
-        png: Option<PathBuf>,
+        svg: Option<PathBuf>,
     },
 }
 
@@ -248,12 +248,12 @@ fn run(command: Command) -> anyhow::Result<()> {
             output::write_all(&out, &hdl_gen::testbench::testbench(&opts, vectors, seed)?)?;
             eprintln!("wrote {}", out.display());
         }
-        Command::Report { report: Report::Accuracy { brdf, png } } => {
+        Command::Report { report: Report::Accuracy { brdf, svg } } => {
             let unit = Options { brdf: brdf.plan()?, ..Options::default() }.specular_unit();
             let report = hdl_gen::report::AccuracyReport::measure(&unit);
             // The file first: a failed write then leaves no table behind either.
-            if let Some(path) = &png {
-                output::write_one(path, &report.png().map_err(anyhow::Error::msg)?)?;
+            if let Some(path) = &svg {
+                output::write_one(path, report.svg().as_bytes())?;
                 eprintln!("wrote {}", path.display());
             }
             print!("{}", report.table());

@@ -1,7 +1,7 @@
 //! Writing output files so that a folder never holds a half-written set: every file is staged
 //! under a temporary name in its own folder (`tempfile`, so a failed run removes what it
 //! staged) and renamed over its destination only when all of them were written. The one
-//! implementation behind `generate`, `rom`, `report --png`, `render` and `sweep --out`.
+//! implementation behind `generate`, `rom`, `report --svg`, `render` and `sweep --out`.
 
 use crate::GeneratedFile;
 use std::fs;
