@@ -416,3 +416,69 @@ pub(crate) fn agrees(out: &SegView, span: &Span, seg: &Segment, row: &[u8], p: u
 pub(crate) fn describe(s: &Stim) -> String {
     format!("span y = {} x0 = {} len = {} i0 = {} di = {}", s.y, s.span.x0, s.span.len, s.span.i0, s.span.di)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use golden::rng::SeedRng;
+    use golden::segment::segments;
+    use golden::Align;
+    use rand::{Rng, SeedableRng};
+
+    /// Golden's segment as the model would offer it: in-span lanes enabled with their pixels,
+    /// the other lanes off, holding `junk`.
+    fn offered(cfg: &Config, span: &Span, seg: &Segment, junk: u8) -> ([u8; 256], [u8; 32]) {
+        let (mut pix, mut mask) = ([junk; 256], [0u8; 32]);
+        for i in 0..cfg.p {
+            if let Some(j) = seg.lane_pixel(i) {
+                pix[i as usize] = span.pixel(j, cfg.frac);
+                mask[(i / 8) as usize] |= 1 << (i % 8);
+            }
+        }
+        (pix, mask)
+    }
+
+    /// The scoreboard's fast path (`agrees`) is `check_lanes` made fast: on golden's own segment
+    /// both pass and count the same pixels, whatever the masked-off lanes hold; and every single
+    /// corruption (a pixel of an enabled lane, a mask bit, `out_x`, `out_last`) fails both.
+    #[test]
+    fn agrees_is_check_lanes_fast() {
+        let mut rng = SeedRng::seed_from_u64(13);
+        for p in [1, 2, 4, 8, 16, 64, 256] {
+            for align in Align::ALL {
+                let cfg = Config { p, align, ..Config::default() };
+                let mut row = golden_row(&cfg);
+                let half = 1i32 << (cfg.dw() - 1);
+                for _ in 0..60 {
+                    let x0 = rng.gen_range(0..cfg.max_len());
+                    let len = rng.gen_range(1..=(cfg.max_len() - x0).min(4 * p + 3));
+                    let span = Span { x0, len, i0: rng.gen_range(0..1 << cfg.iw()), di: rng.gen_range(-half..half) };
+                    let stim = Stim { triangle: 0, y: 0, span };
+                    row.write_span(0, &span, cfg.frac);
+                    for seg in segments(&cfg, &span) {
+                        let check = |pix: &[u8], mask: &[u8], x: u32, last: bool| {
+                            let view = SegView { out_x: x, out_last: last, pix, mask };
+                            let mut report = Report::default();
+                            check_lanes(&cfg, &stim, &seg, &view, &mut report);
+                            (agrees(&view, &span, &seg, row.pixels(), p), report.ok().then_some(report.pixels))
+                        };
+                        let (pix, mask) = offered(&cfg, &span, &seg, rng.gen());
+                        let (fast, slow) = check(&pix, &mask, seg.x, seg.last);
+                        assert!(fast.is_some() && fast == slow, "p {p} {align} {span:?} segment {}: {fast:?} {slow:?}", seg.index);
+                        let on: Vec<u32> = (0..p).filter(|&i| seg.lane_pixel(i).is_some()).collect();
+                        let lane = on[rng.gen_range(0..on.len())] as usize;
+                        let mut bad = pix;
+                        bad[lane] ^= 1 << rng.gen_range(0..8);
+                        assert_eq!(check(&bad, &mask, seg.x, seg.last), (None, None), "pixel of lane {lane}");
+                        let bit = rng.gen_range(0..p) as usize;
+                        let mut bad = mask;
+                        bad[bit / 8] ^= 1 << (bit % 8);
+                        assert_eq!(check(&pix, &bad, seg.x, seg.last), (None, None), "mask bit {bit}");
+                        assert_eq!(check(&pix, &mask, seg.x ^ 1, seg.last), (None, None), "out_x");
+                        assert_eq!(check(&pix, &mask, seg.x, !seg.last), (None, None), "out_last");
+                    }
+                }
+            }
+        }
+    }
+}
