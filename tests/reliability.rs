@@ -7,19 +7,21 @@
 //!   `out_valid` is low right after a reset and that an offered output holds until taken);
 //! - `out_valid` rises without waiting for `out_ready`, at the stated latency;
 //! - every word of both specular ROMs is reached (so a changed word cannot hide);
-//! - the harness API rejects spans the ports cannot carry before they reach a model;
-//! - bad triangle input is rejected with its line number, never a panic or garbage pixels.
+//! - the harness API rejects spans the ports cannot carry before they reach a model.
+//!
+//! Bad triangle input (rejected with its line number, never a panic or garbage pixels) is
+//! golden's alone: `golden::setup`'s tests.
 
 use golden::rng::SeedRng;
-use golden::setup::{parse_triangles, triangle_spans, Screen, Triangle, Vertex, COORD_LIMIT};
+use golden::setup::{triangle_spans, Screen, Triangle, Vertex, COORD_LIMIT};
 use golden::specular::{SpecularSpan, N_BITS};
-use golden::{Config, Span};
+use golden::{Config, Span, SpanError};
 use rand::{Rng, SeedableRng};
-use verilator_harness::cosim::{assert_clean, Report, SegmentCosim, Stim, Stress, Traffic};
+use verilator_harness::cosim::{assert_clean, Report, SegmentCosim, SpanRejected, Stim, Stress, Traffic};
 use verilator_harness::ffi::{
     require_models, require_specular_model, specular_unit, to_port, ModelInfo, Rtl, SegIn, SegOut, SpecIn, SpecOut, RTL_DIR, SEGMENT_MODELS,
 };
-use verilator_harness::specular::{random_span, SpecularCosim};
+use verilator_harness::specular::{random_span, SpecSpanRejected, SpecularCosim};
 use verilator_harness::stimulus::{directed, random_triangle};
 
 /// Backpressure bursts, input gaps and a reset about every 700 clocks.
@@ -253,20 +255,21 @@ fn harness_rejects_spans_the_rtl_cannot_take() {
         let max = cfg.max_len();
         let good = Span { x0: 0, len: 4, i0: 0, di: 0 };
         let half = 1i32 << (cfg.dw() - 1);
+        let (iw, dw, frac) = (cfg.iw(), cfg.dw(), cfg.frac);
         let bad = [
-            (Span { x0: max - 3, len: 4, ..good }, "beyond the screen width"),
-            (Span { x0: 0, len: max + 1, ..good }, "exceeds 2^XW"),
-            (Span { x0: max, len: 0, ..good }, "beyond the screen width"),
-            (Span { i0: 1 << cfg.iw(), ..good }, "does not fit UQ8"),
-            (Span { di: half, ..good }, "signed bits"),
-            (Span { di: -half - 1, ..good }, "signed bits"),
+            (Span { x0: max - 3, len: 4, ..good }, SpanError::Beyond { x0: max - 3, len: 4, max }),
+            (Span { x0: 0, len: max + 1, ..good }, SpanError::Len { len: max + 1, max }),
+            (Span { x0: max, len: 0, ..good }, SpanError::Beyond { x0: max, len: 0, max }),
+            (Span { i0: 1 << iw, ..good }, SpanError::I0 { i0: 1 << iw, frac }),
+            (Span { di: half, ..good }, SpanError::Di { di: half, bits: dw }),
+            (Span { di: -half - 1, ..good }, SpanError::Di { di: -half - 1, bits: dw }),
         ];
-        for (span, needle) in bad {
+        for (span, error) in bad {
             let stims = [Stim { triangle: 0, y: 0, span: good }, Stim { triangle: 7, y: 9, span }];
             let mut sim = SegmentCosim::new(info, 1, Traffic::FULL);
             let mut report = Report::default();
             let e = sim.try_stream(&stims, &mut report, |_, _| {}).expect_err(&format!("{}: {span:?} accepted", info.tag));
-            assert!(e.contains("span 1 (triangle 7, y = 9)") && e.contains(needle), "{}: {e}", info.tag);
+            assert_eq!(e, SpanRejected { index: 1, triangle: 7, y: 9, error }, "{}", info.tag);
             assert_eq!((report.cycles, report.spans), (0, 0), "{}: the model saw a clock", info.tag);
         }
         if info.tag == SEGMENT_MODELS[0].tag {
@@ -287,13 +290,14 @@ fn harness_rejects_spans_the_rtl_cannot_take() {
     let Some(info) = spec_model("the specular unit's port limits") else { return };
     let port_max = (1u32 << (info.cfg.xbits + 1)) - 1;
     let good = SpecularSpan { c: 100, n: 10, theta0: 0, dtheta: 1000, len: 3 };
-    for (span, needle) in
-        [(SpecularSpan { len: port_max + 1, ..good }, "in_len port"), (SpecularSpan { n: 1 << N_BITS, ..good }, "in_n port")]
-    {
+    let bits = info.cfg.xbits + 1;
+    for (span, error) in [
+        (SpecularSpan { len: port_max + 1, ..good }, SpecSpanRejected::Len { index: 1, len: port_max + 1, bits }),
+        (SpecularSpan { n: 1 << N_BITS, ..good }, SpecSpanRejected::N { index: 1, n: 1 << N_BITS, bits: N_BITS }),
+    ] {
         let mut sim = SpecularCosim::new(info, specular_unit(), 1, Traffic::FULL);
         let mut report = Report::default();
-        let e = sim.try_stream(&[good, span], &mut report).expect_err("accepted");
-        assert!(e.contains("span 1") && e.contains(needle), "{e}");
+        assert_eq!(sim.try_stream(&[good, span], &mut report), Err(error));
         assert_eq!(report.cycles, 0);
     }
     // What the ports carry is valid input, an n outside 1..1000 included (out_err = 1), and the
@@ -304,56 +308,6 @@ fn harness_rejects_spans_the_rtl_cannot_take() {
     sim.try_stream(&spans, &mut report).unwrap();
     assert_clean("specular port extremes", 1, &report);
     assert_eq!(report.pixels, 6 + port_max as u64);
-}
-
-/// Bad triangle text is rejected with its line number; NaN, infinities and coordinates beyond
-/// the set-up's limits never reach a span. Random garbage never panics the parser.
-#[test]
-fn bad_triangle_input_is_rejected_with_its_line() {
-    let good = "0 0 0 10 0 128 0 10 255";
-    let cases = [
-        ("nan 0 0 1 0 0 0 1 0", "x0 = 'nan' is not finite"),
-        ("0 NaN 0 1 0 0 0 1 0", "y0 = 'NaN' is not finite"),
-        ("0 0 0 inf 0 0 0 1 0", "x1 = 'inf' is not finite"),
-        ("0 0 0 1 -inf 0 0 1 0", "y1 = '-inf' is not finite"),
-        ("0 0 0 1 0 0 1e400 1 0", "x2 = '1e400' is not finite"),
-        ("0 0 0 1 0 0 0 1 infinity", "i2 = 'infinity' is not finite"),
-        ("1e300 0 0 1 0 0 0 1 0", "vertex 0: x = 1000000000000000"),
-        ("0 0 0 32768.004 0 0 0 1 0", "vertex 1: x = 32768.004"),
-        ("0 0 0 1 0 0 0 -32769 0", "vertex 2: y = -32769"),
-        ("0 0 0 1 0 0 0 1 255.5", "vertex 2: intensity 255.5"),
-        ("0 0 0 1 0 0 0 1", "expected 9 numbers"),
-        ("0 0 0 1 0 0 0 1 0 0", "expected 9 numbers"),
-        ("0 0 0 1 0 0 0 1 0x10", "i2 = '0x10' is not a number"),
-        ("0,0,0 1 0 0 0 1 0", "expected 9 numbers"),
-    ];
-    for (bad, want) in cases {
-        let text = format!("# scene\n{good}\n\n{bad}\n{good}\n");
-        let e = parse_triangles(&text).expect_err(bad);
-        assert_eq!(e.line, 4, "{bad}");
-        assert!(e.message.contains(want), "{bad}: '{}' should contain '{want}'", e.message);
-    }
-    // Fuzz: lines of random tokens, numbers and junk.
-    let mut rng = SeedRng::seed_from_u64(6);
-    let tokens = ["0", "-1", "1e9", "nan", "inf", "-0", "255", "3.5", "#", "x", "", "1e-400", "32768", "-32768", "\t", "1e308"];
-    for _ in 0..5000 {
-        let line: Vec<&str> = (0..rng.gen_range(0..12)).map(|_| tokens[rng.gen_range(0..tokens.len())]).collect();
-        if let Ok(tris) = parse_triangles(&line.join(" ")) {
-            for t in tris {
-                t.check().expect("the parser returns only valid triangles");
-            }
-        }
-    }
-    // Built in code, the same triangles are rejected by the set-up, not turned into spans.
-    let cfg = Config::default();
-    let screen = Screen::default();
-    for bad in [f64::NAN, f64::INFINITY, f64::NEG_INFINITY, 1e300, COORD_LIMIT + 0.01] {
-        let t = Triangle { v: [Vertex { x: 0.0, y: 0.0, i: 0.0 }, Vertex { x: bad, y: 5.0, i: 9.0 }, Vertex { x: 3.0, y: 9.0, i: 1.0 }] };
-        let mut spans = 0;
-        let e = triangle_spans(&cfg, &screen, &t, |_, _| spans += 1).expect_err("accepted");
-        assert!(e.contains("vertex 1"), "{e}");
-        assert_eq!(spans, 0);
-    }
 }
 
 /// Triangles at the coordinate limits are clipped to the screen: every span fits the ports, and

@@ -20,6 +20,7 @@ use golden::pipeline::Pipeline;
 use golden::setup::Screen;
 use golden::specular::{Decoder, DecoderRepr, KRange, SpecularGeometry, SpecularPlan};
 use golden::{Align, Config};
+use hdl_gen::manifest::{Manifest, ModuleEntry, Role, MANIFEST_FILE};
 use std::fmt::Write as _;
 use std::fs;
 use std::path::{Path, PathBuf};
@@ -95,11 +96,12 @@ fn main() {
     println!("cargo:rerun-if-env-changed=COSIM_TRACE");
     let out = PathBuf::from(std::env::var("OUT_DIR").unwrap());
     let rtl_dir = std::env::var_os("COSIM_RTL_DIR").map(PathBuf::from);
-    let models = match &rtl_dir {
-        Some(dir) => {
-            println!("cargo:rerun-if-changed={}", dir.display());
-            models_from_dir(dir)
-        }
+    let manifest = rtl_dir.as_deref().map(|dir| {
+        println!("cargo:rerun-if-changed={}", dir.display());
+        (dir, read_manifest(dir))
+    });
+    let models = match &manifest {
+        Some((dir, m)) => models_from_dir(dir, m),
         None => generated_models(),
     };
     let trace_all = std::env::var_os("COSIM_TRACE").is_some();
@@ -134,8 +136,8 @@ fn main() {
     }
     println!("cargo:rustc-link-lib=pthread");
     println!("cargo:rustc-link-lib=atomic");
-    let tables = match &rtl_dir {
-        Some(dir) => tables_from_dir(dir),
+    let tables = match &manifest {
+        Some((dir, m)) => tables_from_dir(dir, m),
         None => SpecTables::of(hdl_gen::Options::default().specular_unit().plan(), None),
     };
     fs::write(out.join("models.rs"), models_rs(&models, &twins, trace_all, rtl_dir.as_deref(), &tables)).unwrap();
@@ -168,24 +170,33 @@ impl SpecTables {
     }
 }
 
-/// The table set of COSIM_RTL_DIR's manifest (its `specular` section, read as golden's typed
+/// `DIR/manifest.json`, read as the generator's own schema (`hdl_gen::manifest::Manifest`), or
+/// the build stops saying why.
+fn read_manifest(dir: &Path) -> Manifest {
+    let path = dir.join(MANIFEST_FILE);
+    let text = fs::read_to_string(&path).unwrap_or_else(|e| panic!("COSIM_RTL_DIR={}: cannot read {MANIFEST_FILE}: {e}", dir.display()));
+    Manifest::parse(&text).unwrap_or_else(|e| panic!("COSIM_RTL_DIR={}: {e}", dir.display()))
+}
+
+/// The table set of COSIM_RTL_DIR's manifest (its `specular` section, golden's typed
 /// `SpecularGeometry`), checked to rebuild in golden the very plan the section states (tables,
-/// widths, pipeline), so the checkers compare the RTL with the unit it was generated as. The
-/// default set when the folder has no specular unit (no checker then uses it).
-fn tables_from_dir(dir: &Path) -> SpecTables {
-    let fail = |what: String| -> ! { panic!("COSIM_RTL_DIR={}: manifest.json: specular: {what}", dir.display()) };
-    let text = fs::read_to_string(dir.join("manifest.json")).unwrap_or_else(|e| fail(format!("cannot read: {e}")));
-    let m: serde_json::Value = serde_json::from_str(&text).unwrap_or_else(|e| fail(e.to_string()));
-    if m.get("specular").is_none() {
+/// widths, and the pipeline of `parameters.pipeline`), so the checkers compare the RTL with the
+/// unit it was generated as. The default set when the folder has no specular unit (no checker
+/// then uses it).
+fn tables_from_dir(dir: &Path, m: &Manifest) -> SpecTables {
+    let fail = |what: String| -> ! { panic!("COSIM_RTL_DIR={}: {MANIFEST_FILE}: specular: {what}", dir.display()) };
+    if m.by_role(Role::SpecularUnit).is_none() {
         return SpecTables::of(&SpecularPlan::patent(), None);
     }
-    let stated: SpecularGeometry = serde_json::from_value(m["specular"].clone()).unwrap_or_else(|e| fail(e.to_string()));
-    let decoder = Decoder::try_from(DecoderRepr { ks: stated.ks.clone(), ranges: stated.k_ranges.clone() }).unwrap_or_else(|e| fail(e));
+    let stated = &m.specular.geometry;
+    let decoder =
+        Decoder::try_from(DecoderRepr { ks: stated.ks.clone(), ranges: stated.k_ranges.clone() }).unwrap_or_else(|e| fail(e.to_string()));
     // hdl-gen builds with the builder's word width, or for some `auto` sets the search's.
     let mut last = String::new();
     for w in [None, Some(stated.brdf_word_bits)] {
         match SpecularPlan::build(decoder.clone(), w) {
             Ok(plan) => {
+                let plan = plan.with_pipeline(m.parameters.pipeline);
                 let mut built = plan.geometry();
                 // f64::powi rounds differently at different opt-levels (hdl-gen's against this
                 // build script's): the approximation error may differ in its last digits.
@@ -193,23 +204,30 @@ fn tables_from_dir(dir: &Path) -> SpecTables {
                 if (a - b).abs() <= 1e-9 * a.abs().max(b.abs()) {
                     built.approx_error.0 = b;
                 }
-                if built == stated {
+                if built == *stated {
                     return SpecTables::of(&plan, w);
                 }
-                let rebuilt = serde_json::to_value(&built).expect("a plan serializes");
-                let differ: Vec<String> = rebuilt
-                    .as_object()
-                    .into_iter()
-                    .flatten()
-                    .filter(|(k, v)| m["specular"].get(k.as_str()) != Some(*v))
-                    .map(|(k, v)| format!("{k}: manifest {}, golden {v}", m["specular"][k.as_str()]))
-                    .collect();
-                last = format!("with word_bits {w:?}, {}", differ.join("; "));
+                last = format!("with word_bits {w:?}, {}", geometry_diff(stated, &built));
             }
-            Err(e) => last = e,
+            Err(e) => last = e.to_string(),
         }
     }
     fail(format!("golden's plan for k = {:?} and these k_ranges is not the one the manifest states: {last}", stated.ks))
+}
+
+/// The fields of two geometries that differ, as `field: manifest X, golden Y`.
+fn geometry_diff(stated: &SpecularGeometry, built: &SpecularGeometry) -> String {
+    let fields = |g: &SpecularGeometry| match serde_json::to_value(g).expect("a geometry serializes") {
+        serde_json::Value::Object(map) => map,
+        _ => unreachable!("a struct serializes as an object"),
+    };
+    let (stated, built) = (fields(stated), fields(built));
+    built
+        .iter()
+        .filter(|(k, v)| stated.get(k.as_str()) != Some(*v))
+        .map(|(k, v)| format!("{k}: manifest {}, golden {v}", stated.get(k.as_str()).unwrap_or(&serde_json::Value::Null)))
+        .collect::<Vec<_>>()
+        .join("; ")
 }
 
 fn generated_models() -> Vec<Model> {
@@ -415,146 +433,67 @@ fn generated_models() -> Vec<Model> {
     models
 }
 
-/// The models described by `DIR/manifest.json`, as `hdl-gen generate` writes it: the Verilog is
-/// read from DIR as it is, so hand-edited or third-party RTL is checked against golden.
-fn models_from_dir(dir: &Path) -> Vec<Model> {
+/// The models described by `DIR/manifest.json` (`m`), as `hdl-gen generate` writes it: the
+/// Verilog is read from DIR as it is, so hand-edited or third-party RTL is checked against golden.
+/// Modules are found by their role; each model's top, file and latency are the manifest's.
+fn models_from_dir(dir: &Path, m: &Manifest) -> Vec<Model> {
     let fail = |what: String| -> ! { panic!("COSIM_RTL_DIR={}: {what}", dir.display()) };
-    let text = fs::read_to_string(dir.join("manifest.json")).unwrap_or_else(|e| fail(format!("cannot read manifest.json: {e}")));
-    let m: serde_json::Value = serde_json::from_str(&text).unwrap_or_else(|e| fail(format!("manifest.json: {e}")));
-    let param = |k: &str| m["parameters"][k].as_u64().unwrap_or_else(|| fail(format!("manifest has no parameters.{k}"))) as u32;
-    let align: Align = m["parameters"]["align"].as_str().unwrap_or("span").parse().unwrap_or_else(|e| fail(e));
-    let cfg = Config::new(param("p"), param("frac"), param("xbits"), align).unwrap_or_else(|e| fail(e));
-    let level = m["parameters"]["pipeline"].as_u64().unwrap_or(0) as u32;
-    let pipeline = Pipeline::new(level).unwrap_or_else(|| fail(format!("parameters.pipeline {level} is above {}", Pipeline::MAX)));
-    let modules = m["modules"].as_array().unwrap_or_else(|| fail("manifest has no modules".into()));
+    let params = &m.parameters;
+    let cfg = Config::new(params.p, params.frac, params.xbits, params.align).unwrap_or_else(|e| fail(format!("{MANIFEST_FILE}: {e}")));
+    let pipeline = params.pipeline;
     let read = |file: &str| {
         let text = fs::read_to_string(dir.join(file)).unwrap_or_else(|e| fail(format!("cannot read {file}: {e}")));
         (file.to_string(), text)
     };
-    let files_of = |roles: &[&str]| -> Vec<(String, String)> {
-        modules
-            .iter()
-            .filter(|x| roles.iter().any(|r| x["role"] == *r))
-            .map(|x| read(x["file"].as_str().unwrap_or_else(|| fail("a module has no file".into()))))
-            .collect()
+    let files_of =
+        |roles: &[Role]| -> Vec<(String, String)> { m.modules.iter().filter(|x| roles.contains(&x.role)).map(|x| read(&x.file)).collect() };
+    // A model of one module: its kind, tag and role's entry, its sources.
+    let model = |kind: Kind, tag: String, entry: &ModuleEntry, screen: Screen, di: DiMode, pipeline: Pipeline, sources| Model {
+        tag,
+        kind,
+        cfg,
+        di,
+        screen,
+        top: entry.name.clone(),
+        latency: entry.latency,
+        pipeline,
+        sources,
     };
-    let sources = files_of(&["bfpi", "segment_shader"]);
-    let module_of = |role: &str| modules.iter().find(|x| x["role"] == role);
-    let top_of = |role: &str| module_of(role).and_then(|x| x["name"].as_str()).map(str::to_string);
-    let latency_of = |role: &str| module_of(role).and_then(|x| x["latency"].as_u64()).unwrap_or(0) as u32;
+    let (none, screen0, di0) = (Pipeline::NONE, Screen::default(), DiMode::Triangle);
+    let sources = files_of(&[Role::Bfpi, Role::SegmentShader]);
     let mut models = Vec::new();
-    if let Some(top) = top_of("bfpi") {
-        let file = format!("{top}.v");
-        let src = sources.iter().filter(|(n, _)| *n == file).cloned().collect();
-        models.push(Model {
-            tag: format!("bfpi_p{}", cfg.p),
-            kind: Kind::Bfpi,
-            cfg,
-            di: DiMode::Triangle,
-            screen: Screen::default(),
-            top,
-            latency: 0,
-            pipeline: Pipeline::NONE,
-            sources: src,
-        });
+    if let Some(bfpi) = m.by_role(Role::Bfpi) {
+        let src = vec![read(&bfpi.file)];
+        models.push(model(Kind::Bfpi, format!("bfpi_p{}", cfg.p), bfpi, screen0, di0, none, src));
     }
-    if let Some(top) = top_of("segment_shader") {
-        let latency = latency_of("segment_shader");
-        models.push(Model {
-            tag: format!("seg_p{}_{}", cfg.p, cfg.align),
-            kind: Kind::Segment,
-            cfg,
-            di: DiMode::Triangle,
-            screen: Screen::default(),
-            top,
-            latency,
-            pipeline,
-            sources: sources.clone(),
-        });
+    if let Some(seg) = m.by_role(Role::SegmentShader) {
+        models.push(model(Kind::Segment, format!("seg_p{}_{}", cfg.p, cfg.align), seg, screen0, di0, pipeline, sources.clone()));
     }
-    if let (Some(fe_top), Some(tri_top)) = (top_of("frontend"), top_of("triangle_shader")) {
-        let sc = &m["frontend"]["screen"];
-        let dim = |k: &str| sc[k].as_u64().unwrap_or_else(|| fail(format!("manifest has no frontend.screen.{k}"))) as u32;
-        let screen = Screen { width: dim("width"), height: dim("height") };
-        let di: DiMode = serde_json::from_value(m["frontend"]["di"].clone()).unwrap_or_default();
-        let fe_src = files_of(&["frontend"]);
+    if let (Some(fe_mod), Some(tri)) = (m.by_role(Role::Frontend), m.by_role(Role::TriangleShader)) {
+        let fe = m.frontend.as_ref().unwrap_or_else(|| fail(format!("{MANIFEST_FILE} lists a front-end module but no frontend section")));
+        let (screen, di) = (fe.screen, fe.di);
+        let fe_src = files_of(&[Role::Frontend]);
         let mut all = sources.clone();
         all.extend(fe_src.iter().cloned());
-        all.extend(files_of(&["triangle_shader"]));
-        models.push(Model {
-            tag: "fe".into(),
-            kind: Kind::Frontend,
-            cfg,
-            di,
-            screen,
-            top: fe_top,
-            latency: latency_of("frontend"),
-            pipeline: Pipeline::NONE,
-            sources: fe_src,
-        });
-        let tag = format!("tris_p{}_{}", cfg.p, cfg.align);
-        models.push(Model {
-            tag,
-            kind: Kind::TriShader,
-            cfg,
-            di,
-            screen,
-            top: tri_top,
-            latency: latency_of("triangle_shader"),
-            pipeline: Pipeline::NONE,
-            sources: all.clone(),
-        });
-        if let (Some(wr_top), Some(fb_top)) = (top_of("writer"), top_of("triangle_writer")) {
-            let wr_src = files_of(&["writer"]);
-            let tag = format!("wr_p{}_{}", cfg.p, cfg.align);
-            models.push(Model {
-                tag,
-                kind: Kind::Writer,
-                cfg,
-                di,
-                screen,
-                top: wr_top,
-                latency: latency_of("writer"),
-                pipeline: Pipeline::NONE,
-                sources: wr_src.clone(),
-            });
+        all.extend(files_of(&[Role::TriangleShader]));
+        models.push(model(Kind::Frontend, "fe".into(), fe_mod, screen, di, none, fe_src));
+        models.push(model(Kind::TriShader, format!("tris_p{}_{}", cfg.p, cfg.align), tri, screen, di, pipeline, all.clone()));
+        if let (Some(wr), Some(fb)) = (m.by_role(Role::Writer), m.by_role(Role::TriangleWriter)) {
+            let wr_src = files_of(&[Role::Writer]);
+            models.push(model(Kind::Writer, format!("wr_p{}_{}", cfg.p, cfg.align), wr, screen, di, none, wr_src.clone()));
             all.extend(wr_src);
-            all.extend(files_of(&["triangle_writer"]));
-            let tag = format!("trw_p{}_{}", cfg.p, cfg.align);
-            models.push(Model {
-                tag,
-                kind: Kind::TriWriter,
-                cfg,
-                di,
-                screen,
-                top: fb_top,
-                latency: latency_of("triangle_writer"),
-                pipeline: Pipeline::NONE,
-                sources: all,
-            });
+            all.extend(files_of(&[Role::TriangleWriter]));
+            models.push(model(Kind::TriWriter, format!("trw_p{}_{}", cfg.p, cfg.align), fb, screen, di, pipeline, all));
         }
     }
-    if let Some(top) = top_of("specular_unit") {
-        let mut src = files_of(&["specular_unit", "rom"]);
-        for rom in ["brdf_rom", "nk_rom"] {
-            let file = m["specular"][rom]["file"].as_str().unwrap_or_else(|| fail(format!("manifest has no specular.{rom}.file")));
-            src.push(read(file));
-        }
-        let latency = latency_of("specular_unit");
-        models.push(Model {
-            tag: "spec".into(),
-            kind: Kind::Specular,
-            cfg,
-            di: DiMode::Triangle,
-            screen: Screen::default(),
-            top,
-            latency,
-            pipeline: Pipeline::NONE,
-            sources: src,
-        });
+    if let Some(unit) = m.by_role(Role::SpecularUnit) {
+        let mut src = files_of(&[Role::SpecularUnit, Role::Rom]);
+        src.push(read(&m.specular.brdf_rom.file));
+        src.push(read(&m.specular.nk_rom.file));
+        models.push(model(Kind::Specular, "spec".into(), unit, screen0, di0, pipeline, src));
     }
     if models.is_empty() {
-        fail("manifest lists no bfpi, segment_shader or specular_unit module".into());
+        fail(format!("{MANIFEST_FILE} lists no bfpi, segment_shader or specular_unit module"));
     }
     models
 }
@@ -873,8 +812,37 @@ fn require_zlib(v: &Verilator, obj: &Path) {
     }
 }
 
+/// The layout csrc/shim.h states (`SEGSHADE_OFFSET(S, F, N);`, `SEGSHADE_SIZE(S, N);`, checked
+/// there by the C++ compiler) as Rust `const` asserts on ffi.rs's structs: one statement of the
+/// layout, checked by both compilers.
+fn layout_asserts(shim: &str) -> String {
+    let mut s = String::from("// csrc/shim.h's layout of the per-clock structs, checked on ffi.rs's.\n");
+    let args = |line: &str, macro_: &str| -> Option<Vec<String>> {
+        let inner = line.trim().strip_prefix(macro_)?.strip_prefix('(')?.strip_suffix(");")?;
+        Some(inner.split(',').map(|a| a.trim().to_string()).collect())
+    };
+    let (mut offsets, mut sizes) = (0, 0);
+    for line in shim.lines() {
+        if let Some(a) = args(line, "SEGSHADE_OFFSET").filter(|a| a.len() == 3) {
+            writeln!(
+                s,
+                "const _: () = assert!(std::mem::offset_of!({}, {}) == {}, \"{}.{} (csrc/shim.h)\");",
+                a[0], a[1], a[2], a[0], a[1]
+            )
+            .unwrap();
+            offsets += 1;
+        } else if let Some(a) = args(line, "SEGSHADE_SIZE").filter(|a| a.len() == 2) {
+            writeln!(s, "const _: () = assert!(std::mem::size_of::<{}>() == {}, \"size of {} (csrc/shim.h)\");", a[0], a[1], a[0]).unwrap();
+            sizes += 1;
+        }
+    }
+    assert!(offsets > 0 && sizes > 0, "csrc/shim.h states no layout (SEGSHADE_OFFSET/SEGSHADE_SIZE lines)");
+    s
+}
+
 fn models_rs(models: &[Model], twins: &[Model], trace_all: bool, rtl_dir: Option<&Path>, tables: &SpecTables) -> String {
     let mut s = String::from("// Generated by build.rs: the models linked into this crate.\n");
+    s.push_str(&layout_asserts(include_str!("csrc/shim.h")));
     let dir = rtl_dir.map_or("None".to_string(), |d| format!("Some({:?})", d.display().to_string()));
     writeln!(s, "/// The COSIM_RTL_DIR the models came from; `None`: all generated.\npub const RTL_DIR: Option<&str> = {dir};").unwrap();
     writeln!(s, "/// Whether COSIM_TRACE was set when these models were built (every streaming model traced).\npub const TRACED_BUILD: bool = {trace_all};")

@@ -35,17 +35,6 @@ impl fmt::Display for Align {
     }
 }
 
-impl std::str::FromStr for Align {
-    type Err = String;
-    fn from_str(s: &str) -> Result<Self, String> {
-        match s {
-            "span" => Ok(Align::Span),
-            "screen" => Ok(Align::Screen),
-            _ => Err(format!("unknown alignment '{s}' (expected 'span' or 'screen')")),
-        }
-    }
-}
-
 /// Allowed ranges of SPEC §2.
 pub const P_MAX: u32 = 256;
 pub const FRAC_RANGE: std::ops::RangeInclusive<u32> = 4..=20;
@@ -69,19 +58,32 @@ impl Default for Config {
     }
 }
 
+/// A configuration outside SPEC §2's ranges; the message names the parameter.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, thiserror::Error)]
+pub enum ConfigError {
+    #[error("segment width p = {0} must be a power of two in 1..{P_MAX}")]
+    P(u32),
+    #[error("fraction bits F = {0} is outside {lo}..{hi}", lo = FRAC_RANGE.start(), hi = FRAC_RANGE.end())]
+    Frac(u32),
+    #[error("screen-x bits XW = {0} is outside {lo}..{hi}", lo = XBITS_RANGE.start(), hi = XBITS_RANGE.end())]
+    Xbits(u32),
+    /// A segment wider than the whole screen could never be filled.
+    #[error("segment width p = {p} exceeds the screen width 2^XW = {w}", w = 1u32 << xbits)]
+    WiderThanScreen { p: u32, xbits: u32 },
+}
+
 impl Config {
-    /// A configuration checked against SPEC §2's ranges; the error names the parameter.
-    pub fn new(p: u32, frac: u32, xbits: u32, align: Align) -> Result<Config, String> {
+    /// A configuration checked against SPEC §2's ranges.
+    pub fn new(p: u32, frac: u32, xbits: u32, align: Align) -> Result<Config, ConfigError> {
         check_p(p)?;
         if !FRAC_RANGE.contains(&frac) {
-            return Err(format!("fraction bits F = {frac} is outside {}..{}", FRAC_RANGE.start(), FRAC_RANGE.end()));
+            return Err(ConfigError::Frac(frac));
         }
         if !XBITS_RANGE.contains(&xbits) {
-            return Err(format!("screen-x bits XW = {xbits} is outside {}..{}", XBITS_RANGE.start(), XBITS_RANGE.end()));
+            return Err(ConfigError::Xbits(xbits));
         }
         if p > 1 << xbits {
-            // A segment wider than the whole screen could never be filled.
-            return Err(format!("segment width p = {p} exceeds the screen width 2^XW = {}", 1u32 << xbits));
+            return Err(ConfigError::WiderThanScreen { p, xbits });
         }
         Ok(Config { p, frac, xbits, align })
     }
@@ -125,9 +127,9 @@ impl Config {
 }
 
 /// P must be a power of two in 1..=256.
-pub fn check_p(p: u32) -> Result<(), String> {
+pub fn check_p(p: u32) -> Result<(), ConfigError> {
     if p == 0 || p > P_MAX || !p.is_power_of_two() {
-        return Err(format!("segment width p = {p} must be a power of two in 1..{P_MAX}"));
+        return Err(ConfigError::P(p));
     }
     Ok(())
 }
@@ -157,22 +159,36 @@ impl Span {
         pixel_of(self.value(j), frac)
     }
     /// Whether the span fits the ports of `cfg` and the screen: everything the RTL can take.
-    pub fn check(&self, cfg: &Config) -> Result<(), String> {
-        if self.len > cfg.max_len() {
-            return Err(format!("span length {} exceeds 2^XW = {}", self.len, cfg.max_len()));
+    pub fn check(&self, cfg: &Config) -> Result<(), SpanError> {
+        let max = cfg.max_len();
+        if self.len > max {
+            return Err(SpanError::Len { len: self.len, max });
         }
-        if self.x0 as u64 + self.len as u64 > cfg.max_len() as u64 || self.x0 >= cfg.max_len() {
-            return Err(format!("span x0 = {} + len = {} reaches beyond the screen width 2^XW = {}", self.x0, self.len, cfg.max_len()));
+        if self.x0 as u64 + self.len as u64 > max as u64 || self.x0 >= max {
+            return Err(SpanError::Beyond { x0: self.x0, len: self.len, max });
         }
         if self.i0 >= 1 << cfg.iw() {
-            return Err(format!("span I0 = {} does not fit UQ8.{}", self.i0, cfg.frac));
+            return Err(SpanError::I0 { i0: self.i0, frac: cfg.frac });
         }
         let half = 1i64 << (cfg.dw() - 1);
         if (self.di as i64) < -half || self.di as i64 >= half {
-            return Err(format!("span dI = {} does not fit {} signed bits", self.di, cfg.dw()));
+            return Err(SpanError::Di { di: self.di, bits: cfg.dw() });
         }
         Ok(())
     }
+}
+
+/// A span the ports of a configuration cannot carry ([`Span::check`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, thiserror::Error)]
+pub enum SpanError {
+    #[error("span length {len} exceeds 2^XW = {max}")]
+    Len { len: u32, max: u32 },
+    #[error("span x0 = {x0} + len = {len} reaches beyond the screen width 2^XW = {max}")]
+    Beyond { x0: u32, len: u32, max: u32 },
+    #[error("span I0 = {i0} does not fit UQ8.{frac}")]
+    I0 { i0: u32, frac: u32 },
+    #[error("span dI = {di} does not fit {bits} signed bits")]
+    Di { di: i32, bits: u32 },
 }
 
 #[cfg(test)]
@@ -206,6 +222,10 @@ mod tests {
         let c = Config::default();
         let s = Span { x0: 0, len: c.max_len(), i0: (1 << c.iw()) - 1, di: (1 << (c.dw() - 1)) - 1 };
         s.check(&c).unwrap();
+        assert_eq!(Span { len: c.max_len() + 1, ..s }.check(&c), Err(SpanError::Len { len: c.max_len() + 1, max: c.max_len() }));
+        assert_eq!(Span { x0: 1, ..s }.check(&c), Err(SpanError::Beyond { x0: 1, len: c.max_len(), max: c.max_len() }));
+        assert_eq!(Span { i0: 1 << c.iw(), ..s }.check(&c), Err(SpanError::I0 { i0: 1 << c.iw(), frac: c.frac }));
+        assert_eq!(Span { di: 1 << (c.dw() - 1), ..s }.check(&c), Err(SpanError::Di { di: 1 << (c.dw() - 1), bits: c.dw() }));
         let v = s.value(s.len - 1);
         assert!(v < 1i64 << (c.aw() - 1), "accumulator width must hold {v}");
         let s = Span { di: -(1 << (c.dw() - 1)), i0: 0, ..s };
@@ -227,13 +247,17 @@ mod tests {
 
     #[test]
     fn rejects_bad_configurations() {
-        assert!(Config::new(3, 12, 12, Align::Span).unwrap_err().contains("power of two"));
-        assert!(Config::new(512, 12, 12, Align::Span).is_err());
-        assert!(Config::new(0, 12, 12, Align::Span).is_err());
-        assert!(Config::new(8, 3, 12, Align::Span).unwrap_err().contains("F = 3"));
-        assert!(Config::new(8, 12, 17, Align::Span).unwrap_err().contains("XW = 17"));
+        assert_eq!(Config::new(3, 12, 12, Align::Span), Err(ConfigError::P(3)));
+        assert_eq!(Config::new(512, 12, 12, Align::Span), Err(ConfigError::P(512)));
+        assert_eq!(Config::new(0, 12, 12, Align::Span), Err(ConfigError::P(0)));
+        assert_eq!(Config::new(8, 3, 12, Align::Span), Err(ConfigError::Frac(3)));
+        assert_eq!(Config::new(8, 12, 17, Align::Span), Err(ConfigError::Xbits(17)));
         assert!(Config::new(256, 20, 16, Align::Screen).is_ok());
-        assert!(Config::new(32, 12, 4, Align::Span).unwrap_err().contains("exceeds the screen width"));
+        assert_eq!(Config::new(32, 12, 4, Align::Span), Err(ConfigError::WiderThanScreen { p: 32, xbits: 4 }));
         assert!(Config::new(16, 12, 4, Align::Screen).is_ok());
+        // The messages the CLIs print name the parameter and its range.
+        assert_eq!(ConfigError::P(3).to_string(), "segment width p = 3 must be a power of two in 1..256");
+        assert_eq!(ConfigError::Frac(3).to_string(), "fraction bits F = 3 is outside 4..20");
+        assert_eq!(ConfigError::WiderThanScreen { p: 32, xbits: 4 }.to_string(), "segment width p = 32 exceeds the screen width 2^XW = 16");
     }
 }

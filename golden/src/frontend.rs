@@ -56,39 +56,26 @@
 use crate::format::{Config, Span};
 use crate::setup::{is_top_left, snap, Screen, Snapped, Triangle, SUBPIXEL};
 use serde::{Deserialize, Serialize};
-use std::fmt;
 
 const HALF: i64 = SUBPIXEL / 2;
 
 /// Why a front-end configuration is refused.
-#[derive(Clone, Debug, PartialEq, Eq)]
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
 pub enum FrontEndError {
     /// The screen is wider than the `in_x` / `in_len` ports of the configuration.
+    #[error("screen width {width} is outside 1..={max} (2^XW of the configuration)")]
     Width { width: u32, max: u32 },
     /// The F-bit `dI` cannot keep every pixel within 1 of the plane on so wide a screen.
+    #[error(
+        "screen width {width} exceeds 2^F = {}: with F = {frac} fraction bits a pixel could \
+         end up more than 1 from the plane (bound 1/2 + W 2^-(F+1)); raise --frac",
+        1u64 << frac
+    )]
     Accuracy { width: u32, frac: u32 },
     /// Height outside 1..=65536.
+    #[error("screen height {height} is outside 1..=65536")]
     Height { height: u32 },
 }
-
-impl fmt::Display for FrontEndError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match *self {
-            FrontEndError::Width { width, max } => {
-                write!(f, "screen width {width} is outside 1..={max} (2^XW of the configuration)")
-            }
-            FrontEndError::Accuracy { width, frac } => write!(
-                f,
-                "screen width {width} exceeds 2^F = {}: with F = {frac} fraction bits a pixel could \
-                 end up more than 1 from the plane (bound 1/2 + W 2^-(F+1)); raise --frac",
-                1u64 << frac
-            ),
-            FrontEndError::Height { height } => write!(f, "screen height {height} is outside 1..=65536"),
-        }
-    }
-}
-
-impl std::error::Error for FrontEndError {}
 
 /// Where a span's `dI` comes from.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]

@@ -13,6 +13,7 @@ pub mod schemes;
 pub mod segment;
 pub mod setup;
 pub mod specular;
+pub mod stimulus;
 pub mod writer;
 
-pub use format::{Align, Config, Span};
+pub use format::{Align, Config, ConfigError, Span, SpanError};

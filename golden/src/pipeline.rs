@@ -52,8 +52,26 @@ pub fn numbered(body: Vec<(&str, String, Vec<PipeReg>)>) -> Vec<PipeStage> {
 /// Level 0 is the default: the smallest circuit and the shortest latency, byte for byte the
 /// RTL every earlier release generated. `docs/fpga.md` gives each level's area and Fmax.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize, Deserialize)]
-#[serde(transparent)]
+#[serde(try_from = "u32", into = "u32")]
 pub struct Pipeline(u32);
+
+/// A pipeline level above [`Pipeline::MAX`] (a manifest's `parameters.pipeline`, say).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, thiserror::Error)]
+#[error("pipeline level {0} is above the deepest, {max}", max = Pipeline::MAX)]
+pub struct PipelineError(pub u32);
+
+impl TryFrom<u32> for Pipeline {
+    type Error = PipelineError;
+    fn try_from(level: u32) -> Result<Pipeline, PipelineError> {
+        Pipeline::new(level).ok_or(PipelineError(level))
+    }
+}
+
+impl From<Pipeline> for u32 {
+    fn from(p: Pipeline) -> u32 {
+        p.0
+    }
+}
 
 impl Pipeline {
     /// The deepest level.
@@ -118,6 +136,11 @@ mod tests {
         assert_eq!(Pipeline::new(Pipeline::MAX).map(Pipeline::level), Some(Pipeline::MAX));
         assert_eq!(Pipeline::new(Pipeline::MAX + 1), None);
         assert_eq!(Pipeline::default(), Pipeline::NONE);
+        // A file's level is checked as it is read, as a number.
+        assert_eq!(serde_json::from_str::<Pipeline>("2").unwrap(), Pipeline::at(2));
+        assert_eq!(serde_json::to_string(&Pipeline::at(1)).unwrap(), "1");
+        let e = serde_json::from_str::<Pipeline>("3").unwrap_err().to_string();
+        assert!(e.contains(&PipelineError(3).to_string()), "{e}");
     }
 
     #[test]

@@ -8,7 +8,7 @@
 //! intensity so errors can be measured, not just bounded.
 
 use crate::format::Span;
-use crate::setup::{Screen, Snapped, Triangle};
+use crate::setup::{Screen, SetupError, Snapped, Triangle};
 use std::fmt;
 
 /// What the hardware (or the golden model standing in for it) wrote: 8-bit pixels and which
@@ -146,7 +146,7 @@ pub fn round_intensity(v: f64) -> u8 {
 /// Calls `f(x, y, I)` for every pixel of `screen` the triangle covers, `I` the exact plane
 /// intensity at its centre, in row-major order. Checks its inputs like `triangle_spans`
 /// (except that the screen need not fit a configuration).
-pub fn reference_pixels(screen: &Screen, tri: &Triangle, mut f: impl FnMut(u32, u32, f64)) -> Result<(), String> {
+pub fn reference_pixels(screen: &Screen, tri: &Triangle, mut f: impl FnMut(u32, u32, f64)) -> Result<(), SetupError> {
     screen.check()?;
     tri.check()?;
     let sn = Snapped::new(tri);
@@ -190,12 +190,21 @@ pub fn reference_pixels(screen: &Screen, tri: &Triangle, mut f: impl FnMut(u32, 
     Ok(())
 }
 
+/// Why [`reference_triangle`] paints nothing.
+#[derive(Clone, Copy, Debug, PartialEq, thiserror::Error)]
+pub enum ReferenceError {
+    #[error(transparent)]
+    Setup(#[from] SetupError),
+    #[error("screen {}x{} and reference frame {}x{} differ", screen.width, screen.height, frame.0, frame.1)]
+    FrameSize { screen: Screen, frame: (u32, u32) },
+}
+
 /// Paints the triangle's exact intensities into `frame` (later triangles overwrite earlier).
-pub fn reference_triangle(screen: &Screen, tri: &Triangle, frame: &mut RefFrame) -> Result<(), String> {
+pub fn reference_triangle(screen: &Screen, tri: &Triangle, frame: &mut RefFrame) -> Result<(), ReferenceError> {
     if (screen.width, screen.height) != (frame.width, frame.height) {
-        return Err(format!("screen {}x{} and reference frame {}x{} differ", screen.width, screen.height, frame.width, frame.height));
+        return Err(ReferenceError::FrameSize { screen: *screen, frame: (frame.width, frame.height) });
     }
-    reference_pixels(screen, tri, |x, y, v| frame.set(x, y, v))
+    Ok(reference_pixels(screen, tri, |x, y, v| frame.set(x, y, v))?)
 }
 
 /// How a frame compares with the reference.
@@ -534,7 +543,8 @@ mod tests {
         frame.clear();
         let c = compare(&frame, &reference);
         assert_eq!((c.only_reference, c.first_mismatch), (reference_count(&reference), Some((0, 0))));
-        assert!(reference_triangle(&Screen { width: 9, height: 4 }, &t, &mut reference).is_err());
+        let e = reference_triangle(&Screen { width: 9, height: 4 }, &t, &mut reference).unwrap_err();
+        assert_eq!(e, ReferenceError::FrameSize { screen: Screen { width: 9, height: 4 }, frame: (reference.width, reference.height) });
     }
 
     fn reference_count(r: &RefFrame) -> u64 {

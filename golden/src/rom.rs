@@ -50,18 +50,6 @@ impl RomFormat {
     }
 }
 
-impl std::str::FromStr for RomFormat {
-    type Err = String;
-    fn from_str(s: &str) -> Result<Self, String> {
-        match s {
-            "hex" => Ok(RomFormat::Hex),
-            "mif" => Ok(RomFormat::Mif),
-            "coe" => Ok(RomFormat::Coe),
-            _ => Err(format!("unknown ROM format '{s}' (expected hex, mif or coe)")),
-        }
-    }
-}
-
 /// Bits needed to address `depth` words (at least 1, so a port never has width 0).
 pub fn addr_bits(depth: usize) -> u32 {
     (usize::BITS - depth.saturating_sub(1).leading_zeros()).max(1)
@@ -150,31 +138,68 @@ impl Rom {
     }
 
     /// Reads any of the three formats back into a ROM of the given name and width.
-    pub fn parse(name: &str, width: u32, format: RomFormat, text: &str) -> Result<Rom, String> {
+    ///
+    /// Nothing in the flow reads a ROM image back (the RTL loads the hex with `$readmemh`, vendor
+    /// tools the MIF and COE): this and the `parse_*` readers below serve the tests, golden's
+    /// round trips and `hdl-gen/tests/specular_cli.rs`, which read what `hdl-gen rom` wrote. They
+    /// are public for that integration test, and strict enough to catch a writer that drifts.
+    pub fn parse(name: &str, width: u32, format: RomFormat, text: &str) -> Result<Rom, RomParseError> {
         let words = match format {
             RomFormat::Hex => parse_hex(text)?,
             RomFormat::Mif => {
-                let (w, words) = parse_mif(text)?;
-                if w != width {
-                    return Err(format!("MIF declares WIDTH={w}, expected {width}"));
+                let (declared, words) = parse_mif(text)?;
+                if declared != width {
+                    return Err(RomParseError::MifWidth { declared, expected: width });
                 }
                 words
             }
             RomFormat::Coe => parse_coe(text)?,
         };
         if width < 64 {
-            if let Some((a, w)) = words.iter().enumerate().find(|(_, &w)| w >> width != 0) {
-                return Err(format!("word {w:#x} at address {a} does not fit {width} bits"));
+            if let Some((addr, &word)) = words.iter().enumerate().find(|(_, &w)| w >> width != 0) {
+                return Err(RomParseError::WordWidth { word, addr, width });
             }
         }
         Ok(Rom { name: name.to_string(), width, words })
     }
 }
 
-fn put(words: &mut Vec<u64>, addr: usize, w: u64) -> Result<(), String> {
+/// A ROM image text that does not read ([`Rom::parse`] and the `parse_*` readers).
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+pub enum RomParseError {
+    #[error("unterminated /* comment")]
+    UnterminatedComment,
+    #[error("stray '/' in hex image")]
+    StraySlash,
+    #[error("bad hex token '{token}': {error}")]
+    HexToken { token: String, error: std::num::ParseIntError },
+    #[error("bad number '{text}': {error}")]
+    Number { text: String, error: std::num::ParseIntError },
+    #[error("unsupported radix '{0}'")]
+    Radix(String),
+    #[error("address {0:#x} is beyond any ROM this project builds")]
+    Address(usize),
+    /// A part the format requires is missing (`WIDTH`, `DEPTH`, `CONTENT`, ...).
+    #[error("{format} has no {part}")]
+    Missing { format: &'static str, part: &'static str },
+    #[error("unknown {format} field '{field}'")]
+    Field { format: &'static str, field: String },
+    #[error("bad {format} statement '{statement}'")]
+    Statement { format: &'static str, statement: String },
+    #[error("MIF range '{0}' needs exactly one word")]
+    MifRangeWords(String),
+    #[error("MIF address {addr} beyond DEPTH={depth}")]
+    MifAddress { addr: usize, depth: usize },
+    #[error("MIF declares WIDTH={declared}, expected {expected}")]
+    MifWidth { declared: u32, expected: u32 },
+    #[error("word {word:#x} at address {addr} does not fit {width} bits")]
+    WordWidth { word: u64, addr: usize, width: u32 },
+}
+
+fn put(words: &mut Vec<u64>, addr: usize, w: u64) -> Result<(), RomParseError> {
     // Cap the growth so a corrupt `@ffffffff` cannot allocate gigabytes.
     if addr >= 1 << 24 {
-        return Err(format!("address {addr:#x} is beyond any ROM this project builds"));
+        return Err(RomParseError::Address(addr));
     }
     if words.len() <= addr {
         words.resize(addr + 1, 0);
@@ -183,7 +208,7 @@ fn put(words: &mut Vec<u64>, addr: usize, w: u64) -> Result<(), String> {
     Ok(())
 }
 
-fn strip_c_comments(text: &str) -> Result<String, String> {
+fn strip_c_comments(text: &str) -> Result<String, RomParseError> {
     let mut out = String::with_capacity(text.len());
     let mut rest = text;
     while let Some(i) = rest.find('/') {
@@ -192,11 +217,11 @@ fn strip_c_comments(text: &str) -> Result<String, String> {
         if tail.starts_with("//") {
             rest = tail.find('\n').map_or("", |j| &tail[j..]);
         } else if tail.starts_with("/*") {
-            let j = tail.find("*/").ok_or("unterminated /* comment")?;
+            let j = tail.find("*/").ok_or(RomParseError::UnterminatedComment)?;
             out.push(' ');
             rest = &tail[j + 2..];
         } else {
-            return Err("stray '/' in hex image".into());
+            return Err(RomParseError::StraySlash);
         }
     }
     out.push_str(rest);
@@ -205,7 +230,8 @@ fn strip_c_comments(text: &str) -> Result<String, String> {
 
 /// `$readmemh` text: whitespace-separated hex words, `//` and `/* */` comments, `@addr`
 /// jumps; locations never written read as 0. `_` inside a number is ignored as in Verilog.
-pub fn parse_hex(text: &str) -> Result<Vec<u64>, String> {
+/// For tests (see [`Rom::parse`]).
+pub fn parse_hex(text: &str) -> Result<Vec<u64>, RomParseError> {
     let mut words = Vec::new();
     let mut addr = 0usize;
     for tok in strip_c_comments(text)?.split_whitespace() {
@@ -214,7 +240,7 @@ pub fn parse_hex(text: &str) -> Result<Vec<u64>, String> {
             None => (false, tok),
         };
         let digits: String = digits.chars().filter(|&c| c != '_').collect();
-        let v = u64::from_str_radix(&digits, 16).map_err(|e| format!("bad hex token '{tok}': {e}"))?;
+        let v = u64::from_str_radix(&digits, 16).map_err(|error| RomParseError::HexToken { token: tok.into(), error })?;
         if jump {
             addr = v as usize;
         } else {
@@ -225,23 +251,26 @@ pub fn parse_hex(text: &str) -> Result<Vec<u64>, String> {
     Ok(words)
 }
 
-fn radix_of(s: &str) -> Result<u32, String> {
+fn radix_of(s: &str) -> Result<u32, RomParseError> {
     match s.trim().to_ascii_uppercase().as_str() {
         "HEX" | "16" => Ok(16),
         "UNS" | "DEC" | "10" => Ok(10),
         "BIN" | "2" => Ok(2),
         "OCT" | "8" => Ok(8),
-        r => Err(format!("unsupported radix '{r}'")),
+        r => Err(RomParseError::Radix(r.into())),
     }
 }
 
-fn num(s: &str, radix: u32) -> Result<u64, String> {
-    u64::from_str_radix(s.trim(), radix).map_err(|e| format!("bad number '{}': {e}", s.trim()))
+fn num(s: &str, radix: u32) -> Result<u64, RomParseError> {
+    u64::from_str_radix(s.trim(), radix).map_err(|error| RomParseError::Number { text: s.trim().into(), error })
 }
 
 /// Intel MIF: the header's WIDTH, DEPTH and radices, then `addr : w w ...;` or
-/// `[lo..hi] : w;` lines; `--` and `% %` comments. Returns (width, words of DEPTH).
-pub fn parse_mif(text: &str) -> Result<(u32, Vec<u64>), String> {
+/// `[lo..hi] : w;` lines; `--` and `% %` comments. Returns (width, words of DEPTH). For tests
+/// (see [`Rom::parse`]).
+pub fn parse_mif(text: &str) -> Result<(u32, Vec<u64>), RomParseError> {
+    let missing = |part| RomParseError::Missing { format: "MIF", part };
+    let statement = |s: &str| RomParseError::Statement { format: "MIF", statement: s.into() };
     let mut clean = String::with_capacity(text.len());
     let mut in_pct = false;
     for line in text.lines() {
@@ -256,7 +285,7 @@ pub fn parse_mif(text: &str) -> Result<(u32, Vec<u64>), String> {
         clean.push('\n');
     }
     let upper = clean.to_ascii_uppercase();
-    let body_at = upper.find("CONTENT").ok_or("MIF has no CONTENT section")?;
+    let body_at = upper.find("CONTENT").ok_or(missing("CONTENT section"))?;
     let (mut width, mut depth, mut ar, mut dr) = (None, None, 16, 16);
     for stmt in upper[..body_at].split(';') {
         if let Some((k, v)) = stmt.split_once('=') {
@@ -265,22 +294,22 @@ pub fn parse_mif(text: &str) -> Result<(u32, Vec<u64>), String> {
                 "DEPTH" => depth = Some(num(v, 10)? as usize),
                 "ADDRESS_RADIX" => ar = radix_of(v)?,
                 "DATA_RADIX" => dr = radix_of(v)?,
-                other => return Err(format!("unknown MIF header field '{other}'")),
+                other => return Err(RomParseError::Field { format: "MIF", field: other.into() }),
             }
         }
     }
-    let width = width.ok_or("MIF has no WIDTH")?;
-    let depth = depth.ok_or("MIF has no DEPTH")?;
+    let width = width.ok_or(missing("WIDTH"))?;
+    let depth = depth.ok_or(missing("DEPTH"))?;
     let body = &upper[body_at + "CONTENT".len()..];
-    let body = body.trim_start().strip_prefix("BEGIN").ok_or("MIF CONTENT without BEGIN")?;
-    let end = body.rfind("END").ok_or("MIF CONTENT without END")?;
+    let body = body.trim_start().strip_prefix("BEGIN").ok_or(missing("BEGIN after CONTENT"))?;
+    let end = body.rfind("END").ok_or(missing("END of its CONTENT"))?;
     let mut words = vec![0u64; depth];
     for stmt in body[..end].split(';').map(str::trim).filter(|s| !s.is_empty()) {
-        let (a, d) = stmt.split_once(':').ok_or_else(|| format!("bad MIF line '{stmt}'"))?;
+        let (a, d) = stmt.split_once(':').ok_or_else(|| statement(stmt))?;
         let a = a.trim();
         let (lo, hi) = match a.strip_prefix('[').and_then(|r| r.strip_suffix(']')) {
             Some(r) => {
-                let (lo, hi) = r.split_once("..").ok_or_else(|| format!("bad MIF range '{a}'"))?;
+                let (lo, hi) = r.split_once("..").ok_or_else(|| statement(stmt))?;
                 (num(lo, ar)? as usize, Some(num(hi, ar)? as usize))
             }
             None => (num(a, ar)? as usize, None),
@@ -289,11 +318,11 @@ pub fn parse_mif(text: &str) -> Result<(u32, Vec<u64>), String> {
         // A range repeats its (single) word; a plain address takes a run of words.
         let cells: Vec<(usize, u64)> = match hi {
             Some(hi) if data.len() == 1 => (lo..=hi).map(|i| (i, data[0])).collect(),
-            Some(_) => return Err(format!("MIF range '{a}' needs exactly one word")),
+            Some(_) => return Err(RomParseError::MifRangeWords(a.into())),
             None => data.iter().enumerate().map(|(i, &w)| (lo + i, w)).collect(),
         };
         for (i, w) in cells {
-            *words.get_mut(i).ok_or_else(|| format!("MIF address {i} beyond DEPTH={depth}"))? = w;
+            *words.get_mut(i).ok_or(RomParseError::MifAddress { addr: i, depth })? = w;
         }
     }
     Ok((width, words))
@@ -301,20 +330,21 @@ pub fn parse_mif(text: &str) -> Result<(u32, Vec<u64>), String> {
 
 /// Xilinx COE: `memory_initialization_radix=R;` and `memory_initialization_vector=` followed
 /// by words separated by commas or whitespace, ended by `;`. `;` starts a comment elsewhere.
-pub fn parse_coe(text: &str) -> Result<Vec<u64>, String> {
+/// For tests (see [`Rom::parse`]).
+pub fn parse_coe(text: &str) -> Result<Vec<u64>, RomParseError> {
     // A line starting with ';' is a comment; elsewhere ';' ends a statement.
     let body: String = text.lines().filter(|l| !l.trim_start().starts_with(';')).flat_map(|l| [l, "\n"]).collect();
     let mut radix = 10;
     let mut vector = None;
     for stmt in body.split(';').map(str::trim).filter(|s| !s.is_empty()) {
-        let (k, v) = stmt.split_once('=').ok_or_else(|| format!("bad COE statement '{stmt}'"))?;
+        let (k, v) = stmt.split_once('=').ok_or_else(|| RomParseError::Statement { format: "COE", statement: stmt.into() })?;
         match k.trim().to_ascii_lowercase().as_str() {
             "memory_initialization_radix" => radix = num(v, 10)? as u32,
             "memory_initialization_vector" => vector = Some(v.to_string()),
-            other => return Err(format!("unknown COE key '{other}'")),
+            other => return Err(RomParseError::Field { format: "COE", field: other.into() }),
         }
     }
-    let v = vector.ok_or("COE has no memory_initialization_vector")?;
+    let v = vector.ok_or(RomParseError::Missing { format: "COE", part: "memory_initialization_vector" })?;
     v.split(|c: char| c == ',' || c.is_whitespace()).filter(|t| !t.is_empty()).map(|t| num(t, radix)).collect()
 }
 
@@ -385,9 +415,15 @@ mod tests {
         assert_eq!(parse_mif(mif).unwrap(), (8, vec![9, 9, 9, 1, 2, 3]));
         let coe = "; comment\nmemory_initialization_radix = 2;\nmemory_initialization_vector = 1 10,\n11;";
         assert_eq!(parse_coe(coe).unwrap(), vec![1, 2, 3]);
-        assert!(parse_hex("zz").is_err());
-        assert!(parse_mif("WIDTH=4;DEPTH=1;CONTENT BEGIN 1 : 0; END;").is_err());
-        assert!(Rom::parse("x", 4, RomFormat::Hex, "1f").is_err());
+        assert!(matches!(parse_hex("zz"), Err(RomParseError::HexToken { token, .. }) if token == "zz"));
+        assert_eq!(parse_hex("@1000000 0"), Err(RomParseError::Address(1 << 24)));
+        assert_eq!(parse_hex("1 /* 2"), Err(RomParseError::UnterminatedComment));
+        assert_eq!(parse_mif("WIDTH=4;DEPTH=1;CONTENT BEGIN 1 : 0; END;"), Err(RomParseError::MifAddress { addr: 1, depth: 1 }));
+        assert_eq!(parse_mif("WIDTH=4;CONTENT BEGIN END;"), Err(RomParseError::Missing { format: "MIF", part: "DEPTH" }));
+        assert_eq!(parse_coe("radix=2;"), Err(RomParseError::Field { format: "COE", field: "radix".into() }));
+        assert_eq!(Rom::parse("x", 4, RomFormat::Hex, "1f"), Err(RomParseError::WordWidth { word: 0x1f, addr: 0, width: 4 }));
+        let mif = Rom::new("m", 8, vec![1]).to_mif();
+        assert_eq!(Rom::parse("m", 4, RomFormat::Mif, &mif), Err(RomParseError::MifWidth { declared: 8, expected: 4 }));
     }
 
     #[test]

@@ -22,7 +22,7 @@
 //! `Σ segments + fill()` ([`Scheme::Segment`]); the co-simulation sweep checks it clock for clock.
 
 use crate::format::{Align, Config, Span};
-use crate::setup::{triangle_spans, Screen, Triangle, Vertex};
+use crate::setup::{triangle_spans, Screen, SetupError, Triangle, Vertex};
 use std::fmt;
 
 /// Pipeline fill charged once per stream: the latency of the segment shader as SPEC's seed builds it
@@ -142,7 +142,7 @@ impl Count {
 
 /// One triangle's count under `scheme`. `cfg` gives the formats of the set-up (its `p` and
 /// `align` are ignored: the scheme says how spans are cut). Errors are the set-up's.
-pub fn triangle_count(scheme: Scheme, cfg: &Config, screen: &Screen, tri: &Triangle) -> Result<Count, String> {
+pub fn triangle_count(scheme: Scheme, cfg: &Config, screen: &Screen, tri: &Triangle) -> Result<Count, SetupError> {
     let mut c = Count { triangles: 1, ..Count::default() };
     let mut spans: Vec<Span> = Vec::new();
     triangle_spans(cfg, screen, tri, |_, s| spans.push(s))?;
@@ -155,11 +155,19 @@ pub fn triangle_count(scheme: Scheme, cfg: &Config, screen: &Screen, tri: &Trian
     Ok(c)
 }
 
+/// The first triangle of a workload the set-up refuses, numbered from 0.
+#[derive(Clone, Copy, Debug, PartialEq, thiserror::Error)]
+#[error("triangle {triangle}: {error}")]
+pub struct WorkloadError {
+    pub triangle: usize,
+    pub error: SetupError,
+}
+
 /// A workload's count under `scheme`: the triangles in order, one stream.
-pub fn workload_count(scheme: Scheme, cfg: &Config, screen: &Screen, tris: &[Triangle]) -> Result<Count, String> {
+pub fn workload_count(scheme: Scheme, cfg: &Config, screen: &Screen, tris: &[Triangle]) -> Result<Count, WorkloadError> {
     let mut total = Count::default();
-    for (k, t) in tris.iter().enumerate() {
-        total.add(&triangle_count(scheme, cfg, screen, t).map_err(|e| format!("triangle {k}: {e}"))?);
+    for (triangle, t) in tris.iter().enumerate() {
+        total.add(&triangle_count(scheme, cfg, screen, t).map_err(|error| WorkloadError { triangle, error })?);
     }
     Ok(total)
 }
@@ -189,7 +197,7 @@ pub fn midline_split(tri: &Triangle) -> [Triangle; 4] {
 /// `r`, rows numbered from each sub-triangle's first covered row (from its last for the middle,
 /// point-reflected one, whose scan runs the template's rows backwards). That is, the clocks are
 /// `Σ_r max_k len_k(r)`, never less than a quarter of the pixels.
-pub fn midline_clocks(cfg: &Config, screen: &Screen, tri: &Triangle) -> Result<u64, String> {
+pub fn midline_clocks(cfg: &Config, screen: &Screen, tri: &Triangle) -> Result<u64, SetupError> {
     let subs = midline_split(tri);
     let mut rows: [Vec<u64>; 4] = Default::default();
     for (k, t) in subs.iter().enumerate() {
@@ -326,6 +334,9 @@ mod tests {
             assert_eq!((c.triangles, c.pixels, c.clocks, c.total_clocks()), (1, 0, 0, 0));
         }
         let bad = tri([[f64::NAN, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]);
-        assert!(workload_count(Scheme::Classical, &Config::default(), &screen, &[off, bad]).unwrap_err().starts_with("triangle 1"));
+        let e = workload_count(Scheme::Classical, &Config::default(), &screen, &[off, bad]).unwrap_err();
+        assert_eq!(e.triangle, 1);
+        assert!(matches!(e.error, SetupError::Triangle(crate::setup::TriangleError::Coordinate { vertex: 0, axis: "x", .. })), "{e}");
+        assert!(e.to_string().starts_with("triangle 1: vertex 0: x = NaN"), "{e}");
     }
 }

@@ -56,11 +56,39 @@ impl Default for Screen {
     }
 }
 
+/// A screen the set-up cannot serve ([`Screen::check`], [`Screen::check_for`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, thiserror::Error)]
+pub enum ScreenError {
+    #[error("screen {width}x{height} exceeds {SCREEN_LIMIT}x{SCREEN_LIMIT}")]
+    TooLarge { width: u32, height: u32 },
+    #[error("screen width {width} exceeds 2^XW = {max} pixels of the configuration")]
+    WiderThanPorts { width: u32, max: u32 },
+}
+
+/// A triangle outside the set-up's numeric limits ([`Triangle::check`]).
+#[derive(Clone, Copy, Debug, PartialEq, thiserror::Error)]
+pub enum TriangleError {
+    /// `axis` is "x" or "y"; the value is NaN, infinite or beyond [`COORD_LIMIT`].
+    #[error("vertex {vertex}: {axis} = {value} is outside -{COORD_LIMIT}..={COORD_LIMIT}")]
+    Coordinate { vertex: usize, axis: &'static str, value: f64 },
+    #[error("vertex {vertex}: intensity {value} is outside 0..=255")]
+    Intensity { vertex: usize, value: f64 },
+}
+
+/// Why [`triangle_spans`] (or the f64 reference) refuses a triangle on a screen.
+#[derive(Clone, Copy, Debug, PartialEq, thiserror::Error)]
+pub enum SetupError {
+    #[error(transparent)]
+    Screen(#[from] ScreenError),
+    #[error(transparent)]
+    Triangle(#[from] TriangleError),
+}
+
 impl Screen {
     /// Both dimensions within [`SCREEN_LIMIT`] (needed for the exactness argument above).
-    pub fn check(&self) -> Result<(), String> {
+    pub fn check(&self) -> Result<(), ScreenError> {
         if self.width > SCREEN_LIMIT || self.height > SCREEN_LIMIT {
-            return Err(format!("screen {}x{} exceeds {SCREEN_LIMIT}x{SCREEN_LIMIT}", self.width, self.height));
+            return Err(ScreenError::TooLarge { width: self.width, height: self.height });
         }
         Ok(())
     }
@@ -71,10 +99,10 @@ impl Screen {
     }
 
     /// As [`Screen::check`], and every span of this screen fits `cfg`'s `in_x`/`in_len` ports.
-    pub fn check_for(&self, cfg: &Config) -> Result<(), String> {
+    pub fn check_for(&self, cfg: &Config) -> Result<(), ScreenError> {
         self.check()?;
         if self.width > cfg.max_len() {
-            return Err(format!("screen width {} exceeds 2^XW = {} pixels of the configuration", self.width, cfg.max_len()));
+            return Err(ScreenError::WiderThanPorts { width: self.width, max: cfg.max_len() });
         }
         Ok(())
     }
@@ -82,15 +110,15 @@ impl Screen {
 
 impl Triangle {
     /// The validation `parse_triangles` applies, for triangles built in code.
-    pub fn check(&self) -> Result<(), String> {
-        for (n, v) in self.v.iter().enumerate() {
-            for (name, c) in [("x", v.x), ("y", v.y)] {
-                if !c.is_finite() || c.abs() > COORD_LIMIT {
-                    return Err(format!("vertex {n}: {name} = {c} is outside -{COORD_LIMIT}..={COORD_LIMIT}"));
+    pub fn check(&self) -> Result<(), TriangleError> {
+        for (vertex, v) in self.v.iter().enumerate() {
+            for (axis, value) in [("x", v.x), ("y", v.y)] {
+                if !value.is_finite() || value.abs() > COORD_LIMIT {
+                    return Err(TriangleError::Coordinate { vertex, axis, value });
                 }
             }
             if !(v.i.is_finite() && (0.0..=255.0).contains(&v.i)) {
-                return Err(format!("vertex {n}: intensity {} is outside 0..=255", v.i));
+                return Err(TriangleError::Intensity { vertex, value: v.i });
             }
         }
         Ok(())
@@ -108,20 +136,28 @@ impl fmt::Display for Triangle {
     }
 }
 
-#[derive(Clone, Debug, PartialEq, Eq)]
+/// A line of triangle text [`parse_triangles`] refuses.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+#[error("line {line}: {kind}")]
 pub struct ParseError {
     /// 1-based line number.
     pub line: usize,
-    pub message: String,
+    pub kind: ParseErrorKind,
 }
 
-impl fmt::Display for ParseError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(f, "line {}: {}", self.line, self.message)
-    }
+/// What is wrong with the line.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum ParseErrorKind {
+    #[error("expected 9 numbers (x0 y0 i0 x1 y1 i1 x2 y2 i2), found {0}")]
+    FieldCount(usize),
+    /// `field` is one of x0 y0 i0 ... i2; Rust parses "inf" and "NaN", which are no coordinates.
+    #[error("{field} = '{text}' is not finite")]
+    NotFinite { field: &'static str, text: String },
+    #[error("{field} = '{text}' is not a number")]
+    NotANumber { field: &'static str, text: String },
+    #[error(transparent)]
+    Triangle(#[from] TriangleError),
 }
-
-impl std::error::Error for ParseError {}
 
 const FIELD_NAMES: [&str; 9] = ["x0", "y0", "i0", "x1", "y1", "i1", "x2", "y2", "i2"];
 
@@ -129,27 +165,28 @@ const FIELD_NAMES: [&str; 9] = ["x0", "y0", "i0", "x1", "y1", "i1", "x2", "y2", 
 pub fn parse_triangles(text: &str) -> Result<Vec<Triangle>, ParseError> {
     let mut out = Vec::new();
     for (n, raw) in text.lines().enumerate() {
-        let err = |message: String| ParseError { line: n + 1, message };
+        let err = |kind: ParseErrorKind| ParseError { line: n + 1, kind };
         let body = raw.split('#').next().unwrap_or("");
         let fields: Vec<&str> = body.split_whitespace().collect();
         if fields.is_empty() {
             continue;
         }
         if fields.len() != 9 {
-            return Err(err(format!("expected 9 numbers (x0 y0 i0 x1 y1 i1 x2 y2 i2), found {}", fields.len())));
+            return Err(err(ParseErrorKind::FieldCount(fields.len())));
         }
         let mut f = [0.0f64; 9];
         for (k, s) in fields.iter().enumerate() {
             // Rust also parses "inf" and "NaN"; those are numbers to it but not to us.
+            let (field, text) = (FIELD_NAMES[k], s.to_string());
             f[k] = match s.parse::<f64>() {
                 Ok(v) if v.is_finite() => v,
-                Ok(_) => return Err(err(format!("{} = '{s}' is not finite", FIELD_NAMES[k]))),
-                Err(_) => return Err(err(format!("{} = '{s}' is not a number", FIELD_NAMES[k]))),
+                Ok(_) => return Err(err(ParseErrorKind::NotFinite { field, text })),
+                Err(_) => return Err(err(ParseErrorKind::NotANumber { field, text })),
             };
         }
         let vertex = |k: usize| Vertex { x: f[3 * k], y: f[3 * k + 1], i: f[3 * k + 2] };
         let tri = Triangle { v: [vertex(0), vertex(1), vertex(2)] };
-        tri.check().map_err(err)?;
+        tri.check().map_err(|e| err(e.into()))?;
         out.push(tri);
     }
     Ok(out)
@@ -304,7 +341,7 @@ impl Snapped {
 
 /// Validates `screen` against `cfg` and `tri`, then emits the triangle's spans (see
 /// [`Snapped::spans`]). No allocation; the hot path of the co-simulation.
-pub fn triangle_spans(cfg: &Config, screen: &Screen, tri: &Triangle, out: impl FnMut(u32, Span)) -> Result<(), String> {
+pub fn triangle_spans(cfg: &Config, screen: &Screen, tri: &Triangle, out: impl FnMut(u32, Span)) -> Result<(), SetupError> {
     screen.check_for(cfg)?;
     tri.check()?;
     Snapped::new(tri).spans(cfg, screen, out);
@@ -369,26 +406,90 @@ mod tests {
 
     #[test]
     fn parse_errors_name_the_line() {
+        use ParseErrorKind::*;
         let good = "0 0 0 1 0 0 0 1 0\n";
+        let text = |field: &'static str, text: &str| (field, text.to_string());
+        let (coord, intensity) = (
+            |vertex, axis, value| Triangle(TriangleError::Coordinate { vertex, axis, value }),
+            |vertex, value| Triangle(TriangleError::Intensity { vertex, value }),
+        );
         let cases = [
-            ("0 0 0 1 0 0 0 1", "found 8"),
-            ("0 0 0 1 0 0 0 1 0 5", "found 10"),
-            ("0 0 0 1 zero 0 0 1 0", "y1 = 'zero' is not a number"),
-            ("0 0 0 1 0 0 0 1 NaN", "i2 = 'NaN' is not finite"),
-            ("inf 0 0 1 0 0 0 1 0", "x0 = 'inf' is not finite"),
-            ("0 0 0 1 0 256 0 1 0", "vertex 1: intensity 256"),
-            ("0 0 -0.5 1 0 0 0 1 0", "vertex 0: intensity -0.5"),
-            ("0 0 0 1 0 0 0 -40000 0", "vertex 2: y = -40000"),
-            ("32768.5 0 0 1 0 0 0 1 0", "vertex 0: x = 32768.5"),
+            ("0 0 0 1 0 0 0 1", FieldCount(8)),
+            ("0 0 0 1 0 0 0 1 0 5", FieldCount(10)),
+            ("0 0 0 1 zero 0 0 1 0", {
+                let (field, text) = text("y1", "zero");
+                NotANumber { field, text }
+            }),
+            ("0 0 0 1 0 0 0 1 NaN", {
+                let (field, text) = text("i2", "NaN");
+                NotFinite { field, text }
+            }),
+            ("inf 0 0 1 0 0 0 1 0", {
+                let (field, text) = text("x0", "inf");
+                NotFinite { field, text }
+            }),
+            ("0 0 0 1 0 256 0 1 0", intensity(1, 256.0)),
+            ("0 0 -0.5 1 0 0 0 1 0", intensity(0, -0.5)),
+            ("0 0 0 1 0 0 0 -40000 0", coord(2, "y", -40000.0)),
+            ("32768.5 0 0 1 0 0 0 1 0", coord(0, "x", 32768.5)),
+            ("1e300 0 0 1 0 0 0 1 0", coord(0, "x", 1e300)),
+            ("0 0 0 32768.004 0 0 0 1 0", coord(1, "x", 32768.004)),
+            ("0 0 0 1 0 0 0 -32769 0", coord(2, "y", -32769.0)),
+            ("0 0 0 1 0 0 0 1 255.5", intensity(2, 255.5)),
+            ("0 NaN 0 1 0 0 0 1 0", {
+                let (field, text) = text("y0", "NaN");
+                NotFinite { field, text }
+            }),
+            ("0 0 0 1 -inf 0 0 1 0", {
+                let (field, text) = text("y1", "-inf");
+                NotFinite { field, text }
+            }),
+            ("0 0 0 1 0 0 1e400 1 0", {
+                let (field, text) = text("x2", "1e400");
+                NotFinite { field, text }
+            }),
+            ("0 0 0 1 0 0 0 1 infinity", {
+                let (field, text) = text("i2", "infinity");
+                NotFinite { field, text }
+            }),
+            ("0 0 0 1 0 0 0 1 0x10", {
+                let (field, text) = text("i2", "0x10");
+                NotANumber { field, text }
+            }),
+            ("0,0,0 1 0 0 0 1 0", FieldCount(7)),
         ];
         for (bad, want) in cases {
             let text = format!("# c\n{good}\n{bad} # comment\n{good}");
             let e = parse_triangles(&text).unwrap_err();
-            assert_eq!(e.line, 4, "{bad}");
-            assert!(e.message.contains(want), "{bad}: got '{}'", e.message);
-            assert!(e.to_string().starts_with("line 4: "));
+            assert_eq!(e, ParseError { line: 4, kind: want }, "{bad}");
         }
+        // The message the CLIs print: the line, then what is wrong with it.
+        let e = parse_triangles("0 0 0 1 zero 0 0 1 0").unwrap_err().to_string();
+        assert_eq!(e, "line 1: y1 = 'zero' is not a number");
+        let e = parse_triangles("0 0 0 1 0 0 0 -40000 0").unwrap_err().to_string();
+        assert_eq!(e, "line 1: vertex 2: y = -40000 is outside -32768..=32768");
         assert!(parse_triangles("32768 -32768 255 0 0 0 0 0 0").is_ok());
+    }
+
+    /// Lines of random tokens, numbers and junk never panic the parser, and whatever it returns
+    /// passes the set-up's own validation.
+    #[test]
+    fn parser_fuzz_returns_only_valid_triangles() {
+        use crate::rng::SeedRng;
+        use rand::{Rng, SeedableRng};
+        let mut rng = SeedRng::seed_from_u64(6);
+        let tokens = ["0", "-1", "1e9", "nan", "inf", "-0", "255", "3.5", "#", "x", "", "1e-400", "32768", "-32768", "\t", "1e308"];
+        let mut parsed = 0;
+        for _ in 0..5000 {
+            let line: Vec<&str> = (0..rng.gen_range(0..12)).map(|_| tokens[rng.gen_range(0..tokens.len())]).collect();
+            if let Ok(tris) = parse_triangles(&line.join(" ")) {
+                for t in tris {
+                    t.check().expect("the parser returns only valid triangles");
+                    parsed += 1;
+                }
+            }
+        }
+        assert!(parsed > 0, "the fuzz never produced a valid line: it tests nothing");
     }
 
     #[test]
@@ -396,13 +497,24 @@ mod tests {
         let cfg = Config::default();
         let screen = Screen::default();
         let bad = tri([[0.0, 0.0, 0.0], [f64::NAN, 0.0, 0.0], [0.0, 1.0, 0.0]]);
-        assert!(triangle_spans(&cfg, &screen, &bad, |_, _| {}).unwrap_err().contains("vertex 1"));
+        let e = triangle_spans(&cfg, &screen, &bad, |_, _| {}).unwrap_err();
+        assert!(matches!(e, SetupError::Triangle(TriangleError::Coordinate { vertex: 1, axis: "x", value }) if value.is_nan()), "{e}");
         let ok = tri([[0.0, 0.0, 0.0], [5.0, 0.0, 0.0], [0.0, 5.0, 0.0]]);
         let narrow = Config::new(8, 12, 9, crate::Align::Span).unwrap();
         let e = triangle_spans(&narrow, &screen, &ok, |_, _| {}).unwrap_err();
-        assert!(e.contains("exceeds 2^XW = 512"), "{e}");
+        assert_eq!(e, SetupError::Screen(ScreenError::WiderThanPorts { width: 640, max: 512 }));
+        assert_eq!(e.to_string(), "screen width 640 exceeds 2^XW = 512 pixels of the configuration");
+        // Built in code, triangles the parser would refuse are refused by the set-up: no span.
+        for bad in [f64::NAN, f64::INFINITY, f64::NEG_INFINITY, 1e300, COORD_LIMIT + 0.01] {
+            let t = tri([[0.0, 0.0, 0.0], [bad, 5.0, 9.0], [3.0, 9.0, 1.0]]);
+            let mut spans = 0;
+            let e = triangle_spans(&cfg, &screen, &t, |_, _| spans += 1).unwrap_err();
+            assert!(matches!(e, SetupError::Triangle(TriangleError::Coordinate { vertex: 1, axis: "x", .. })), "{e}");
+            assert_eq!(spans, 0);
+        }
         let huge = Screen { width: 100, height: SCREEN_LIMIT + 1 };
-        assert!(triangle_spans(&cfg, &huge, &ok, |_, _| {}).is_err());
+        let e = triangle_spans(&cfg, &huge, &ok, |_, _| {}).unwrap_err();
+        assert_eq!(e, SetupError::Screen(ScreenError::TooLarge { width: 100, height: SCREEN_LIMIT + 1 }));
     }
 
     #[test]

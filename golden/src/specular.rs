@@ -36,8 +36,10 @@ pub mod setup;
 pub use crate::pipeline::{PipeReg, PipeStage};
 pub use accuracy::{accuracy_of, accuracy_table, AccuracySummary, NAccuracy};
 pub use auto::{auto_plan, best_reachable, MAX_AUTO_TABLES};
-pub use decoder::{check_k_set, BrdfK, Decoder, DecoderRepr, KRange};
-pub use plan::{table_end, SpecularGeometry, SpecularPlan, TableFailure, TablePlan, NK_MANT_RANGE, TABLE_END, THETA_DROP, WORD_BITS_RANGE};
+pub use decoder::{check_k_set, parse_rel_error, BrdfK, BrdfKError, Decoder, DecoderError, DecoderRepr, KRange, KSetError, TargetError};
+pub use plan::{
+    table_end, PlanError, SpecularGeometry, SpecularPlan, TableFailure, TablePlan, NK_MANT_RANGE, TABLE_END, THETA_DROP, WORD_BITS_RANGE,
+};
 pub use setup::{setup_span, Fallbacks, SpanEnds, SpecularSetup, Vec3};
 
 use crate::rom::{self, Rom};

@@ -21,27 +21,25 @@
 use crate::format::{Config, Span};
 use crate::raster::Frame;
 use crate::setup::Screen;
-use std::fmt;
 
 /// A screen the writer cannot address.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, thiserror::Error)]
 pub enum WriterError {
     /// Wider than `2^XW`: a span's `x` would not fit `in_x`.
+    #[error("screen width {width} exceeds 2^XW = {max} pixels")]
     Width { width: u32, max: u32 },
     /// No rows, or more than 2^16.
+    #[error("screen height {height} is outside 1..65536")]
     Height { height: u32 },
 }
 
-impl fmt::Display for WriterError {
-    fn fmt(&self, f: &mut fmt::Formatter) -> fmt::Result {
-        match self {
-            WriterError::Width { width, max } => write!(f, "screen width {width} exceeds 2^XW = {max} pixels"),
-            WriterError::Height { height } => write!(f, "screen height {height} is outside 1..65536"),
-        }
-    }
+/// A block write outside the memory ([`Memory::apply`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, thiserror::Error)]
+#[error("block address {addr} outside the {blocks}-block memory")]
+pub struct AddressError {
+    pub addr: u32,
+    pub blocks: u32,
 }
-
-impl std::error::Error for WriterError {}
 
 /// One block write: `we` bit `i` (word `i / 64`) enables lane `i`; `pix` holds the P pixels,
 /// 0 under a clear enable (don't-care on the port).
@@ -171,10 +169,10 @@ impl Memory {
     }
 
     /// Applies one write; `Err` if the address is outside the memory.
-    pub fn apply(&mut self, w: &BlockWrite) -> Result<(), String> {
+    pub fn apply(&mut self, w: &BlockWrite) -> Result<(), AddressError> {
         let p = self.writer.cfg.p;
         if w.addr >= self.writer.blocks() {
-            return Err(format!("block address {} outside the {}-block memory", w.addr, self.writer.blocks()));
+            return Err(AddressError { addr: w.addr, blocks: self.writer.blocks() });
         }
         for i in (0..p).filter(|&i| w.enabled(i)) {
             let at = (w.addr * p + i) as usize;
@@ -282,7 +280,7 @@ mod tests {
         m.apply(&off).unwrap();
         assert!(m.wrote_off_screen(), "x = 23 lies past the 21-pixel row");
         off.addr = 12;
-        assert!(m.apply(&off).is_err());
+        assert_eq!(m.apply(&off), Err(AddressError { addr: 12, blocks: 12 }));
     }
 
     #[test]

@@ -10,7 +10,6 @@ use crate::Names;
 use golden::bfpi::BfpiPlan;
 use golden::Config;
 use std::fmt;
-use std::str::FromStr;
 
 /// How the multiples `1..P` of the increment are formed.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, clap::ValueEnum)]
@@ -39,13 +38,6 @@ impl BfpiArch {
 impl fmt::Display for BfpiArch {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         f.write_str(self.name())
-    }
-}
-
-impl FromStr for BfpiArch {
-    type Err = String;
-    fn from_str(s: &str) -> Result<Self, String> {
-        BfpiArch::ALL.into_iter().find(|a| a.name() == s).ok_or_else(|| format!("bfpi arch '{s}' is not one of shift-add, naive, tree"))
     }
 }
 

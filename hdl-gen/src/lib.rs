@@ -48,13 +48,18 @@ impl Names {
     }
 }
 
+/// A module-name prefix that would not keep every name a plain Verilog identifier.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+#[error("prefix '{0}' is not a Verilog identifier start (letters, digits, '_', not starting with a digit)")]
+pub struct PrefixError(pub String);
+
 /// A module-name prefix must keep every name a plain Verilog identifier.
-pub fn check_prefix(prefix: &str) -> Result<(), String> {
+pub fn check_prefix(prefix: &str) -> Result<(), PrefixError> {
     let ok = prefix.chars().enumerate().all(|(k, c)| c == '_' || c.is_ascii_alphabetic() || (k > 0 && c.is_ascii_digit()));
     if ok {
         Ok(())
     } else {
-        Err(format!("prefix '{prefix}' is not a Verilog identifier start (letters, digits, '_', not starting with a digit)"))
+        Err(PrefixError(prefix.to_string()))
     }
 }
 

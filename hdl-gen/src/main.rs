@@ -1,10 +1,11 @@
 //! `hdl-gen`: the command line of the segshade generator.
 
-use clap::builder::TypedValueParser;
+use anyhow::{bail, Context};
+use clap::builder::{StringValueParser, TypedValueParser};
 use clap::{Args, Parser, Subcommand};
 use golden::frontend::DiMode;
 use golden::rom::RomFormat;
-use golden::specular::{BrdfK, SpecularPlan};
+use golden::specular::{parse_rel_error, BrdfK, SpecularPlan};
 use golden::{Align, Config};
 use hdl_gen::{check_prefix, generate, output, BfpiArch, Options};
 use std::path::PathBuf;
@@ -113,9 +114,9 @@ enum Report {
     Accuracy {
         #[command(flatten)]
         brdf: BrdfArgs,
-        /// Also draw the error against n into this PNG file.
+        /// Also draw the error against n into this SVG file.
         #[arg(long)]
-        png: Option<PathBuf>,
+        svg: Option<PathBuf>,
     },
 }
 
@@ -123,7 +124,8 @@ enum Report {
 #[derive(Args)]
 struct ConfigArgs {
     /// Segment width: pixels per clock, a power of two in 1..256.
-    #[arg(long, default_value_t = golden::format::DEFAULT_P, value_parser = parse_p)]
+    #[arg(long, default_value_t = golden::format::DEFAULT_P,
+          value_parser = clap::value_parser!(u32).try_map(|p| golden::format::check_p(p).map(|()| p)))]
     p: u32,
     /// Fraction bits F of the intensity format UQ8.F (4..20).
     #[arg(long = "frac", default_value_t = golden::format::DEFAULT_FRAC, value_parser = clap::value_parser!(u32).range(4..=20))]
@@ -135,13 +137,13 @@ struct ConfigArgs {
     #[arg(long, value_enum, default_value_t = Align::Span)]
     align: Align,
     /// String prepended to every module name.
-    #[arg(long, default_value = "", value_parser = parse_prefix)]
+    #[arg(long, default_value = "", value_parser = StringValueParser::new().try_map(|s| check_prefix(&s).map(|()| s)))]
     prefix: String,
 }
 
 impl ConfigArgs {
     /// Options for this configuration with the table set `brdf`; the rest default.
-    fn options(self, brdf: &BrdfArgs) -> Result<Options, String> {
+    fn options(self, brdf: &BrdfArgs) -> anyhow::Result<Options> {
         let cfg = Config::new(self.p, self.frac, self.xbits, self.align)?;
         Ok(Options { cfg, prefix: self.prefix, brdf: brdf.plan()?, ..Options::default() })
     }
@@ -153,7 +155,7 @@ struct BrdfArgs {
     /// BRDF table set: a list of k (ascending, 1..64; each n then takes its least-error table),
     /// or `auto` to choose the set with the least ROM that meets --max-rel-error.
     /// Default: the patent's 1,2,4,16 with its n ranges.
-    #[arg(long = "brdf-k", value_parser = parse_brdf_k)]
+    #[arg(long = "brdf-k")]
     brdf_k: Option<BrdfK>,
     /// With `--brdf-k auto`: largest relative error of the approximation inside the epicentre,
     /// as a fraction (0.01) or a percentage (1%).
@@ -163,44 +165,15 @@ struct BrdfArgs {
 
 impl BrdfArgs {
     /// The plan, or `None` for the patent's own (the default).
-    fn plan(&self) -> Result<Option<SpecularPlan>, String> {
+    fn plan(&self) -> anyhow::Result<Option<SpecularPlan>> {
         let choice = match (&self.brdf_k, self.max_rel_error) {
             (None, _) => return Ok(None),
             (Some(BrdfK::Auto { .. }), Some(e)) => BrdfK::Auto { max_err: e },
-            (Some(BrdfK::List(_)), Some(_)) => return Err("--max-rel-error goes with --brdf-k auto".into()),
+            (Some(BrdfK::List(_)), Some(_)) => bail!("--max-rel-error goes with --brdf-k auto"),
             (Some(b), None) => b.clone(),
         };
-        SpecularPlan::from_brdf_k(&choice).map(Some).map_err(|e| format!("--brdf-k {choice}: {e}"))
+        SpecularPlan::from_brdf_k(&choice).map(Some).with_context(|| format!("--brdf-k {choice}"))
     }
-}
-
-fn parse_brdf_k(s: &str) -> Result<BrdfK, String> {
-    s.parse()
-}
-
-fn parse_rel_error(s: &str) -> Result<f64, String> {
-    let (num, scale) = match s.strip_suffix('%') {
-        Some(n) => (n, 0.01),
-        None => (s, 1.0),
-    };
-    let e: f64 = num.trim().parse().map_err(|_| format!("'{s}' is not a number"))?;
-    let e = e * scale;
-    if e.is_finite() && e > 0.0 && e < 1.0 {
-        Ok(e)
-    } else {
-        Err(format!("'{s}' is not a relative error between 0 and 1 (or 0% and 100%)"))
-    }
-}
-
-fn parse_p(s: &str) -> Result<u32, String> {
-    let p: u32 = s.parse().map_err(|_| format!("'{s}' is not a whole number"))?;
-    golden::format::check_p(p)?;
-    Ok(p)
-}
-
-fn parse_prefix(s: &str) -> Result<String, String> {
-    check_prefix(s)?;
-    Ok(s.to_string())
 }
 
 /// The command line, every subcommand reading a negative number as a value (which its flag's
@@ -223,66 +196,68 @@ enum RomTable {
 }
 
 fn main() -> ExitCode {
-    let cli = parse_cli();
-    let result = match cli.command {
-        Command::Generate { config, bfpi_arch, brdf, width, height, fe_div_bits, fe_di, pipeline, out } => config
-            .options(&brdf)
-            .and_then(|opts| {
-                let default = Options::default_screen(&opts.cfg);
-                let screen = golden::setup::Screen { width: width.unwrap_or(default.width), height: height.unwrap_or(default.height) };
-                let pipeline = golden::pipeline::Pipeline::new(pipeline).expect("clap checked the range");
-                if pipeline.span_stage() && bfpi_arch == BfpiArch::Tree {
-                    return Err(hdl_gen::segment::TREE_UNPIPELINED.to_string());
-                }
-                let opts = Options { bfpi_arch, screen: Some(screen), fe_div_bits, fe_di, pipeline, ..opts };
-                opts.frontend().map_err(|e| format!("--width/--height: {e}"))?;
-                Ok(opts)
-            })
-            .and_then(|opts| output::write_all(&out, &generate(&opts)))
-            .map(|()| eprintln!("wrote {}", out.display())),
-        Command::Rom { table, format, brdf, out } => brdf.plan().and_then(|plan| {
-            let unit = Options { brdf: plan, ..Options::default() }.specular_unit();
+    match run(parse_cli().command) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            // The context (a flag, a file) and the library's message, on one line.
+            eprintln!("error: {e:#}");
+            ExitCode::from(2)
+        }
+    }
+}
+
+fn run(command: Command) -> anyhow::Result<()> {
+    match command {
+        Command::Generate { config, bfpi_arch, brdf, width, height, fe_div_bits, fe_di, pipeline, out } => {
+            let opts = config.options(&brdf)?;
+            let default = Options::default_screen(&opts.cfg);
+            let screen = golden::setup::Screen { width: width.unwrap_or(default.width), height: height.unwrap_or(default.height) };
+            let pipeline = golden::pipeline::Pipeline::new(pipeline).expect("clap checked the range");
+            if pipeline.span_stage() && bfpi_arch == BfpiArch::Tree {
+                bail!(hdl_gen::segment::TREE_UNPIPELINED);
+            }
+            let opts = Options { bfpi_arch, screen: Some(screen), fe_div_bits, fe_di, pipeline, ..opts };
+            opts.frontend().context("--width/--height")?;
+            output::write_all(&out, &generate(&opts))?;
+            eprintln!("wrote {}", out.display());
+        }
+        Command::Rom { table, format, brdf, out } => {
+            let unit = Options { brdf: brdf.plan()?, ..Options::default() }.specular_unit();
             let rom = match table {
                 RomTable::Brdf => unit.brdf_rom(),
                 RomTable::Nk => unit.nk_rom(),
             };
             let text = rom.to_text(format);
             match out {
-                Some(path) => output::write_one(&path, text.as_bytes()).map(|()| eprintln!("wrote {}", path.display())),
-                None => {
-                    print!("{text}");
-                    Ok(())
+                Some(path) => {
+                    output::write_one(&path, text.as_bytes())?;
+                    eprintln!("wrote {}", path.display());
                 }
+                None => print!("{text}"),
             }
-        }),
-        Command::SynthWrapper { rtl, module, out } => std::fs::read_to_string(rtl.join("manifest.json"))
-            .map_err(|e| format!("cannot read {}: {e}", rtl.join("manifest.json").display()))
-            .and_then(|text| hdl_gen::wrapper::ports_from_manifest(&text, &module))
-            .and_then(|ports| hdl_gen::wrapper::module(&module, &ports))
-            .and_then(|m| output::write_one(&out, m.render().as_bytes()))
-            .map(|()| eprintln!("wrote {}", out.display())),
-        Command::Testbench { config, brdf, vectors, seed, out } => config
-            .options(&brdf)
-            .and_then(|opts| hdl_gen::testbench::testbench(&opts, vectors, seed))
-            .and_then(|files| output::write_all(&out, &files))
-            .map(|()| eprintln!("wrote {}", out.display())),
-        Command::Report { report: Report::Accuracy { brdf, png } } => brdf.plan().and_then(|plan| {
-            let unit = Options { brdf: plan, ..Options::default() }.specular_unit();
+        }
+        Command::SynthWrapper { rtl, module, out } => {
+            let path = rtl.join(hdl_gen::manifest::MANIFEST_FILE);
+            let text = std::fs::read_to_string(&path).with_context(|| format!("cannot read {}", path.display()))?;
+            let ports = hdl_gen::wrapper::ports_from_manifest(&text, &module)?;
+            output::write_one(&out, hdl_gen::wrapper::module(&module, &ports)?.render().as_bytes())?;
+            eprintln!("wrote {}", out.display());
+        }
+        Command::Testbench { config, brdf, vectors, seed, out } => {
+            let opts = config.options(&brdf)?;
+            output::write_all(&out, &hdl_gen::testbench::testbench(&opts, vectors, seed)?)?;
+            eprintln!("wrote {}", out.display());
+        }
+        Command::Report { report: Report::Accuracy { brdf, svg } } => {
+            let unit = Options { brdf: brdf.plan()?, ..Options::default() }.specular_unit();
             let report = hdl_gen::report::AccuracyReport::measure(&unit);
             // The file first: a failed write then leaves no table behind either.
-            if let Some(path) = &png {
-                output::write_one(path, &report.png()?)?;
+            if let Some(path) = &svg {
+                output::write_one(path, report.svg().as_bytes())?;
                 eprintln!("wrote {}", path.display());
             }
             print!("{}", report.table());
-            Ok(())
-        }),
-    };
-    match result {
-        Ok(()) => ExitCode::SUCCESS,
-        Err(e) => {
-            eprintln!("error: {e}");
-            ExitCode::from(2)
         }
     }
+    Ok(())
 }

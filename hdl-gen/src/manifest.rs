@@ -183,10 +183,13 @@ pub struct Bfpi {
 }
 
 /// A `manifest.json` that does not read as [`Manifest`].
+///
+/// Like every error of the workspace's libraries, its message is complete on its own (the JSON
+/// error's text is in it, and not repeated as `source()`): the CLIs print it on one line.
 #[derive(Debug, thiserror::Error)]
 pub enum ManifestError {
     #[error("manifest.json: {0}")]
-    Json(#[from] serde_json::Error),
+    Json(serde_json::Error),
     #[error("manifest.json lists no module '{module}' (it lists {listed})")]
     NoModule { module: String, listed: String },
 }
@@ -194,7 +197,7 @@ pub enum ManifestError {
 impl Manifest {
     /// Reads a `manifest.json` text.
     pub fn parse(text: &str) -> Result<Manifest, ManifestError> {
-        Ok(serde_json::from_str(text)?)
+        serde_json::from_str(text).map_err(ManifestError::Json)
     }
 
     /// The entry of the module named `name`.

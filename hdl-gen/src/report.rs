@@ -1,11 +1,11 @@
 //! `hdl-gen report accuracy`: the specular unit's max relative error inside the epicentre
-//! (SPEC §4) per n, as a Markdown table and as a two-panel plot after the patent's figures
-//! 5 and 9. Every figure comes from golden's measurements; this module only arranges them.
+//! (SPEC §4) per n, as a Markdown table and as a two-panel SVG plot after the patent's figures
+//! 5 and 9 (drawn by `plotters`). Every figure comes from golden's measurements; this module only
+//! arranges them.
 
 use golden::specular::reference::approx_error;
 use golden::specular::{accuracy_table, AccuracySummary, Decoder, NAccuracy, SpecularUnit, N_MAX, N_MIN};
-use image::codecs::png::{CompressionType, FilterType, PngEncoder};
-use image::{ExtendedColorType, ImageEncoder, Rgb, RgbImage};
+use plotters::prelude::*;
 use std::fmt::Write as _;
 use std::ops::RangeInclusive;
 
@@ -121,8 +121,9 @@ impl AccuracyReport {
 
     /// Max relative error against n in two panels: the approximations (the prototype's cos^2
     /// against the configured set, after the patent's figures 5 and 9), and the RTL's total
-    /// error with the configured approximation under it for scale.
-    pub fn png(&self) -> Result<Vec<u8>, String> {
+    /// error with the configured approximation under it for scale. An SVG document: its text is
+    /// SVG text, set in the viewer's sans-serif, so drawing it needs no font files.
+    pub fn svg(&self) -> String {
         let set = ks_label(&self.decoder);
         let series = |f: &dyn Fn(u32) -> f64| (N_MIN..=N_MAX).map(f).collect::<Vec<f64>>();
         let approx = series(&|n| self.row(n).approx_vs_exact);
@@ -139,150 +140,65 @@ impl AccuracyReport {
             Curve { label: "RTL (= golden) vs exact C cos^n, C max".into(), color: BLACK, ys: series(&|n| self.row(n).model_vs_exact) },
             Curve { label: format!("approximation alone, k = {set}"), color: GREY, ys: approx },
         ];
-        let mut img = RgbImage::from_pixel(2 * PANEL_W, IMG_H, WHITE);
-        centred(&mut img, PANEL_W, 12, "max relative error inside the epicentre (SPEC 4) vs n", BLACK);
-        panel(&mut img, 0, "approximation of cos^n (f64)", &left);
-        panel(&mut img, PANEL_W, "total error of the RTL", &right);
-        let mut png = Vec::new();
-        PngEncoder::new_with_quality(&mut png, CompressionType::Best, FilterType::Adaptive)
-            .write_image(img.as_raw(), img.width(), img.height(), ExtendedColorType::Rgb8)
-            .map_err(|e| format!("cannot encode the PNG: {e}"))?;
-        Ok(png)
+        let mut svg = String::new();
+        {
+            let root = SVGBackend::with_string(&mut svg, (2 * PANEL_W, IMG_H)).into_drawing_area();
+            root.fill(&WHITE).expect(DRAWN);
+            let root = root.titled("max relative error inside the epicentre (SPEC §4) vs n", ("sans-serif", 22)).expect(DRAWN);
+            let (a, b) = root.split_horizontally(PANEL_W);
+            panel(&a, "approximation of cos^n (f64)", &left);
+            panel(&b, "total error of the RTL", &right);
+            root.present().expect(DRAWN);
+        }
+        svg
     }
 }
 
+/// Drawing into a `String` has nothing that can fail.
+const DRAWN: &str = "an SVG drawn into a String";
+
 struct Curve {
     label: String,
-    color: Rgb<u8>,
+    color: RGBColor,
     /// `ys[n - 1]`, relative error.
     ys: Vec<f64>,
 }
 
-const WHITE: Rgb<u8> = Rgb([255, 255, 255]);
-const BLACK: Rgb<u8> = Rgb([0, 0, 0]);
-const GRID: Rgb<u8> = Rgb([225, 225, 225]);
-const GREY: Rgb<u8> = Rgb([150, 150, 150]);
-const RED: Rgb<u8> = Rgb([210, 40, 30]);
-const BLUE: Rgb<u8> = Rgb([30, 80, 200]);
-const GREEN: Rgb<u8> = Rgb([20, 150, 60]);
+const GREY: RGBColor = RGBColor(150, 150, 150);
+const RED: RGBColor = RGBColor(210, 40, 30);
+const BLUE: RGBColor = RGBColor(30, 80, 200);
+const GREEN: RGBColor = RGBColor(20, 150, 60);
 
 const PANEL_W: u32 = 700;
-const IMG_H: u32 = 540;
-/// Plot box inside a panel: left, top, right, bottom.
-const BOX: (i32, i32, i32, i32) = (90, 70, 660, 400);
-/// Text is the 5x7 font doubled: 10x14 pixels a glyph, 12 a character cell.
-const SCALE: i32 = 2;
-const CELL: i32 = 6 * SCALE;
+const IMG_H: u32 = 520;
 
-fn panel(img: &mut RgbImage, x0: u32, title: &str, curves: &[Curve]) {
-    let (l, t, r, b) = (BOX.0 + x0 as i32, BOX.1, BOX.2 + x0 as i32, BOX.3);
-    centred(img, x0 + PANEL_W / 2, t - 30, title, BLACK);
-    let x_of = |n: f64| l as f64 + n.log10() / (N_MAX as f64).log10() * (r - l) as f64;
-    // y: a 1-2-5 step giving four to eight gridlines, in percent.
+/// One panel: error in percent against n on a log axis, a line per curve, the legend below.
+fn panel(area: &DrawingArea<SVGBackend, plotters::coord::Shift>, title: &str, curves: &[Curve]) {
     let top = curves.iter().flat_map(|c| &c.ys).fold(0.0f64, |a, &y| a.max(y)) * 100.0;
-    let raw = top.max(1e-6) / 6.0;
-    let mag = 10f64.powf(raw.log10().floor());
-    let step = [1.0, 2.0, 5.0, 10.0].iter().map(|m| m * mag).find(|&s| s >= raw).unwrap_or(10.0 * mag);
-    let ticks = (top / step).ceil().max(1.0) as i32;
-    let y_of = |pct: f64| b as f64 - pct / (step * ticks as f64) * (b - t) as f64;
-    let decimals = (-step.log10().floor()).max(0.0) as usize;
-    for i in 0..=ticks {
-        let v = step * i as f64;
-        let y = y_of(v).round() as i32;
-        rect(img, l, y, r, y, GRID);
-        let label = format!("{v:.decimals$}%");
-        text(img, l - 8 - CELL * label.len() as i32, y - 7, &label, BLACK);
+    let (plot, legend) = area.split_vertically(IMG_H - 110);
+    let mut chart = ChartBuilder::on(&plot)
+        .caption(title, ("sans-serif", 18))
+        .margin(12)
+        .margin_right(28)
+        .x_label_area_size(44)
+        .y_label_area_size(70)
+        .build_cartesian_2d((N_MIN as f64..N_MAX as f64).log_scale(), 0.0..top * 1.05)
+        .expect(DRAWN);
+    chart
+        .configure_mesh()
+        .x_desc("n (log scale)")
+        .y_desc("max relative error")
+        .y_label_formatter(&|v| format!("{v:.1}%"))
+        .x_label_formatter(&|v| format!("{v:.0}"))
+        .draw()
+        .expect(DRAWN);
+    for c in curves {
+        let points = c.ys.iter().enumerate().map(|(j, &y)| ((j as u32 + N_MIN) as f64, y * 100.0));
+        chart.draw_series(LineSeries::new(points, c.color.stroke_width(2))).expect(DRAWN);
     }
-    for decade in [1u32, 10, 100] {
-        for m in 2..10 {
-            let x = x_of((decade * m) as f64).round() as i32;
-            rect(img, x, t, x, b, GRID);
-            rect(img, x, b, x, b + 4, BLACK);
-        }
-    }
-    for n in [1u32, 10, 100, 1000] {
-        let x = x_of(n as f64).round() as i32;
-        rect(img, x, t, x, b, GREY);
-        rect(img, x, b, x, b + 8, BLACK);
-        centred(img, x as u32, b + 14, &n.to_string(), BLACK);
-    }
-    centred(img, x0 + PANEL_W / 2, b + 38, "n (log scale)", BLACK);
-    rect(img, l, t, l, b, BLACK);
-    rect(img, l, b, r, b, BLACK);
     for (i, c) in curves.iter().enumerate() {
-        let pts: Vec<(f64, f64)> = c.ys.iter().enumerate().map(|(j, &y)| (x_of((j as u32 + N_MIN) as f64), y_of(y * 100.0))).collect();
-        for w in pts.windows(2) {
-            line(img, w[0], w[1], c.color);
-        }
-        let y = b + 70 + 22 * i as i32;
-        line(img, (l as f64, y as f64), ((l + 40) as f64, y as f64), c.color);
-        text(img, l + 52, y - 7, &c.label, BLACK);
+        let y = 20 + 24 * i as i32;
+        legend.draw(&PathElement::new(vec![(90, y), (130, y)], c.color.stroke_width(2))).expect(DRAWN);
+        legend.draw(&Text::new(c.label.clone(), (142, y - 8), ("sans-serif", 15))).expect(DRAWN);
     }
 }
-
-/// Filled rectangle, corners inclusive, clipped to the image.
-fn rect(img: &mut RgbImage, x0: i32, y0: i32, x1: i32, y1: i32, c: Rgb<u8>) {
-    for y in y0.max(0)..=y1.min(img.height() as i32 - 1) {
-        for x in x0.max(0)..=x1.min(img.width() as i32 - 1) {
-            img.put_pixel(x as u32, y as u32, c);
-        }
-    }
-}
-
-/// A 2-pixel line, stamped every half pixel (steep jumps between n stay continuous).
-fn line(img: &mut RgbImage, a: (f64, f64), b: (f64, f64), c: Rgb<u8>) {
-    let steps = ((b.0 - a.0).abs().max((b.1 - a.1).abs()) * 2.0).ceil().max(1.0) as i32;
-    for i in 0..=steps {
-        let f = i as f64 / steps as f64;
-        let (x, y) = ((a.0 + f * (b.0 - a.0)).round() as i32, (a.1 + f * (b.1 - a.1)).round() as i32);
-        rect(img, x, y, x + 1, y + 1, c);
-    }
-}
-
-fn centred(img: &mut RgbImage, cx: u32, y: i32, s: &str, c: Rgb<u8>) {
-    text(img, cx as i32 - CELL * s.chars().count() as i32 / 2, y, s, c);
-}
-
-/// Text in the built-in font, upper case (the font has no lower case).
-fn text(img: &mut RgbImage, x: i32, y: i32, s: &str, c: Rgb<u8>) {
-    for (i, ch) in s.chars().enumerate() {
-        let rows = FONT.iter().find(|g| g.0 == ch.to_ascii_uppercase()).map_or(UNKNOWN, |g| g.1);
-        for (dy, bits) in rows.iter().enumerate() {
-            for dx in 0..5 {
-                if bits >> (4 - dx) & 1 == 1 {
-                    let (px, py) = (x + i as i32 * CELL + dx * SCALE, y + dy as i32 * SCALE);
-                    rect(img, px, py, px + SCALE - 1, py + SCALE - 1, c);
-                }
-            }
-        }
-    }
-}
-
-/// A filled box marks a character the font lacks, so a new label cannot lose one unseen.
-const UNKNOWN: [u8; 7] = [0x1f; 7];
-/// 5x7 glyphs, one row a byte, bit 4 leftmost.
-#[rustfmt::skip]
-const FONT: &[(char, [u8; 7])] = &[
-    (' ', [0, 0, 0, 0, 0, 0, 0]), ('.', [0, 0, 0, 0, 0, 0x0c, 0x0c]), (',', [0, 0, 0, 0, 0x0c, 0x04, 0x08]),
-    ('%', [0x18, 0x19, 0x02, 0x04, 0x08, 0x13, 0x03]), ('=', [0, 0, 0x1f, 0, 0x1f, 0, 0]), ('-', [0, 0, 0, 0x1f, 0, 0, 0]),
-    ('(', [0x02, 0x04, 0x08, 0x08, 0x08, 0x04, 0x02]), (')', [0x08, 0x04, 0x02, 0x02, 0x02, 0x04, 0x08]),
-    ('/', [0, 0x01, 0x02, 0x04, 0x08, 0x10, 0]), ('^', [0x04, 0x0a, 0x11, 0, 0, 0, 0]), (':', [0, 0x0c, 0x0c, 0, 0x0c, 0x0c, 0]),
-    ('0', [0x0e, 0x11, 0x13, 0x15, 0x19, 0x11, 0x0e]), ('1', [0x04, 0x0c, 0x04, 0x04, 0x04, 0x04, 0x0e]),
-    ('2', [0x0e, 0x11, 0x01, 0x02, 0x04, 0x08, 0x1f]), ('3', [0x1f, 0x02, 0x04, 0x02, 0x01, 0x11, 0x0e]),
-    ('4', [0x02, 0x06, 0x0a, 0x12, 0x1f, 0x02, 0x02]), ('5', [0x1f, 0x10, 0x1e, 0x01, 0x01, 0x11, 0x0e]),
-    ('6', [0x06, 0x08, 0x10, 0x1e, 0x11, 0x11, 0x0e]), ('7', [0x1f, 0x01, 0x02, 0x04, 0x08, 0x08, 0x08]),
-    ('8', [0x0e, 0x11, 0x11, 0x0e, 0x11, 0x11, 0x0e]), ('9', [0x0e, 0x11, 0x11, 0x0f, 0x01, 0x02, 0x0c]),
-    ('A', [0x0e, 0x11, 0x11, 0x1f, 0x11, 0x11, 0x11]), ('B', [0x1e, 0x11, 0x11, 0x1e, 0x11, 0x11, 0x1e]),
-    ('C', [0x0e, 0x11, 0x10, 0x10, 0x10, 0x11, 0x0e]), ('D', [0x1c, 0x12, 0x11, 0x11, 0x11, 0x12, 0x1c]),
-    ('E', [0x1f, 0x10, 0x10, 0x1e, 0x10, 0x10, 0x1f]), ('F', [0x1f, 0x10, 0x10, 0x1e, 0x10, 0x10, 0x10]),
-    ('G', [0x0e, 0x11, 0x10, 0x17, 0x11, 0x11, 0x0f]), ('H', [0x11, 0x11, 0x11, 0x1f, 0x11, 0x11, 0x11]),
-    ('I', [0x0e, 0x04, 0x04, 0x04, 0x04, 0x04, 0x0e]), ('J', [0x07, 0x02, 0x02, 0x02, 0x02, 0x12, 0x0c]),
-    ('K', [0x11, 0x12, 0x14, 0x18, 0x14, 0x12, 0x11]), ('L', [0x10, 0x10, 0x10, 0x10, 0x10, 0x10, 0x1f]),
-    ('M', [0x11, 0x1b, 0x15, 0x15, 0x11, 0x11, 0x11]), ('N', [0x11, 0x11, 0x19, 0x15, 0x13, 0x11, 0x11]),
-    ('O', [0x0e, 0x11, 0x11, 0x11, 0x11, 0x11, 0x0e]), ('P', [0x1e, 0x11, 0x11, 0x1e, 0x10, 0x10, 0x10]),
-    ('Q', [0x0e, 0x11, 0x11, 0x11, 0x15, 0x12, 0x0d]), ('R', [0x1e, 0x11, 0x11, 0x1e, 0x14, 0x12, 0x11]),
-    ('S', [0x0f, 0x10, 0x10, 0x0e, 0x01, 0x01, 0x1e]), ('T', [0x1f, 0x04, 0x04, 0x04, 0x04, 0x04, 0x04]),
-    ('U', [0x11, 0x11, 0x11, 0x11, 0x11, 0x11, 0x0e]), ('V', [0x11, 0x11, 0x11, 0x11, 0x11, 0x0a, 0x04]),
-    ('W', [0x11, 0x11, 0x11, 0x15, 0x15, 0x15, 0x0a]), ('X', [0x11, 0x11, 0x0a, 0x04, 0x0a, 0x11, 0x11]),
-    ('Y', [0x11, 0x11, 0x11, 0x0a, 0x04, 0x04, 0x04]), ('Z', [0x1f, 0x01, 0x02, 0x04, 0x08, 0x10, 0x1f]),
-];

@@ -16,18 +16,20 @@
 //! over the whole port ranges (including the last screen column and the extremes of I0 and dI)
 //! and zero-length spans. Specular spans come from golden's set-up of random normals and
 //! half-vectors, plus n outside 1..1000 (which the port carries: `out_err = 1`) and
-//! zero-length spans. The random source is a fixed generator seeded by `--seed`, so the same
+//! zero-length spans. Every vector comes from `golden::stimulus`, the generators the
+//! co-simulation uses, drawing from `golden::rng::SeedRng` seeded by `--seed`, so the same
 //! command always writes the same bytes.
 
 use crate::specular::SpecNames;
 use crate::verilog::{bus, comment, reg, Item, Module, Param, Port, Stmt};
 use crate::{generate, GeneratedFile, Names, Options};
-use golden::frontend::{FixedTriangle, FrontEnd};
+use golden::frontend::FixedTriangle;
+use golden::rng::SeedRng;
 use golden::segment::segments;
-use golden::setup::{triangle_spans, Screen, Triangle, Vertex};
-use golden::specular::setup::{setup_span, SpanEnds, Vec3};
 use golden::specular::{SpecularSpan, N_BITS};
+use golden::stimulus::{random_fixed_triangles, random_span, segment_spans};
 use golden::{Config, Span};
+use rand::{Rng, RngCore, SeedableRng};
 
 /// Largest `--vectors`: keeps the expected-output files within a few hundred megabytes.
 pub const MAX_VECTORS: u32 = 1_000_000;
@@ -55,47 +57,28 @@ impl BenchNames {
     }
 }
 
+/// A vector count [`testbench`] refuses: outside `1..=MAX_VECTORS`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, thiserror::Error)]
+#[error("--vectors {0} is outside 1..{MAX_VECTORS}")]
+pub struct VectorCountError(pub u32);
+
 /// Everything `generate` writes for `opts`, then both benches and their vector files.
-pub fn testbench(opts: &Options, vectors: u32, seed: u64) -> Result<Vec<GeneratedFile>, String> {
+pub fn testbench(opts: &Options, vectors: u32, seed: u64) -> Result<Vec<GeneratedFile>, VectorCountError> {
     if !(1..=MAX_VECTORS).contains(&vectors) {
-        return Err(format!("--vectors {vectors} is outside 1..{MAX_VECTORS}"));
+        return Err(VectorCountError(vectors));
     }
     let mut files = generate(opts);
     let bench = BenchNames::new(opts);
-    let mut rng = Rng::new(seed);
-    let spans = segment_spans(&opts.cfg, vectors as usize, &mut rng);
-    files.extend(segment_bench(opts, &bench.segment, &spans, rng.next_u64() as u32 | 1));
-    let spec = specular_spans(&opts.cfg, vectors as usize, &mut rng);
-    files.extend(specular_bench(opts, &bench.specular, &spec, rng.next_u64() as u32 | 1));
+    let mut rng = SeedRng::seed_from_u64(seed);
+    let spans = segment_spans(&mut rng, &opts.cfg, vectors as usize);
+    files.extend(segment_bench(opts, &bench.segment, &spans, rng.next_u32() | 1));
+    let spec = specular_spans(&mut rng, &opts.cfg, vectors as usize);
+    files.extend(specular_bench(opts, &bench.specular, &spec, rng.next_u32() | 1));
     if let Ok(hw) = opts.frontend() {
-        let tris = frontend_triangles(&hw.fe, vectors as usize, &mut rng);
-        files.extend(frontend_bench(opts, &hw, &bench.frontend, &tris, rng.next_u64() as u32 | 1));
+        let tris = random_fixed_triangles(&mut rng, &hw.fe, vectors as usize);
+        files.extend(frontend_bench(opts, &hw, &bench.frontend, &tris, rng.next_u32() | 1));
     }
     Ok(files)
-}
-
-/// `n` triangles on the front-end's ports: anywhere in the guard band (big, mostly clipped),
-/// small ones on screen, a few outside the band (dropped) and a few of zero area.
-pub fn frontend_triangles(fe: &FrontEnd, n: usize, rng: &mut Rng) -> Vec<FixedTriangle> {
-    let (w, h) = (fe.screen.width as i64 * 256, fe.screen.height as i64 * 256);
-    let imax = 255i64 << fe.cfg.frac;
-    (0..n)
-        .map(|_| {
-            let kind = rng.range(0, 9);
-            let (cx, cy) = (rng.range(0, w - 1), rng.range(0, h - 1));
-            let mut t = FixedTriangle { x: [0; 3], y: [0; 3], i: [0; 3] };
-            for k in 0..3 {
-                (t.x[k], t.y[k]) = match kind {
-                    0 => (rng.range(-w, 2 * w - 1), rng.range(-h, 2 * h - 1)),
-                    1 => (rng.range(-w - 5000, -w + 5000), cy),
-                    2 => (cx, cy),
-                    _ => ((cx + rng.range(-6000, 6000)).clamp(-w, 2 * w - 1), (cy + rng.range(-6000, 6000)).clamp(-h, 2 * h - 1)),
-                };
-                t.i[k] = rng.range(0, imax) as u32;
-            }
-            t
-        })
-        .collect()
 }
 
 fn frontend_bench(opts: &Options, hw: &crate::frontend::Hw, name: &str, tris: &[FixedTriangle], seed: u32) -> Vec<GeneratedFile> {
@@ -176,127 +159,15 @@ fn frontend_bench(opts: &Options, hw: &crate::frontend::Hw, name: &str, tris: &[
     ]
 }
 
-/// SplitMix64: a small, fixed generator, so vectors depend on the seed alone.
-pub struct Rng(u64);
-
-impl Rng {
-    pub fn new(seed: u64) -> Rng {
-        Rng(seed)
-    }
-    pub fn next_u64(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-        z ^ (z >> 31)
-    }
-    /// Uniform in `lo..=hi`.
-    pub fn range(&mut self, lo: i64, hi: i64) -> i64 {
-        debug_assert!(lo <= hi);
-        lo + (self.next_u64() % (hi - lo + 1) as u64) as i64
-    }
-    /// Uniform in [0, 1).
-    pub fn unit(&mut self) -> f64 {
-        (self.next_u64() >> 11) as f64 / (1u64 << 53) as f64
-    }
-    pub fn uniform(&mut self, lo: f64, hi: f64) -> f64 {
-        lo + (hi - lo) * self.unit()
-    }
-}
-
-/// A random triangle of log-uniform size around a point of (or near) the screen.
-fn random_triangle(rng: &mut Rng, screen: &Screen) -> Triangle {
-    let (w, h) = (screen.width as f64, screen.height as f64);
-    let radius = rng.uniform(0.3f64.ln(), (w.max(h) / 3.0).max(1.0).ln()).exp();
-    let (cx, cy) = (rng.uniform(-radius * 0.5, w + radius * 0.5), rng.uniform(-radius * 0.5, h + radius * 0.5));
-    let mut corner = || {
-        let a = rng.uniform(0.0, std::f64::consts::TAU);
-        let r = radius * rng.uniform(0.2, 1.0);
-        Vertex { x: cx + r * a.cos(), y: cy + r * a.sin(), i: rng.uniform(0.0, 255.0) }
-    };
-    Triangle { v: [corner(), corner(), corner()] }
-}
-
-/// `n` segment-shader spans: mostly golden set-up of random triangles, some raw spans over the
-/// whole port ranges, some of length 0.
-pub fn segment_spans(cfg: &Config, n: usize, rng: &mut Rng) -> Vec<Span> {
-    let max = cfg.max_len() as i64;
-    let screen = Screen { width: cfg.max_len().min(640), height: 480 };
-    let half = 1i64 << (cfg.dw() - 1);
-    let mut spans = Vec::with_capacity(n);
-    while spans.len() < n {
-        let r = rng.unit();
-        if r < 0.04 {
-            let x0 = rng.range(0, max - 1) as u32;
-            spans.push(Span { x0, len: 0, i0: rng.range(0, (1 << cfg.iw()) - 1) as u32, di: rng.range(-half, half - 1) as i32 });
-        } else if r < 0.15 {
-            let len = match rng.range(0, 3) {
-                0 => max,
-                1 => rng.range(1, max),
-                _ => rng.range(1, (4 * cfg.p as i64).min(max)),
-            };
-            // Half of them end on the last column.
-            let x0 = if rng.unit() < 0.5 { max - len } else { rng.range(0, max - len) };
-            let i0 = match rng.range(0, 3) {
-                0 => 0,
-                1 => (1 << cfg.iw()) - 1,
-                _ => rng.range(0, (1 << cfg.iw()) - 1),
-            };
-            let di = match rng.range(0, 3) {
-                0 => -half,
-                1 => half - 1,
-                _ => rng.range(-half, half - 1),
-            };
-            spans.push(Span { x0: x0 as u32, len: len as u32, i0: i0 as u32, di: di as i32 });
-        } else {
-            let t = random_triangle(rng, &screen);
-            let room = n - spans.len();
-            let mut got = Vec::new();
-            triangle_spans(cfg, &screen, &t, |_, s| got.push(s)).expect("set-up of a triangle inside the limits");
-            spans.extend(got.into_iter().take(room));
-        }
-    }
-    for s in &spans {
-        s.check(cfg).expect("every span fits the ports");
-    }
-    spans
-}
-
-fn unit_vector(rng: &mut Rng) -> Vec3 {
-    loop {
-        let v = [rng.uniform(-1.0, 1.0), rng.uniform(-1.0, 1.0), rng.uniform(-1.0, 1.0)];
-        let l = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
-        if (0.1..=1.0).contains(&l) {
-            return [v[0] / l, v[1] / l, v[2] / l];
-        }
-    }
-}
-
-/// `n` specular spans from golden's set-up: highlights crossing the span, arbitrary vectors,
-/// every k range and its boundaries, n outside 1..1000, and zero-length spans.
-pub fn specular_spans(cfg: &Config, n: usize, rng: &mut Rng) -> Vec<SpecularSpan> {
-    let max_len = (cfg.max_len() as i64).min(200);
+/// `n` specular spans: golden's random spans (every k range and its boundaries, n outside
+/// 1..1000, highlights across the span and arbitrary vectors) of up to 200 pixels, 4% of them
+/// of length zero.
+fn specular_spans(rng: &mut impl Rng, cfg: &Config, n: usize) -> Vec<SpecularSpan> {
+    let max_len = cfg.max_len().min(200);
     (0..n)
         .map(|_| {
-            let shininess = match rng.range(0, 19) {
-                0..=7 => rng.range(7, 1000),
-                8..=10 => rng.range(3, 6),
-                11 => 1,
-                12 => 2,
-                13..=16 => [1, 2, 3, 6, 7, 1000][rng.range(0, 5) as usize],
-                17 => [0, 1001, (1 << N_BITS) - 1][rng.range(0, 2) as usize],
-                _ => rng.range(1001, (1 << N_BITS) - 1),
-            } as u16;
-            let n1 = unit_vector(rng);
-            let near = |rng: &mut Rng, spread: f64| {
-                let u = unit_vector(rng);
-                [n1[0] + spread * u[0], n1[1] + spread * u[1], n1[2] + spread * u[2]]
-            };
-            let spread = if rng.unit() < 0.1 { 2.0 } else { rng.uniform(0.01, 0.8) };
-            let ends = SpanEnds { n1, h1: near(rng, spread), n2: near(rng, spread), h2: near(rng, spread) };
-            let l = rng.range(0, max_len - 1) as u32;
-            let mut s = setup_span(&ends, rng.uniform(0.5, 300.0), 1.0, shininess, l).port;
-            if rng.unit() < 0.04 {
+            let mut s = random_span(rng, max_len);
+            if rng.gen_bool(0.04) {
                 s.len = 0;
             }
             s
@@ -725,17 +596,19 @@ mod tests {
         let opts = Options::default();
         assert_eq!(testbench(&opts, 50, 7).unwrap(), testbench(&opts, 50, 7).unwrap());
         assert_ne!(testbench(&opts, 50, 7).unwrap(), testbench(&opts, 50, 8).unwrap());
-        assert!(testbench(&opts, 0, 7).is_err());
+        assert_eq!(testbench(&opts, 0, 7), Err(VectorCountError(0)));
+        assert_eq!(testbench(&opts, MAX_VECTORS + 1, 7), Err(VectorCountError(MAX_VECTORS + 1)));
     }
 
     #[test]
     fn spans_fit_the_ports_in_narrow_configurations() {
         for (p, xw) in [(1, 4), (16, 4), (256, 8), (8, 16)] {
             let cfg = Config::new(p, 12, xw, golden::Align::Screen).unwrap();
-            let spans = segment_spans(&cfg, 500, &mut Rng::new(1));
-            assert_eq!(spans.len(), 500);
+            // Enough spans that the 4% of zero-length draws come up whatever the seed.
+            let spans = segment_spans(&mut SeedRng::seed_from_u64(1), &cfg, 5000);
+            assert_eq!(spans.len(), 5000);
             assert!(spans.iter().any(|s| s.len == 0));
-            let spec = specular_spans(&cfg, 200, &mut Rng::new(2));
+            let spec = specular_spans(&mut SeedRng::seed_from_u64(2), &cfg, 200);
             assert!(spec.iter().all(|s| s.len <= cfg.max_len()));
         }
     }

@@ -14,7 +14,7 @@
 //! The ports come from the module's entry in `manifest.json`, so any module `generate` lists is
 //! covered, whatever it is.
 
-use crate::manifest::Manifest;
+use crate::manifest::{Manifest, ManifestError};
 use crate::verilog::{bit, reg, set, Dir, Item, Module, Port, Stmt};
 
 /// One port of the wrapped block, as the manifest lists it.
@@ -25,24 +25,35 @@ pub struct BlockPort {
     pub width: u32,
 }
 
+/// Why no harness is written for a module.
+#[derive(Debug, thiserror::Error)]
+pub enum WrapperError {
+    #[error(transparent)]
+    Manifest(#[from] ManifestError),
+    #[error("module '{0}' has no one-bit input clk")]
+    NoClock(String),
+    #[error("module '{0}' needs at least one input besides clk and one output")]
+    NoData(String),
+}
+
 /// The ports of `module` in a `manifest.json` text.
-pub fn ports_from_manifest(manifest: &str, module: &str) -> Result<Vec<BlockPort>, String> {
-    let m = Manifest::parse(manifest).map_err(|e| e.to_string())?;
-    let entry = m.module(module).map_err(|e| e.to_string())?;
+pub fn ports_from_manifest(manifest: &str, module: &str) -> Result<Vec<BlockPort>, ManifestError> {
+    let m = Manifest::parse(manifest)?;
+    let entry = m.module(module)?;
     Ok(entry.ports.iter().map(|p| BlockPort { name: p.name.clone(), dir: p.direction, width: p.width }).collect())
 }
 
 /// The harness module `<block>_synth` around `block`, which must have an input `clk`.
-pub fn module(block: &str, ports: &[BlockPort]) -> Result<Module, String> {
+pub fn module(block: &str, ports: &[BlockPort]) -> Result<Module, WrapperError> {
     if !ports.iter().any(|p| p.name == "clk" && p.dir == Dir::Input && p.width == 1) {
-        return Err(format!("module '{block}' has no one-bit input clk"));
+        return Err(WrapperError::NoClock(block.into()));
     }
     let ins: Vec<&BlockPort> = ports.iter().filter(|p| p.dir == Dir::Input && p.name != "clk").collect();
     let outs: Vec<&BlockPort> = ports.iter().filter(|p| p.dir == Dir::Output).collect();
     let n_in: u32 = ins.iter().map(|p| p.width).sum();
     let n_out: u32 = outs.iter().map(|p| p.width).sum();
     if n_in == 0 || n_out == 0 {
-        return Err(format!("module '{block}' needs at least one input besides clk and one output"));
+        return Err(WrapperError::NoData(block.into()));
     }
 
     let mut body = vec![Item::Comment("Input registers: one shift chain from si.".into()), reg("in_q", n_in)];
@@ -145,6 +156,9 @@ mod tests {
 
     #[test]
     fn needs_a_clock() {
-        assert!(module("blk", &[port("a", Dir::Input, 2), port("y", Dir::Output, 2)]).is_err());
+        let e = module("blk", &[port("a", Dir::Input, 2), port("y", Dir::Output, 2)]).unwrap_err();
+        assert!(matches!(&e, WrapperError::NoClock(b) if b == "blk"), "{e}");
+        let e = module("blk", &[port("clk", Dir::Input, 1), port("y", Dir::Output, 2)]).unwrap_err();
+        assert!(matches!(&e, WrapperError::NoData(b) if b == "blk"), "{e}");
     }
 }

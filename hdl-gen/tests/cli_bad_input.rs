@@ -180,7 +180,7 @@ fn report_bad_flags() {
     std::fs::create_dir_all(&dir).unwrap();
     let cases: &[(&[&str], &str)] = &[
         (&["report", "precision"], "precision"),
-        (&["report", "accuracy", "--png"], "--png"),
+        (&["report", "accuracy", "--svg"], "--svg"),
         (&["report", "accuracy", "--brdf-k"], "--brdf-k"),
         (&["report", "accuracy", "--brdf-k", "auto", "--max-rel-error", "0%"], "--max-rel-error"),
         (&["report", "accuracy", "--max-rel-error"], "--max-rel-error"),

@@ -129,32 +129,42 @@ fn report_accuracy_prints_spec_figures() {
     }
 }
 
+/// The plot is an SVG with one line of a point per n for each curve, each curve named in the
+/// legend, the same bytes for the same command.
 #[test]
-fn report_accuracy_draws_a_png() {
-    let dir = scratch("png");
-    let path = dir.join("accuracy.png");
+fn report_accuracy_draws_an_svg() {
+    let dir = scratch("svg");
+    let path = dir.join("accuracy.svg");
     let p = path.to_str().unwrap();
-    let table = succeeds(&["report", "accuracy", "--png", p]);
-    assert_eq!(table, succeeds(&["report", "accuracy"]), "the PNG does not change the table");
-    let first = std::fs::read(&path).unwrap();
-    let img = image::load_from_memory_with_format(&first, image::ImageFormat::Png).unwrap().to_rgb8();
-    assert!(img.width() >= 800 && img.height() >= 300, "{}x{}", img.width(), img.height());
-    let colours: std::collections::HashSet<_> = img.pixels().map(|p| p.0).collect();
-    assert!(colours.len() >= 4, "axes, text and curves in several colours: {colours:?}");
-    succeeds(&["report", "accuracy", "--png", p]);
-    assert_eq!(std::fs::read(&path).unwrap(), first, "same command, same bytes");
-    assert_eq!(entries(&dir), ["accuracy.png"]);
+    let table = succeeds(&["report", "accuracy", "--svg", p]);
+    assert_eq!(table, succeeds(&["report", "accuracy"]), "the plot does not change the table");
+    let first = std::fs::read_to_string(&path).unwrap();
+    assert!(first.starts_with("<svg width=\"1400\"") && first.trim_end().ends_with("</svg>"), "{}", &first[..200]);
+    let points = |l: &str| l.split("points=\"").nth(1).and_then(|p| p.split('"').next()).map_or(0, |p| p.split_whitespace().count());
+    let lines: Vec<usize> = first.split("<polyline").skip(1).map(points).collect();
+    let curves = lines.iter().filter(|&&points| points == 1000).count();
+    assert_eq!(curves, 4, "two curves a panel, a point per n: {lines:?}");
+    for label in ["cos^2(sqrt(n/2) x), prototype", "cos^k(sqrt(n/k) x), k = 1,2,4,16", "RTL (= golden) vs exact C cos^n, C max"] {
+        assert!(first.contains(label), "legend: {label}");
+    }
+    succeeds(&["report", "accuracy", "--svg", p]);
+    assert_eq!(std::fs::read_to_string(&path).unwrap(), first, "same command, same bytes");
+    assert_eq!(entries(&dir), ["accuracy.svg"]);
+    // Another table set adds the patent's curve for comparison.
+    succeeds(&["report", "accuracy", "--brdf-k", "1,2,3,9", "--svg", p]);
+    let other = std::fs::read_to_string(&path).unwrap();
+    assert!(other.contains("patent, k = 1,2,4,16") && !first.contains("patent, k ="));
 }
 
 #[test]
-fn report_accuracy_bad_png_path_exits_2_and_writes_nothing() {
-    let dir = scratch("bad-png");
-    let missing = dir.join("no-such-folder").join("accuracy.png");
-    fails(&["report", "accuracy", "--png", missing.to_str().unwrap()], missing.to_str().unwrap());
+fn report_accuracy_bad_svg_path_exits_2_and_writes_nothing() {
+    let dir = scratch("bad-svg");
+    let missing = dir.join("no-such-folder").join("accuracy.svg");
+    fails(&["report", "accuracy", "--svg", missing.to_str().unwrap()], missing.to_str().unwrap());
     // A folder in the way: the file is staged, then cannot replace it.
     let folder = dir.join("taken");
     std::fs::create_dir(&folder).unwrap();
-    fails(&["report", "accuracy", "--png", folder.to_str().unwrap()], folder.to_str().unwrap());
+    fails(&["report", "accuracy", "--svg", folder.to_str().unwrap()], folder.to_str().unwrap());
     assert_eq!(entries(&dir), ["taken"]);
     assert!(entries(&folder).is_empty());
 }

@@ -59,10 +59,19 @@ template <class M> struct SegshadeModel {
     }
 };
 
-// A model's constructor and destructor as C symbols.
+// A model's constructor and destructor as C symbols. No C++ exception crosses into Rust: `new`
+// returns null when construction throws (the harness refuses a null handle), and `free` and
+// every `step` are noexcept, so an exception there ends the process (std::terminate) instead
+// of unwinding through Rust frames.
 #define SEGSHADE_LIFETIME(CLASS, SYM)                                                        \
-    extern "C" void* SYM##_new(uint64_t seed) { return new SegshadeModel<CLASS>(seed); }      \
-    extern "C" void SYM##_free(void* h) { delete static_cast<SegshadeModel<CLASS>*>(h); }
+    extern "C" void* SYM##_new(uint64_t seed) noexcept {                                      \
+        try {                                                                                 \
+            return new SegshadeModel<CLASS>(seed);                                            \
+        } catch (...) {                                                                       \
+            return nullptr;                                                                   \
+        }                                                                                     \
+    }                                                                                         \
+    extern "C" void SYM##_free(void* h) noexcept { delete static_cast<SegshadeModel<CLASS>*>(h); }
 
 // One clock of a streaming unit (both share SPEC §3's control ports). Inputs are applied with
 // the clock low and the outputs sampled there: they are the values the rising edge sees, so a
@@ -86,7 +95,7 @@ static inline void segshade_clock(M* m, const In* in, Out* out, Data data, Sampl
 
 #define SEGSHADE_SEGMENT_SHIM(CLASS, SYM, P)                                                 \
     SEGSHADE_LIFETIME(CLASS, SYM)                                                             \
-    extern "C" void SYM##_step(void* h, const SegIn* in, SegOut* out) {                       \
+    extern "C" void SYM##_step(void* h, const SegIn* in, SegOut* out) noexcept {          \
         CLASS* m = static_cast<SegshadeModel<CLASS>*>(h)->top;                                \
         segshade_clock(                                                                       \
             m, in, out,                                                                       \
@@ -114,7 +123,7 @@ struct BfpiOut {
 // The BFPI is combinational: one evaluation per call, no clock.
 #define SEGSHADE_BFPI_SHIM(CLASS, SYM, BYTES)                                                \
     SEGSHADE_LIFETIME(CLASS, SYM)                                                             \
-    extern "C" void SYM##_step(void* h, const BfpiIn* in, BfpiOut* out) {                     \
+    extern "C" void SYM##_step(void* h, const BfpiIn* in, BfpiOut* out) noexcept {        \
         CLASS* m = static_cast<SegshadeModel<CLASS>*>(h)->top;                                \
         m->di = in->di;                                                                       \
         m->eval();                                                                            \
@@ -134,7 +143,7 @@ struct SpecOut {
 
 #define SEGSHADE_SPECULAR_SHIM(CLASS, SYM)                                                   \
     SEGSHADE_LIFETIME(CLASS, SYM)                                                             \
-    extern "C" void SYM##_step(void* h, const SpecIn* in, SpecOut* out) {                     \
+    extern "C" void SYM##_step(void* h, const SpecIn* in, SpecOut* out) noexcept {        \
         CLASS* m = static_cast<SegshadeModel<CLASS>*>(h)->top;                                \
         segshade_clock(                                                                       \
             m, in, out,                                                                       \
@@ -179,7 +188,7 @@ struct FeOut {
 // The front-end has no out_last, so it has its own clock (same order as segshade_clock).
 #define SEGSHADE_FRONTEND_SHIM(CLASS, SYM)                                                   \
     SEGSHADE_LIFETIME(CLASS, SYM)                                                             \
-    extern "C" void SYM##_step(void* h, const TriIn* in, FeOut* out) {                        \
+    extern "C" void SYM##_step(void* h, const TriIn* in, FeOut* out) noexcept {           \
         CLASS* m = static_cast<SegshadeModel<CLASS>*>(h)->top;                                \
         m->clk = 0;                                                                           \
         m->rst = in->rst;                                                                     \
@@ -211,7 +220,7 @@ struct TriSegOut {
 
 #define SEGSHADE_TRISHADER_SHIM(CLASS, SYM, P)                                               \
     SEGSHADE_LIFETIME(CLASS, SYM)                                                             \
-    extern "C" void SYM##_step(void* h, const TriIn* in, TriSegOut* out) {                    \
+    extern "C" void SYM##_step(void* h, const TriIn* in, TriSegOut* out) noexcept {       \
         CLASS* m = static_cast<SegshadeModel<CLASS>*>(h)->top;                                \
         segshade_clock(                                                                       \
             m, in, out, [&] { SEGSHADE_TRI_PORTS(m, in) },                                    \
@@ -262,7 +271,7 @@ struct WrOut {
 
 #define SEGSHADE_WRITER_SHIM(CLASS, SYM, P)                                                  \
     SEGSHADE_LIFETIME(CLASS, SYM)                                                             \
-    extern "C" void SYM##_step(void* h, const WrIn* in, WrOut* out) {                         \
+    extern "C" void SYM##_step(void* h, const WrIn* in, WrOut* out) noexcept {            \
         CLASS* m = static_cast<SegshadeModel<CLASS>*>(h)->top;                                \
         SEGSHADE_MEM_CLOCK(m, in, out, P, {                                                   \
             m->in_x = in->in_x;                                                               \
@@ -276,15 +285,96 @@ struct WrOut {
 // tri_fb_p<P>: triangles in, block writes out.
 #define SEGSHADE_TRIWRITER_SHIM(CLASS, SYM, P)                                               \
     SEGSHADE_LIFETIME(CLASS, SYM)                                                             \
-    extern "C" void SYM##_step(void* h, const TriIn* in, WrOut* out) {                        \
+    extern "C" void SYM##_step(void* h, const TriIn* in, WrOut* out) noexcept {           \
         CLASS* m = static_cast<SegshadeModel<CLASS>*>(h)->top;                                \
         SEGSHADE_MEM_CLOCK(m, in, out, P, { SEGSHADE_TRI_PORTS(m, in) }, m->err)               \
     }
 
-static_assert(sizeof(WrIn) == 304, "WrIn layout is mirrored in ffi.rs");
-static_assert(offsetof(WrIn, pix) == 16, "WrIn layout is mirrored in ffi.rs");
-static_assert(sizeof(WrOut) == 296, "WrOut layout is mirrored in ffi.rs");
-static_assert(offsetof(WrOut, data) == 8, "WrOut layout is mirrored in ffi.rs");
-static_assert(sizeof(TriIn) == 40, "TriIn layout is mirrored in ffi.rs");
-static_assert(sizeof(FeOut) == 24, "FeOut layout is mirrored in ffi.rs");
-static_assert(sizeof(TriSegOut) == 300, "TriSegOut layout is mirrored in ffi.rs");
+// The per-clock structs' layout, stated once: every field's offset and every struct's size.
+// The C++ compiler checks them here; build.rs reads these lines and has the Rust compiler check
+// the same numbers against ffi.rs's #[repr(C)] structs (generated `const` asserts in models.rs),
+// so neither side can drift from the other. A new field gets a line here.
+#define SEGSHADE_OFFSET(S, F, N) static_assert(offsetof(S, F) == N, #S "." #F " is at byte " #N " (ffi.rs agrees)")
+#define SEGSHADE_SIZE(S, N) static_assert(sizeof(S) == N, #S " is " #N " bytes (ffi.rs agrees)")
+SEGSHADE_OFFSET(SegIn, in_x, 0);
+SEGSHADE_OFFSET(SegIn, in_len, 4);
+SEGSHADE_OFFSET(SegIn, in_i0, 8);
+SEGSHADE_OFFSET(SegIn, in_di, 12);
+SEGSHADE_OFFSET(SegIn, rst, 16);
+SEGSHADE_OFFSET(SegIn, in_valid, 17);
+SEGSHADE_OFFSET(SegIn, out_ready, 18);
+SEGSHADE_OFFSET(SegIn, keep, 19);
+SEGSHADE_SIZE(SegIn, 20);
+SEGSHADE_OFFSET(SegOut, out_x, 0);
+SEGSHADE_OFFSET(SegOut, in_ready, 4);
+SEGSHADE_OFFSET(SegOut, out_valid, 5);
+SEGSHADE_OFFSET(SegOut, out_last, 6);
+SEGSHADE_OFFSET(SegOut, pix, 7);
+SEGSHADE_OFFSET(SegOut, mask, 263);
+SEGSHADE_SIZE(SegOut, 296);
+SEGSHADE_OFFSET(BfpiIn, di, 0);
+SEGSHADE_SIZE(BfpiIn, 4);
+SEGSHADE_OFFSET(BfpiOut, inc, 0);
+SEGSHADE_SIZE(BfpiOut, 1024);
+SEGSHADE_OFFSET(SpecIn, in_c, 0);
+SEGSHADE_OFFSET(SpecIn, in_n, 4);
+SEGSHADE_OFFSET(SpecIn, in_theta0, 8);
+SEGSHADE_OFFSET(SpecIn, in_dtheta, 12);
+SEGSHADE_OFFSET(SpecIn, in_len, 16);
+SEGSHADE_OFFSET(SpecIn, rst, 20);
+SEGSHADE_OFFSET(SpecIn, in_valid, 21);
+SEGSHADE_OFFSET(SpecIn, out_ready, 22);
+SEGSHADE_OFFSET(SpecIn, keep, 23);
+SEGSHADE_SIZE(SpecIn, 24);
+SEGSHADE_OFFSET(SpecOut, out_spec, 0);
+SEGSHADE_OFFSET(SpecOut, in_ready, 2);
+SEGSHADE_OFFSET(SpecOut, out_valid, 3);
+SEGSHADE_OFFSET(SpecOut, out_last, 4);
+SEGSHADE_OFFSET(SpecOut, out_err, 5);
+SEGSHADE_SIZE(SpecOut, 6);
+SEGSHADE_OFFSET(TriIn, x, 0);
+SEGSHADE_OFFSET(TriIn, y, 12);
+SEGSHADE_OFFSET(TriIn, i, 24);
+SEGSHADE_OFFSET(TriIn, rst, 36);
+SEGSHADE_OFFSET(TriIn, in_valid, 37);
+SEGSHADE_OFFSET(TriIn, out_ready, 38);
+SEGSHADE_OFFSET(TriIn, keep, 39);
+SEGSHADE_SIZE(TriIn, 40);
+SEGSHADE_OFFSET(FeOut, out_x, 0);
+SEGSHADE_OFFSET(FeOut, out_len, 4);
+SEGSHADE_OFFSET(FeOut, out_i0, 8);
+SEGSHADE_OFFSET(FeOut, out_di, 12);
+SEGSHADE_OFFSET(FeOut, out_y, 16);
+SEGSHADE_OFFSET(FeOut, in_ready, 20);
+SEGSHADE_OFFSET(FeOut, out_valid, 21);
+SEGSHADE_OFFSET(FeOut, err, 22);
+SEGSHADE_OFFSET(FeOut, pad, 23);
+SEGSHADE_SIZE(FeOut, 24);
+SEGSHADE_OFFSET(TriSegOut, out_x, 0);
+SEGSHADE_OFFSET(TriSegOut, out_y, 4);
+SEGSHADE_OFFSET(TriSegOut, in_ready, 8);
+SEGSHADE_OFFSET(TriSegOut, out_valid, 9);
+SEGSHADE_OFFSET(TriSegOut, out_last, 10);
+SEGSHADE_OFFSET(TriSegOut, err, 11);
+SEGSHADE_OFFSET(TriSegOut, pix, 12);
+SEGSHADE_OFFSET(TriSegOut, mask, 268);
+SEGSHADE_SIZE(TriSegOut, 300);
+SEGSHADE_OFFSET(WrIn, in_x, 0);
+SEGSHADE_OFFSET(WrIn, in_y, 4);
+SEGSHADE_OFFSET(WrIn, rst, 8);
+SEGSHADE_OFFSET(WrIn, in_valid, 9);
+SEGSHADE_OFFSET(WrIn, out_ready, 10);
+SEGSHADE_OFFSET(WrIn, keep, 11);
+SEGSHADE_OFFSET(WrIn, in_last, 12);
+SEGSHADE_OFFSET(WrIn, pad, 13);
+SEGSHADE_OFFSET(WrIn, pix, 16);
+SEGSHADE_OFFSET(WrIn, mask, 272);
+SEGSHADE_SIZE(WrIn, 304);
+SEGSHADE_OFFSET(WrOut, mem_addr, 0);
+SEGSHADE_OFFSET(WrOut, in_ready, 4);
+SEGSHADE_OFFSET(WrOut, out_valid, 5);
+SEGSHADE_OFFSET(WrOut, err, 6);
+SEGSHADE_OFFSET(WrOut, pad, 7);
+SEGSHADE_OFFSET(WrOut, data, 8);
+SEGSHADE_OFFSET(WrOut, we, 264);
+SEGSHADE_SIZE(WrOut, 296);

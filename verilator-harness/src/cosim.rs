@@ -9,15 +9,17 @@
 
 use crate::driver::{Check, Driver, Unit};
 use crate::ffi::{to_port, ModelInfo, Rtl, SegIn, SegOut};
+use crate::report::Mismatch;
 use crate::traffic::TrafficGen;
 use golden::raster::{compare, reference_triangle, Frame, RefFrame};
 use golden::segment::{segment, Segment};
 use golden::setup::{triangle_spans, Screen, Triangle};
 use golden::{Config, Span};
-use std::collections::BTreeSet;
-use std::fmt;
 
+// The vocabulary of a run, re-exported where the suites and binaries find it with the segment
+// shader's co-simulation: its report, its stress and its traffic.
 pub use crate::driver::{Stress, DRAIN_CLOCKS};
+pub use crate::report::{assert_clean, Report};
 pub use crate::traffic::Traffic;
 
 /// A span with where it came from, for failure messages.
@@ -28,110 +30,16 @@ pub struct Stim {
     pub span: Span,
 }
 
-/// One disagreement between the RTL and golden.
-#[derive(Clone, Debug)]
-pub struct Mismatch {
-    pub triangle: Option<usize>,
-    pub context: String,
-    pub what: String,
-}
-
-impl fmt::Display for Mismatch {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match self.triangle {
-            Some(t) => write!(f, "triangle {t}: {}: {}", self.context, self.what),
-            None => write!(f, "{}: {}", self.context, self.what),
-        }
-    }
-}
-
-/// Counts of one run; [`Report::absorb`] adds another run's.
-#[derive(Clone, Debug, Default)]
-pub struct Report {
-    pub triangles: usize,
-    pub spans: u64,
-    pub segments: u64,
-    pub pixels: u64,
-    pub cycles: u64,
-    pub failed: BTreeSet<usize>,
-    pub mismatch_count: u64,
-    /// The first mismatches, in full.
-    pub mismatches: Vec<Mismatch>,
-    /// Worst |pixel - exact plane| over all frames compared with the f64 reference.
-    pub max_error: f64,
-    /// Resets injected by [`Stress`], and the accepted spans they cut short.
-    pub resets: u64,
-    pub cut_spans: u64,
-    /// Side pulses the unit raised (the front-end's guard-band `err`).
-    pub pulses: u64,
-    /// The waveforms written for failures (COSIM_TRACE, `--trace`: [`crate::waveform`]), each
-    /// also named in its mismatch's message.
-    pub waveforms: Vec<crate::waveform::Waveform>,
-}
-
-const KEEP_MISMATCHES: usize = 20;
-
-impl Report {
-    /// Adds `other`'s counts and mismatches to this report's (its mismatches after these).
-    pub fn absorb(&mut self, other: Report) {
-        self.triangles += other.triangles;
-        self.spans += other.spans;
-        self.segments += other.segments;
-        self.pixels += other.pixels;
-        self.cycles += other.cycles;
-        self.failed.extend(other.failed);
-        self.mismatch_count += other.mismatch_count;
-        let room = KEEP_MISMATCHES.saturating_sub(self.mismatches.len());
-        self.mismatches.extend(other.mismatches.into_iter().take(room));
-        self.max_error = self.max_error.max(other.max_error);
-        self.resets += other.resets;
-        self.cut_spans += other.cut_spans;
-        self.pulses += other.pulses;
-        self.waveforms.extend(other.waveforms);
-    }
-
-    pub fn mismatch(&mut self, m: Mismatch) {
-        self.mismatch_count += 1;
-        if let Some(t) = m.triangle {
-            self.failed.insert(t);
-        }
-        if self.mismatches.len() < KEEP_MISMATCHES {
-            self.mismatches.push(m);
-        }
-    }
-
-    pub fn ok(&self) -> bool {
-        self.mismatch_count == 0
-    }
-
-    /// Triangles that failed; a mismatch no triangle can be blamed for counts as one.
-    pub fn failed_count(&self) -> usize {
-        if !self.ok() && self.failed.is_empty() {
-            1
-        } else {
-            self.failed.len()
-        }
-    }
-
-    pub fn passed_count(&self) -> usize {
-        self.triangles - self.failed.len().min(self.triangles)
-    }
-
-    pub fn pixels_per_clock(&self) -> f64 {
-        self.pixels as f64 / self.cycles.max(1) as f64
-    }
-}
-
-/// Stops a test with every mismatch it kept, the seed and the replay hint.
-pub fn assert_clean(what: &str, seed: u64, report: &Report) {
-    if report.ok() {
-        return;
-    }
-    let mut msg = format!("{what}: {} mismatches (seed {seed}, replay with COSIM_SEED={seed})\n", report.mismatch_count);
-    for m in &report.mismatches {
-        msg.push_str(&format!("  {m}\n"));
-    }
-    panic!("{msg}");
+/// A span the segment shader's ports cannot carry ([`SegmentCosim::try_stream`]); nothing
+/// was streamed.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, thiserror::Error)]
+#[error("span {index} (triangle {triangle}, y = {y}) rejected: {error}")]
+pub struct SpanRejected {
+    /// The span's index in the stream.
+    pub index: usize,
+    pub triangle: usize,
+    pub y: u32,
+    pub error: golden::SpanError,
 }
 
 /// A segment offered by the model, as the checker sees it: `out_x`, `out_last` and the lane
@@ -357,10 +265,15 @@ impl SegmentCosim {
     /// Besides the scoreboard, a protocol monitor checks SPEC §3's valid/ready rules on the
     /// output: a segment offered and not taken stays offered, unchanged, in the next clock; in
     /// the first clock after a reset `out_valid` is low.
-    pub fn try_stream(&mut self, stims: &[Stim], report: &mut Report, paint: impl FnMut(&Stim, &SegView) + Send) -> Result<(), String> {
+    pub fn try_stream(
+        &mut self,
+        stims: &[Stim],
+        report: &mut Report,
+        paint: impl FnMut(&Stim, &SegView) + Send,
+    ) -> Result<(), SpanRejected> {
         let cfg = self.unit.cfg;
-        for (k, s) in stims.iter().enumerate() {
-            s.span.check(&cfg).map_err(|e| format!("span {k} (triangle {}, y = {}) rejected: {e}", s.triangle, s.y))?;
+        for (index, s) in stims.iter().enumerate() {
+            s.span.check(&cfg).map_err(|error| SpanRejected { index, triangle: s.triangle, y: s.y, error })?;
         }
         let check = SegCheck { unit: &self.unit, stims, row_of: None, row: &mut self.row, paint };
         self.driver.stream(&self.unit, stims, report, check);
@@ -502,4 +415,70 @@ pub(crate) fn agrees(out: &SegView, span: &Span, seg: &Segment, row: &[u8], p: u
 
 pub(crate) fn describe(s: &Stim) -> String {
     format!("span y = {} x0 = {} len = {} i0 = {} di = {}", s.y, s.span.x0, s.span.len, s.span.i0, s.span.di)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use golden::rng::SeedRng;
+    use golden::segment::segments;
+    use golden::Align;
+    use rand::{Rng, SeedableRng};
+
+    /// Golden's segment as the model would offer it: in-span lanes enabled with their pixels,
+    /// the other lanes off, holding `junk`.
+    fn offered(cfg: &Config, span: &Span, seg: &Segment, junk: u8) -> ([u8; 256], [u8; 32]) {
+        let (mut pix, mut mask) = ([junk; 256], [0u8; 32]);
+        for i in 0..cfg.p {
+            if let Some(j) = seg.lane_pixel(i) {
+                pix[i as usize] = span.pixel(j, cfg.frac);
+                mask[(i / 8) as usize] |= 1 << (i % 8);
+            }
+        }
+        (pix, mask)
+    }
+
+    /// The scoreboard's fast path (`agrees`) is `check_lanes` made fast: on golden's own segment
+    /// both pass and count the same pixels, whatever the masked-off lanes hold; and every single
+    /// corruption (a pixel of an enabled lane, a mask bit, `out_x`, `out_last`) fails both.
+    #[test]
+    fn agrees_is_check_lanes_fast() {
+        let mut rng = SeedRng::seed_from_u64(13);
+        for p in [1, 2, 4, 8, 16, 64, 256] {
+            for align in Align::ALL {
+                let cfg = Config { p, align, ..Config::default() };
+                let mut row = golden_row(&cfg);
+                let half = 1i32 << (cfg.dw() - 1);
+                for _ in 0..60 {
+                    let x0 = rng.gen_range(0..cfg.max_len());
+                    let len = rng.gen_range(1..=(cfg.max_len() - x0).min(4 * p + 3));
+                    let span = Span { x0, len, i0: rng.gen_range(0..1 << cfg.iw()), di: rng.gen_range(-half..half) };
+                    let stim = Stim { triangle: 0, y: 0, span };
+                    row.write_span(0, &span, cfg.frac);
+                    for seg in segments(&cfg, &span) {
+                        let check = |pix: &[u8], mask: &[u8], x: u32, last: bool| {
+                            let view = SegView { out_x: x, out_last: last, pix, mask };
+                            let mut report = Report::default();
+                            check_lanes(&cfg, &stim, &seg, &view, &mut report);
+                            (agrees(&view, &span, &seg, row.pixels(), p), report.ok().then_some(report.pixels))
+                        };
+                        let (pix, mask) = offered(&cfg, &span, &seg, rng.gen());
+                        let (fast, slow) = check(&pix, &mask, seg.x, seg.last);
+                        assert!(fast.is_some() && fast == slow, "p {p} {align} {span:?} segment {}: {fast:?} {slow:?}", seg.index);
+                        let on: Vec<u32> = (0..p).filter(|&i| seg.lane_pixel(i).is_some()).collect();
+                        let lane = on[rng.gen_range(0..on.len())] as usize;
+                        let mut bad = pix;
+                        bad[lane] ^= 1 << rng.gen_range(0..8);
+                        assert_eq!(check(&bad, &mask, seg.x, seg.last), (None, None), "pixel of lane {lane}");
+                        let bit = rng.gen_range(0..p) as usize;
+                        let mut bad = mask;
+                        bad[bit / 8] ^= 1 << (bit % 8);
+                        assert_eq!(check(&pix, &bad, seg.x, seg.last), (None, None), "mask bit {bit}");
+                        assert_eq!(check(&pix, &mask, seg.x ^ 1, seg.last), (None, None), "out_x");
+                        assert_eq!(check(&pix, &mask, seg.x, !seg.last), (None, None), "out_last");
+                    }
+                }
+            }
+        }
+    }
 }

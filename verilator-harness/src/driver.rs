@@ -13,10 +13,11 @@
 //! With waveforms on ([`crate::waveform`]), the driver also keeps a tape of its model's inputs,
 //! and the first mismatch of the run names the FST file of its clocks and its clock.
 
-use crate::cosim::{Mismatch, Report};
-use crate::ffi::Rtl;
+use crate::ffi::{Control, Handshake, Rtl};
+use crate::report::{Mismatch, Report};
+use crate::tape::{NoTape, Recorder, Tape};
 use crate::traffic::TrafficGen;
-use crate::waveform::{NoTape, Recorder, Tape, Waveform, AFTER, BEFORE};
+use crate::waveform::{TraceError, Waveform, AFTER, BEFORE};
 use rand::Rng;
 use std::collections::VecDeque;
 use std::path::PathBuf;
@@ -121,21 +122,6 @@ impl<const ON: bool> Pacer<ON> {
             self.gap_left = self.rng.gen_range(1..=self.stress.gap_max.max(1));
         }
     }
-}
-
-/// The control inputs of a streaming unit.
-pub trait Control: Copy + Default + 'static {
-    fn set_control(&mut self, rst: bool, in_valid: bool, out_ready: bool);
-    /// Whether the next step may leave the data ports as the last one wrote them.
-    fn keep_data(&mut self, keep: bool);
-    /// What the two above set: `rst | in_valid << 1 | out_ready << 2 | keep << 3`.
-    fn control(&self) -> u8;
-}
-
-/// The handshake outputs of a streaming unit.
-pub trait Handshake: Copy + Default + 'static {
-    fn in_ready(&self) -> bool;
-    fn out_valid(&self) -> bool;
 }
 
 /// What the driving thread knows of a unit: how a span goes onto its ports, how many outputs
@@ -383,8 +369,7 @@ impl<U: Unit> Driver<U> {
             // Nothing was taped: the model has no twin to replay into (a traced model always
             // has a tape). The note goes on this stream's first mismatch.
             (_, None) => {
-                let tag = self.rtl.info().tag;
-                let note = format!("COSIM_TRACE: no waveform: this build has no traced model of {tag} (build with COSIM_TRACE set)");
+                let note = format!("COSIM_TRACE: no waveform: {}", TraceError::NoTwin(self.rtl.info().tag));
                 annotate(report.mismatches.get_mut(kept).or(checked.mismatches.first_mut()), &note);
                 self.waves = Waves::Done;
                 return;
@@ -409,26 +394,26 @@ impl<U: Unit> Driver<U> {
     /// The waveform of a failure in clock `clock`: the traced model's own file, or the tape's
     /// window around `clock` replayed into the model's twin, written and checked whole.
     #[cold]
-    fn waveform(&self, tape: &Tape<U::In>, clock: u64) -> Result<Waveform, String> {
+    fn waveform(&self, tape: &Tape<U::In>, clock: u64) -> Result<Waveform, TraceError> {
         let dir = match &self.waves {
             Waves::Live => {
                 let path = self.rtl.waves().expect("a traced model has a file").to_path_buf();
                 return Ok(Waveform { path, clock, window: None });
             }
             Waves::OnFailure(dir) => dir,
-            Waves::Off | Waves::Done => return Err("waveforms are off".into()),
+            Waves::Off | Waves::Done => return Err(TraceError::Off),
         };
         let (first, last) = tape.clocks();
         let (from, to) = (clock.saturating_sub(BEFORE).max(first), (clock + AFTER).min(last));
         let info = self.rtl.info();
-        std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+        std::fs::create_dir_all(dir).map_err(|error| TraceError::Io { path: dir.clone(), error })?;
         let path = dir.join(format!("{}-seed{}-clock{clock}.fst", info.tag, self.rtl.seed()));
         let mut twin = Rtl::traced(info, self.rtl.seed())?;
         tape.replay(&mut twin, from, to, &path)?;
         drop(twin);
-        let file = crate::waveform::check_fst(&path).map_err(|e| format!("written but unreadable: {e}"))?;
+        let file = crate::waveform::check_fst(&path).map_err(TraceError::Unreadable)?;
         if (file.first, file.last) != (from, to) {
-            return Err(format!("{} holds clocks {} to {}, not {from} to {to}", path.display(), file.first, file.last));
+            return Err(TraceError::Window { path, held: (file.first, file.last), wanted: (from, to) });
         }
         Ok(Waveform { path, clock, window: Some((from, to)) })
     }
@@ -632,4 +617,176 @@ fn consume(rx: Receiver<Batch>, back: SyncSender<Batch>, rb: usize, mut check: i
         let _ = back.try_send(batch);
     }
     (report, first_bad)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::ffi::{require_segment_model, to_port, SegIn, SegOut};
+    use crate::traffic::Traffic;
+    use golden::{Align, Config, Span};
+    use std::sync::{Arc, Mutex};
+
+    /// The driver's view of a segment shader, as little as the driver needs: a record is
+    /// `out_x | out_last << 31`, and `extra` segments are claimed beyond what golden says each
+    /// span owes (a negative control: a unit that miscounts).
+    struct Segments {
+        cfg: Config,
+        extra: i32,
+    }
+
+    impl Unit for Segments {
+        type In = SegIn;
+        type Out = SegOut;
+        type Span = Span;
+        fn record_bytes(&self) -> usize {
+            4
+        }
+        fn load(&self, input: &mut SegIn, s: &Span) {
+            (input.in_x, input.in_len, input.in_i0, input.in_di) = (s.x0, s.len, s.i0, to_port(s.di as i64, self.cfg.dw()));
+        }
+        fn owed(&self, s: &Span) -> u32 {
+            (self.cfg.segment_count(s.x0, s.len) as i32 + self.extra).max(0) as u32
+        }
+        fn record(&self, out: &SegOut, rec: &mut [u8]) {
+            rec.copy_from_slice(&(out.out_x | (out.out_last as u32) << 31).to_le_bytes());
+        }
+        fn same(&self, held: &[u8], out: &SegOut) -> bool {
+            let mut now = [0; 4];
+            self.record(out, &mut now);
+            held == now
+        }
+        fn describe_change(&self, _held: &[u8], _out: &SegOut) -> String {
+            "changed".into()
+        }
+        fn blame(&self, k: usize, _s: &Span) -> (Option<usize>, String) {
+            (Some(k), format!("span {k}"))
+        }
+    }
+
+    /// (span, output, record) of one output the checker got.
+    type Got = (usize, u32, u32);
+
+    /// Every output the checker got, in order.
+    #[derive(Clone, Default)]
+    struct Seen(Arc<Mutex<Vec<Got>>>);
+
+    impl Check for Seen {
+        fn check(&mut self, k: usize, j: u32, rec: &[u8], _report: &mut Report) {
+            self.0.lock().unwrap().push((k, j, u32::from_le_bytes(rec.try_into().unwrap())));
+        }
+    }
+
+    fn spans(n: u32) -> Vec<Span> {
+        (0..n).map(|k| Span { x0: (k * 7) % 200, len: k % 23, i0: 100 << 12, di: 1 << 10 }).collect()
+    }
+
+    /// Runs `spans` through `seg_p2_span` with `unit` under `traffic` and `stress`; `None` when
+    /// this build has no such model (COSIM_RTL_DIR).
+    fn run(unit: &Segments, spans: &[Span], traffic: Traffic, stress: Stress) -> Option<(Report, Vec<Got>)> {
+        let info = require_segment_model(2, Align::Span, "driver: its own tests")?;
+        let mut d = Driver::<Segments>::new(Rtl::new(info, 3), TrafficGen::new(traffic, 3));
+        d.set_waveforms(None);
+        d.stress = stress;
+        let (mut report, seen) = (Report::default(), Seen::default());
+        d.stream(unit, spans, &mut report, seen.clone());
+        let got = seen.0.lock().unwrap().clone();
+        Some((report, got))
+    }
+
+    /// Every output golden owes reaches the checker once, in order (span by span, each span's
+    /// outputs numbered from 0), with golden's x and last flag; the counts add up.
+    #[test]
+    fn every_owed_output_reaches_the_checker_in_order() {
+        let cfg = Config { p: 2, ..Config::default() };
+        let unit = Segments { cfg, extra: 0 };
+        let s = spans(300);
+        for traffic in [Traffic::FULL, Traffic::RANDOM] {
+            let Some((report, got)) = run(&unit, &s, traffic, Stress::BURSTS) else { return };
+            assert!(report.ok(), "{:?}", report.mismatches);
+            assert_eq!(report.spans, s.len() as u64);
+            let want: Vec<Got> = s
+                .iter()
+                .enumerate()
+                .flat_map(|(k, sp)| golden::segment::segments(&cfg, sp).map(move |g| (k, g.index, g.x | (g.last as u32) << 31)))
+                .collect();
+            assert_eq!(got, want);
+        }
+    }
+
+    /// With resets, a span cut short stops early and nothing of it comes later: per span the
+    /// output numbers run 0, 1, 2, ... and spans come in order; resets and cuts are counted.
+    #[test]
+    fn resets_cut_spans_and_nothing_stale_follows() {
+        let unit = Segments { cfg: Config { p: 2, ..Config::default() }, extra: 0 };
+        let Some((report, got)) = run(&unit, &spans(2000), Traffic::RANDOM, Stress::HARSH) else { return };
+        assert!(report.ok(), "{:?}", report.mismatches);
+        assert!(report.resets > 0 && report.cut_spans > 0, "{report:?}");
+        for w in got.windows(2) {
+            let ((k0, j0, _), (k1, j1, _)) = (w[0], w[1]);
+            assert!((k1 == k0 && j1 == j0 + 1) || (k1 > k0 && j1 == 0), "{:?} then {:?}", w[0], w[1]);
+        }
+    }
+
+    /// Negative controls of the protocol monitor: a unit that owes one output too few sees
+    /// output with no span outstanding; one that owes one too many sees the model stop, and the
+    /// driver declares it hung instead of waiting forever.
+    #[test]
+    fn miscounted_outputs_are_mismatches() {
+        let cfg = Config { p: 2, ..Config::default() };
+        let s: Vec<Span> = spans(40).into_iter().filter(|s| s.len > 0).collect();
+        let Some((few, _)) = run(&Segments { cfg, extra: -1 }, &s, Traffic::RANDOM, Stress::NONE) else { return };
+        assert!(few.mismatches.iter().any(|m| m.what == "output with no span outstanding"), "{:?}", few.mismatches);
+        let Some((many, _)) = run(&Segments { cfg, extra: 1 }, &s, Traffic::RANDOM, Stress::NONE) else { return };
+        assert!(
+            many.mismatches.iter().any(|m| m.what.starts_with(&format!("no transfer for {STALL_LIMIT} clocks"))),
+            "{:?}",
+            many.mismatches
+        );
+    }
+
+    /// The checking thread hands back the index, in transfer order, of the first output that
+    /// failed, over batches; the driver names the waveform after it.
+    #[test]
+    fn the_checker_names_its_first_failing_output() {
+        struct FailFrom(usize, usize);
+        impl Check for FailFrom {
+            fn check(&mut self, _k: usize, _j: u32, _rec: &[u8], report: &mut Report) {
+                if self.1 >= self.0 {
+                    report.mismatch(Mismatch { triangle: None, context: String::new(), what: "planted".into() });
+                }
+                self.1 += 1;
+            }
+        }
+        let (tx, rx) = sync_channel(IN_FLIGHT);
+        let (back, _back_rx) = sync_channel(IN_FLIGHT + 2);
+        let rb = 4;
+        let per = Batch::records(rb);
+        let sender = std::thread::spawn(move || {
+            for b in 0..3 {
+                let mut batch = Batch::new(rb);
+                for r in 0..per {
+                    batch.at.push((b, r as u32));
+                }
+                tx.send(batch).unwrap();
+            }
+        });
+        let (report, first_bad) = consume(rx, back, rb, FailFrom(per + 5, 0));
+        sender.join().unwrap();
+        assert_eq!(first_bad, Some(per + 5));
+        assert_eq!(report.mismatch_count, (3 * per - per - 5) as u64);
+    }
+
+    /// Without stress the pacer is the plain traffic, draw for draw (the benches' stream).
+    #[test]
+    fn an_unstressed_pacer_is_the_plain_traffic() {
+        let (mut plain, mut pacer) =
+            (TrafficGen::new(Traffic::RANDOM, 9), Pacer::<false>::new(Stress::NONE, TrafficGen::new(Traffic::RANDOM, 9)));
+        for _ in 0..10_000 {
+            plain.clock();
+            pacer.clock();
+            assert!(!pacer.reset());
+            assert_eq!((pacer.offer(), pacer.ready()), (plain.offer(), plain.ready()));
+        }
+    }
 }

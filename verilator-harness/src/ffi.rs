@@ -2,8 +2,8 @@
 //! free); `step` takes every input of one clock in one struct and returns every output in
 //! another, so a clock costs one FFI call whatever the port count.
 
-use crate::driver::{Control, Handshake};
-use golden::specular::{Decoder, DecoderRepr, KRange, SpecularPlan, SpecularUnit};
+use crate::waveform::TraceError;
+use golden::specular::{Decoder, DecoderRepr, KRange, PlanError, SpecularPlan, SpecularUnit};
 use golden::{Align, Config};
 use std::ffi::{c_char, c_int, c_void, CString};
 use std::path::{Path, PathBuf};
@@ -203,15 +203,24 @@ impl Default for WrOut {
     }
 }
 
-// The C++ side (csrc/shim.h) asserts the same sizes.
-const _: () = assert!(std::mem::size_of::<WrIn>() == 304);
-const _: () = assert!(std::mem::offset_of!(WrIn, pix) == 16);
-const _: () = assert!(std::mem::size_of::<WrOut>() == 296);
-const _: () = assert!(std::mem::offset_of!(WrOut, data) == 8);
-const _: () = assert!(std::mem::size_of::<TriIn>() == 40);
-const _: () = assert!(std::mem::size_of::<FeOut>() == 24);
-const _: () = assert!(std::mem::size_of::<TriSegOut>() == 300);
-const _: () = assert!(std::mem::offset_of!(TriSegOut, pix) == 12);
+// Every struct's size and field offsets are stated once, in csrc/shim.h (SEGSHADE_OFFSET,
+// SEGSHADE_SIZE), where the C++ compiler checks them; build.rs turns the same lines into
+// `const` asserts on these structs in models.rs, included below.
+
+/// The control inputs of a streaming unit.
+pub trait Control: Copy + Default + 'static {
+    fn set_control(&mut self, rst: bool, in_valid: bool, out_ready: bool);
+    /// Whether the next step may leave the data ports as the last one wrote them.
+    fn keep_data(&mut self, keep: bool);
+    /// What the two above set: `rst | in_valid << 1 | out_ready << 2 | keep << 3`.
+    fn control(&self) -> u8;
+}
+
+/// The handshake outputs of a streaming unit.
+pub trait Handshake: Copy + Default + 'static {
+    fn in_ready(&self) -> bool;
+    fn out_valid(&self) -> bool;
+}
 
 /// The control inputs and handshake outputs the streaming units share.
 macro_rules! streaming_ports {
@@ -247,7 +256,8 @@ streaming_ports!(SpecIn, SpecOut);
 streaming_ports!(TriIn, FeOut, TriSegOut, WrOut);
 streaming_ports!(WrIn);
 
-/// A linked model: its configuration and its three symbols.
+/// A linked model: its configuration and its three symbols. The symbols are private: only
+/// [`Rtl`], which owns what `new` returns, calls them.
 pub struct ModelInfo<I: 'static, O: 'static> {
     /// `seg_p8_span`, `bfpi_p8`, ...: also the Verilator class suffix.
     pub tag: &'static str,
@@ -262,9 +272,9 @@ pub struct ModelInfo<I: 'static, O: 'static> {
     pub screen: golden::setup::Screen,
     /// Where a front-end model's `dI` comes from (`--fe-di`).
     pub di: golden::frontend::DiMode,
-    pub new: unsafe extern "C" fn(u64) -> *mut c_void,
-    pub free: unsafe extern "C" fn(*mut c_void),
-    pub step: unsafe extern "C" fn(*mut c_void, *const I, *mut O),
+    new: unsafe extern "C" fn(u64) -> *mut c_void,
+    free: unsafe extern "C" fn(*mut c_void),
+    step: unsafe extern "C" fn(*mut c_void, *const I, *mut O),
     /// Its traced twin, when this build has one (see [`crate::waveform`]).
     pub traced: Option<TracedModel<I, O>>,
 }
@@ -272,19 +282,26 @@ pub struct ModelInfo<I: 'static, O: 'static> {
 /// A model's traced twin (`verilator --trace-fst`, `csrc/trace.h`): the same RTL and the same
 /// per-clock structs, and an FST file it dumps every clock into while one is open. build.rs
 /// builds one for every streaming model when COSIM_TRACE is set, and for `seg_p2_span` always.
-#[derive(Clone, Copy)]
 pub struct TracedModel<I: 'static, O: 'static> {
     /// `<tag>_tr`: its symbol prefix and the suffix of its Verilator class.
     pub tag: &'static str,
-    pub new: unsafe extern "C" fn(u64) -> *mut c_void,
-    pub free: unsafe extern "C" fn(*mut c_void),
-    pub step: unsafe extern "C" fn(*mut c_void, *const I, *mut O),
+    new: unsafe extern "C" fn(u64) -> *mut c_void,
+    free: unsafe extern "C" fn(*mut c_void),
+    step: unsafe extern "C" fn(*mut c_void, *const I, *mut O),
     /// (handle, path, clock): the next step is clock `clock`; every clock from then on goes into
     /// the FST file at `path`. 0, or 1 when the file cannot be created, 2 on another error.
-    pub trace_open: unsafe extern "C" fn(*mut c_void, *const c_char, u64) -> c_int,
+    trace_open: unsafe extern "C" fn(*mut c_void, *const c_char, u64) -> c_int,
     /// Flushes and closes the file (dropping the model does too). 0, or 2 on an error.
-    pub trace_close: unsafe extern "C" fn(*mut c_void) -> c_int,
+    trace_close: unsafe extern "C" fn(*mut c_void) -> c_int,
 }
+
+// Function pointers and a name: copied whatever I and O are (a derive would ask I, O: Copy).
+impl<I, O> Clone for TracedModel<I, O> {
+    fn clone(&self) -> Self {
+        *self
+    }
+}
+impl<I, O> Copy for TracedModel<I, O> {}
 
 /// The table set the specular model was generated with (`--brdf-k`): build.rs takes it from
 /// the generator's default or from COSIM_RTL_DIR's manifest, where it checks that golden
@@ -298,7 +315,7 @@ pub struct SpecularTables {
 }
 
 impl SpecularTables {
-    pub fn plan(&self) -> Result<SpecularPlan, String> {
+    pub fn plan(&self) -> Result<SpecularPlan, PlanError> {
         let decoder = Decoder::try_from(DecoderRepr { ks: self.ks.to_vec(), ranges: self.k_ranges.to_vec() })?;
         SpecularPlan::build(decoder, self.word_bits)
     }
@@ -313,7 +330,33 @@ pub fn specular_unit() -> SpecularUnit {
     UNIT.get_or_init(|| SpecularUnit::new(SPECULAR_TABLES.plan().expect("build.rs rebuilt this plan"))).clone()
 }
 
+/// A model's clock: `(handle, inputs, outputs)`, as `<tag>_step` in the shim.
+pub type StepFn<I, O> = unsafe extern "C" fn(*mut c_void, *const I, *mut O);
+
 impl<I, O> ModelInfo<I, O> {
+    /// The model's own clock, for a fault-injecting wrapper ([`ModelInfo::with_step`]).
+    pub fn step_fn(&self) -> StepFn<I, O> {
+        self.step
+    }
+
+    /// This model with `step` as its clock (its traced twin unchanged): a test's mutant, whose
+    /// step calls [`ModelInfo::step_fn`]'s and then changes an output.
+    ///
+    /// # Safety
+    /// `step` is called with this model's handles, inputs and outputs: it must be safe to call
+    /// wherever the model's own step is.
+    pub unsafe fn with_step(&self, step: StepFn<I, O>) -> ModelInfo<I, O> {
+        ModelInfo { step, ..*self }
+    }
+
+    /// For `--trace`: whether this model has a traced twin in this build.
+    pub fn require_traced(&self) -> Result<(), TraceError> {
+        match self.traced {
+            Some(_) => Ok(()),
+            None => Err(TraceError::NoTwin(self.tag)),
+        }
+    }
+
     /// Golden's front-end for a front-end model (`tri_frontend`, `tri_shader_p<P>`, `tri_fb_p<P>`).
     pub fn frontend(&self) -> golden::frontend::FrontEnd {
         golden::frontend::FrontEnd::new(self.cfg, self.screen).expect("the model's front-end").with_di(self.di)
@@ -436,13 +479,12 @@ impl<I, O: Default> Rtl<I, O> {
     }
 
     /// The traced twin of `info` (no file open yet), or why there is none.
-    pub fn traced(info: &'static ModelInfo<I, O>, seed: u64) -> Result<Self, String> {
-        let Some(twin) = &info.traced else {
-            return Err(format!("this build has no traced twin of {} (build with COSIM_TRACE set)", info.tag));
-        };
+    pub fn traced(info: &'static ModelInfo<I, O>, seed: u64) -> Result<Self, TraceError> {
+        let Some(twin) = &info.traced else { return Err(TraceError::NoTwin(info.tag)) };
+        // SAFETY: the twin's constructor; a null handle (it caught an exception) is refused.
         let handle = unsafe { (twin.new)(seed) };
         if handle.is_null() {
-            return Err(format!("the traced model {} failed to construct", twin.tag));
+            return Err(TraceError::Construct(twin.tag));
         }
         Ok(Rtl { handle, info, step: twin.step, free: twin.free, seed, twin: Some(twin), waves: None })
     }
@@ -468,28 +510,30 @@ impl<I, O: Default> Rtl<I, O> {
 
     /// The twin only: from the next step on, which is clock `clock` of the run (the file's time
     /// is 10 `clock`), every clock goes into a new FST file at `path`.
-    pub fn open_waves(&mut self, path: &Path, clock: u64) -> Result<(), String> {
-        let Some(twin) = self.twin else { return Err(format!("{} is not a traced model", self.info.tag)) };
+    pub fn open_waves(&mut self, path: &Path, clock: u64) -> Result<(), TraceError> {
+        let Some(twin) = self.twin else { return Err(TraceError::NotTraced(self.info.tag)) };
         use std::os::unix::ffi::OsStrExt;
-        let c = CString::new(path.as_os_str().as_bytes()).map_err(|_| format!("{}: a NUL in the path", path.display()))?;
+        let c = CString::new(path.as_os_str().as_bytes()).map_err(|_| TraceError::Nul(path.to_path_buf()))?;
         // The FST writer cannot say why it fails to create a file: find out first.
-        std::fs::File::create(path).map_err(|e| format!("{}: {e}", path.display()))?;
+        std::fs::File::create(path).map_err(|error| TraceError::Io { path: path.to_path_buf(), error })?;
+        // SAFETY: our handle of the twin, and a NUL-terminated path that outlives the call.
         match unsafe { (twin.trace_open)(self.handle, c.as_ptr(), clock) } {
             0 => {
                 self.waves = Some(path.to_path_buf());
                 Ok(())
             }
-            1 => Err(format!("{}: the FST writer cannot create it", path.display())),
-            _ => Err(format!("{}: the FST writer failed", path.display())),
+            1 => Err(TraceError::Create(path.to_path_buf())),
+            _ => Err(TraceError::Writer(path.to_path_buf())),
         }
     }
 
     /// Flushes and closes the FST file, if one is open.
-    pub fn close_waves(&mut self) -> Result<(), String> {
+    pub fn close_waves(&mut self) -> Result<(), TraceError> {
         let (Some(twin), Some(path)) = (self.twin, self.waves.take()) else { return Ok(()) };
+        // SAFETY: our handle of the twin.
         match unsafe { (twin.trace_close)(self.handle) } {
             0 => Ok(()),
-            _ => Err(format!("{}: the FST writer failed to close it", path.display())),
+            _ => Err(TraceError::Close(path)),
         }
     }
 }

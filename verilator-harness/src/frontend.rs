@@ -8,16 +8,15 @@
 //! driver's input item; it owes its spans (or segments), and its guard-band `err` pulse is
 //! counted against golden's.
 
-use crate::cosim::{agrees, check_lanes, describe, golden_row, Mismatch, Report, SegView, Stim};
+use crate::cosim::{agrees, check_lanes, describe, golden_row, SegView, Stim};
 use crate::driver::{Check, Driver, Stress, Unit, DRAIN_CLOCKS};
 use crate::ffi::{to_port, FeOut, ModelInfo, Rtl, TriIn, TriSegOut};
+use crate::report::{Mismatch, Report};
 use crate::traffic::{Traffic, TrafficGen};
 use golden::frontend::{FixedTriangle, FrontEnd, Outcome};
 use golden::raster::{compare, reference_triangle, Frame, RefFrame};
-use golden::rng::SeedRng;
 use golden::segment::segment;
 use golden::Span;
-use rand::Rng;
 
 /// A triangle with golden's verdict: its spans are `spans[first..first + count]`.
 #[derive(Clone, Copy, Debug)]
@@ -387,7 +386,7 @@ pub(crate) fn check_frame(exp: &Expected, frame: &Frame, writes: &[u8], report: 
         }
         if st.outcome != Outcome::Guard {
             if let Err(e) = reference_triangle(&screen, &st.tri.to_triangle(cfg.frac), &mut reference) {
-                report.mismatch(Mismatch { triangle: Some(st.triangle), context: "f64 reference".into(), what: e });
+                report.mismatch(Mismatch { triangle: Some(st.triangle), context: "f64 reference".into(), what: e.to_string() });
             }
         }
     }
@@ -406,84 +405,5 @@ pub(crate) fn check_frame(exp: &Expected, frame: &Frame, writes: &[u8], report: 
     }
 }
 
-/// Random port-level triangles of every kind: anywhere in the guard band (huge), tiny, slivers
-/// both ways, vertices on pixel centres, horizontal edges, on the band's edges, outside it,
-/// zero-area, entirely off-screen.
-pub fn random_triangles(rng: &mut SeedRng, fe: &FrontEnd, n: usize) -> Vec<FixedTriangle> {
-    let (w, h) = (fe.screen.width as i64 * 256, fe.screen.height as i64 * 256);
-    let wd = fe.widths();
-    // SPEC §5's intensities 0..255 (the port takes up to 2^IW - 1; the f64 reference does not).
-    let imax = 255i64 << fe.cfg.frac;
-    (0..n)
-        .map(|_| {
-            let kind = rng.gen_range(0..10);
-            let (cx, cy) = (rng.gen_range(-w / 8..w + w / 8), rng.gen_range(-h / 8..h + h / 8));
-            let mut x = [0i64; 3];
-            let mut y = [0i64; 3];
-            for k in 0..3 {
-                (x[k], y[k]) = match kind {
-                    0 => (rng.gen_range(-w..2 * w), rng.gen_range(-h..2 * h)),
-                    1 => (cx + rng.gen_range(-1500..1500), cy + rng.gen_range(-1500..1500)),
-                    2 => (cx + rng.gen_range(-20_000..20_000), cy + rng.gen_range(-200..200)),
-                    3 => (cx + rng.gen_range(-200..200), cy + rng.gen_range(-20_000..20_000)),
-                    4 => ((cx >> 8 << 8) + 128 + 256 * rng.gen_range(-12..12), (cy >> 8 << 8) + 128 + 256 * rng.gen_range(-12..12)),
-                    5 => (cx + rng.gen_range(-8000..8000), if k < 2 { cy } else { cy + rng.gen_range(-8000..8000) }),
-                    6 => (if rng.gen_bool(0.5) { -w } else { 2 * w - 1 }, rng.gen_range(-h..2 * h)),
-                    // Mostly outside the guard band, within the ports.
-                    7 => (
-                        rng.gen_range(-(1i64 << (wd.cx - 1))..(1i64 << (wd.cx - 1))),
-                        rng.gen_range(-(1i64 << (wd.cy - 1))..(1i64 << (wd.cy - 1))),
-                    ),
-                    8 => (cx + 300 * k as i64, cy + 300 * k as i64),
-                    _ => (cx + rng.gen_range(-6000..6000) - 2 * w, cy + rng.gen_range(-6000..6000)),
-                };
-            }
-            let band = |v: i64, lo: i64, hi: i64| if kind == 7 { v } else { v.clamp(lo, hi - 1) };
-            FixedTriangle {
-                x: x.map(|v| band(v, -w, 2 * w)),
-                y: y.map(|v| band(v, -h, 2 * h)),
-                i: [0; 3].map(|_: u32| rng.gen_range(0..=imax) as u32),
-            }
-        })
-        .collect()
-}
-
-/// A mesh of triangles sharing edges: a jittered grid over the screen, each cell cut on a
-/// random diagonal, vertices sometimes exactly on pixel centres.
-pub fn mesh(rng: &mut SeedRng, fe: &FrontEnd, cols: i64, rows: i64) -> Vec<FixedTriangle> {
-    let (w, h) = (fe.screen.width as i64 * 256, fe.screen.height as i64 * 256);
-    let imax = 255i64 << fe.cfg.frac;
-    let mut pts = vec![(0i64, 0i64, 0u32); ((cols + 1) * (rows + 1)) as usize];
-    for r in 0..=rows {
-        for c in 0..=cols {
-            let (mut x, mut y) = (c * w / cols, r * h / rows);
-            if c > 0 && c < cols && r > 0 && r < rows {
-                // At most a fifth of a cell: every quad stays convex, so both diagonals split it.
-                x += rng.gen_range(-(w / cols / 5)..w / cols / 5);
-                y += rng.gen_range(-(h / rows / 5)..h / rows / 5);
-                if rng.gen_bool(0.3) {
-                    (x, y) = ((x >> 8 << 8) + 128, (y >> 8 << 8) + 128);
-                }
-            }
-            pts[(r * (cols + 1) + c) as usize] = (x, y, rng.gen_range(0..=imax) as u32);
-        }
-    }
-    let at = |c: i64, r: i64| pts[(r * (cols + 1) + c) as usize];
-    let tri = |a: (i64, i64, u32), b: (i64, i64, u32), c: (i64, i64, u32)| FixedTriangle {
-        x: [a.0, b.0, c.0],
-        y: [a.1, b.1, c.1],
-        i: [a.2, b.2, c.2],
-    };
-    let mut out = Vec::new();
-    for r in 0..rows {
-        for c in 0..cols {
-            let (p00, p10, p01, p11) = (at(c, r), at(c + 1, r), at(c, r + 1), at(c + 1, r + 1));
-            if rng.gen_bool(0.5) {
-                out.extend([tri(p00, p10, p11), tri(p00, p11, p01)]);
-            } else {
-                out.extend([tri(p00, p10, p01), tri(p10, p11, p01)]);
-            }
-        }
-    }
-    out
-}
+// Golden's generators (golden::stimulus), where the suites and binaries import them.
+pub use golden::stimulus::{fixed_mesh as mesh, random_fixed_triangles as random_triangles};

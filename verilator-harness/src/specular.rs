@@ -2,14 +2,12 @@
 //! against golden, within SPEC §4 of the f64 approximation `C cos^k(sqrt(n/k) delta)`, and,
 //! along each span, never brighter where |theta| is larger.
 
-use crate::cosim::{Mismatch, Report, Stress, Traffic};
-use crate::driver::{Check, Driver, Unit};
+use crate::driver::{Check, Driver, Stress, Unit};
 use crate::ffi::{to_port, ModelInfo, Rtl, SpecIn, SpecOut};
-use crate::traffic::TrafficGen;
+use crate::report::{Mismatch, Report};
+use crate::traffic::{Traffic, TrafficGen};
 use golden::specular::reference::{approx, cos_k, epicentre};
-use golden::specular::setup::{norm, normalize, setup_span, SpanEnds, Vec3};
-use golden::specular::{n_valid, theta_at, tolerance, SpecularSpan, SpecularUnit, C_FRAC, N_MAX, THETA_FRAC};
-use rand::Rng;
+use golden::specular::{n_valid, theta_at, tolerance, SpecularSpan, SpecularUnit, C_FRAC, THETA_FRAC};
 use std::f64::consts::FRAC_PI_2;
 
 /// The specular unit under test: its driver and the checker's golden twin and caches.
@@ -133,7 +131,7 @@ impl SpecularCosim {
     /// With [`Stress`] resets, a span cut by a reset owes no more pixels; a protocol monitor
     /// checks that a pixel offered and not taken stays, unchanged, and that `out_valid` is low
     /// in the first clock after a reset.
-    pub fn try_stream(&mut self, spans: &[SpecularSpan], report: &mut Report) -> Result<(), String> {
+    pub fn try_stream(&mut self, spans: &[SpecularSpan], report: &mut Report) -> Result<(), SpecSpanRejected> {
         self.try_stream_with(spans, report, |_, _, _| {})
     }
 
@@ -152,14 +150,14 @@ impl SpecularCosim {
         spans: &[SpecularSpan],
         report: &mut Report,
         pixel: impl FnMut(usize, u32, &SpecOut) + Send,
-    ) -> Result<(), String> {
-        let len_max = (1u32 << (self.info.cfg.xbits + 1)) - 1;
-        for (k, s) in spans.iter().enumerate() {
-            if s.len > len_max {
-                return Err(format!("span {k} rejected: len = {} does not fit the {}-bit in_len port", s.len, self.info.cfg.xbits + 1));
+    ) -> Result<(), SpecSpanRejected> {
+        let bits = self.info.cfg.xbits + 1;
+        for (index, s) in spans.iter().enumerate() {
+            if s.len >= 1 << bits {
+                return Err(SpecSpanRejected::Len { index, len: s.len, bits });
             }
             if s.n as u32 >= 1 << golden::specular::N_BITS {
-                return Err(format!("span {k} rejected: n = {} does not fit the {}-bit in_n port", s.n, golden::specular::N_BITS));
+                return Err(SpecSpanRejected::N { index, n: s.n, bits: golden::specular::N_BITS });
             }
         }
         self.judge.along.clear();
@@ -167,6 +165,16 @@ impl SpecularCosim {
         self.driver.stream(&SpecPorts, spans, report, check);
         Ok(())
     }
+}
+
+/// A span the specular unit's ports cannot carry ([`SpecularCosim::try_stream`]); nothing was
+/// streamed.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, thiserror::Error)]
+pub enum SpecSpanRejected {
+    #[error("span {index} rejected: len = {len} does not fit the {bits}-bit in_len port")]
+    Len { index: usize, len: u32, bits: u32 },
+    #[error("span {index} rejected: n = {n} does not fit the {bits}-bit in_n port")]
+    N { index: usize, n: u16, bits: u32 },
 }
 
 /// The scoreboard of the specular unit, on the checking thread.
@@ -378,52 +386,8 @@ fn monotone(along: &[(u32, u16)]) -> bool {
     }
 }
 
-/// The shininess of a random span: all four default k ranges, their boundaries, and invalid n.
-pub fn random_n(rng: &mut impl Rng) -> u16 {
-    match rng.gen_range(0..20) {
-        0..=7 => rng.gen_range(7..=N_MAX as u16),
-        8..=10 => rng.gen_range(3..=6),
-        11 => 1,
-        12 => 2,
-        13..=16 => [1, 2, 3, 6, 7, 1000][rng.gen_range(0..6)],
-        17 => [0, 1001, 1023][rng.gen_range(0..3)],
-        _ => rng.gen_range(1001..=1023),
-    }
-}
-
-/// Uniform on the sphere: rejection from the cube, away from the centre.
-fn unit_vector(rng: &mut impl Rng) -> Vec3 {
-    loop {
-        let v: Vec3 = [rng.gen_range(-1.0..1.0), rng.gen_range(-1.0..1.0), rng.gen_range(-1.0..1.0)];
-        if (0.1..=1.0).contains(&norm(v)) {
-            return normalize(v).expect("not near zero");
-        }
-    }
-}
-
-fn near(rng: &mut impl Rng, v: Vec3, spread: f64) -> Vec3 {
-    let u = unit_vector(rng);
-    [v[0] + spread * u[0], v[1] + spread * u[1], v[2] + spread * u[2]]
-}
-
-/// A random span as the host would set it up: normals and half-vectors at both ends (mostly a
-/// highlight crossing the span, sometimes anything at all, including degenerate pairs).
-pub fn random_span(rng: &mut impl Rng, max_len: u32) -> SpecularSpan {
-    let n = random_n(rng);
-    let n1 = unit_vector(rng);
-    let ends = match rng.gen_range(0..10) {
-        0 => SpanEnds { n1, h1: unit_vector(rng), n2: unit_vector(rng), h2: unit_vector(rng) },
-        1 => SpanEnds { n1, h1: n1, n2: n1, h2: n1 },
-        2 => SpanEnds { n1, h1: near(rng, n1, 0.3), n2: [-n1[0], -n1[1], -n1[2]], h2: near(rng, n1, 0.3) },
-        _ => {
-            let spread = rng.gen_range(0.01..0.8);
-            SpanEnds { n1, h1: near(rng, n1, spread), n2: near(rng, n1, spread), h2: near(rng, n1, spread) }
-        }
-    };
-    let l = rng.gen_range(0..max_len.min(400));
-    let il_ks = rng.gen_range(0.5..300.0);
-    setup_span(&ends, il_ks, 1.0, n, l).port
-}
+// Golden's generator (golden::stimulus), where the suites and binaries import it.
+pub use golden::stimulus::random_span;
 
 #[cfg(test)]
 mod tests {

@@ -2,7 +2,7 @@
 //!
 //! **On failure (`COSIM_TRACE=DIR`).** Built with COSIM_TRACE set, every streaming model has a
 //! traced twin (`verilator --trace-fst`: [`crate::ffi::TracedModel`]; a default build has one for
-//! `seg_p2_span` only). Run with it set, every driver keeps a [`Tape`] of what it put on its
+//! `seg_p2_span` only). Run with it set, every driver keeps a tape (`tape.rs`) of what it put on its
 //! model's ports, and when a check fails, it replays the tape into the twin and writes the failing
 //! window to `DIR/<tag>-seed<seed>-clock<N>.fst`; the mismatch's message names the file and the
 //! clock N of the first mismatch. One file per model instance: its first failure's.
@@ -22,7 +22,7 @@
 //! protocol) carry their clock; for the scoreboard's, on the other thread, the tape notes the
 //! clock of every output transfer and the checker the index of its first failing output. The
 //! file is checked whole ([`check_fst`]) before it is named. With waveforms off nothing is taped
-//! and the clock loop is the code it was: the recorder is a type parameter ([`NoTape`]).
+//! and the clock loop is the code it was: the recorder is a type parameter (`NoTape`).
 //!
 //! **Everything (`--trace DIR`).** [`trace_everything`] makes every model instance of the process
 //! its traced twin, writing `DIR/<tag>-seed<seed>.fst` from its first clock (the `cosim` and
@@ -33,11 +33,42 @@
 //! where the outputs are sampled too (the values its rising edge sees, as the harness reads
 //! them), and its rising edge at t = 10 N + 5, in ns (a 100 MHz clock on screen).
 
-use crate::driver::Control;
-use crate::ffi::{ModelInfo, Rtl};
 use std::fmt;
 use std::path::{Path, PathBuf};
 use std::sync::{Mutex, OnceLock};
+
+/// Why a waveform was not written (or a traced model not made).
+#[derive(Debug, thiserror::Error)]
+pub enum TraceError {
+    #[error(
+        "this build has no traced model of {0} (traced models are built when COSIM_TRACE is set at build time, e.g. \
+         COSIM_TRACE=target/waves cargo run --release -p verilator-harness --bin ...)"
+    )]
+    NoTwin(&'static str),
+    #[error("the traced model {0} failed to construct")]
+    Construct(&'static str),
+    #[error("{0} is not a traced model")]
+    NotTraced(&'static str),
+    #[error("{}: {error}", path.display())]
+    Io { path: PathBuf, error: std::io::Error },
+    #[error("{}: a NUL in the path", .0.display())]
+    Nul(PathBuf),
+    #[error("{}: the FST writer cannot create it", .0.display())]
+    Create(PathBuf),
+    #[error("{}: the FST writer failed", .0.display())]
+    Writer(PathBuf),
+    #[error("{}: the FST writer failed to close it", .0.display())]
+    Close(PathBuf),
+    #[error("waveforms: trace_everything called twice")]
+    Twice,
+    #[error("waveforms are off")]
+    Off,
+    /// Written, but [`check_fst`] does not read it whole.
+    #[error("written but unreadable: {0}")]
+    Unreadable(FstError),
+    #[error("{} holds clocks {} to {}, not {} to {}", path.display(), held.0, held.1, wanted.0, wanted.1)]
+    Window { path: PathBuf, held: (u64, u64), wanted: (u64, u64) },
+}
 
 /// Nanoseconds per clock in a waveform file: clock N at t = 10 N (`clk` low), its edge at 10 N + 5.
 pub const TIME_PER_CLOCK: u64 = 10;
@@ -58,10 +89,11 @@ static WRITTEN: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
 
 /// From now on every model instance this process builds ([`Rtl::new`]) is its traced twin,
 /// writing every clock to a file of its own in `dir` (created if missing). Check first that the
-/// models to run have twins ([`require_traced`]): an instance without one panics.
-pub fn trace_everything(dir: &Path) -> Result<(), String> {
-    std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
-    EVERYTHING.set(dir.to_path_buf()).map_err(|_| "waveforms: trace_everything called twice".to_string())
+/// models to run have twins ([`crate::ffi::ModelInfo::require_traced`]): an instance without
+/// one panics.
+pub fn trace_everything(dir: &Path) -> Result<(), TraceError> {
+    std::fs::create_dir_all(dir).map_err(|error| TraceError::Io { path: dir.to_path_buf(), error })?;
+    EVERYTHING.set(dir.to_path_buf()).map_err(|_| TraceError::Twice)
 }
 
 pub(crate) fn everything() -> Option<&'static Path> {
@@ -88,18 +120,6 @@ pub fn written() -> Vec<PathBuf> {
     WRITTEN.lock().unwrap_or_else(|e| e.into_inner()).clone()
 }
 
-/// For `--trace`: an error message unless `info` has a traced twin in this build.
-pub fn require_traced<I, O>(info: &ModelInfo<I, O>) -> Result<(), String> {
-    if info.traced.is_some() {
-        return Ok(());
-    }
-    Err(format!(
-        "--trace: this build has no traced model of {} (traced models are built when COSIM_TRACE is set at build time, e.g. \
-         COSIM_TRACE=target/waves cargo run --release -p verilator-harness --bin ...)",
-        info.tag
-    ))
-}
-
 /// A waveform written for a failure: where, and the clock of the first mismatch.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Waveform {
@@ -119,133 +139,29 @@ impl fmt::Display for Waveform {
     }
 }
 
-/// What the clock loop tells the tape ([`Tape`]; [`NoTape`] with waveforms off).
-pub(crate) trait Recorder<I> {
-    /// Clock `clock` was stepped with `input`.
-    fn clock(&mut self, clock: u64, input: &I);
-    /// An output transferred in clock `clock`: the stream's next record.
-    fn transfer(&mut self, clock: u64);
-    /// The driver found a mismatch in clock `clock`.
-    fn found(&mut self, clock: u64);
-    /// A reset starts at clock `clock`, the next to be stepped.
-    fn reset(&mut self, clock: u64);
+/// A file [`check_fst`] does not read as a whole FST file.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+#[error("{}: {problem}", path.display())]
+pub struct FstError {
+    pub path: PathBuf,
+    pub problem: FstProblem,
 }
 
-/// Waveforms off: nothing recorded, and nothing left in the clock loop.
-pub(crate) struct NoTape;
-
-impl<I> Recorder<I> for NoTape {
-    #[inline(always)]
-    fn clock(&mut self, _clock: u64, _input: &I) {}
-    #[inline(always)]
-    fn transfer(&mut self, _clock: u64) {}
-    #[inline(always)]
-    fn found(&mut self, _clock: u64) {}
-    #[inline(always)]
-    fn reset(&mut self, _clock: u64) {}
-}
-
-/// [`Control::control`]'s bits, and the tape's own: this clock's whole struct is stored.
-const RST: u8 = 1;
-const VALID: u8 = 2;
-const READY: u8 = 4;
-const KEEP: u8 = 8;
-const STORED: u8 = 16;
-
-/// Every clock's inputs since a reset (see the module comment), and where this stream's outputs
-/// and first mismatch happened.
-pub(crate) struct Tape<I> {
-    /// The clock of `ctl[0]`, a reset's first.
-    start: u64,
-    /// Per clock: the control bits, and [`STORED`] when the clock's struct is in `data`.
-    ctl: Vec<u8>,
-    data: Vec<I>,
-    /// Store the next clock's struct whatever its `keep` (a replay may start there).
-    force: bool,
-    /// The last reset seen: (clock, `ctl` and `data` lengths then), where the tape is cut when
-    /// the stream ends.
-    cut: Option<(u64, usize, usize)>,
-    /// This stream: the clock of each output transfer, in record order.
-    pub transfers: Vec<u64>,
-    /// This stream: the clock of the driver's first mismatch.
-    pub found: Option<u64>,
-}
-
-impl<I: Control> Tape<I> {
-    /// An empty tape whose first clock, `start`, is a reset's.
-    pub fn new(start: u64) -> Tape<I> {
-        Tape { start, ctl: Vec::new(), data: Vec::new(), force: true, cut: None, transfers: Vec::new(), found: None }
-    }
-
-    pub fn new_stream(&mut self) {
-        self.transfers.clear();
-        self.found = None;
-    }
-
-    /// After a stream (and its waveform): forget what came before its last reset.
-    pub fn end_stream(&mut self) {
-        if let Some((clock, ctl, data)) = self.cut.take() {
-            self.ctl.drain(..ctl);
-            self.data.drain(..data);
-            self.start = clock;
-        }
-    }
-
-    /// The clocks on the tape, first and last.
-    pub fn clocks(&self) -> (u64, u64) {
-        (self.start, (self.start + self.ctl.len() as u64).saturating_sub(1))
-    }
-
-    /// Steps `rtl` (a traced twin, fresh) through the tape up to clock `to`, writing clocks
-    /// `from..=to` to the FST file at `path`.
-    pub fn replay<O: Default>(&self, rtl: &mut Rtl<I, O>, from: u64, to: u64, path: &Path) -> Result<(), String> {
-        let (mut input, mut output) = (I::default(), O::default());
-        let mut data = self.data.iter();
-        for (k, &c) in self.ctl.iter().enumerate() {
-            let clock = self.start + k as u64;
-            if clock > to {
-                break;
-            }
-            if clock == from {
-                rtl.open_waves(path, clock)?;
-            }
-            if c & STORED != 0 {
-                input = *data.next().expect("a struct for every STORED clock");
-            }
-            input.set_control(c & RST != 0, c & VALID != 0, c & READY != 0);
-            input.keep_data(c & KEEP != 0 && c & STORED == 0);
-            rtl.step_into(&input, &mut output);
-        }
-        rtl.close_waves()
-    }
-}
-
-impl<I: Control> Recorder<I> for Tape<I> {
-    #[inline]
-    fn clock(&mut self, clock: u64, input: &I) {
-        debug_assert_eq!(clock, self.start + self.ctl.len() as u64, "the tape missed a clock");
-        let c = input.control();
-        let stored = std::mem::take(&mut self.force) || c & KEEP == 0;
-        if stored {
-            self.data.push(*input);
-        }
-        self.ctl.push(c | if stored { STORED } else { 0 });
-    }
-
-    #[inline]
-    fn transfer(&mut self, clock: u64) {
-        self.transfers.push(clock);
-    }
-
-    fn found(&mut self, clock: u64) {
-        self.found.get_or_insert(clock);
-    }
-
-    fn reset(&mut self, clock: u64) {
-        debug_assert_eq!(clock, self.start + self.ctl.len() as u64, "a reset off the tape's end");
-        self.cut = Some((clock, self.ctl.len(), self.data.len()));
-        self.force = true;
-    }
+/// What is wrong with the file.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum FstProblem {
+    #[error("{0}")]
+    Read(String),
+    #[error("not an FST file (no header block)")]
+    NoHeader,
+    #[error("header cut short")]
+    ShortHeader,
+    #[error("block at byte {at} cut short")]
+    ShortBlock { at: usize },
+    #[error("block {kind} at byte {at} runs past the end")]
+    PastEnd { kind: usize, at: usize },
+    #[error("{blocks} blocks: {vc} of value changes, {geometry} geometry, {hier} hierarchy (unfinished?)")]
+    Unfinished { blocks: u64, vc: u64, geometry: u64, hier: u64 },
 }
 
 /// What [`check_fst`] found in a waveform file.
@@ -264,24 +180,24 @@ pub struct FstSummary {
 /// big-endian length) that end exactly at the end of the file, with a hierarchy, a geometry and
 /// value changes among them, as GTKWave's `fstapi.c` writes them. No decompression: `fst2vcd`
 /// (Debian's gtkwave) reads the values (`tests/waveforms.rs`, `scripts/check-rtl-dir --trace`).
-pub fn check_fst(path: &Path) -> Result<FstSummary, String> {
-    let fail = |what: &str| format!("{}: {what}", path.display());
-    let bytes = std::fs::read(path).map_err(|e| fail(&e.to_string()))?;
+pub fn check_fst(path: &Path) -> Result<FstSummary, FstError> {
+    let fail = |problem: FstProblem| FstError { path: path.to_path_buf(), problem };
+    let bytes = std::fs::read(path).map_err(|e| fail(FstProblem::Read(e.to_string())))?;
     let u64_at = |at: usize| bytes.get(at..at + 8).map(|b| u64::from_be_bytes(b.try_into().expect("8 bytes")));
     // fstapi.h: FST_BL_HDR 0, VCDATA 1, GEOM 3, HIER 4, VCDATA_DYN_ALIAS 5, HIER_LZ4 6,
     // HIER_LZ4DUO 7, VCDATA_DYN_ALIAS2 8, BLACKOUT 2, SKIP 255.
     if bytes.first() != Some(&0) {
-        return Err(fail("not an FST file (no header block)"));
+        return Err(fail(FstProblem::NoHeader));
     }
     // The header's fields after its type and length: start and end time, an endianness test,
     // memory used, scopes, variables.
-    let (Some(start), Some(end), Some(vars)) = (u64_at(9), u64_at(17), u64_at(49)) else { return Err(fail("header cut short")) };
+    let (Some(start), Some(end), Some(vars)) = (u64_at(9), u64_at(17), u64_at(49)) else { return Err(fail(FstProblem::ShortHeader)) };
     let (mut at, mut kinds, mut blocks) = (0usize, [0u64; 256], 0);
     while at < bytes.len() {
         let kind = bytes[at] as usize;
-        let len = u64_at(at + 1).ok_or_else(|| fail(&format!("block at byte {at} cut short")))? as usize;
+        let len = u64_at(at + 1).ok_or_else(|| fail(FstProblem::ShortBlock { at }))? as usize;
         if len < 8 || at + 1 + len > bytes.len() {
-            return Err(fail(&format!("block {kind} at byte {at} runs past the end")));
+            return Err(fail(FstProblem::PastEnd { kind, at }));
         }
         kinds[kind] += 1;
         blocks += 1;
@@ -290,7 +206,7 @@ pub fn check_fst(path: &Path) -> Result<FstSummary, String> {
     let hier = kinds[4] + kinds[6] + kinds[7];
     let vc = kinds[1] + kinds[5] + kinds[8];
     if kinds[3] != 1 || hier != 1 || vc == 0 {
-        return Err(fail(&format!("{blocks} blocks: {vc} of value changes, {} geometry, {hier} hierarchy (unfinished?)", kinds[3])));
+        return Err(fail(FstProblem::Unfinished { blocks, vc, geometry: kinds[3], hier }));
     }
     Ok(FstSummary { first: start / TIME_PER_CLOCK, last: end / TIME_PER_CLOCK, vars, blocks: vc })
 }

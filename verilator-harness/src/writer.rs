@@ -7,10 +7,10 @@
 //! pixel written twice within one span, and an address outside the memory; the memory it fills
 //! is then compared, as a frame, with golden's frame and the f64 reference.
 
-use crate::cosim::{Mismatch, Report};
 use crate::driver::{Check, Driver, Stress, Unit};
 use crate::ffi::{ModelInfo, Rtl, TriIn, WrIn, WrOut};
 use crate::frontend::{Expected, TriStim};
+use crate::report::{Mismatch, Report};
 use crate::traffic::{Traffic, TrafficGen};
 use golden::frontend::FrontEnd;
 use golden::raster::Frame;
@@ -182,7 +182,7 @@ impl MemoryCheck {
             }
         }
         if let Err(e) = self.memory.apply(&kept) {
-            report.mismatch(Mismatch { triangle, context: context(), what: e });
+            report.mismatch(Mismatch { triangle, context: context(), what: e.to_string() });
             return;
         }
         let twice: Vec<u32> = (0..p)

@@ -12,7 +12,7 @@
 //! from; the chosen set is then built and verified like any other.
 
 use super::decoder::Decoder;
-use super::plan::{analytic_len, SpecularPlan, WORD_BITS_RANGE};
+use super::plan::{analytic_len, PlanError, SpecularPlan, WORD_BITS_RANGE};
 use super::reference::{approx_error, epicentre_arg};
 use super::{K_MAX, NK_DEPTH, N_MAX};
 use crate::rom::addr_bits;
@@ -126,9 +126,9 @@ pub fn best_reachable(max_tables: usize) -> (f64, Vec<u32>) {
 
 /// The plan with the least ROM (BRDF plus n-table bits) whose approximation error inside
 /// every epicentre is at most `max_err`, over sets of at most [`MAX_AUTO_TABLES`] tables.
-pub fn auto_plan(max_err: f64) -> Result<SpecularPlan, String> {
+pub fn auto_plan(max_err: f64) -> Result<SpecularPlan, PlanError> {
     if max_err.is_nan() || max_err <= 0.0 {
-        return Err(format!("error target {max_err} must be positive"));
+        return Err(PlanError::AutoTarget(max_err));
     }
     let tb = Tables::new();
     let e_ok = |e: f64| e <= max_err;
@@ -196,13 +196,8 @@ pub fn auto_plan(max_err: f64) -> Result<SpecularPlan, String> {
         }
     }
     let Some((_, w, ks)) = winner else {
-        let (e, ks) = best_reachable(MAX_AUTO_TABLES);
-        return Err(format!(
-            "no set of at most {MAX_AUTO_TABLES} BRDF tables (k in 1..{K_MAX}) keeps the epicentre error within {:.3}%; \
-             the best reachable is {:.3}% with k = {ks:?}",
-            max_err * 100.0,
-            e * 100.0
-        ));
+        let (best, best_ks) = best_reachable(MAX_AUTO_TABLES);
+        return Err(PlanError::Unreachable { max_err, best, best_ks });
     };
     let decoder = Decoder::least_error(&ks)?;
     // The search sized with one W; let the builder settle W on the verified sizes.
@@ -221,7 +216,9 @@ mod tests {
         let (e5, k5) = best_reachable(5);
         assert!(e5 < e4 && k5.len() == 5, "{e5} {k5:?}");
         let err = auto_plan(e5 * 0.99).unwrap_err();
-        assert!(err.contains("best reachable"), "{err}");
+        assert_eq!(err, PlanError::Unreachable { max_err: e5 * 0.99, best: e5, best_ks: k5 });
+        assert!(err.to_string().contains("the best reachable is"), "{err}");
+        assert_eq!(auto_plan(0.0), Err(PlanError::AutoTarget(0.0)));
     }
 
     #[test]

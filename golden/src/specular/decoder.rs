@@ -37,18 +37,45 @@ impl From<Decoder> for DecoderRepr {
     }
 }
 
+/// A k set the unit cannot hold ([`check_k_set`]).
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+pub enum KSetError {
+    #[error("the BRDF k set is empty")]
+    Empty,
+    #[error("{0} BRDF tables is more than the 16 this unit supports")]
+    TooMany(usize),
+    #[error("BRDF k = {0} is outside 1..{K_MAX}")]
+    OutOfRange(u32),
+    #[error("BRDF k set {0:?} is not strictly ascending")]
+    NotAscending(Vec<u32>),
+}
+
+/// A decoder that does not put every valid n on one of its tables.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+pub enum DecoderError {
+    #[error(transparent)]
+    KSet(#[from] KSetError),
+    /// A serialized range that does not start where the last ended, or names another k.
+    #[error("decoder range {range:?} does not continue from n = {next} on the k set {ks:?}")]
+    Gap { range: KRange, next: u32, ks: Vec<u32> },
+    #[error("decoder ranges end at n = {end}, not {N_MAX}")]
+    Short { end: u32 },
+    #[error("n = {n} assigned to table {table} of only {tables}")]
+    NoTable { n: u32, table: usize, tables: usize },
+}
+
 impl TryFrom<DecoderRepr> for Decoder {
-    type Error = String;
-    fn try_from(r: DecoderRepr) -> Result<Decoder, String> {
+    type Error = DecoderError;
+    fn try_from(r: DecoderRepr) -> Result<Decoder, DecoderError> {
         let mut next = N_MIN;
         for g in &r.ranges {
             if g.n_lo != next || g.n_hi < g.n_lo || r.ks.get(g.table as usize) != Some(&g.k) {
-                return Err(format!("decoder range {g:?} does not continue from n = {next} on the k set {:?}", r.ks));
+                return Err(DecoderError::Gap { range: *g, next, ks: r.ks.clone() });
             }
             next = g.n_hi + 1;
         }
         if next != N_MAX + 1 {
-            return Err(format!("decoder ranges end at n = {}, not {N_MAX}", next - 1));
+            return Err(DecoderError::Short { end: next - 1 });
         }
         let at = |n: u32| r.ranges.iter().find(|g| g.n_lo <= n && n <= g.n_hi).map_or(0, |g| g.table as usize);
         Decoder::from_fn(&r.ks, at)
@@ -57,18 +84,18 @@ impl TryFrom<DecoderRepr> for Decoder {
 
 /// A k-set must be strictly ascending, non-empty, within 1..=64, and small enough that the
 /// select field stays a few bits.
-pub fn check_k_set(ks: &[u32]) -> Result<(), String> {
+pub fn check_k_set(ks: &[u32]) -> Result<(), KSetError> {
     if ks.is_empty() {
-        return Err("the BRDF k set is empty".into());
+        return Err(KSetError::Empty);
     }
     if ks.len() > 16 {
-        return Err(format!("{} BRDF tables is more than the 16 this unit supports", ks.len()));
+        return Err(KSetError::TooMany(ks.len()));
     }
-    if let Some(k) = ks.iter().find(|&&k| k == 0 || k > K_MAX) {
-        return Err(format!("BRDF k = {k} is outside 1..{K_MAX}"));
+    if let Some(&k) = ks.iter().find(|&&k| k == 0 || k > K_MAX) {
+        return Err(KSetError::OutOfRange(k));
     }
     if ks.windows(2).any(|w| w[0] >= w[1]) {
-        return Err(format!("BRDF k set {ks:?} is not strictly ascending"));
+        return Err(KSetError::NotAscending(ks.to_vec()));
     }
     Ok(())
 }
@@ -89,7 +116,7 @@ impl Decoder {
 
     /// Each n takes the table whose approximation error over its epicentre is least
     /// (a tie goes to the smaller k). For {1, 2, 4, 16} this is exactly the patent's decoder.
-    pub fn least_error(ks: &[u32]) -> Result<Decoder, String> {
+    pub fn least_error(ks: &[u32]) -> Result<Decoder, KSetError> {
         check_k_set(ks)?;
         let table = (N_MIN..=N_MAX)
             .map(|n| {
@@ -106,13 +133,13 @@ impl Decoder {
     }
 
     /// A decoder from an explicit assignment `table_of(n)` for n in 1..=1000.
-    pub fn from_fn(ks: &[u32], table_of: impl Fn(u32) -> usize) -> Result<Decoder, String> {
+    pub fn from_fn(ks: &[u32], table_of: impl Fn(u32) -> usize) -> Result<Decoder, DecoderError> {
         check_k_set(ks)?;
         let mut table = Vec::with_capacity(N_MAX as usize);
         for n in N_MIN..=N_MAX {
             let t = table_of(n);
             if t >= ks.len() {
-                return Err(format!("n = {n} assigned to table {t} of only {}", ks.len()));
+                return Err(DecoderError::NoTable { n, table: t, tables: ks.len() });
             }
             table.push(t as u8);
         }
@@ -188,27 +215,53 @@ impl Default for BrdfK {
     }
 }
 
+/// A relative-error target (`--max-rel-error`, `--brdf-k auto:T`) that does not read.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+pub enum TargetError {
+    #[error("'{0}' is not a number")]
+    NotANumber(String),
+    #[error("'{0}' is not a relative error between 0 and 1 (or 0% and 100%)")]
+    Range(String),
+}
+
+/// A relative error written as a fraction (`0.01`) or a percentage (`1%`), strictly between 0
+/// and 1: `--max-rel-error` and the target of `--brdf-k auto:T`.
+pub fn parse_rel_error(s: &str) -> Result<f64, TargetError> {
+    let (num, per) = match s.strip_suffix('%') {
+        Some(n) => (n, 100.0),
+        None => (s, 1.0),
+    };
+    let e = num.trim().parse::<f64>().map_err(|_| TargetError::NotANumber(s.to_string()))? / per;
+    if e.is_finite() && e > 0.0 && e < 1.0 {
+        Ok(e)
+    } else {
+        Err(TargetError::Range(s.to_string()))
+    }
+}
+
+/// A `--brdf-k` value [`BrdfK`] does not read.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+pub enum BrdfKError {
+    #[error(transparent)]
+    Target(#[from] TargetError),
+    #[error("bad k '{k}' in '{list}'")]
+    K { k: String, list: String },
+    #[error(transparent)]
+    KSet(#[from] KSetError),
+}
+
 impl std::str::FromStr for BrdfK {
-    type Err = String;
-    fn from_str(s: &str) -> Result<Self, String> {
+    type Err = BrdfKError;
+    fn from_str(s: &str) -> Result<Self, BrdfKError> {
         let s = s.trim();
         if let Some(rest) = s.strip_prefix("auto") {
             let e = rest.trim_start_matches([':', '=']).trim();
-            let max_err = if e.is_empty() {
-                0.01
-            } else if let Some(p) = e.strip_suffix('%') {
-                p.trim().parse::<f64>().map_err(|_| format!("bad error target '{e}'"))? / 100.0
-            } else {
-                e.parse::<f64>().map_err(|_| format!("bad error target '{e}'"))?
-            };
-            if !(max_err > 0.0 && max_err < 1.0) {
-                return Err(format!("error target {e} must be between 0 and 100%"));
-            }
+            let max_err = if e.is_empty() { 0.01 } else { parse_rel_error(e)? };
             return Ok(BrdfK::Auto { max_err });
         }
         let ks = s
             .split(',')
-            .map(|t| t.trim().parse::<u32>().map_err(|_| format!("bad k '{}' in '{s}'", t.trim())))
+            .map(|t| t.trim().parse::<u32>().map_err(|_| BrdfKError::K { k: t.trim().to_string(), list: s.to_string() }))
             .collect::<Result<Vec<_>, _>>()?;
         check_k_set(&ks)?;
         Ok(BrdfK::List(ks))
@@ -279,11 +332,12 @@ mod tests {
             let r = DecoderRepr::from(d.clone());
             assert_eq!(Decoder::try_from(r.clone()).unwrap(), d);
             let mut gap = r.clone();
-            gap.ranges.remove(1);
-            assert!(Decoder::try_from(gap).is_err());
+            let lost = gap.ranges.remove(1);
+            let next = gap.ranges[1];
+            assert_eq!(Decoder::try_from(gap), Err(DecoderError::Gap { range: next, next: lost.n_lo, ks: r.ks.clone() }));
             let mut short = r;
             short.ranges.last_mut().unwrap().n_hi -= 1;
-            assert!(Decoder::try_from(short).is_err());
+            assert_eq!(Decoder::try_from(short), Err(DecoderError::Short { end: N_MAX - 1 }));
         }
     }
 
@@ -294,9 +348,25 @@ mod tests {
         assert_eq!("auto".parse::<BrdfK>().unwrap(), BrdfK::Auto { max_err: 0.01 });
         assert_eq!("auto:0.5%".parse::<BrdfK>().unwrap(), BrdfK::Auto { max_err: 0.005 });
         assert_eq!("auto=0.002".parse::<BrdfK>().unwrap(), BrdfK::Auto { max_err: 0.002 });
-        for bad in ["", "1,1", "4,2", "0,3", "65", "1,x", "auto:0", "auto:150%"] {
-            assert!(bad.parse::<BrdfK>().is_err(), "{bad}");
+        let k = |k: &str, list: &str| BrdfKError::K { k: k.into(), list: list.into() };
+        let cases = [
+            ("", k("", "")),
+            ("1,1", KSetError::NotAscending(vec![1, 1]).into()),
+            ("4,2", KSetError::NotAscending(vec![4, 2]).into()),
+            ("0,3", KSetError::OutOfRange(0).into()),
+            ("65", KSetError::OutOfRange(65).into()),
+            ("1,x", k("x", "1,x")),
+            ("auto:0", TargetError::Range("0".into()).into()),
+            ("auto:150%", TargetError::Range("150%".into()).into()),
+            ("auto:lots", TargetError::NotANumber("lots".into()).into()),
+            ("auto:inf", TargetError::Range("inf".into()).into()),
+        ];
+        for (bad, want) in cases {
+            assert_eq!(bad.parse::<BrdfK>(), Err(want), "{bad}");
         }
+        assert_eq!(Decoder::from_fn(&[1, 2], |n| n as usize % 3), Err(DecoderError::NoTable { n: 2, table: 2, tables: 2 }));
+        assert_eq!(check_k_set(&(1..=17).collect::<Vec<_>>()), Err(KSetError::TooMany(17)));
+        assert_eq!(check_k_set(&[]), Err(KSetError::Empty));
         assert_eq!(BrdfK::Auto { max_err: 0.005 }.to_string(), "auto:0.5%");
         assert_eq!(BrdfK::default().to_string(), "1,2,4,16");
     }

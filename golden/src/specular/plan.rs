@@ -22,9 +22,10 @@
 //! rounding adds at most 0.5/256 and C < 256. A table that fails grows by 0.5% and is
 //! checked again.
 
-use super::decoder::{BrdfK, Decoder, KRange};
+use super::auto::MAX_AUTO_TABLES;
+use super::decoder::{BrdfK, Decoder, DecoderError, KRange, KSetError};
 use super::reference::{cos_k, epicentre_arg, epicentre_code};
-use super::{INSIDE_REL, NK_DEPTH, N_MIN, OUTSIDE_REL, THETA_FRAC};
+use super::{INSIDE_REL, K_MAX, NK_DEPTH, N_MIN, OUTSIDE_REL, THETA_FRAC};
 use crate::pipeline::{PipeReg, PipeStage, Pipeline};
 use crate::rom::addr_bits;
 use serde::{Deserialize, Serialize};
@@ -164,6 +165,38 @@ pub(super) fn analytic_len(k: u32, epicentre_arg: f64, word_bits: u32, m_err: f6
     (len <= MAX_TABLE_LEN).then_some(len.max(2))
 }
 
+/// Why no plan meets SPEC §4 for a table set (or the set itself is wrong).
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum PlanError {
+    #[error(transparent)]
+    Decoder(#[from] DecoderError),
+    #[error("BRDF word width {0} is outside {WORD_BITS_RANGE:?}")]
+    WordBits(u32),
+    #[error("no BRDF word width can meet SPEC §4")]
+    NoWordWidth,
+    #[error("table k = {k} cannot meet SPEC §4 with {word_bits}-bit words and {m_bits}-bit M")]
+    Table { k: u32, word_bits: u32, m_bits: u32 },
+    #[error("table k = {k} needs more than {m_bits} bits of M")]
+    Mantissa { k: u32, m_bits: u32 },
+    /// `--brdf-k auto` with a target that is no positive fraction.
+    #[error("error target {0} must be positive")]
+    AutoTarget(f64),
+    /// `--brdf-k auto`: no set of at most `MAX_AUTO_TABLES` tables is that accurate.
+    #[error(
+        "no set of at most {MAX_AUTO_TABLES} BRDF tables (k in 1..{K_MAX}) keeps the epicentre error within {:.3}%; \
+         the best reachable is {:.3}% with k = {best_ks:?}",
+        max_err * 100.0,
+        best * 100.0
+    )]
+    Unreachable { max_err: f64, best: f64, best_ks: Vec<u32> },
+}
+
+impl From<KSetError> for PlanError {
+    fn from(e: KSetError) -> PlanError {
+        PlanError::Decoder(e.into())
+    }
+}
+
 impl SpecularPlan {
     /// The default: the patent's k-set and ranges.
     pub fn patent() -> SpecularPlan {
@@ -171,11 +204,11 @@ impl SpecularPlan {
     }
 
     /// `--brdf-k LIST`: each n on its least-error table.
-    pub fn from_k_set(ks: &[u32]) -> Result<SpecularPlan, String> {
+    pub fn from_k_set(ks: &[u32]) -> Result<SpecularPlan, PlanError> {
         SpecularPlan::build(Decoder::least_error(ks)?, None)
     }
 
-    pub fn from_brdf_k(b: &BrdfK) -> Result<SpecularPlan, String> {
+    pub fn from_brdf_k(b: &BrdfK) -> Result<SpecularPlan, PlanError> {
         match b {
             BrdfK::List(ks) => SpecularPlan::from_k_set(ks),
             BrdfK::Auto { max_err } => super::auto::auto_plan(*max_err),
@@ -185,10 +218,10 @@ impl SpecularPlan {
     /// Sizes, packs and verifies the tables for a decoder. `word_bits = None` lets the
     /// sizing pick W; W and the width of M are chosen for the fewest ROM bits (BRDF plus
     /// n-table).
-    pub fn build(decoder: Decoder, word_bits: Option<u32>) -> Result<SpecularPlan, String> {
+    pub fn build(decoder: Decoder, word_bits: Option<u32>) -> Result<SpecularPlan, PlanError> {
         if let Some(w) = word_bits {
             if !WORD_BITS_RANGE.contains(&w) {
-                return Err(format!("BRDF word width {w} is outside {WORD_BITS_RANGE:?}"));
+                return Err(PlanError::WordBits(w));
             }
         }
         let sel_bits = addr_bits(decoder.tables());
@@ -216,7 +249,7 @@ impl SpecularPlan {
         // Fewest bits first; on a tie the wider words (more accuracy for the same bits).
         candidates.sort_by_key(|&(bits, w, nw, _)| (bits, std::cmp::Reverse((w, nw))));
         let mut best: Option<SpecularPlan> = None;
-        let mut last_err = String::from("no BRDF word width can meet SPEC §4");
+        let mut last_err = PlanError::NoWordWidth;
         for (estimate, w, nw, lens) in candidates {
             if best.as_ref().is_some_and(|b| b.rom_bits() <= estimate) {
                 break;
@@ -232,7 +265,7 @@ impl SpecularPlan {
     }
 
     /// Grows each table from its estimate until the exhaustive check passes.
-    fn fit(decoder: &Decoder, x_epi: &[f64], w: u32, nw: u32, lens: &[u32]) -> Result<SpecularPlan, String> {
+    fn fit(decoder: &Decoder, x_epi: &[f64], w: u32, nw: u32, lens: &[u32]) -> Result<SpecularPlan, PlanError> {
         let tables = decoder
             .ks()
             .iter()
@@ -261,7 +294,7 @@ impl SpecularPlan {
                 let len = plan.tables[t].len;
                 // Far past the estimate, more entries are not what is missing (M or W is).
                 if len >= MAX_TABLE_LEN || len > 2 * lens[t] {
-                    return Err(format!("table k = {} cannot meet SPEC §4 with {w}-bit words and {nw}-bit M", plan.tables[t].k));
+                    return Err(PlanError::Table { k: plan.tables[t].k, word_bits: w, m_bits: nw });
                 }
                 plan.tables[t].len = (len + len.div_ceil(200)).min(MAX_TABLE_LEN);
             }
@@ -276,7 +309,7 @@ impl SpecularPlan {
 
     /// Sets table t to `len` entries over `[0, table_end(k))` and picks the largest shift
     /// that keeps every M of the table within `nk_mant_bits`.
-    fn resize(&mut self, t: usize, len: u32) -> Result<(), String> {
+    fn resize(&mut self, t: usize, len: u32) -> Result<(), PlanError> {
         let k = self.tables[t].k;
         let step = table_end(k) / len as f64;
         self.tables[t].len = len;
@@ -287,7 +320,7 @@ impl SpecularPlan {
         loop {
             shift -= 1;
             if shift < 0 {
-                return Err(format!("table k = {k} needs more than {} bits of M", self.nk_mant_bits));
+                return Err(PlanError::Mantissa { k, m_bits: self.nk_mant_bits });
             }
             self.tables[t].shift = shift as u32;
             if self.m_in_table(t, n_top) < limit {
@@ -637,6 +670,10 @@ mod tests {
         let f = p.check_table(t).unwrap_err();
         assert!(f.inside, "the epicentre edge binds first: {f:?}");
         // And a wide enough word width alone does not rescue it.
-        assert!(SpecularPlan::build(Decoder::patent(), Some(8)).is_err());
+        assert_eq!(SpecularPlan::build(Decoder::patent(), Some(8)), Err(PlanError::NoWordWidth));
+        assert_eq!(SpecularPlan::build(Decoder::patent(), Some(99)), Err(PlanError::WordBits(99)));
+        let e = SpecularPlan::from_k_set(&[2, 1]).unwrap_err();
+        assert_eq!(e, PlanError::Decoder(KSetError::NotAscending(vec![2, 1]).into()));
+        assert_eq!(e.to_string(), "BRDF k set [2, 1] is not strictly ascending", "a k set's message as it is");
     }
 }

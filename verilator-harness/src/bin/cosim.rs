@@ -87,8 +87,8 @@ struct Args {
 /// status 2 when `info` has no traced twin in this build or DIR cannot be made.
 fn start_trace<I, O>(args: &Args, info: &ModelInfo<I, O>) -> Result<(), ExitCode> {
     let Some(dir) = &args.trace else { return Ok(()) };
-    waveform::require_traced(info).and_then(|()| waveform::trace_everything(dir)).map_err(|e| {
-        eprintln!("error: {e}");
+    info.require_traced().and_then(|()| waveform::trace_everything(dir)).map_err(|e| {
+        eprintln!("error: --trace: {e}");
         ExitCode::from(2)
     })
 }

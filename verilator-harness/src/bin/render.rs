@@ -18,7 +18,7 @@ use verilator_harness::ffi::{
     segment_model, ModelInfo, SEGMENT_MODELS, SPECULAR_MODELS, TRISHADER_MODELS, TRIWRITER_MODELS, WRITER_MODELS,
 };
 use verilator_harness::render::{busy_cycles, difference_image, obj_job, run_with, scene_job, triangles_job, Chain, Job, SceneKind};
-use verilator_harness::waveform::{require_traced, trace_everything};
+use verilator_harness::waveform::trace_everything;
 
 #[derive(Parser)]
 #[command(about = "Render a scene or a triangle file through the generated RTL to PNG, checked against golden")]
@@ -182,16 +182,16 @@ fn main() -> ExitCode {
     if let Some(trace) = &args.trace {
         // The models this run builds instances of must have traced twins.
         let mut need = match chain {
-            Chain::Host => vec![require_traced(info)],
-            Chain::HostToMemory(w) => vec![require_traced(info), require_traced(w)],
-            Chain::Rtl(m) => vec![require_traced(m)],
-            Chain::RtlToMemory(m) => vec![require_traced(m)],
+            Chain::Host => vec![info.require_traced()],
+            Chain::HostToMemory(w) => vec![info.require_traced(), w.require_traced()],
+            Chain::Rtl(m) => vec![m.require_traced()],
+            Chain::RtlToMemory(m) => vec![m.require_traced()],
         };
         if args.scene.is_some() || args.obj.is_some() {
-            need.extend(SPECULAR_MODELS.first().map(require_traced));
+            need.extend(SPECULAR_MODELS.first().map(ModelInfo::require_traced));
         }
-        if let Err(e) = need.into_iter().collect::<Result<Vec<()>, String>>().and_then(|_| trace_everything(trace)) {
-            return fail(e);
+        if let Err(e) = need.into_iter().collect::<Result<Vec<()>, _>>().and_then(|_| trace_everything(trace)) {
+            return fail(format!("--trace: {e}"));
         }
     }
 
