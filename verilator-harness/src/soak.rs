@@ -4,7 +4,7 @@
 //!
 //! nextest partitions by test, so one configuration's random triangles cannot be one test: each
 //! segment-shader model's random test is [`SLICES`] tests (`segment::random_triangles::<model>::
-//! slice_<k>`), and the specular unit's random test is [`SLICES`] tests too. Slice `k` of a
+//! slice_<k>`), and the specular units' random test is [`SLICES`] tests too. Slice `k` of a
 //! total `N` draws [`share`]`(N, k)` triangles (pixels), numbered from [`share`]'s first, from a
 //! seed derived from the test's base seed, the model and `k` ([`slice_seed`]). The slices of a
 //! model add up to exactly `N` whatever the number of shards and however nextest deals them out,
@@ -12,7 +12,7 @@
 //!
 //! - [`TRIANGLES_VAR`] (`SEGSHADE_SOAK_TRIANGLES`): random triangles per segment-shader model
 //!   (per p, alignment and pipeline level), [`DEFAULT_TRIANGLES`] when unset;
-//! - [`PIXELS_VAR`] (`SEGSHADE_SOAK_PIXELS`): random specular pixels per run,
+//! - [`PIXELS_VAR`] (`SEGSHADE_SOAK_PIXELS`): random specular pixels per run and specular model,
 //!   [`PIXELS_PER_TRIANGLE`] × the triangles when only `SEGSHADE_SOAK_TRIANGLES` is set,
 //!   [`DEFAULT_PIXELS`] when neither is.
 //!
