@@ -1,42 +1,66 @@
 //! Co-simulation of every `segment_shader_p<P>` model built (both alignments): random
-//! triangles under random gaps and backpressure, directed corner cases, zero-length spans and
-//! full-rate throughput. Every segment is checked bit-exactly against golden, every frame
-//! against golden and the f64 reference.
+//! triangles under random gaps and backpressure (sliced for soaking: `verilator_harness::soak`),
+//! directed corner cases, zero-length spans and full-rate throughput. Every segment is checked
+//! bit-exactly against golden, every frame against golden and the f64 reference.
 
 use golden::rng::SeedRng;
 use golden::setup::Screen;
 use golden::Span;
 use rand::{Rng, SeedableRng};
 use verilator_harness::cosim::{assert_clean, Report, SegmentCosim, Stim, Traffic, DRAIN_CLOCKS};
-use verilator_harness::ffi::{require_models, SEGMENT_MODELS};
+use verilator_harness::ffi::{require, SEGMENT_MODELS};
+use verilator_harness::soak;
 use verilator_harness::stimulus::{directed, random_triangle};
 
-const RANDOM_TRIANGLES: usize = 2_000;
-const BATCH: usize = 50;
+const BATCH: u64 = 50;
 
-#[test]
-fn random_triangles_every_model() {
-    let Some(models) = require_models(SEGMENT_MODELS, "segment shader", "segment: random triangles") else { return };
-    let seed = verilator_harness::seed("random_triangles_every_model");
+/// Slice `k` of one model's random triangles under random gaps and backpressure: its
+/// [`soak::share`] of [`soak::triangles`] (2,000 per model by default; `SEGSHADE_SOAK_TRIANGLES`
+/// soaks), numbered from the slice's first so that a mismatch names a triangle as one whole run
+/// would. Every segment is checked bit-exactly and every batch's frame against golden and the
+/// f64 reference.
+fn random_slice(tag: &str, k: u32) {
+    let what = format!("segment: random triangles of {tag}, slice {k}");
+    let Some(info) = require(SEGMENT_MODELS.iter().find(|m| m.tag == tag), tag, &what) else { return };
+    let base = verilator_harness::seed(&format!("random_triangles::{tag}::slice_{k}"));
+    let seed = soak::slice_seed(base, tag, k);
+    let (first, count) = soak::share(soak::triangles(), k);
     let screen = Screen::default();
-    for (k, info) in models.iter().enumerate() {
-        let model_seed = seed.wrapping_add(k as u64);
-        let mut rng = SeedRng::seed_from_u64(model_seed);
-        let mut sim = SegmentCosim::new(info, model_seed, Traffic::RANDOM);
-        let mut report = Report::default();
-        for first in (0..RANDOM_TRIANGLES).step_by(BATCH) {
-            let batch: Vec<_> = (0..BATCH).map(|_| random_triangle(&mut rng, &screen)).collect();
-            sim.run_triangles(&screen, &batch, first, &mut report);
-        }
-        assert_clean(info.tag, seed, &report);
-        assert_eq!(report.triangles, RANDOM_TRIANGLES);
-        assert!(report.pixels > 100_000, "{}: only {} pixels compared", info.tag, report.pixels);
-        eprintln!(
-            "{}: {} triangles, {} spans, {} segments, {} pixels, {} clocks, worst error {:.3}",
-            info.tag, report.triangles, report.spans, report.segments, report.pixels, report.cycles, report.max_error
-        );
+    let mut rng = SeedRng::seed_from_u64(seed);
+    let mut sim = SegmentCosim::new(info, seed, Traffic::RANDOM);
+    let mut report = Report::default();
+    for start in (0..count).step_by(BATCH as usize) {
+        let batch: Vec<_> = (start..count.min(start + BATCH)).map(|_| random_triangle(&mut rng, &screen)).collect();
+        sim.run_triangles(&screen, &batch, (first + start) as usize, &mut report);
     }
+    assert_clean(&format!("{tag} slice {k}"), base, &report);
+    assert_eq!(report.triangles as u64, count);
+    eprintln!(
+        "{tag} slice {k}/{}: triangles {first}..{}: {} spans, {} segments, {} pixels, {} clocks, worst error {:.3}",
+        soak::SLICES,
+        first + count,
+        report.spans,
+        report.segments,
+        report.pixels,
+        report.cycles,
+        report.max_error
+    );
 }
+
+/// `segment::random_triangles::<model>::slice_<k>`: one module per segment-shader model this
+/// build has (build.rs lists them), one test per soak slice.
+macro_rules! random_triangle_slices {
+    ($($tag:ident),* $(,)?) => {
+        mod random_triangles {
+            $(
+                mod $tag {
+                    soak_slices!(|k| super::super::random_slice(stringify!($tag), k));
+                }
+            )*
+        }
+    };
+}
+include!(concat!(env!("OUT_DIR"), "/segment_slices.rs"));
 
 /// Each directed case on its own frame, on the default screen and on the widest screen the
 /// configuration allows (so spans reach x = 2^XW - 1).

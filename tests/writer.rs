@@ -106,7 +106,10 @@ fn the_scoreboard_catches_a_wrong_writer() {
         let w = writer_of(m);
         let spans = random_spans(&mut SeedRng::seed_from_u64(seed), &w, 300);
         let narrow = Writer::new(m.cfg, Screen { width: w.screen.width - m.cfg.p, ..w.screen }).unwrap();
-        let spans_narrow: Vec<(u32, Span)> = spans.iter().filter(|(_, s)| s.x0 + s.len <= narrow.screen.width).cloned().collect();
+        let mut spans_narrow: Vec<(u32, Span)> = spans.iter().filter(|(_, s)| s.x0 + s.len <= narrow.screen.width).cloned().collect();
+        // A pixel of row 1, whose address the two row strides put a block apart: the control
+        // catches the wrong writer for every seed, not only when the random spans leave row 0.
+        spans_narrow.push((1, Span { x0: 0, len: 1, ..spans[0].1 }));
         let run = run_writer_against(m, seed, Traffic::RANDOM, Stress::NONE, &spans_narrow, narrow);
         assert!(!run.report.ok(), "{}: a writer with another row stride passed", m.tag);
     }

@@ -141,6 +141,11 @@ fn main() {
         None => SpecTables::of(hdl_gen::Options::default().specular_unit().plan(), None),
     };
     fs::write(out.join("models.rs"), models_rs(&models, &twins, trace_all, rtl_dir.as_deref(), &tables)).unwrap();
+    // The segment suite's random test is one test per (model, soak slice), so that nextest can
+    // deal a configuration's soak out to several machines (`verilator_harness::soak`): its list
+    // of models is this build's, written where tests/segment.rs includes it.
+    let seg: Vec<&str> = models.iter().filter(|m| m.kind == Kind::Segment).map(|m| m.tag.as_str()).collect();
+    fs::write(out.join("segment_slices.rs"), format!("random_triangle_slices!({});\n", seg.join(", "))).unwrap();
 }
 
 /// The runtime files the lists ask for, each once, in the order first asked.

@@ -293,15 +293,6 @@ mod tests {
     use crate::setup::{max_span_error, triangle_spans, Vertex, COORD_LIMIT};
     use rand::{Rng, SeedableRng};
 
-    /// GOLDEN_SEED replays a run; otherwise a fresh seed, printed so a failure can be replayed.
-    fn seed() -> u64 {
-        let s = std::env::var("GOLDEN_SEED").ok().and_then(|s| s.parse().ok()).unwrap_or_else(|| {
-            std::time::SystemTime::now().duration_since(std::time::UNIX_EPOCH).map(|d| d.as_nanos() as u64).unwrap_or(1)
-        });
-        println!("GOLDEN_SEED={s}");
-        s
-    }
-
     fn tri(p: [[f64; 3]; 3]) -> Triangle {
         Triangle { v: p.map(|[x, y, i]| Vertex { x, y, i }) }
     }
@@ -430,7 +421,7 @@ mod tests {
 
     #[test]
     fn random_triangles_match_the_reference() {
-        let mut rng = SeedRng::seed_from_u64(seed());
+        let mut rng = SeedRng::seed_from_u64(crate::rng::test_seed("random_triangles_match_the_reference"));
         let align = crate::Align::Span;
         let runs = [
             (Config::default(), Screen { width: 400, height: 300 }, 3000),
@@ -462,7 +453,7 @@ mod tests {
 
     #[test]
     fn jittered_mesh_covers_every_pixel_once() {
-        let mut rng = SeedRng::seed_from_u64(seed());
+        let mut rng = SeedRng::seed_from_u64(crate::rng::test_seed("jittered_mesh_covers_every_pixel_once"));
         let screen = Screen { width: 200, height: 150 };
         for _ in 0..4 {
             // A lattice through pixel centres, extending two cells past the screen on every

@@ -7,6 +7,30 @@
 
 pub type SeedRng = rand_chacha::ChaCha12Rng;
 
+/// The seed of a random test: the environment variable `var` when set (to replay a failure),
+/// else a fresh one from the clock and the process id (nextest runs each test in a process of
+/// its own, so two tests started in the same nanosecond still differ). A value that is not a
+/// whole number stops the test with a message naming the variable instead of being ignored.
+/// Callers print the seed (golden's tests `GOLDEN_SEED`, the harness's `COSIM_SEED`).
+pub fn env_or_clock_seed(var: &str) -> u64 {
+    match std::env::var(var) {
+        Ok(s) => s.trim().parse().unwrap_or_else(|_| panic!("{var}='{s}' is not a whole number")),
+        Err(_) => std::time::SystemTime::now()
+            .duration_since(std::time::UNIX_EPOCH)
+            .map(|d| d.as_nanos() as u64 ^ (std::process::id() as u64) << 32)
+            .unwrap_or(1),
+    }
+}
+
+/// The seed of one of golden's random unit tests, from `GOLDEN_SEED` or the clock, printed to
+/// the test's captured output, which `cargo test` and nextest show when the test fails.
+#[cfg(test)]
+pub(crate) fn test_seed(test: &str) -> u64 {
+    let seed = env_or_clock_seed("GOLDEN_SEED");
+    eprintln!("{test}: seed {seed} (replay with GOLDEN_SEED={seed})");
+    seed
+}
+
 #[cfg(test)]
 mod tests {
     use super::SeedRng;

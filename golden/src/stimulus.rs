@@ -317,4 +317,58 @@ mod tests {
         let ns: Vec<u16> = (0..2000).map(|_| random_n(&mut rng)).collect();
         assert!(ns.contains(&0) && ns.contains(&1) && ns.contains(&1000) && ns.iter().any(|&n| n > 1000), "every k range and invalid n");
     }
+
+    /// The random mix is worth co-simulating: 2,000 triangles (one model's fast-suite share) set
+    /// up to over 100,000 pixels on the default screen, from a fixed seed, so this holds or fails
+    /// the same on every run. (The co-simulation draws from the clock and asserts no pixel
+    /// count: what it compares is exact; its volume is what this test pins.)
+    #[test]
+    fn two_thousand_random_triangles_cover_a_hundred_thousand_pixels() {
+        let (cfg, screen) = (Config::default(), Screen::default());
+        let mut rng = SeedRng::seed_from_u64(1);
+        let mut pixels = 0u64;
+        for _ in 0..2_000 {
+            crate::setup::triangle_spans(&cfg, &screen, &random_triangle(&mut rng, &screen), |_, s| pixels += s.len as u64).unwrap();
+        }
+        assert!(pixels > 100_000, "{pixels} pixels");
+    }
+
+    /// The specular mix lights what the SPEC §4 checks judge: from a fixed seed, over a third of
+    /// 1,200 random spans' pixels lie inside their n's epicentre, and every n of the
+    /// co-simulation's coverage list is drawn.
+    #[test]
+    fn random_spans_light_a_third_of_their_pixels() {
+        use crate::specular::reference::epicentre;
+        use crate::specular::{n_valid, theta_at, THETA_FRAC};
+        let mut rng = SeedRng::seed_from_u64(1);
+        let (mut owed, mut inside, mut seen) = (0u64, 0u64, [false; 1024]);
+        for _ in 0..1_200 {
+            let s = random_span(&mut rng, 4096);
+            owed += s.len as u64;
+            seen[s.n as usize] = true;
+            if n_valid(s.n as u32) {
+                let edge = epicentre(s.n as u32);
+                let angle = |j| theta_at(s.theta0, s.dtheta, j).unsigned_abs() as f64 / (1u64 << THETA_FRAC) as f64;
+                inside += (0..s.len).filter(|&j| angle(j) <= edge).count() as u64;
+            }
+        }
+        assert!(inside * 3 > owed, "only {inside} of {owed} pixels inside an epicentre");
+        for n in [0, 1, 2, 3, 6, 7, 1000, 1001, 1023] {
+            assert!(seen[n], "n = {n} never drawn");
+        }
+    }
+
+    /// The premise of the front-end suite's "every outcome is reached" check (tests/frontend.rs):
+    /// each outcome has a probability of at least 1/20 per random port triangle, here on 20,000
+    /// triangles from a fixed seed.
+    #[test]
+    fn random_fixed_triangles_reach_each_outcome_one_time_in_twenty() {
+        use crate::frontend::Outcome;
+        let fe = FrontEnd::new(Config::default(), Screen::default()).unwrap();
+        let tris = random_fixed_triangles(&mut SeedRng::seed_from_u64(1), &fe, 20_000);
+        for o in [Outcome::Guard, Outcome::Culled, Outcome::Walked] {
+            let n = tris.iter().filter(|t| fe.span_list(t).0 == o).count();
+            assert!(n >= 1_000, "{o:?}: {n} of 20000");
+        }
+    }
 }

@@ -64,8 +64,13 @@ fn module_names(manifest: &str) -> Vec<String> {
     hdl_gen::manifest::Manifest::parse(manifest).unwrap().modules.into_iter().map(|e| e.name).collect()
 }
 
-#[test]
-fn verilator_lint_and_icarus_are_clean() {
+/// The sweep is cut into [`PARTS`] tests, part `i` taking every `PARTS`-th run from the `i`-th:
+/// as one test it was the workspace's longest (about a minute on 2 cores) and the critical path
+/// of a sharded regression (docs/regressions.md). Each part runs one tool at a time; the test
+/// runner runs parts side by side.
+const PARTS: usize = 8;
+
+fn lint_part(part: usize) {
     // The front-end depends on F, XW, the screen, the prefix and the divider rate, not on P, the
     // alignment or the increment form: it is linted once per front-end configuration, and the
     // chain there and at the extreme P values (scripts/lint-all lints every configuration).
@@ -79,21 +84,30 @@ fn verilator_lint_and_icarus_are_clean() {
     for bits in [1, 4] {
         runs.push((Config::default(), "", BfpiArch::ShiftAdd, Some(bits), DiMode::Scanline, Pipeline::NONE));
     }
-    // The work is external processes (Verilator, Icarus): two at a time, one per core.
-    let runs: Vec<_> = runs.into_iter().enumerate().map(|(k, r)| (k, r, fe_seen.insert((r.0.frac, r.0.xbits, r.1, r.3, r.4)))).collect();
-    let next = std::sync::atomic::AtomicUsize::new(0);
-    std::thread::scope(|s| {
-        for _ in 0..2 {
-            s.spawn(|| {
-                while let Some(&(k, (cfg, prefix, arch, fe_div_bits, fe_di, pipe), fe_first)) =
-                    runs.get(next.fetch_add(1, std::sync::atomic::Ordering::Relaxed))
-                {
-                    lint_one(k, cfg, prefix, arch, (fe_div_bits, fe_di), pipe, fe_first);
-                }
-            });
+    // Which run lints each front-end is decided over the whole sweep, then each part takes its own.
+    let firsts: Vec<bool> = runs.iter().map(|r| fe_seen.insert((r.0.frac, r.0.xbits, r.1, r.3, r.4))).collect();
+    for (k, ((cfg, prefix, arch, fe_div_bits, fe_di, pipe), fe_first)) in runs.into_iter().zip(firsts).enumerate() {
+        if k % PARTS == part {
+            lint_one(k, cfg, prefix, arch, (fe_div_bits, fe_di), pipe, fe_first);
         }
-    });
+    }
 }
+
+/// `verilator_lint_and_icarus_are_clean::part_<i>`, one test per part.
+macro_rules! parts {
+    ($($name:ident = $i:expr),*) => {
+        mod verilator_lint_and_icarus_are_clean {
+            const _: () = assert!(super::PARTS == [$($i),*].len(), "one test per part");
+            $(
+                #[test]
+                fn $name() {
+                    super::lint_part($i)
+                }
+            )*
+        }
+    };
+}
+parts!(part_0 = 0, part_1 = 1, part_2 = 2, part_3 = 3, part_4 = 4, part_5 = 5, part_6 = 6, part_7 = 7);
 
 fn lint_one(
     k: usize,

@@ -248,6 +248,12 @@ impl SegmentCosim {
         self.info
     }
 
+    /// Clocks the model has run since it was built, reset clocks included: the clock numbers of
+    /// mismatch messages and waveforms (the last stream's last clock is this minus one).
+    pub fn clock(&self) -> u64 {
+        self.driver.clock()
+    }
+
     /// Streams `stims` through the model, checking every segment against golden; `paint` gets
     /// each checked segment that left the model, with its span, in order (on the checking
     /// thread). Panics, before the model sees anything, on a span its ports cannot take (see

@@ -263,6 +263,12 @@ impl<U: Unit> Driver<U> {
         d
     }
 
+    /// Clocks the model has run since it was built, reset clocks included (the numbers of
+    /// mismatch messages and waveforms); after a stream, its last clock is this minus one.
+    pub fn clock(&self) -> u64 {
+        self.clock
+    }
+
     /// Failure waveforms into `dir` (`None`: off) from now on, whatever COSIM_TRACE says; two
     /// clocks of reset start the tape. No effect on a traced model (`--trace`).
     pub fn set_waveforms(&mut self, dir: Option<PathBuf>) {

@@ -15,6 +15,7 @@ pub mod ffi;
 pub mod frontend;
 pub mod render;
 pub mod report;
+pub mod soak;
 pub mod specular;
 pub mod stimulus;
 mod tape;
@@ -23,15 +24,11 @@ pub mod waveform;
 pub mod writer;
 
 /// The seed of a random test: `COSIM_SEED` when set (to replay a failure), else a fresh one.
-/// Printed either way, so every failure can be replayed.
+/// Printed either way, so every failure can be replayed: to the test's captured output, which
+/// both `cargo test` and nextest show for a failing test (and nextest's JUnit report keeps), with
+/// the soak variables when they are set ([`soak`]), since they change what a seed draws.
 pub fn seed(test: &str) -> u64 {
-    let seed = match std::env::var("COSIM_SEED") {
-        Ok(s) => s.trim().parse().unwrap_or_else(|_| panic!("COSIM_SEED='{s}' is not a whole number")),
-        Err(_) => std::time::SystemTime::now()
-            .duration_since(std::time::UNIX_EPOCH)
-            .map(|d| d.as_nanos() as u64 ^ (std::process::id() as u64) << 32)
-            .unwrap_or(1),
-    };
-    eprintln!("{test}: seed {seed} (replay with COSIM_SEED={seed})");
+    let seed = golden::rng::env_or_clock_seed("COSIM_SEED");
+    eprintln!("{test}: seed {seed} (replay with COSIM_SEED={seed}{})", soak::replay_env());
     seed
 }

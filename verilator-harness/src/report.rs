@@ -104,7 +104,8 @@ pub fn assert_clean(what: &str, seed: u64, report: &Report) {
     if report.ok() {
         return;
     }
-    let mut msg = format!("{what}: {} mismatches (seed {seed}, replay with COSIM_SEED={seed})\n", report.mismatch_count);
+    let mut msg =
+        format!("{what}: {} mismatches (seed {seed}, replay with COSIM_SEED={seed}{})\n", report.mismatch_count, crate::soak::replay_env());
     for m in &report.mismatches {
         msg.push_str(&format!("  {m}\n"));
     }

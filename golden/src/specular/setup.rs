@@ -248,11 +248,9 @@ mod tests {
     use crate::rng::SeedRng;
     use rand::{Rng, SeedableRng};
 
-    /// Seeded from GOLDEN_SEED if set, else fresh; the seed is printed so a failure replays.
+    /// Seeded from GOLDEN_SEED if set, else fresh ([`crate::rng::test_seed`]).
     fn rng() -> SeedRng {
-        let seed = std::env::var("GOLDEN_SEED").ok().and_then(|s| s.parse().ok()).unwrap_or_else(rand::random::<u64>);
-        eprintln!("GOLDEN_SEED={seed}");
-        SeedRng::seed_from_u64(seed)
+        SeedRng::seed_from_u64(crate::rng::test_seed("specular setup"))
     }
 
     fn unit(r: &mut SeedRng) -> Vec3 {
@@ -346,12 +344,15 @@ mod tests {
         let mut r = rng();
         let u = SpecularUnit::default();
         let mut checked = 0;
-        for _ in 0..400 {
+        for k in 0..400 {
+            // The first two spans sit on the highlight (H = N all along, theta 0 at every one of
+            // their 601 pixels), so at least 1,202 pixels are checked whatever the seed.
+            let centred = k < 2;
             let n1 = unit(&mut r);
-            let near = |r: &mut SeedRng| normalize(add(n1, scale(unit(r), r.gen_range(0.0..0.6)))).unwrap();
+            let near = |r: &mut SeedRng| normalize(add(n1, scale(unit(r), r.gen_range(0.0..0.6) * !centred as u8 as f64))).unwrap();
             let (h1, h2) = (near(&mut r), near(&mut r));
             let e = SpanEnds { n1, h1, n2: n1, h2 };
-            let (n, l) = (r.gen_range(1..=1000u32), r.gen_range(1..=600u32));
+            let (n, l) = (r.gen_range(1..=1000u32), if centred { 600 } else { r.gen_range(1..=600u32) });
             let s = setup_span(&e, 255.0, 1.0, n as u16, l);
             let p = s.port;
             let k = u.plan().decoder.k_of(n).unwrap();

@@ -70,8 +70,9 @@ struct Args {
     #[arg(long)]
     quiet: bool,
     /// Write every clock of every model instance into FST files in DIR (`<model>-seed<seed>.fst`),
-    /// for GTKWave or Surfer. For small renders (try --width 64 --height 48): a few hundred bytes
-    /// per clock. Needs traced models (built when COSIM_TRACE is set at build time).
+    /// for GTKWave or Surfer. For small renders (try --width 64 --height 48): tens of bytes per
+    /// clock (45 for seg_p8_span, docs/regressions.md). Needs traced models (built when
+    /// COSIM_TRACE is set at build time).
     #[arg(long, value_name = "DIR")]
     trace: Option<PathBuf>,
 }
