@@ -48,9 +48,10 @@ const BUILT_TRI: [(u32, Align); 4] = [(1, Align::Span), (8, Align::Span), (8, Al
 const BUILT_WR: [(u32, Align); 6] =
     [(1, Align::Span), (2, Align::Span), (8, Align::Span), (8, Align::Screen), (64, Align::Span), (64, Align::Screen)];
 const BUILT_FB: [(u32, Align); 2] = [(8, Align::Span), (64, Align::Screen)];
-/// Pipelined shaders (`--pipeline`) built by default, each in both alignments: every level at
-/// P = 8, the deepest at the smallest and largest P (its stages' corners: P = 1 has no BFPI).
-const BUILT_PIPE: [(u32, u32); 4] = [(8, 1), (1, 2), (8, 2), (64, 2)];
+/// Pipelined shaders (`--pipeline`) built by default: every level at P = 8 in both alignments,
+/// the deepest at the smallest and largest P in one alignment each (P = 1 has no lead, so its
+/// alignments are one circuit; P = 64's screen alignment has the widest lead arithmetic).
+const BUILT_PIPE: [(u32, u32, Option<Align>); 4] = [(8, 1, None), (1, 2, Some(Align::Span)), (8, 2, None), (64, 2, Some(Align::Screen))];
 
 #[derive(Clone, Copy, PartialEq)]
 enum Kind {
@@ -404,7 +405,7 @@ fn generated_models() -> Vec<Model> {
             }
             let sources: Vec<(String, String)> =
                 sources.into_iter().filter(|(n, _)| *n == format!("{}.v", names.segment) || *n == format!("{}.v", names.bfpi)).collect();
-            for level in BUILT_PIPE.iter().filter(|(bp, _)| *bp == p).map(|&(_, l)| l) {
+            for level in BUILT_PIPE.iter().filter(|(bp, _, a)| *bp == p && a.is_none_or(|a| a == align)).map(|&(_, l, _)| l) {
                 let pipeline = Pipeline::new(level).expect("a built level exists");
                 let m = hdl_gen::segment::module_with(&cfg, &names, hdl_gen::BfpiArch::ShiftAdd, pipeline);
                 let mut src: Vec<(String, String)> =
