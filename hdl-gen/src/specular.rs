@@ -79,6 +79,58 @@ fn tree(terms: &[String]) -> String {
     }
 }
 
+/// A multiply `a * b` split for clock rate (`--pipeline`): `a` times each `k`-bit slice of `b`
+/// (wires `<product>_j`), registered (`<reg>_j`), and summed a stage later in a balanced tree.
+/// Operands are (name, width).
+struct SplitMul {
+    a: (&'static str, u32),
+    b: (&'static str, u32),
+    k: u32,
+    product: &'static str,
+    reg: &'static str,
+}
+
+impl SplitMul {
+    fn slices(&self) -> u32 {
+        self.b.1.div_ceil(self.k)
+    }
+
+    /// Each slice's product and its register; a partial is `a`'s width plus `k` bits.
+    fn items(&self) -> Vec<Item> {
+        let ((a, aw), (b, bw), k) = (self.a, self.b, self.k);
+        (0..self.slices())
+            .flat_map(|j| {
+                let bits = k.min(bw - j * k);
+                let slice = zext(&format!("{b}[{}:{}]", j * k + bits - 1, j * k), bits, aw + k);
+                [
+                    reg(&format!("{}_{j}", self.reg), aw + k),
+                    wire(&format!("{}_{j}", self.product), aw + k, format!("{} * {slice}", zext(a, aw, aw + k))),
+                ]
+            })
+            .collect()
+    }
+
+    /// The registers' loads, for the stage that holds them.
+    fn loads(&self) -> Vec<Stmt> {
+        (0..self.slices()).map(|j| set(format!("{}_{j}", self.reg), format!("{}_{j}", self.product))).collect()
+    }
+
+    /// The registered partials, each at its slice's weight, summed at `width` bits.
+    fn sum(&self, width: u32) -> String {
+        let terms: Vec<String> = (0..self.slices())
+            .map(|j| {
+                let t = zext(&format!("{}_{j}", self.reg), self.a.1 + self.k, width);
+                if j == 0 {
+                    t
+                } else {
+                    format!("({t} << {})", j * self.k)
+                }
+            })
+            .collect();
+        tree(&terms)
+    }
+}
+
 /// The ROM modules and the unit, in file order.
 pub fn modules(cfg: &Config, unit: &SpecularUnit, names: &SpecNames) -> Vec<Module> {
     vec![
@@ -187,9 +239,10 @@ fn module(cfg: &Config, unit: &SpecularUnit, names: &SpecNames) -> Module {
     ];
     let split = p.pipeline.split_multiplies();
     let k = SpecularPlan::MUL_CHUNK;
+    // Split multiplies (`--pipeline`): |theta| * M and C * w, by k-bit slices of M and of w.
+    let arg_mul = SplitMul { a: ("mag1q", mag), b: ("m1", mw), k, product: "pp1", reg: "pp2a" };
+    let c_mul = SplitMul { a: ("c3q", C_BITS), b: ("w3q", w), k, product: "cp3", reg: "cp4a" };
     if split {
-        // Partial products by k-bit slices of M, registered; their sum is the next stage.
-        let mc = mw.div_ceil(k);
         body.push(comment("Stage 1q: |theta| and the n-table word registered off the ROM's output."));
         body.extend([reg("v1q", 1), reg("mag1q", mag), reg("c1q", C_BITS), reg("last1q", 1), reg("nk1q", g.nk_width), Item::Blank]);
         body.push(comment(format!("Stage 2a: |theta| times each {k}-bit slice of M; M = 0 marks an invalid n.")));
@@ -198,36 +251,14 @@ fn module(cfg: &Config, unit: &SpecularUnit, names: &SpecNames) -> Module {
         if sb > 0 && tables.len() > 1 {
             body.push(reg("sel2a", sb));
         }
-        for j in 0..mc {
-            let bits = k.min(mw - j * k);
-            body.push(reg(&format!("pp2a_{j}"), mag + k));
-            body.push(wire(
-                &format!("pp1_{j}"),
-                mag + k,
-                format!("{} * {}", zext("mag1q", mag, mag + k), zext(&format!("m1[{}:{}]", j * k + bits - 1, j * k), bits, mag + k)),
-            ));
-        }
+        body.extend(arg_mul.items());
         body.push(Item::Blank);
         body.push(comment("Stage 2: the argument, the partial products summed in a balanced tree."));
     } else {
         body.push(comment("Stage 2: the argument multiplier; M = 0 marks an invalid n."));
         body.push(wire("m1", mw, format!("nk1[{}:0]", mw - 1)));
     }
-    let prod_expr = if split {
-        let terms: Vec<String> = (0..mw.div_ceil(k))
-            .map(|j| {
-                let t = zext(&format!("pp2a_{j}"), mag + k, prod);
-                if j == 0 {
-                    t
-                } else {
-                    format!("({t} << {})", j * k)
-                }
-            })
-            .collect();
-        tree(&terms)
-    } else {
-        format!("{} * {}", zext("mag1", mag, prod), zext("m1", mw, prod))
-    };
+    let prod_expr = if split { arg_mul.sum(prod) } else { format!("{} * {}", zext("mag1", mag, prod), zext("m1", mw, prod)) };
     body.extend([
         comment(format!("Bits below the smallest table shift ({lo}) never reach an index: not registered.")),
         comment("verilator lint_off UNUSEDSIGNAL"),
@@ -301,37 +332,14 @@ fn module(cfg: &Config, unit: &SpecularUnit, names: &SpecNames) -> Module {
     let scaled = if split {
         // The word off the ROM into a plain register first; then C times each k-bit slice of
         // it, registered; their sum, with C (C * (w + 1) = C * w + C), is the last stage.
-        let cc = w.div_ceil(k);
         body.push(comment("Stage 3q: the BRDF word registered off the ROM's output."));
         body.extend([reg("v3q", 1), reg("cut3q", 1), reg("err3q", 1), reg("c3q", C_BITS), reg("last3q", 1), reg("w3q", w), Item::Blank]);
         body.push(comment(format!("Stage 4a: C times each {k}-bit slice of w.")));
         body.extend([reg("v4a", 1), reg("cut4a", 1), reg("err4a", 1), reg("c4a", C_BITS), reg("last4a", 1)]);
-        for j in 0..cc {
-            let bits = k.min(w - j * k);
-            body.push(reg(&format!("cp4a_{j}"), C_BITS + k));
-            body.push(wire(
-                &format!("cp3_{j}"),
-                C_BITS + k,
-                format!(
-                    "{} * {}",
-                    zext("c3q", C_BITS, C_BITS + k),
-                    zext(&format!("w3q[{}:{}]", j * k + bits - 1, j * k), bits, C_BITS + k)
-                ),
-            ));
-        }
+        body.extend(c_mul.items());
         body.push(Item::Blank);
-        let terms: Vec<String> = (0..cc)
-            .map(|j| {
-                let t = zext(&format!("cp4a_{j}"), C_BITS + k, sw);
-                if j == 0 {
-                    t
-                } else {
-                    format!("({t} << {})", j * k)
-                }
-            })
-            .collect();
         body.push(comment(format!("Stage 4: out = C * (w + 1) / 2^{w}, the slices and C summed, rounded half up; never above C.")));
-        format!("{} + {} + {}", tree(&terms), zext("c4a", C_BITS, sw), lit(sw, 1 << (w - 1)))
+        format!("{} + {} + {}", c_mul.sum(sw), zext("c4a", C_BITS, sw), lit(sw, 1 << (w - 1)))
     } else {
         body.push(comment(format!("Stage 4: out = C * (w + 1) / 2^{w}, rounded half up; never above C.")));
         format!("{} * {} + {}", zext("c3", C_BITS, sw), zext(&wp, w + 1, sw), lit(sw, 1 << (w - 1)))
@@ -353,7 +361,7 @@ fn module(cfg: &Config, unit: &SpecularUnit, names: &SpecNames) -> Module {
         resets.push(set("v1q", "1'b0"));
         order.push(("v1q", "last1q"));
         let mut part = vec![set("v2a", "v1q"), set("c2a", "c1q"), set("last2a", "last1q"), set("err2a", err_of_m.clone())];
-        part.extend((0..mw.div_ceil(k)).map(|j| set(format!("pp2a_{j}"), format!("pp1_{j}"))));
+        part.extend(arg_mul.loads());
         if multi_table {
             part.push(set("sel2a", sel_of_nk.clone()));
         }
@@ -396,7 +404,7 @@ fn module(cfg: &Config, unit: &SpecularUnit, names: &SpecNames) -> Module {
             set("w3q", "w3"),
         ]);
         let mut part = vec![set("v4a", "v3q"), set("cut4a", "cut3q"), set("err4a", "err3q"), set("c4a", "c3q"), set("last4a", "last3q")];
-        part.extend((0..w.div_ceil(k)).map(|j| set(format!("cp4a_{j}"), format!("cp3_{j}"))));
+        part.extend(c_mul.loads());
         stages.push(part);
         resets.extend([set("v3", "1'b0"), set("v3q", "1'b0"), set("v4a", "1'b0")]);
         order.extend([("v3", "last3"), ("v3q", "last3q"), ("v4a", "last4a")]);
