@@ -1,4 +1,5 @@
-"""The clock-to-clock critical path of a nextpnr --report JSON, in RTL names (scripts/synth)."""
+"""What scripts/synth's readers and tables share: nextpnr's critical path in RTL names, and how a
+row's label reads in the table."""
 import re
 
 
@@ -26,3 +27,29 @@ def critical(rep):
             return {"through": names, "ns": round(total, 2), "logic_ns": round(total - route, 2),
                     "routing_ns": round(route, 2)}
     return None
+
+
+def path_text(cp, missing="-"):
+    """A critical path as the tables print it."""
+    if not cp:
+        return missing
+    return f'{" → ".join(cp["through"])} ({cp["ns"]:.1f} ns: {cp["logic_ns"]:.1f} logic, {cp["routing_ns"]:.1f} routing)'
+
+
+def level(tag):
+    """'+pl2' in a label: the --pipeline level, as the form column says it."""
+    return f"--pipeline {tag[3:]}" if tag else ""
+
+
+def block_form(r):
+    """The block and form columns of a row: 'shift-add+pl2/p8' reads P = 8, shift-add, --pipeline 2."""
+    if r["label"].startswith("specular"):
+        return r["top"], level(r["label"][len("specular"):]) or "—"
+    if r["label"].startswith("ref/"):
+        ref = r["label"][4:]
+        if ref.startswith("acc"):
+            return f"reference: {ref[3:]}-bit accumulator", "—"
+        return f"reference: {ref[3:].replace('x', ' × ')} multiplier", "—"
+    form, p = r["label"].split("/")
+    form, _, pl = form.partition("+")
+    return f"P = {p[1:]}", ", ".join(filter(None, [form, level("+" + pl if pl else "")]))
