@@ -9,8 +9,6 @@
 use clap::{ArgGroup, Parser, ValueEnum};
 use golden::setup::Screen;
 use golden::Align;
-use image::codecs::png::PngEncoder;
-use image::{ExtendedColorType, ImageEncoder};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::time::Instant;
@@ -206,12 +204,12 @@ fn main() -> ExitCode {
     bar.finish_and_clear();
 
     let channels = job.channels();
-    let color = if channels == 3 { ExtendedColorType::Rgb8 } else { ExtendedColorType::L8 };
+    let color = if channels == 3 { png::ColorType::Rgb } else { png::ColorType::Grayscale };
     let mut files =
         vec![(args.out.clone(), png(&outcome.rtl, &screen, color)), (golden_path.clone(), png(&outcome.golden, &screen, color))];
     if args.diff {
         let d = difference_image(&outcome.rtl, &outcome.golden, channels);
-        files.push((diff_path.clone(), png(&d, &screen, ExtendedColorType::Rgb8)));
+        files.push((diff_path.clone(), png(&d, &screen, png::ColorType::Rgb)));
     }
     let staged: Vec<(PathBuf, &[u8])> = files.iter().map(|(p, b)| (p.clone(), b.as_slice())).collect();
     if let Err(e) = hdl_gen::output::write_files(&staged) {
@@ -285,8 +283,13 @@ fn summary(args: &Args, job: &Job, o: &verilator_harness::render::Outcome, tag: 
     println!("wall time:  {secs:.2} s");
 }
 
-fn png(buf: &[u8], screen: &Screen, color: ExtendedColorType) -> Vec<u8> {
+fn png(buf: &[u8], screen: &Screen, color: png::ColorType) -> Vec<u8> {
     let mut out = Vec::new();
-    PngEncoder::new(&mut out).write_image(buf, screen.width, screen.height, color).expect("in-memory PNG encoding");
+    let mut encoder = png::Encoder::new(&mut out, screen.width, screen.height);
+    encoder.set_color(color);
+    encoder.set_depth(png::BitDepth::Eight);
+    let mut writer = encoder.write_header().expect("in-memory PNG header");
+    writer.write_image_data(buf).expect("in-memory PNG encoding");
+    writer.finish().expect("in-memory PNG end");
     out
 }
