@@ -48,10 +48,12 @@ const BUILT_TRI: [(u32, Align); 4] = [(1, Align::Span), (8, Align::Span), (8, Al
 const BUILT_WR: [(u32, Align); 6] =
     [(1, Align::Span), (2, Align::Span), (8, Align::Span), (8, Align::Screen), (64, Align::Span), (64, Align::Screen)];
 const BUILT_FB: [(u32, Align); 2] = [(8, Align::Span), (64, Align::Screen)];
-/// Pipelined shaders (`--pipeline`) built by default: every level at P = 8 in both alignments,
-/// the deepest at the smallest and largest P in one alignment each (P = 1 has no lead, so its
-/// alignments are one circuit; P = 64's screen alignment has the widest lead arithmetic).
-const BUILT_PIPE: [(u32, u32, Option<Align>); 4] = [(8, 1, None), (1, 2, Some(Align::Span)), (8, 2, None), (64, 2, Some(Align::Screen))];
+/// Pipelined shaders (`--pipeline`) built by default: levels 1 and 2 at P = 8 in both alignments,
+/// the deepest at P = 8 and at the smallest and largest P in one alignment each (P = 1 has no
+/// lead, so its alignments are one circuit; P = 64's screen alignment has the widest lead
+/// arithmetic, and its BFPI a second adder level, formed when the span starts).
+const BUILT_PIPE: [(u32, u32, Option<Align>); 5] =
+    [(8, 1, None), (8, 2, None), (1, 3, Some(Align::Span)), (8, 3, Some(Align::Span)), (64, 3, Some(Align::Screen))];
 
 #[derive(Clone, Copy, PartialEq)]
 enum Kind {

@@ -48,6 +48,7 @@ pub fn numbered(body: Vec<(&str, String, Vec<PipeReg>)>) -> Vec<PipeStage> {
 /// | 0 | as SPEC's seed: 2 stages | 5 stages |
 /// | 1 | + a span register; the BFPI's multiples and the last-segment flag registered | + both multiplies split into registered 4-bit partial products and their sum; the BRDF address registered before the ROM, both ROMs' words registered before any arithmetic: 10 stages |
 /// | 2 | + the lane sums registered before round and clamp | as level 1 |
+/// | 3 | + no clock with two adders in a row: the BFPI's first adder level formed as the span enters its register, the rest when it starts; each lane's sum split at the binary point (high part and the fraction's carry registered, joined before the clamp) | as level 1 |
 ///
 /// Level 0 is the default: the smallest circuit and the shortest latency, byte for byte the
 /// RTL every earlier release generated. `docs/fpga.md` gives each level's area and Fmax.
@@ -75,7 +76,7 @@ impl From<Pipeline> for u32 {
 
 impl Pipeline {
     /// The deepest level.
-    pub const MAX: u32 = 2;
+    pub const MAX: u32 = 3;
     /// SPEC's seed structure, no added stage.
     pub const NONE: Pipeline = Pipeline(0);
 
@@ -111,6 +112,15 @@ impl Pipeline {
         self.0 >= 2
     }
 
+    /// Segment shader: the same stages as level 2, with the adders cut so that no clock has two
+    /// in a row (the span register holds the BFPI's first-level values, formed from the input's
+    /// dI; the sum register holds each lane's high part and the carry out of its fraction bits).
+    /// Level 2's limits were the BFPI's two adder levels (p >= 16) and the full-width lane add
+    /// behind the accumulator's fan-out (p = 8).
+    pub fn split_adds(self) -> bool {
+        self.0 >= 3
+    }
+
     /// Specular unit: the argument and C multiplies each become registered partial products
     /// (small multiplies by 4-bit slices) and a registered sum, the BRDF address (the table
     /// select's mux after the per-table index arithmetic) is registered before the ROM read,
@@ -139,13 +149,14 @@ mod tests {
         // A file's level is checked as it is read, as a number.
         assert_eq!(serde_json::from_str::<Pipeline>("2").unwrap(), Pipeline::at(2));
         assert_eq!(serde_json::to_string(&Pipeline::at(1)).unwrap(), "1");
-        let e = serde_json::from_str::<Pipeline>("3").unwrap_err().to_string();
-        assert!(e.contains(&PipelineError(3).to_string()), "{e}");
+        let above = (Pipeline::MAX + 1).to_string();
+        let e = serde_json::from_str::<Pipeline>(&above).unwrap_err().to_string();
+        assert!(e.contains(&PipelineError(Pipeline::MAX + 1).to_string()), "{e}");
     }
 
     #[test]
     fn each_level_adds_to_the_one_before() {
-        let flags = |p: Pipeline| [p.span_stage(), p.sum_stage(), p.split_multiplies()];
+        let flags = |p: Pipeline| [p.span_stage(), p.sum_stage(), p.split_multiplies(), p.split_adds()];
         let levels: Vec<_> = Pipeline::all().collect();
         for w in levels.windows(2) {
             let (a, b) = (flags(w[0]), flags(w[1]));

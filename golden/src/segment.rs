@@ -92,14 +92,27 @@ pub fn stages(cfg: &Config, pipe: Pipeline) -> Vec<PipeStage> {
     ];
     let mut body = Vec::new();
     if pipe.span_stage() {
-        let regs = vec![
+        let mut regs = vec![
             PipeReg::new("x0", xw, "uint"),
             PipeReg::new("m", xw + 1, "uint"),
             PipeReg::new("i0", cfg.iw(), &format!("UQ8.{f}")),
             PipeReg::new("di", cfg.dw(), &format!("signed Q8.{f}")),
             PipeReg::new("valid", 1, "flag (m != 0)"),
         ];
-        body.push(("span", "the accepted span; m = 0 is dropped here".to_string(), regs));
+        let mut logic = "the accepted span; m = 0 is dropped here".to_string();
+        if pipe.split_adds() {
+            let first = first_level(cfg.p);
+            if !first.is_empty() {
+                let list = first.iter().map(|c| format!("{c}*dI")).collect::<Vec<_>>().join(", ");
+                regs.push(PipeReg::new(
+                    "fund",
+                    first.len() as u32 * cfg.mw(),
+                    &format!("{} x signed Q{}.{f}: {list}", first.len(), cfg.mw() - f),
+                ));
+                logic.push_str("; the BFPI's first adder level of the input's dI");
+            }
+        }
+        body.push(("span", logic, regs));
     }
     let mut cur = vec![acc];
     if pipe.span_stage() {
@@ -116,7 +129,22 @@ pub fn stages(cfg: &Config, pipe: Pipeline) -> Vec<PipeStage> {
         format!("acc <= accept ? {start} : acc + P*dI")
     };
     body.push(("current", cur_logic, cur));
-    if pipe.sum_stage() {
+    if pipe.split_adds() {
+        let regs = vec![
+            PipeReg::new(
+                "hi_carry",
+                p * (qw + 1),
+                &format!("{p} x {{signed {qw}-bit (acc >> F) + (inc_i >> F), carry out of the {f} fraction bits of acc + inc_i}}"),
+            ),
+            PipeReg::new("mask", p, "bit per lane"),
+            PipeReg::new("x", xw, "uint"),
+            PipeReg::new("last", 1, "flag"),
+            PipeReg::new("valid", 1, "flag"),
+        ];
+        let logic = "hi_i, carry_i: acc + inc_i cut at the binary point; mask_i = i < rem (and i >= lead)";
+        body.push(("sum", logic.to_string(), regs));
+        body.push(("output", "lane i = clamp(hi_i + carry_i, 0, 255)".to_string(), out));
+    } else if pipe.sum_stage() {
         let regs = vec![
             PipeReg::new("q", p * qw, &format!("{p} x signed {qw}-bit integer part of acc + inc_i")),
             PipeReg::new("mask", p, "bit per lane"),
@@ -130,6 +158,12 @@ pub fn stages(cfg: &Config, pipe: Pipeline) -> Vec<PipeStage> {
         body.push(("output", lanes.to_string(), out));
     }
     numbered(body)
+}
+
+/// The odd multiples of dI the BFPI's first adder level makes (depth 1), which `--pipeline 3`
+/// registers with the span; every deeper adder reads only these and dI itself.
+pub fn first_level(p: u32) -> Vec<u32> {
+    crate::bfpi::BfpiPlan::new(p).adders.iter().filter(|a| a.depth == 1).map(|a| a.value).collect()
 }
 
 /// Clocks from a span's transfer to its first segment's `out_valid` at `pipe`.
@@ -210,7 +244,9 @@ mod tests {
             let c = cfg(8, align);
             assert_eq!(latency(&c, Pipeline::NONE), 2, "SPEC's seed: current span and output registers");
             let lat: Vec<u32> = Pipeline::all().map(|pipe| latency(&c, pipe)).collect();
-            assert!(lat.windows(2).all(|w| w[0] < w[1]), "{lat:?}");
+            assert_eq!(lat, [2, 3, 4, 4], "level 3 cuts adders within level 2's stages");
+            let all: Vec<Vec<PipeStage>> = Pipeline::all().map(|pipe| stages(&c, pipe)).collect();
+            assert!(all.windows(2).all(|w| w[0] != w[1]), "a level that changes no register");
             for pipe in Pipeline::all() {
                 let st = stages(&c, pipe);
                 assert!(st.iter().enumerate().all(|(i, s)| s.stage == i as u32));

@@ -46,10 +46,11 @@ enum Command {
         /// intensities with the same divider: a comparison option, slower and larger).
         #[arg(long = "fe-di", value_enum, default_value_t = DiMode::Triangle)]
         fe_di: DiMode,
-        /// Register stages added for clock rate, 0..2 (golden::pipeline): 1 registers the span and
-        /// the shader's increments, 2 also its lane sums. Values and throughput are the same at
-        /// every level; latency grows (manifest.json). 0, the default: SPEC's seed structure,
-        /// smallest and shortest (docs/fpga.md compares the levels).
+        /// Register stages added for clock rate, 0..3 (golden::pipeline): 1 registers the span and
+        /// the shader's increments, 2 also its lane sums, 3 cuts the shader's adders so no clock
+        /// has two in a row (same stages as 2). Values and throughput are the same at every
+        /// level; latency grows (manifest.json). 0, the default: SPEC's seed structure, smallest
+        /// and shortest (docs/fpga.md compares the levels).
         #[arg(long, default_value_t = 0, value_parser = clap::value_parser!(u32).range(0..=golden::pipeline::Pipeline::MAX as i64))]
         pipeline: u32,
         /// Output folder (created if missing).

@@ -55,6 +55,8 @@ pub fn module_with(cfg: &Config, names: &Names, arch: BfpiArch, pipe: Pipeline) 
     let screen = cfg.align == Align::Screen && p > 1;
     let qw = aw - f; // accumulator after the rounding shift
     let lat = latency(cfg, pipe);
+    // --pipeline 3: the multiples the BFPI's first level makes, registered with the span.
+    let (split, first) = (pipe.split_adds(), golden::segment::first_level(p));
     // Where the span's fields come from when the current stage starts it: the input ports, or
     // the span register in front of it.
     let src = |port: &str| if pipe.span_stage() { port.replacen("in_", "sp_", 1) } else { port.to_string() };
@@ -95,8 +97,12 @@ pub fn module_with(cfg: &Config, names: &Names, arch: BfpiArch, pipe: Pipeline) 
             reg("sp_len", xw + 1),
             reg("sp_i0", iw),
             sreg("sp_di", dw),
-            Item::Blank,
         ]);
+        if split {
+            body.push(comment("The BFPI's first adder level, formed from the input's dI as the span enters."));
+            body.extend(first.iter().map(|c| sreg(&format!("sp_m{c}"), mw)));
+        }
+        body.push(Item::Blank);
     }
     body.push(comment("Current span: accumulator = lane 0's intensity + 2^(F-1), so each lane rounds with one add."));
     body.push(reg("cur_valid", 1));
@@ -111,7 +117,17 @@ pub fn module_with(cfg: &Config, names: &Names, arch: BfpiArch, pipe: Pipeline) 
     if screen {
         body.push(reg("cur_lead", log2p));
     }
-    if pipe.sum_stage() {
+    if split {
+        body.extend([
+            Item::Blank,
+            comment("Sum stage: each lane's sum cut at the binary point, joined before the clamp."),
+            reg("s1_valid", 1),
+            reg("s1_x", xw),
+            reg("s1_hc", p * (qw + 1)),
+            reg("s1_mask", p),
+            reg("s1_last", 1),
+        ]);
+    } else if pipe.sum_stage() {
         body.extend([
             Item::Blank,
             comment("Sum stage: the lanes' integer parts, before round and clamp."),
@@ -178,7 +194,27 @@ pub fn module_with(cfg: &Config, names: &Names, arch: BfpiArch, pipe: Pipeline) 
         let step = if log2p == 0 { "cur_di_ext".to_string() } else { format!("cur_di_ext << {log2p}") };
         body.push(swire("step", aw, step));
     } else {
-        if pipe.span_stage() {
+        if split {
+            // The BFPI's graph inline, cut after its first level: the span register holds those
+            // values, so the clock that starts a span has at most the deeper levels (one adder
+            // for P = 16..128, two at 256) where the instance had the whole graph.
+            let plan = golden::bfpi::BfpiPlan::new(p);
+            let node = |v: u32| if v == 1 || first.contains(&v) { format!("sp_m{v}") } else { format!("m{v}") };
+            body.push(comment("Multiples 1..P of the waiting span's increment (the BFPI's graph, its first level"));
+            body.push(comment("registered with the span), registered when it starts."));
+            body.push(swire("sp_m1", mw, sext("sp_di", dw, mw)));
+            for a in plan.adders.iter().filter(|a| a.depth > 1) {
+                body.push(swire(&node(a.value), mw, a.describe(node)));
+            }
+            body.push(net("sp_inc", p * mw));
+            for c in 1..=p {
+                let (odd, s) = golden::bfpi::BfpiPlan::multiple(c);
+                let rhs = if s == 0 { node(odd) } else { format!("{} << {s}", node(odd)) };
+                body.push(assign(format!("sp_inc[{} +: {mw}]", (c - 1) * mw), rhs));
+            }
+            body.push(net("inc", p * mw));
+            body.push(assign("inc", "cur_inc"));
+        } else if pipe.span_stage() {
             body.push(comment("Multiples 1..P of the waiting span's increment, registered when it starts."));
             body.push(net("sp_inc", p * mw));
             body.push(Item::Instance {
@@ -205,7 +241,11 @@ pub fn module_with(cfg: &Config, names: &Names, arch: BfpiArch, pipe: Pipeline) 
     body.push(Item::Blank);
 
     let sum = pipe.sum_stage();
-    if sum {
+    if split {
+        body.push(comment("Lanes: add in two parts, the fraction's carry and the high part (the half is in the"));
+        body.push(comment("accumulator); join, clamp and mask a stage later."));
+        body.push(net("hcs", p * (qw + 1)));
+    } else if sum {
         body.push(comment("Lanes: add (the half is in the accumulator) and mask; round and clamp a stage later."));
         body.push(net("qs", p * qw));
     } else {
@@ -217,32 +257,59 @@ pub fn module_with(cfg: &Config, names: &Names, arch: BfpiArch, pipe: Pipeline) 
         body.push(wire("lead_mask", p, format!("{{{p}{{1'b1}}}} << cur_lead")));
     }
     let clamp = |q: &str| format!("{q}[{}] ? 8'd0 : (|{q}[{}:8]) ? 8'd255 : {q}[7:0]", qw - 1, qw - 2);
-    let mut lane = vec![
-        Item::Localparam { name: "LANE".into(), width: rw, value: "i".into() },
-        comment("The fraction bits of v only carry into the sum; the pixel is its integer part."),
-        comment("verilator lint_off UNUSEDSIGNAL"),
-        Item::Wire { name: "v".into(), width: aw, signed: true, value: None },
-        if arch == BfpiArch::Tree {
-            assign("v", format!("tree[i*{aw} +: {aw}]"))
-        } else {
+    let mut lane = vec![Item::Localparam { name: "LANE".into(), width: rw, value: "i".into() }];
+    if split {
+        lane.extend([
+            Item::Wire { name: "hi".into(), width: qw, signed: true, value: None },
+            net("c", 1),
             Item::IfGenerate {
                 cond: "i == 0".into(),
-                then: ("base".into(), vec![assign("v", "cur_acc")]),
+                then: ("base".into(), vec![assign("hi", format!("cur_acc[{}:{f}]", aw - 1)), assign("c", "1'b0")]),
                 els: (
                     "offset".into(),
-                    vec![swire("d", mw, format!("inc[(i-1)*{mw} +: {mw}]")), assign("v", format!("cur_acc + {}", sext("d", mw, aw)))],
+                    vec![
+                        swire("d", mw, format!("inc[(i-1)*{mw} +: {mw}]")),
+                        comment("verilator lint_off UNUSEDSIGNAL"),
+                        swire("de", aw, sext("d", mw, aw)),
+                        wire("lo", f + 1, format!("{{1'b0, cur_acc[{fm}:0]}} + {{1'b0, de[{fm}:0]}}", fm = f - 1)),
+                        comment("verilator lint_on UNUSEDSIGNAL"),
+                        assign("hi", format!("cur_acc[{a}:{f}] + de[{a}:{f}]", a = aw - 1)),
+                        assign("c", format!("lo[{f}]")),
+                    ],
                 ),
-            }
-        },
-        swire("q", qw, format!("v[{}:{f}]", aw - 1)),
-        comment("verilator lint_on UNUSEDSIGNAL"),
-    ];
-    if sum {
-        lane.push(assign(format!("qs[i*{qw} +: {qw}]"), "q"));
-        lane.push(swire("r", qw, format!("s1_q[i*{qw} +: {qw}]")));
-        lane.push(assign("pix[i*8 +: 8]", clamp("r")));
+            },
+            comment("Lane i's high part and carry: {hi, c}."),
+            assign(format!("hcs[i*{h} +: {h}]", h = qw + 1), "{hi, c}"),
+            swire("r", qw, format!("s1_hc[i*{h}+1 +: {qw}] + {}", zext(&format!("s1_hc[i*{h}]", h = qw + 1), 1, qw), h = qw + 1)),
+            assign("pix[i*8 +: 8]", clamp("r")),
+        ]);
     } else {
-        lane.push(assign("pix[i*8 +: 8]", clamp("q")));
+        lane.extend([
+            comment("The fraction bits of v only carry into the sum; the pixel is its integer part."),
+            comment("verilator lint_off UNUSEDSIGNAL"),
+            Item::Wire { name: "v".into(), width: aw, signed: true, value: None },
+            if arch == BfpiArch::Tree {
+                assign("v", format!("tree[i*{aw} +: {aw}]"))
+            } else {
+                Item::IfGenerate {
+                    cond: "i == 0".into(),
+                    then: ("base".into(), vec![assign("v", "cur_acc")]),
+                    els: (
+                        "offset".into(),
+                        vec![swire("d", mw, format!("inc[(i-1)*{mw} +: {mw}]")), assign("v", format!("cur_acc + {}", sext("d", mw, aw)))],
+                    ),
+                }
+            },
+            swire("q", qw, format!("v[{}:{f}]", aw - 1)),
+            comment("verilator lint_on UNUSEDSIGNAL"),
+        ]);
+        if sum {
+            lane.push(assign(format!("qs[i*{qw} +: {qw}]"), "q"));
+            lane.push(swire("r", qw, format!("s1_q[i*{qw} +: {qw}]")));
+            lane.push(assign("pix[i*8 +: 8]", clamp("r")));
+        } else {
+            lane.push(assign("pix[i*8 +: 8]", clamp("q")));
+        }
     }
     if screen {
         lane.push(assign("mask[i]", "(LANE < cur_rem) && lead_mask[i]"));
@@ -288,19 +355,32 @@ pub fn module_with(cfg: &Config, names: &Names, arch: BfpiArch, pipe: Pipeline) 
         advance.push(set("cur_last", format!("{} <= {}", zext("cur_rem", rw, rw + 1), lit(rw + 1, 2 * p as u64))));
     }
     if pipe.span_stage() {
+        // Level 3's first BFPI level, from the input's dI (`in_m1`, declared with the other wires).
+        let plan = golden::bfpi::BfpiPlan::new(p);
+        let first_level: Vec<(u32, String)> = if split {
+            plan.adders.iter().filter(|a| a.depth == 1).map(|a| (a.value, a.describe(|_| "in_m1".to_string()))).collect()
+        } else {
+            Vec::new()
+        };
+        if !first_level.is_empty() {
+            body.push(swire("in_m1", mw, sext("in_di", dw, mw)));
+        }
         body.push(comment("A span of length 0 is consumed and dropped in the span register."));
         body.push(Item::Always(vec![Stmt::If(
             "rst".into(),
             vec![set("sp_valid", "1'b0")],
             vec![Stmt::If(
                 "load".into(),
-                vec![
+                [
                     set("sp_valid", "in_len != 0"),
                     set("sp_x", "in_x"),
                     set("sp_len", "in_len"),
                     set("sp_i0", "in_i0"),
                     set("sp_di", "in_di"),
-                ],
+                ]
+                .into_iter()
+                .chain(first_level.iter().map(|(c, e)| set(format!("sp_m{c}"), e.as_str())))
+                .collect(),
                 vec![Stmt::If("start".into(), vec![set("sp_valid", "1'b0")], vec![])],
             )],
         )]));
@@ -326,13 +406,11 @@ pub fn module_with(cfg: &Config, names: &Names, arch: BfpiArch, pipe: Pipeline) 
             vec![set("s1_valid", "1'b0")],
             vec![Stmt::If(
                 "out_free".into(),
-                vec![
-                    set("s1_valid", "cur_valid"),
-                    set("s1_x", "cur_x"),
-                    set("s1_q", "qs"),
-                    set("s1_mask", "mask"),
-                    set("s1_last", "cur_last"),
-                ],
+                [set("s1_valid", "cur_valid"), set("s1_x", "cur_x")]
+                    .into_iter()
+                    .chain(if split { vec![set("s1_hc", "hcs")] } else { vec![set("s1_q", "qs")] })
+                    .chain([set("s1_mask", "mask"), set("s1_last", "cur_last")])
+                    .collect(),
                 vec![],
             )],
         )]));
