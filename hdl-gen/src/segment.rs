@@ -280,8 +280,15 @@ pub fn module_with(cfg: &Config, names: &Names, arch: BfpiArch, pipe: Pipeline) 
             },
             comment("Lane i's high part and carry: {hi, c}."),
             assign(format!("hcs[i*{h} +: {h}]", h = qw + 1), "{hi, c}"),
-            swire("r", qw, format!("s1_hc[i*{h}+1 +: {qw}] + {}", zext(&format!("s1_hc[i*{h}]", h = qw + 1), 1, qw), h = qw + 1)),
-            assign("pix[i*8 +: 8]", clamp("r")),
+            // clamp(h + c) without the qw-bit carry chain of the sum: h <= h + c <= h + 1, so the
+            // clamp is decided by h alone (h < 0 gives 0, h >= 255 gives 255, whatever c is),
+            // and in between the pixel is the 8-bit increment h[7:0] + c.
+            swire("h", qw, format!("s1_hc[i*{h}+1 +: {qw}]", h = qw + 1)),
+            wire("hc", 1, format!("s1_hc[i*{}]", qw + 1)),
+            wire("low", 8, format!("h[7:0] + {}", zext("hc", 1, 8))),
+            wire("neg", 1, format!("h[{}]", qw - 1)),
+            wire("over", 1, format!("!h[{}] && ((|h[{}:8]) || (&h[7:0]))", qw - 1, qw - 2)),
+            assign("pix[i*8 +: 8]", "neg ? 8'd0 : over ? 8'd255 : low"),
         ]);
     } else {
         lane.extend([
