@@ -531,7 +531,8 @@ fn models_from_dir(dir: &Path, m: &Manifest) -> Vec<Model> {
 }
 
 /// The AXI4-Stream wrappers `m` lists (those `wanted` keeps): each the model in `models` of its
-/// core (same kind, top and pipeline level) with the wrapper as top and its file (`read`) added.
+/// core (same kind, top, P, alignment and pipeline level) with the wrapper as top and its file
+/// (`read`) added.
 /// A layout that breaks the packing rule, or a wrapper of a module with no model, is an error.
 fn axis_models(
     models: &[Model],
@@ -552,9 +553,13 @@ fn axis_models(
                 return Err(format!("{MANIFEST_FILE}: axis: {} wraps {} ({other:?}), which has no streaming model", w.module, w.wraps))
             }
         };
+        // The configuration's own model: a default build also has other alignments and pipeline
+        // levels of a top (the front-end has only level 0's, as it has no pipelined form).
+        let p = &m.parameters;
         let core = models
             .iter()
-            .find(|c| c.kind == kind && c.top == w.wraps && c.pipeline == m.parameters.pipeline && c.axis.is_none())
+            .filter(|c| c.kind == kind && c.top == w.wraps && c.axis.is_none() && (c.cfg.p, c.cfg.align) == (p.p, p.align))
+            .min_by_key(|c| c.pipeline != p.pipeline)
             .ok_or_else(|| format!("{MANIFEST_FILE}: axis: no model of {}, which {} wraps", w.wraps, w.module))?;
         let mut sources = core.sources.clone();
         sources.push(read(&entry.file));
@@ -865,6 +870,9 @@ fn native_expand(kind: Kind, m: &Model, model: &str, sym: &str) -> String {
     }
 }
 
+/// The ports whose struct members are byte arrays (lane `i` in byte `i`, or in bit `i`).
+const LANE_BUSES: [&str; 2] = ["out_pix", "out_mask"];
+
 /// The struct member (of the kind's per-clock structs) a SPEC port's value lives in: the same
 /// name, but for lane buses (arrays of bytes) and the triangle structs' vertex arrays.
 fn member(kind: Kind, port: &str) -> String {
@@ -903,7 +911,7 @@ fn axis_step_cpp(kind: Kind, w: &hdl_gen::axis::Wrapper, model: &str, sym: &str)
         write!(sample, "{{ uint8_t d[{}] = {{}}; segshade_copy(d, m->{signal}, {}); ", p.bits / 8 + 8, p.bits / 8).unwrap();
         for f in &p.fields {
             let to = member(kind, &f.port);
-            if f.width > 32 {
+            if LANE_BUSES.contains(&f.port.as_str()) {
                 // A lane bus, byte i lane i: copied whole.
                 write!(sample, "std::memcpy(out->{to}, d + {}, {}); ", f.lsb / 8, f.width.div_ceil(8)).unwrap();
             } else {
