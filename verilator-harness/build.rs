@@ -87,6 +87,9 @@ struct Model {
     pipeline: Pipeline,
     /// Verilog sources and ROM images: (file name, text).
     sources: Vec<(String, String)>,
+    /// `--bus axis`: the model is the AXI4-Stream wrapper `top` of the SPEC module of its kind,
+    /// driven through the kind's per-clock structs, packed as this layout says.
+    axis: Option<hdl_gen::axis::Wrapper>,
 }
 
 fn main() {
@@ -147,7 +150,7 @@ fn main() {
     // The segment suite's random test is one test per (model, soak slice), so that nextest can
     // deal a configuration's soak out to several machines (`verilator_harness::soak`): its list
     // of models is this build's, written where tests/segment.rs includes it.
-    let seg: Vec<&str> = models.iter().filter(|m| m.kind == Kind::Segment).map(|m| m.tag.as_str()).collect();
+    let seg: Vec<&str> = models.iter().filter(|m| m.kind == Kind::Segment && m.axis.is_none()).map(|m| m.tag.as_str()).collect();
     fs::write(out.join("segment_slices.rs"), format!("random_triangle_slices!({});\n", seg.join(", "))).unwrap();
 }
 
@@ -255,6 +258,7 @@ fn generated_models() -> Vec<Model> {
             top: spec_names.unit.clone(),
             latency: opts.specular_unit().plan().latency(),
             pipeline,
+            axis: None,
             sources: hdl_gen::generate(&opts)
                 .into_iter()
                 .filter(|f| f.name.ends_with(".hex") || f.name.starts_with("specular_"))
@@ -280,6 +284,7 @@ fn generated_models() -> Vec<Model> {
                     top: names.bfpi.clone(),
                     latency: 0,
                     pipeline: Pipeline::NONE,
+                    axis: None,
                     sources: bfpi,
                 });
             }
@@ -302,6 +307,7 @@ fn generated_models() -> Vec<Model> {
                         top: names.frontend.clone(),
                         latency: fe_lat,
                         pipeline: Pipeline::NONE,
+                        axis: None,
                         sources: src,
                     });
                     // The classical per-scanline dI (`--fe-di scanline`), the comparison option.
@@ -316,6 +322,7 @@ fn generated_models() -> Vec<Model> {
                         top: m.name.clone(),
                         latency: scan.latency(),
                         pipeline: Pipeline::NONE,
+                        axis: None,
                         sources: vec![(format!("{}.v", m.name), m.render())],
                     });
                     // The other divider rates (`--fe-div-bits`), so co-simulation covers every option.
@@ -332,6 +339,7 @@ fn generated_models() -> Vec<Model> {
                             top: m.name,
                             latency: hw.latency(),
                             pipeline: Pipeline::NONE,
+                            axis: None,
                             sources: src,
                         });
                     }
@@ -354,6 +362,7 @@ fn generated_models() -> Vec<Model> {
                         top: names.top.clone(),
                         latency: scan.latency() + latency,
                         pipeline: Pipeline::NONE,
+                        axis: None,
                         sources: src,
                     });
                 }
@@ -366,6 +375,7 @@ fn generated_models() -> Vec<Model> {
                     top: names.top.clone(),
                     latency: top_lat,
                     pipeline: Pipeline::NONE,
+                    axis: None,
                     sources: src,
                 });
             }
@@ -383,6 +393,7 @@ fn generated_models() -> Vec<Model> {
                     top,
                     latency,
                     pipeline: Pipeline::NONE,
+                    axis: None,
                     sources: src,
                 });
             }
@@ -402,6 +413,7 @@ fn generated_models() -> Vec<Model> {
                     top,
                     latency,
                     pipeline: Pipeline::NONE,
+                    axis: None,
                     sources: src,
                 });
             }
@@ -422,6 +434,7 @@ fn generated_models() -> Vec<Model> {
                     top: names.segment.clone(),
                     latency: golden::segment::latency(&cfg, pipeline),
                     pipeline,
+                    axis: None,
                     sources: src,
                 });
             }
@@ -434,10 +447,20 @@ fn generated_models() -> Vec<Model> {
                 top: names.segment,
                 latency,
                 pipeline: Pipeline::NONE,
+                axis: None,
                 sources,
             });
         }
     }
+    // The AXI4-Stream wrappers (`--bus axis`) of the default shader and specular unit, driven
+    // through their cores' structs: two models, so the default suite stays quick; COSIM_RTL_DIR
+    // builds every wrapper its folder has.
+    let files = hdl_gen::generate(&hdl_gen::Options { bus: hdl_gen::Bus::Axis, ..Default::default() });
+    let text = |name: &str| files.iter().find(|f| f.name == name).map(|f| f.contents.clone()).expect("a generated file");
+    let manifest = Manifest::parse(&text(MANIFEST_FILE)).expect("the generated manifest reads back");
+    let names = hdl_gen::Names::new("", &Config::default());
+    let wanted = |w: &hdl_gen::axis::Wrapper| w.wraps == names.segment || w.wraps == spec_names.unit;
+    models.extend(axis_models(&models, &manifest, wanted, |file| (file.to_string(), text(file))).expect("the default wrappers"));
     models
 }
 
@@ -465,6 +488,7 @@ fn models_from_dir(dir: &Path, m: &Manifest) -> Vec<Model> {
         top: entry.name.clone(),
         latency: entry.latency,
         pipeline,
+        axis: None,
         sources,
     };
     let (none, screen0, di0) = (Pipeline::NONE, Screen::default(), DiMode::Triangle);
@@ -503,7 +527,54 @@ fn models_from_dir(dir: &Path, m: &Manifest) -> Vec<Model> {
     if models.is_empty() {
         fail(format!("{MANIFEST_FILE} lists no bfpi, segment_shader or specular_unit module"));
     }
+    let axis = axis_models(&models, m, |_| true, read).unwrap_or_else(|e| fail(e));
+    models.extend(axis);
     models
+}
+
+/// The AXI4-Stream wrappers `m` lists (those `wanted` keeps): each the model in `models` of its
+/// core (same kind, top, P, alignment and pipeline level) with the wrapper as top and its file
+/// (`read`) added.
+/// A layout that breaks the packing rule, or a wrapper of a module with no model, is an error.
+fn axis_models(
+    models: &[Model],
+    m: &Manifest,
+    wanted: impl Fn(&hdl_gen::axis::Wrapper) -> bool,
+    read: impl Fn(&str) -> (String, String),
+) -> Result<Vec<Model>, String> {
+    let mut out = Vec::new();
+    for w in m.axis.iter().filter(|w| wanted(w)) {
+        w.check().map_err(|e| format!("{MANIFEST_FILE}: axis: {e}"))?;
+        let entry = m.module(&w.module).map_err(|e| e.to_string())?;
+        let kind = match m.module(&w.wraps).map_err(|e| e.to_string())?.role {
+            Role::SegmentShader => Kind::Segment,
+            Role::SpecularUnit => Kind::Specular,
+            Role::Frontend => Kind::Frontend,
+            Role::TriangleShader => Kind::TriShader,
+            other => {
+                return Err(format!("{MANIFEST_FILE}: axis: {} wraps {} ({other:?}), which has no streaming model", w.module, w.wraps))
+            }
+        };
+        // The configuration's own model: a default build also has other alignments and pipeline
+        // levels of a top (the front-end has only level 0's, as it has no pipelined form).
+        let p = &m.parameters;
+        let core = models
+            .iter()
+            .filter(|c| c.kind == kind && c.top == w.wraps && c.axis.is_none() && (c.cfg.p, c.cfg.align) == (p.p, p.align))
+            .min_by_key(|c| c.pipeline != p.pipeline)
+            .ok_or_else(|| format!("{MANIFEST_FILE}: axis: no model of {}, which {} wraps", w.wraps, w.module))?;
+        let mut sources = core.sources.clone();
+        sources.push(read(&entry.file));
+        out.push(Model {
+            tag: format!("{}_axis", core.tag),
+            top: w.module.clone(),
+            latency: entry.latency,
+            sources,
+            axis: Some(w.clone()),
+            ..core.clone()
+        });
+    }
+    Ok(out)
 }
 
 struct Verilator {
@@ -773,14 +844,9 @@ fn shim_cpp(m: &Model, class: &str, traced: bool) -> String {
         false => (class.to_string(), m.tag.clone()),
         true => (format!("SegshadeTraced<{class}>"), format!("{}_raw", m.tag)),
     };
-    let expand = match m.kind {
-        Kind::Segment => format!("SEGSHADE_SEGMENT_SHIM({model}, {sym}, {})", m.cfg.p),
-        Kind::Bfpi => format!("SEGSHADE_BFPI_SHIM({model}, {sym}, {})", (m.cfg.p * m.cfg.mw()).div_ceil(8)),
-        Kind::Specular => format!("SEGSHADE_SPECULAR_SHIM({model}, {sym})"),
-        Kind::Frontend => format!("SEGSHADE_FRONTEND_SHIM({model}, {sym})"),
-        Kind::TriShader => format!("SEGSHADE_TRISHADER_SHIM({model}, {sym}, {})", m.cfg.p),
-        Kind::Writer => format!("SEGSHADE_WRITER_SHIM({model}, {sym}, {})", m.cfg.p),
-        Kind::TriWriter => format!("SEGSHADE_TRIWRITER_SHIM({model}, {sym}, {})", m.cfg.p),
+    let expand = match (&m.axis, m.kind) {
+        (Some(w), _) => axis_step_cpp(m.kind, w, &model, &sym),
+        (None, kind) => native_expand(kind, m, &model, &sym),
     };
     if !traced {
         return format!("// Generated by build.rs.\n#include \"{class}.h\"\n#include \"shim.h\"\n{expand}\n");
@@ -791,6 +857,89 @@ fn shim_cpp(m: &Model, class: &str, traced: bool) -> String {
          SEGSHADE_TRACE_SHIM({class}, {}, {inp}, {outp})\n",
         m.tag
     )
+}
+
+/// shim.h's macro for a native model of `kind`.
+fn native_expand(kind: Kind, m: &Model, model: &str, sym: &str) -> String {
+    match kind {
+        Kind::Segment => format!("SEGSHADE_SEGMENT_SHIM({model}, {sym}, {})", m.cfg.p),
+        Kind::Bfpi => format!("SEGSHADE_BFPI_SHIM({model}, {sym}, {})", (m.cfg.p * m.cfg.mw()).div_ceil(8)),
+        Kind::Specular => format!("SEGSHADE_SPECULAR_SHIM({model}, {sym})"),
+        Kind::Frontend => format!("SEGSHADE_FRONTEND_SHIM({model}, {sym})"),
+        Kind::TriShader => format!("SEGSHADE_TRISHADER_SHIM({model}, {sym}, {})", m.cfg.p),
+        Kind::Writer => format!("SEGSHADE_WRITER_SHIM({model}, {sym}, {})", m.cfg.p),
+        Kind::TriWriter => format!("SEGSHADE_TRIWRITER_SHIM({model}, {sym}, {})", m.cfg.p),
+    }
+}
+
+/// The ports whose struct members are byte arrays (lane `i` in byte `i`, or in bit `i`).
+const LANE_BUSES: [&str; 2] = ["out_pix", "out_mask"];
+
+/// The struct member (of the kind's per-clock structs) a SPEC port's value lives in: the same
+/// name, but for lane buses (arrays of bytes) and the triangle structs' vertex arrays.
+fn member(kind: Kind, port: &str) -> String {
+    let vertex = matches!(kind, Kind::Frontend | Kind::TriShader | Kind::TriWriter);
+    match port {
+        "out_pix" => "pix".into(),
+        "out_mask" => "mask".into(),
+        _ if vertex && port.len() == 5 && ["in_x", "in_y", "in_i"].contains(&&port[..4]) => format!("{}[{}]", &port[3..4], &port[4..]),
+        _ => port.into(),
+    }
+}
+
+/// The C++ step of an AXI4-Stream wrapper's model, printed from its typed layout `w`: the kind's
+/// structs in and out, packed into and out of the wrapper's ports. Also `SYM_step_mispacked`,
+/// the negative control of the packing: the same, with the first two input fields at each
+/// other's bits (what a wrapper and a driver that disagree on the layout do).
+fn axis_step_cpp(kind: Kind, w: &hdl_gen::axis::Wrapper, model: &str, sym: &str) -> String {
+    let (inp, outp) = ports(kind);
+    let (s, o) = (&w.s_axis.tdata, &w.m_axis);
+    let pack = |swap: bool| {
+        let mut c = format!("uint8_t b[{}] = {{}}; ", s.bits / 8 + 8);
+        for (k, f) in s.fields.iter().enumerate() {
+            let at = match (swap, k) {
+                (true, 0) => s.fields[1].lsb,
+                (true, 1) => s.fields[0].lsb,
+                _ => f.lsb,
+            };
+            write!(c, "segshade_put_bits(b, {at}, {}, in->{}); ", f.width, member(kind, &f.port)).unwrap();
+        }
+        write!(c, "segshade_load(m->s_axis_tdata, b, {});", s.bits / 8).unwrap();
+        c
+    };
+    let mut sample = String::new();
+    for (signal, p) in [("m_axis_tdata", Some(&o.tdata)), ("m_axis_tuser", o.tuser.as_ref())] {
+        let Some(p) = p else { continue };
+        write!(sample, "{{ uint8_t d[{}] = {{}}; segshade_copy(d, m->{signal}, {}); ", p.bits / 8 + 8, p.bits / 8).unwrap();
+        for f in &p.fields {
+            let to = member(kind, &f.port);
+            if LANE_BUSES.contains(&f.port.as_str()) {
+                // A lane bus, byte i lane i: copied whole.
+                write!(sample, "std::memcpy(out->{to}, d + {}, {}); ", f.lsb / 8, f.width.div_ceil(8)).unwrap();
+            } else {
+                write!(sample, "out->{to} = segshade_get_bits(d, {}, {}); ", f.lsb, f.width).unwrap();
+            }
+        }
+        sample.push_str("} ");
+    }
+    if let Some(k) = &o.tkeep {
+        write!(sample, "segshade_copy(out->{}, m->m_axis_tkeep, {}); ", member(kind, k), o.tdata.bits.div_ceil(64)).unwrap();
+    }
+    if let Some(l) = &o.tlast {
+        write!(sample, "out->{} = m->m_axis_tlast; ", member(kind, l)).unwrap();
+    }
+    for sb in &w.sideband {
+        write!(sample, "out->{} = m->{sb}; ", member(kind, sb)).unwrap();
+    }
+    let step = |name: &str, swap: bool| {
+        format!(
+            "extern \"C\" void {sym}_{name}(void* h, const {inp}* in, {outp}* out) noexcept {{\n    \
+             {model}* m = static_cast<SegshadeModel<{model}>*>(h)->top;\n    \
+             segshade_axis_clock(m, in, out, [&] {{ {} }}, [&] {{ {sample}}});\n}}\n",
+            pack(swap)
+        )
+    };
+    format!("SEGSHADE_LIFETIME({model}, {sym})\n{}{}", step("step", false), step("step_mispacked", true))
 }
 
 /// The per-clock input and output structs of a kind's shim (the same names in shim.h and ffi.rs).
@@ -862,16 +1011,30 @@ fn models_rs(models: &[Model], twins: &[Model], trace_all: bool, rtl_dir: Option
     let mut tris = String::new();
     let mut wr = String::new();
     let mut trw = String::new();
+    let (mut axis_seg, mut axis_spec, mut axis_fe, mut axis_tris) = (String::new(), String::new(), String::new(), String::new());
+    let mut mispacked = String::new();
     for m in models {
         let (inp, outp) = ports(m.kind);
-        let list = match m.kind {
-            Kind::Segment => &mut seg,
-            Kind::Bfpi => &mut bfpi,
-            Kind::Specular => &mut spec,
-            Kind::Frontend => &mut fe,
-            Kind::TriShader => &mut tris,
-            Kind::Writer => &mut wr,
-            Kind::TriWriter => &mut trw,
+        let list = match (m.kind, m.axis.is_some()) {
+            (Kind::Segment, true) => {
+                writeln!(s, "extern \"C\" {{\n    fn {t}_step_mispacked(h: *mut c_void, i: *const SegIn, o: *mut SegOut);\n}}", t = m.tag)
+                    .unwrap();
+                writeln!(mispacked, "    (\"{t}\", {t}_step_mispacked),", t = m.tag).unwrap();
+                &mut axis_seg
+            }
+            (Kind::Specular, true) => &mut axis_spec,
+            (Kind::Frontend, true) => &mut axis_fe,
+            (Kind::TriShader, true) => &mut axis_tris,
+            (kind, true) => panic!("an AXI4-Stream model of kind {} has no list", ports(kind).0),
+            (kind, false) => match kind {
+                Kind::Segment => &mut seg,
+                Kind::Bfpi => &mut bfpi,
+                Kind::Specular => &mut spec,
+                Kind::Frontend => &mut fe,
+                Kind::TriShader => &mut tris,
+                Kind::Writer => &mut wr,
+                Kind::TriWriter => &mut trw,
+            },
         };
         let t = &m.tag;
         writeln!(
@@ -920,7 +1083,15 @@ fn models_rs(models: &[Model], twins: &[Model], trace_all: bool, rtl_dir: Option
          pub static FRONTEND_MODELS: &[ModelInfo<TriIn, FeOut>] = &[\n{fe}];\n\
          pub static TRISHADER_MODELS: &[ModelInfo<TriIn, TriSegOut>] = &[\n{tris}];\n\
          pub static WRITER_MODELS: &[ModelInfo<WrIn, WrOut>] = &[\n{wr}];\n\
-         pub static TRIWRITER_MODELS: &[ModelInfo<TriIn, WrOut>] = &[\n{trw}];\n"
+         pub static TRIWRITER_MODELS: &[ModelInfo<TriIn, WrOut>] = &[\n{trw}];\n\
+         /// AXI4-Stream wrappers (`--bus axis`), on their cores' structs.\n\
+         pub static AXIS_SEGMENT_MODELS: &[ModelInfo<SegIn, SegOut>] = &[\n{axis_seg}];\n\
+         pub static AXIS_SPECULAR_MODELS: &[ModelInfo<SpecIn, SpecOut>] = &[\n{axis_spec}];\n\
+         pub static AXIS_FRONTEND_MODELS: &[ModelInfo<TriIn, FeOut>] = &[\n{axis_fe}];\n\
+         pub static AXIS_TRISHADER_MODELS: &[ModelInfo<TriIn, TriSegOut>] = &[\n{axis_tris}];\n\
+         /// Each AXI4-Stream shader model's step with its first two input fields packed at each other's\n\
+         /// bits: the negative control of the packing.\n\
+         pub static AXIS_SEGMENT_MISPACKED: &[(&str, StepFn<SegIn, SegOut>)] = &[\n{mispacked}];\n"
     )
     .unwrap();
     let ranges: String = tables

@@ -1,6 +1,7 @@
 //! segshade's Verilog generator: every module of SPEC §3 for one configuration, with its
 //! manifest and FuseSoC core. The binary (`hdl-gen`) is a thin clap front end over this.
 
+pub mod axis;
 pub mod bfpi;
 pub mod formal;
 pub mod frontend;
@@ -15,6 +16,7 @@ pub mod verilog;
 pub mod wrapper;
 pub mod writer;
 
+pub use axis::Bus;
 pub use bfpi::BfpiArch;
 use golden::Config;
 
@@ -81,6 +83,8 @@ pub struct Options {
     pub fe_di: golden::frontend::DiMode,
     /// Register stages added for clock rate (`--pipeline`); level 0 is SPEC's seed structure.
     pub pipeline: golden::pipeline::Pipeline,
+    /// `--bus`: SPEC's ports only, or AXI4-Stream wrappers of the streaming tops as well.
+    pub bus: Bus,
 }
 
 impl Options {
@@ -129,7 +133,16 @@ pub fn generate(opts: &Options) -> Vec<GeneratedFile> {
         modules.push(writer::top_module(&fe, &w, &names));
     }
     let unit = opts.specular_unit();
-    modules.extend(specular::modules(&opts.cfg, &unit, &specular::SpecNames::new(&opts.prefix)));
+    let spec = specular::SpecNames::new(&opts.prefix);
+    modules.extend(specular::modules(&opts.cfg, &unit, &spec));
+    let wrappers = match opts.bus {
+        Bus::Native => Vec::new(),
+        Bus::Axis => axis::wrappers(&modules, &names, &spec),
+    };
+    for w in &wrappers {
+        let core = modules.iter().find(|m| m.name == w.wraps).expect("a wrapper wraps a generated module");
+        modules.push(axis::module(w, core));
+    }
     let mut files: Vec<GeneratedFile> =
         modules.iter().map(|m| GeneratedFile { name: format!("{}.v", m.name), contents: m.render() }).collect();
     // The BFPI's proof reference rides in its file (scripts/prove).
@@ -139,7 +152,8 @@ pub fn generate(opts: &Options) -> Vec<GeneratedFile> {
     for (name, rom) in [(golden::rom::BRDF_HEX, unit.brdf_rom()), (golden::rom::NK_HEX, unit.nk_rom())] {
         files.push(GeneratedFile { name: name.into(), contents: rom.to_hex() });
     }
-    files.push(GeneratedFile { name: manifest::MANIFEST_FILE.into(), contents: manifest::render(opts, &names, &modules, &unit) });
-    files.push(GeneratedFile { name: manifest::CORE_FILE.into(), contents: manifest::core_file(opts, &names, &modules) });
+    files
+        .push(GeneratedFile { name: manifest::MANIFEST_FILE.into(), contents: manifest::render(opts, &names, &modules, &unit, &wrappers) });
+    files.push(GeneratedFile { name: manifest::CORE_FILE.into(), contents: manifest::core_file(opts, &names, &modules, &wrappers) });
     files
 }

@@ -7,7 +7,7 @@ use golden::frontend::DiMode;
 use golden::rom::RomFormat;
 use golden::specular::{parse_rel_error, BrdfK, SpecularPlan};
 use golden::{Align, Config};
-use hdl_gen::{check_prefix, generate, output, BfpiArch, Options};
+use hdl_gen::{check_prefix, generate, output, BfpiArch, Bus, Options};
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -53,6 +53,11 @@ enum Command {
         /// and shortest (docs/fpga.md compares the levels).
         #[arg(long, default_value_t = 0, value_parser = clap::value_parser!(u32).range(0..=golden::pipeline::Pipeline::MAX as i64))]
         pipeline: u32,
+        /// Stream interfaces: `native` (SPEC's ports only) or `axis`, which also writes an
+        /// AXI4-Stream wrapper `<module>_axis` of the segment shader, the front-end, its chain
+        /// and the specular unit, with Vivado interface attributes (docs/axis.md).
+        #[arg(long, value_enum, default_value_t = Bus::Native)]
+        bus: Bus,
         /// Output folder (created if missing).
         #[arg(long)]
         out: PathBuf,
@@ -209,7 +214,7 @@ fn main() -> ExitCode {
 
 fn run(command: Command) -> anyhow::Result<()> {
     match command {
-        Command::Generate { config, bfpi_arch, brdf, width, height, fe_div_bits, fe_di, pipeline, out } => {
+        Command::Generate { config, bfpi_arch, brdf, width, height, fe_div_bits, fe_di, pipeline, bus, out } => {
             let opts = config.options(&brdf)?;
             let default = Options::default_screen(&opts.cfg);
             let screen = golden::setup::Screen { width: width.unwrap_or(default.width), height: height.unwrap_or(default.height) };
@@ -217,7 +222,7 @@ fn run(command: Command) -> anyhow::Result<()> {
             if pipeline.span_stage() && bfpi_arch == BfpiArch::Tree {
                 bail!(hdl_gen::segment::TREE_UNPIPELINED);
             }
-            let opts = Options { bfpi_arch, screen: Some(screen), fe_div_bits, fe_di, pipeline, ..opts };
+            let opts = Options { bfpi_arch, screen: Some(screen), fe_div_bits, fe_di, pipeline, bus, ..opts };
             opts.frontend().context("--width/--height")?;
             output::write_all(&out, &generate(&opts))?;
             eprintln!("wrote {}", out.display());

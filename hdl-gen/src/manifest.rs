@@ -33,6 +33,9 @@ pub struct Manifest {
     /// SPEC §7's segment writer and block memory; present with the front-end.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub writer: Option<WriterEntry>,
+    /// `--bus axis`: each AXI4-Stream wrapper and where it packs every port; absent for native.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub axis: Vec<crate::axis::Wrapper>,
 }
 
 /// What a module is in the chain; readers find modules by role, not by name (names take a prefix).
@@ -47,6 +50,9 @@ pub enum Role {
     TriangleWriter,
     SpecularUnit,
     Rom,
+    /// `<module>_axis`: an AXI4-Stream wrapper (`--bus axis`); the manifest's `axis` section says
+    /// which module it wraps.
+    Axis,
 }
 
 /// The block memory the writer addresses, and its timing.
@@ -131,6 +137,13 @@ pub struct Parameters {
     /// `--pipeline`; only written above level 0, so the default output stays as it was.
     #[serde(default, skip_serializing_if = "is_seed_pipeline")]
     pub pipeline: golden::pipeline::Pipeline,
+    /// `--bus`; only written for `axis`, so the default output stays as it was.
+    #[serde(default, skip_serializing_if = "is_native")]
+    pub bus: crate::Bus,
+}
+
+fn is_native(b: &crate::Bus) -> bool {
+    *b == crate::Bus::Native
 }
 
 fn is_seed_pipeline(p: &golden::pipeline::Pipeline) -> bool {
@@ -228,7 +241,7 @@ fn ports(m: &Module) -> Vec<PortEntry> {
         .collect()
 }
 
-pub fn render(opts: &Options, names: &Names, modules: &[Module], unit: &SpecularUnit) -> String {
+pub fn render(opts: &Options, names: &Names, modules: &[Module], unit: &SpecularUnit, wrappers: &[crate::axis::Wrapper]) -> String {
     let cfg = &opts.cfg;
     let plan = BfpiPlan::new(cfg.p);
     let spec = SpecNames::new(&opts.prefix);
@@ -237,23 +250,26 @@ pub fn render(opts: &Options, names: &Names, modules: &[Module], unit: &Specular
     let seg_latency = golden::segment::latency(cfg, opts.pipeline);
     let wr = opts.writer().ok().filter(|_| fe.is_some());
     let entry = |m: &Module| {
-        let (role, latency, throughput) = if m.name == names.bfpi {
+        // A wrapper's timing is its core's: it only renames and packs ports.
+        let name = wrappers.iter().find(|w| w.module == m.name).map_or(&m.name, |w| &w.wraps);
+        let (role, latency, throughput) = if name == &names.bfpi {
             (Role::Bfpi, 0, "combinational")
-        } else if m.name == names.segment {
+        } else if name == &names.segment {
             (Role::SegmentShader, seg_latency, "one segment per clock")
-        } else if m.name == names.frontend {
+        } else if name == &names.frontend {
             (Role::Frontend, fe_latency, "one span per clock; set-up per walked triangle as in frontend.setup_clocks")
-        } else if m.name == names.top {
+        } else if name == &names.top {
             (Role::TriangleShader, fe_latency + seg_latency, "one segment per clock")
-        } else if m.name == names.writer {
+        } else if name == &names.writer {
             (Role::Writer, golden::writer::LATENCY, "one block write per clock")
-        } else if m.name == names.fb_top {
+        } else if name == &names.fb_top {
             (Role::TriangleWriter, fe_latency + seg_latency + golden::writer::LATENCY, "one block write per clock")
-        } else if m.name == spec.unit {
+        } else if name == &spec.unit {
             (Role::SpecularUnit, unit.plan().latency(), "one pixel per clock")
         } else {
             (Role::Rom, 1, "one word per clock")
         };
+        let role = if name == &m.name { role } else { Role::Axis };
         let stages = if role == Role::SegmentShader && opts.pipeline != golden::pipeline::Pipeline::NONE {
             golden::segment::stages(cfg, opts.pipeline)
         } else {
@@ -279,6 +295,7 @@ pub fn render(opts: &Options, names: &Names, modules: &[Module], unit: &Specular
             prefix: opts.prefix.clone(),
             bfpi_arch: (opts.bfpi_arch != BfpiArch::ShiftAdd).then(|| opts.bfpi_arch.name().into()),
             pipeline: opts.pipeline,
+            bus: opts.bus,
         },
         formats: Formats {
             intensity: format!("UQ8.{}", cfg.frac),
@@ -338,6 +355,7 @@ pub fn render(opts: &Options, names: &Names, modules: &[Module], unit: &Specular
             }
             .into(),
         }),
+        axis: wrappers.to_vec(),
     };
     serde_json::to_string_pretty(&manifest).expect("manifest serializes") + "\n"
 }
@@ -345,7 +363,11 @@ pub fn render(opts: &Options, names: &Names, modules: &[Module], unit: &Specular
 /// A FuseSoC CAPI2 core for the generated files: a default target with the segment shader as
 /// top level, a `specular` target with the specular unit, and a Verilator lint target. The ROM
 /// images are copied into the tool's work folder, where `$readmemh` looks for them.
-pub fn core_file(opts: &Options, names: &Names, modules: &[Module]) -> String {
+///
+/// With `--bus axis` the wrappers are in the `rtl` fileset like every module, and each gets a
+/// target of its own (`<role>_axis`: `segment_axis`, `specular_axis`, ...) with the wrapper as
+/// top level, plus `lint_axis` for the shader's wrapper.
+pub fn core_file(opts: &Options, names: &Names, modules: &[Module], wrappers: &[crate::axis::Wrapper]) -> String {
     let cfg = &opts.cfg;
     let mut files = String::new();
     for m in modules {
@@ -356,6 +378,26 @@ pub fn core_file(opts: &Options, names: &Names, modules: &[Module]) -> String {
         true => format!("\x20 frame:\n\x20   filesets: [rtl]\n\x20   toplevel: {}\n", names.fb_top),
         false => String::new(),
     };
+    let spec = SpecNames::new(&opts.prefix);
+    let mut axis = String::new();
+    for w in wrappers {
+        let (target, filesets) = if w.wraps == names.segment {
+            ("segment_axis", "[rtl]")
+        } else if w.wraps == spec.unit {
+            ("specular_axis", "[rtl, rom]")
+        } else if w.wraps == names.frontend {
+            ("frontend_axis", "[rtl]")
+        } else {
+            ("triangle_axis", "[rtl]")
+        };
+        axis.push_str(&format!("\x20 {target}:\n\x20   filesets: {filesets}\n\x20   toplevel: {}\n", w.module));
+        if w.wraps == names.segment {
+            axis.push_str(&format!(
+                "\x20 lint_axis:\n\x20   default_tool: verilator\n\x20   filesets: [rtl]\n\x20   toplevel: {}\n\x20   tools:\n\x20     verilator:\n\x20       mode: lint-only\n\x20       verilator_options: [-Wall]\n",
+                w.module
+            ));
+        }
+    }
     format!(
         "CAPI=2:\n\
          # Generated by segshade hdl-gen {VERSION}; do not edit.\n\
@@ -380,6 +422,7 @@ pub fn core_file(opts: &Options, names: &Names, modules: &[Module]) -> String {
          \x20   filesets: [rtl, rom]\n\
          \x20   toplevel: {spec_top}\n\
          {frame}\
+         {axis}\
          \x20 lint:\n\
          \x20   default_tool: verilator\n\
          \x20   filesets: [rtl]\n\
@@ -389,7 +432,7 @@ pub fn core_file(opts: &Options, names: &Names, modules: &[Module]) -> String {
          \x20       mode: lint-only\n\
          \x20       verilator_options: [-Wall]\n",
         top = names.segment,
-        spec_top = SpecNames::new(&opts.prefix).unit,
+        spec_top = spec.unit,
         p = cfg.p,
         f = cfg.frac,
         xw = cfg.xbits,
@@ -410,6 +453,7 @@ mod tests {
             Options::default(),
             Options { cfg: Config { p: 64, align: Align::Screen, ..Config::default() }, prefix: "x_".into(), ..Default::default() },
             Options { cfg: Config::new(2, 20, 16, Align::Span).unwrap(), bfpi_arch: BfpiArch::Tree, ..Default::default() },
+            Options { prefix: "a_".into(), bus: crate::Bus::Axis, ..Default::default() },
         ];
         for opts in configs {
             let files = crate::generate(&opts);
@@ -418,6 +462,12 @@ mod tests {
             assert_eq!(&(serde_json::to_string_pretty(&m).unwrap() + "\n"), text);
             assert_eq!(m.parameters.align, opts.cfg.align);
             assert!(m.by_role(Role::SegmentShader).is_some());
+            assert_eq!(m.axis.len(), if opts.bus == crate::Bus::Axis { 4 } else { 0 });
+            for w in &m.axis {
+                w.check().unwrap();
+                assert_eq!(m.module(&w.module).unwrap().role, Role::Axis);
+                assert_eq!(m.module(&w.module).unwrap().latency, m.module(&w.wraps).unwrap().latency);
+            }
         }
     }
 

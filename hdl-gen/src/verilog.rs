@@ -25,11 +25,24 @@ pub struct Port {
     pub vector: bool,
     pub format: String,
     pub doc: String,
+    /// Verilog-2005 attribute instances printed before the declaration, one per line, each the
+    /// text between `(*` and `*)`: vendor tools read interfaces from them (`--bus axis`).
+    pub attrs: Vec<String>,
 }
 
 impl Port {
     pub fn input(name: &str, width: u32, format: &str, doc: &str) -> Port {
-        Port { name: name.into(), dir: Dir::Input, width, signed: false, reg: false, vector: false, format: format.into(), doc: doc.into() }
+        Port {
+            name: name.into(),
+            dir: Dir::Input,
+            width,
+            signed: false,
+            reg: false,
+            vector: false,
+            format: format.into(),
+            doc: doc.into(),
+            attrs: Vec::new(),
+        }
     }
     pub fn output(name: &str, width: u32, format: &str, doc: &str) -> Port {
         Port { dir: Dir::Output, ..Port::input(name, width, format, doc) }
@@ -44,6 +57,11 @@ impl Port {
     }
     pub fn vector(mut self) -> Port {
         self.vector = true;
+        self
+    }
+    /// Adds the attribute instance `(* attr *)` before the declaration.
+    pub fn attr(mut self, attr: impl Into<String>) -> Port {
+        self.attrs.push(attr.into());
         self
     }
 }
@@ -291,6 +309,9 @@ impl Module {
             .collect();
         let pad = decls.iter().map(|d| d.len()).max().unwrap_or(0) + 1;
         for (k, (d, p)) in decls.iter().zip(&self.ports).enumerate() {
+            for a in &p.attrs {
+                writeln!(o, "  (* {a} *)").unwrap();
+            }
             let comma = if k + 1 < self.ports.len() { "," } else { " " };
             let note = match (p.format.as_str(), p.doc.as_str()) {
                 ("", doc) => doc.to_string(),
@@ -465,6 +486,20 @@ mod tests {
         assert!(text.contains("input  wire signed [3:0] a,"), "{text}");
         assert!(text.contains("output reg  [3:0] y "), "{text}");
         assert!(text.contains("end else if (a[2]) begin\n"), "{text}");
+    }
+
+    #[test]
+    fn attributes_precede_their_port() {
+        let m = Module {
+            name: "t".into(),
+            header: vec![],
+            params: vec![],
+            ports: vec![Port::input("clk", 1, "", "").attr("A = \"x\"").attr("B = \"y\""), Port::output("y", 1, "", "")],
+            body: vec![assign("y", "clk")],
+        };
+        let text = m.render();
+        assert!(text.contains("(\n  (* A = \"x\" *)\n  (* B = \"y\" *)\n  input  wire clk,"), "{text}");
+        assert!(text.contains("clk, // \n  output wire y "), "{text}");
     }
 
     #[test]

@@ -55,6 +55,8 @@ fn generate_bad_flags() {
         (&["generate", "--out", d, "--prefix", "a-b"], "--prefix"),
         (&["generate", "--out", d, "--prefix", "a b"], "--prefix"),
         (&["generate", "--out", d, "--bfpi-arch", "wallace"], "--bfpi-arch"),
+        (&["generate", "--out", d, "--bus", "axi"], "--bus"),
+        (&["generate", "--out", d, "--bus"], "--bus"),
         (&["generate", "--out", d, "--brdf-k", "16,4"], "--brdf-k"),
         (&["generate", "--out", d, "--brdf-k", "0"], "--brdf-k"),
         (&["generate", "--out", d, "--brdf-k", "auto", "--max-rel-error", "150%"], "--max-rel-error"),

@@ -21,6 +21,7 @@ const CONFIGS: &[&str] = &[
     "--p 256 --align screen --frac 20 --xbits 16",
     "--p 8 --bfpi-arch naive",
     "--p 16 --align screen --bfpi-arch tree",
+    "--p 2 --align screen --prefix acme_ --pipeline 1 --bus axis",
 ];
 
 /// Runs `hdl-gen generate ARGS --out out` in `cwd` with exactly `env`.

@@ -9,7 +9,7 @@
 use golden::frontend::DiMode;
 use golden::pipeline::Pipeline;
 use golden::{Align, Config};
-use hdl_gen::{generate, output, wrapper, BfpiArch, Options};
+use hdl_gen::{generate, output, wrapper, BfpiArch, Bus, Options};
 use std::path::Path;
 use std::process::Command;
 
@@ -95,20 +95,36 @@ fn lint_part(part: usize) {
     // alignment or the increment form: it is linted once per front-end configuration, and the
     // chain there and at the extreme P values (scripts/lint-all lints every configuration).
     let mut fe_seen = std::collections::HashSet::new();
-    let mut runs =
-        configs().into_iter().map(|(cfg, prefix, arch, pipe)| (cfg, prefix, arch, None, DiMode::Triangle, pipe)).collect::<Vec<_>>();
+    let mut runs = configs()
+        .into_iter()
+        .map(|(cfg, prefix, arch, pipe)| (cfg, prefix, arch, None, DiMode::Triangle, pipe, Bus::Native))
+        .collect::<Vec<_>>();
     for bits in hdl_gen::frontend::DIV_BITS {
-        runs.push((Config::default(), "", BfpiArch::ShiftAdd, Some(bits), DiMode::Triangle, Pipeline::NONE));
+        runs.push((Config::default(), "", BfpiArch::ShiftAdd, Some(bits), DiMode::Triangle, Pipeline::NONE, Bus::Native));
     }
     // The per-scanline dI (`--fe-di scanline`) at the slowest and the fastest divider.
     for bits in [1, 4] {
-        runs.push((Config::default(), "", BfpiArch::ShiftAdd, Some(bits), DiMode::Scanline, Pipeline::NONE));
+        runs.push((Config::default(), "", BfpiArch::ShiftAdd, Some(bits), DiMode::Scanline, Pipeline::NONE, Bus::Native));
     }
+    // `--bus axis`: only the wrappers are linted as tops (their cores are the native modules of
+    // the same options, linted above), at the default P and at P = 1 with a prefix and the
+    // deepest pipeline.
+    runs.push((Config::default(), "", BfpiArch::ShiftAdd, None, DiMode::Triangle, Pipeline::NONE, Bus::Axis));
+    let deepest = Pipeline::new(Pipeline::MAX).unwrap();
+    runs.push((
+        Config { p: 1, align: Align::Screen, ..Config::default() },
+        "acme_",
+        BfpiArch::ShiftAdd,
+        None,
+        DiMode::Triangle,
+        deepest,
+        Bus::Axis,
+    ));
     // Which run lints each front-end is decided over the whole sweep, then each part takes its own.
-    let firsts: Vec<bool> = runs.iter().map(|r| fe_seen.insert((r.0.frac, r.0.xbits, r.1, r.3, r.4))).collect();
-    for (k, ((cfg, prefix, arch, fe_div_bits, fe_di, pipe), fe_first)) in runs.into_iter().zip(firsts).enumerate() {
+    let firsts: Vec<bool> = runs.iter().map(|r| r.6 == Bus::Native && fe_seen.insert((r.0.frac, r.0.xbits, r.1, r.3, r.4))).collect();
+    for (k, ((cfg, prefix, arch, fe_div_bits, fe_di, pipe, bus), fe_first)) in runs.into_iter().zip(firsts).enumerate() {
         if k % PARTS == part {
-            lint_one(k, cfg, prefix, arch, (fe_div_bits, fe_di), pipe, fe_first);
+            lint_one(k, cfg, prefix, arch, (fe_div_bits, fe_di), (pipe, bus), fe_first);
         }
     }
 }
@@ -135,19 +151,25 @@ fn lint_one(
     prefix: &str,
     arch: BfpiArch,
     (fe_div_bits, fe_di): (Option<u32>, DiMode),
-    pipeline: Pipeline,
+    (pipeline, bus): (Pipeline, Bus),
     fe_first: bool,
 ) {
     {
         let what = format!(
-            "{cfg:?}, prefix '{prefix}', --bfpi-arch {arch}, --fe-div-bits {fe_div_bits:?}, --fe-di {fe_di:?}, --pipeline {pipeline}"
+            "{cfg:?}, prefix '{prefix}', --bfpi-arch {arch}, --fe-div-bits {fe_div_bits:?}, --fe-di {fe_di:?}, --pipeline {pipeline}, --bus {bus}"
         );
         let dir = std::env::temp_dir().join(format!("hdl-gen-lint-{}-{k}", std::process::id()));
         let _ = std::fs::remove_dir_all(&dir);
-        let opts = Options { cfg, prefix: prefix.into(), bfpi_arch: arch, fe_div_bits, fe_di, pipeline, ..Default::default() };
+        let opts = Options { cfg, prefix: prefix.into(), bfpi_arch: arch, fe_div_bits, fe_di, pipeline, bus, ..Default::default() };
         let names = hdl_gen::Names::new(prefix, &cfg);
         let chain = fe_first || (arch == BfpiArch::ShiftAdd && [1, 256].contains(&cfg.p));
-        let skip = |module: &str| (module == names.frontend && !fe_first) || ((module == names.top || module == names.fb_top) && !chain);
+        let axis = bus == Bus::Axis;
+        let skip = |module: &str| {
+            if axis {
+                return !module.ends_with("_axis");
+            }
+            (module == names.frontend && !fe_first) || ((module == names.top || module == names.fb_top) && !chain)
+        };
         let files = generate(&opts);
         // A configuration linted clean before, byte for byte with the same tools and this test, is
         // not linted again: warm runs of ./scripts/test skip the sweep (scripts/lint-all does not).

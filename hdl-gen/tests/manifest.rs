@@ -4,7 +4,7 @@
 //! has is documented in docs/manifest.md.
 
 use golden::{Align, Config};
-use hdl_gen::{generate, BfpiArch, GeneratedFile, Options};
+use hdl_gen::{generate, BfpiArch, Bus, GeneratedFile, Options};
 use serde_json::Value;
 use std::collections::BTreeSet;
 
@@ -21,6 +21,16 @@ fn configs() -> Vec<Options> {
         let pipeline = golden::pipeline::Pipeline::new(level).unwrap();
         v.push(Options { cfg: Config { p: 8, align: Align::Screen, ..Config::default() }, pipeline, ..Default::default() });
     }
+    // `--bus axis`: the wrappers are listed with their ports like every module, and the `axis`
+    // section's fields are documented.
+    v.push(Options { cfg: Config { p: 8, ..Config::default() }, bus: Bus::Axis, ..Default::default() });
+    v.push(Options {
+        cfg: Config::new(1, 4, 4, Align::Screen).unwrap(),
+        prefix: "acme_".into(),
+        bus: Bus::Axis,
+        pipeline: golden::pipeline::Pipeline::new(2).unwrap(),
+        ..Default::default()
+    });
     v
 }
 
@@ -156,4 +166,45 @@ fn every_manifest_field_is_documented() {
     }
     let missing: Vec<&String> = paths.iter().filter(|p| !doc.contains(&format!("`{p}`"))).collect();
     assert!(missing.is_empty(), "docs/manifest.md does not document (as `path`) these manifest fields: {missing:?}");
+}
+
+/// Where the layout tables lie between docs/axis.md's markers, or `None` without the markers.
+fn axis_span(doc: &str) -> Option<std::ops::Range<usize>> {
+    let start = doc.find(AXIS_BEGIN)? + AXIS_BEGIN.len() + 1;
+    let end = start + doc[start..].find(AXIS_END)?;
+    Some(start..end)
+}
+
+fn axis_tables(doc: &str) -> Option<&str> {
+    axis_span(doc).map(|r| &doc[r])
+}
+
+const AXIS_BEGIN: &str =
+    "<!-- generated: hdl-gen generate --p 8 --bus axis; refresh with SEGSHADE_BLESS=1 cargo test -p hdl-gen --test manifest -->";
+const AXIS_END: &str = "<!-- end of generated tables -->";
+
+/// docs/axis.md's layout tables are the typed layout's (`hdl_gen::axis::markdown` of the
+/// default configuration's manifest), so the document cannot drift from the generator.
+#[test]
+fn docs_axis_tables_are_the_layout() {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../docs/axis.md");
+    let doc = std::fs::read_to_string(&path).expect("docs/axis.md exists");
+    let files = generate(&Options { bus: Bus::Axis, ..Default::default() });
+    let m = hdl_gen::manifest::Manifest::parse(&files.iter().find(|f| f.name == "manifest.json").unwrap().contents).unwrap();
+    assert_eq!(m.axis.len(), 4, "the shader, the front-end, its chain and the specular unit have wrappers");
+    let want = hdl_gen::axis::markdown(&m.axis);
+    if std::env::var_os("SEGSHADE_BLESS").is_some() {
+        let r = axis_span(&doc).expect("docs/axis.md has the generated-table markers");
+        std::fs::write(&path, format!("{}{want}{}", &doc[..r.start], &doc[r.end..])).unwrap();
+        return;
+    }
+    assert_eq!(
+        axis_tables(&doc),
+        Some(want.as_str()),
+        "docs/axis.md's tables differ from the layout; refresh: SEGSHADE_BLESS=1 cargo test -p hdl-gen --test manifest"
+    );
+    // The negative control: one field's bits changed in the document is a difference.
+    let broken = doc.replacen("| `[11:0]` | `in_x` |", "| `[12:0]` | `in_x` |", 1);
+    assert_ne!(broken, doc, "the control edits a row the tables have");
+    assert_ne!(axis_tables(&broken), Some(want.as_str()));
 }

@@ -290,6 +290,39 @@ struct WrOut {
         SEGSHADE_MEM_CLOCK(m, in, out, P, { SEGSHADE_TRI_PORTS(m, in) }, m->err)               \
     }
 
+// AXI4-Stream wrappers (`generate --bus axis`): the same per-clock structs as the wrapped
+// block's model, on the wrapper's ports. build.rs prints each wrapper's step from the typed
+// layout (hdl_gen::axis): DATA packs the struct's fields into s_axis_tdata with
+// segshade_put_bits, SAMPLE unpacks m_axis_* with segshade_get_bits and segshade_copy.
+template <class M, class In, class Out, class Data, class Sample>
+static inline void segshade_axis_clock(M* m, const In* in, Out* out, Data data, Sample sample) {
+    m->clk = 0;
+    m->rst = in->rst;
+    m->s_axis_tvalid = in->in_valid;
+    m->m_axis_tready = in->out_ready;
+    if (!in->keep) data();
+    m->eval();
+    out->in_ready = m->s_axis_tready;
+    out->out_valid = m->m_axis_tvalid;
+    sample();
+    m->clk = 1;
+    m->eval();
+}
+
+// Bits [lsb, lsb + width) of a little-endian byte buffer (width <= 32). The buffers build.rs
+// declares have 8 spare bytes, so the 64-bit window never reads or writes past them.
+static inline uint32_t segshade_get_bits(const uint8_t* b, unsigned lsb, unsigned width) {
+    uint64_t w;
+    std::memcpy(&w, b + lsb / 8, 8);
+    return static_cast<uint32_t>((w >> (lsb % 8)) & ((uint64_t(1) << width) - 1));
+}
+static inline void segshade_put_bits(uint8_t* b, unsigned lsb, unsigned width, uint32_t v) {
+    uint64_t w, mask = ((uint64_t(1) << width) - 1) << (lsb % 8);
+    std::memcpy(&w, b + lsb / 8, 8);
+    w = (w & ~mask) | ((uint64_t(v) << (lsb % 8)) & mask);
+    std::memcpy(b + lsb / 8, &w, 8);
+}
+
 // The per-clock structs' layout, stated once: every field's offset and every struct's size.
 // The C++ compiler checks them here; build.rs reads these lines and has the Rust compiler check
 // the same numbers against ffi.rs's #[repr(C)] structs (generated `const` asserts in models.rs),

@@ -425,6 +425,10 @@ pub fn require<T>(found: Option<T>, model: &str, what: &str) -> Option<T> {
         .chain(TRISHADER_MODELS.iter().map(|m| m.tag))
         .chain(WRITER_MODELS.iter().map(|m| m.tag))
         .chain(TRIWRITER_MODELS.iter().map(|m| m.tag))
+        .chain(AXIS_SEGMENT_MODELS.iter().map(|m| m.tag))
+        .chain(AXIS_SPECULAR_MODELS.iter().map(|m| m.tag))
+        .chain(AXIS_FRONTEND_MODELS.iter().map(|m| m.tag))
+        .chain(AXIS_TRISHADER_MODELS.iter().map(|m| m.tag))
         .collect();
     let built = if built.is_empty() { "nothing".to_string() } else { built.join(", ") };
     match RTL_DIR {
