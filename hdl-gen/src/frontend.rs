@@ -729,6 +729,23 @@ pub fn module(hw: &Hw, names: &Names) -> Module {
         )],
     )]));
 
+    // The formal properties (scripts/prove): the per-triangle dI's control. The scanline
+    // comparison option's divider adds a stall of its own and is left to co-simulation.
+    if !scan {
+        body.push(crate::formal::frontend_properties(&crate::formal::FrontendShape {
+            yw,
+            cx,
+            cy,
+            xw,
+            width: w as u64,
+            height: h as u64,
+            cnt_w,
+            bits,
+            rw,
+            div_clocks: hw.div_clocks(),
+        }));
+    }
+
     Module {
         name: names.frontend.clone(),
         header,
