@@ -778,8 +778,9 @@ module tri_frontend (
     end
   end
 `ifdef FORMAL
-  // scripts/prove: cutpoint t:$mul
-  // (the multipliers: area, edges, plane, I0; values are left to co-simulation)
+  // scripts/prove: cutpoint t:$mul w:ei0_p w:ei0_d w:ei0_q w:es0_p w:es0_d w:es0_q w:ei1_p w:ei1_d w:ei1_q w:es1_p w:es1_d w:es1_q w:ei2_p w:ei2_d w:ei2_q w:es2_p w:es2_d w:es2_q w:ddi_p w:ddi_d w:ddi_q w:drn_p w:drn_d w:drn_q
+  // (the multipliers: area, edges, plane, I0; and the set-up dividers' registers, free every clock:
+  // the control never reads them, and their values are left to co-simulation)
   // Clocks since the start: $past is meaningful once f_past is set.
   reg f_past = 1'b0;
   reg f_past2 = 1'b0;
@@ -850,12 +851,30 @@ module tri_frontend (
   reg [8:0] f_2y;
   reg f_ov;
   reg [8:0] f_oy;
-  // The error pulse owed, and counts: accepted, flagged (at the port), culled, walked.
+  // Each span's tag: its triangle's first (the walker has emitted none of it yet: f_wnew).
+  reg f_wnew;
+  reg f_1n;
+  reg f_2n;
+  reg f_on;
+  // The dI of the last span offered, and whether the output register could load (f_free):
+  // a span on the output is new when it is valid and f_free.
+  reg [20:0] f_pdi;
+  reg f_free;
+  always @(posedge clk) begin
+    f_free <= rst || !out_valid || out_ready;
+    if (out_valid) begin
+      f_pdi <= out_di;
+    end
+  end
+  // The error pulse owed, and counts: triangles accepted, flagged (at the port), culled,
+  // walked; spans the walker produced (covered rows) and spans taken at the port.
   reg f_errp;
   reg [3:0] f_nacc;
   reg [3:0] f_nerr;
   reg [3:0] f_ncull;
   reg [3:0] f_nwalk;
+  reg [3:0] f_nrow;
+  reg [3:0] f_nout;
   wire f_adv = !out_valid || out_ready;
   wire f_wend = f_wrow == f_wlast;
   wire f_take = f_sb && f_sh && f_adv && (!f_wv || f_wend);
@@ -878,6 +897,8 @@ module tri_frontend (
       f_nerr <= 4'd0;
       f_ncull <= 4'd0;
       f_nwalk <= 4'd0;
+      f_nrow <= 4'd0;
+      f_nout <= 4'd0;
     end else begin
       f_errp <= 1'b0;
       if (f_acc) begin
@@ -885,6 +906,12 @@ module tri_frontend (
       end
       if (err) begin
         f_nerr <= f_nerr + 4'd1;
+      end
+      if (f_adv && f_wv && f_cover) begin
+        f_nrow <= f_nrow + 4'd1;
+      end
+      if (out_valid && out_ready) begin
+        f_nout <= f_nout + 4'd1;
       end
       if (f_acc) begin
         f_vf <= 1'b1;
@@ -923,21 +950,30 @@ module tri_frontend (
         f_wlast <= s_last;
         f_wymin <= f_symin;
         f_wymax <= f_symax;
+        f_wnew <= 1'b1;
         f_nwalk <= f_nwalk + 4'd1;
-      end else if (f_adv && f_wv) begin
-        if (f_wend) begin
-          f_wv <= 1'b0;
-        end else begin
-          f_wrow <= f_wrow + 9'd1;
+      end else begin
+        if (f_adv && f_wv && f_cover) begin
+          f_wnew <= 1'b0;
+        end
+        if (f_adv && f_wv) begin
+          if (f_wend) begin
+            f_wv <= 1'b0;
+          end else begin
+            f_wrow <= f_wrow + 9'd1;
+          end
         end
       end
       if (f_adv) begin
         f_1v <= f_wv && f_cover;
         f_1y <= f_wrow;
+        f_1n <= f_wnew;
         f_2v <= f_1v;
         f_2y <= f_1y;
+        f_2n <= f_1n;
         f_ov <= f_2v;
         f_oy <= f_2y;
+        f_on <= f_2n;
       end
     end
   end
@@ -956,6 +992,11 @@ module tri_frontend (
       if (out_valid) begin
         assert(out_len != 13'd0);
         assert({2'd0, out_x} + {1'd0, out_len} <= 14'd640);
+      end
+      // dI once per triangle: a new span that is not its triangle's first carries the dI of
+      // the span before it (the same triangle's).
+      if (out_valid && f_free && !f_on) begin
+        assert(out_di == f_pdi);
       end
     end
   end
@@ -982,6 +1023,12 @@ module tri_frontend (
   always @(*) begin
     if (f_past) begin
       assert(f_nacc == f_nerr + {3'd0, err} + f_ncull + f_nwalk + {3'd0, f_vf} + {3'd0, f_sb});
+    end
+  end
+  // Every span the walker produced is offered once: taken at the port, or still in a stage.
+  always @(*) begin
+    if (f_past) begin
+      assert(f_nrow == f_nout + {3'd0, f_1v} + {3'd0, f_2v} + {3'd0, f_ov});
     end
   end
   // Linking invariants: every stage's registers are the reference's; a row's centre
@@ -1024,6 +1071,19 @@ module tri_frontend (
       assert(p2_v == f_2v);
       if (f_2v) begin
         assert(p2_y == f_2y);
+      end
+      // A span that is not its triangle's first has the dI of the span ahead of it.
+      if (f_ov && !f_free) begin
+        assert(out_di == f_pdi);
+      end
+      if (f_2v && !f_2n) begin
+        assert(p2_di == (f_ov ? out_di : f_pdi));
+      end
+      if (f_1v && !f_1n) begin
+        assert(p1_di == (f_2v ? p2_di : f_ov ? out_di : f_pdi));
+      end
+      if (f_wv && !f_wnew) begin
+        assert(w_di == (f_1v ? p1_di : f_2v ? p2_di : f_ov ? out_di : f_pdi));
       end
       if (p1_v) begin
         assert(p1_len != 13'd0);

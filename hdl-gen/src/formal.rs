@@ -666,6 +666,8 @@ pub struct FrontendShape {
     pub cx: u32,
     pub cy: u32,
     pub xw: u32,
+    /// `dI`'s bits (`out_di`).
+    pub dw: u32,
     /// Screen width and height, pixels.
     pub width: u64,
     pub height: u64,
@@ -675,6 +677,8 @@ pub struct FrontendShape {
     pub bits: u32,
     pub rw: u32,
     pub div_clocks: u32,
+    /// The set-up dividers' registers (partial remainder, divisor, quotient of each): cut.
+    pub div_regs: Vec<String>,
 }
 
 /// Properties of `tri_frontend` (SPEC §6; names as `frontend::module` declares them), with the
@@ -696,20 +700,24 @@ pub struct FrontendShape {
 /// `out_valid` and `out_y` equal the reference's (no triangle dropped or invented, spans top
 /// to bottom in order, a triangle's spans before the next one's, `err` exactly once per
 /// triangle outside the band and never otherwise); the triangle count (accepted = flagged +
-/// culled + walked + in flight); reset and stability; and the linking invariants. Every
-/// multiplier is cut (`cutpoint t:$mul`: area, edge and plane products, I0's product and
-/// correction): their values never decide the control beyond what the reference takes as
-/// given, and the values are co-simulated bit-exactly against golden.
+/// culled + walked + in flight); the rate (a row every free clock, no bubble between triangles
+/// when the set-up is done, a dropped triangle costs one clock); reset and stability; and the
+/// linking invariants. Every multiplier is cut (area, edge and plane products, I0's product and
+/// correction) and so are the set-up dividers' registers (free every clock): their values never
+/// decide the control beyond what the reference takes as given, and the values are
+/// co-simulated bit-exactly against golden. The dividers' cut is for speed: a run from reset
+/// through their restoring steps (66 bits wide at 640x480) is more than twice as slow.
 pub fn frontend_properties(s: &FrontendShape) -> Item {
-    let FrontendShape { yw, cx, cy, xw, width, height, cnt_w, bits, rw, div_clocks } = *s;
+    let FrontendShape { yw, cx, cy, xw, dw, width, height, cnt_w, bits, rw, div_clocks, ref div_regs } = *s;
     // No `*` below: the proof cuts every multiplier, the properties' own too.
     assert!(bits.is_power_of_two(), "divider bits per clock: {bits}");
     // Reference counters: wide enough for the stages they count through, modulo 2^cw.
     let cw = 4;
     let nw = 32 - div_clocks.leading_zeros();
     let mut b = vec![
-        comment(format!("{CUT_TAG}cutpoint t:$mul")),
-        comment("(the multipliers: area, edges, plane, I0; values are left to co-simulation)"),
+        comment(format!("{CUT_TAG}cutpoint t:$mul {}", div_regs.iter().map(|r| format!("w:{r}")).collect::<Vec<_>>().join(" "))),
+        comment("(the multipliers: area, edges, plane, I0; and the set-up dividers' registers, free every clock:"),
+        comment("the control never reads them, and their values are left to co-simulation)"),
     ];
     b.extend(past_flags());
     b.extend(reset_and_stability("span", OUT, &["out_y", "out_x", "out_len", "out_i0", "out_di"]));
@@ -749,8 +757,16 @@ pub fn frontend_properties(s: &FrontendShape) -> Item {
     b.push(Item::Reg { name: "f_wymax".into(), width: cy, signed: true });
     b.push(comment("The spans: the walker's row in the two I0 stages and the output (valid, row)."));
     b.extend([reg("f_1v", 1), reg("f_1y", yw), reg("f_2v", 1), reg("f_2y", yw), reg("f_ov", 1), reg("f_oy", yw)]);
-    b.push(comment("The error pulse owed, and counts: accepted, flagged (at the port), culled, walked."));
+    b.push(comment("Each span's tag: its triangle's first (the walker has emitted none of it yet: f_wnew)."));
+    b.extend([reg("f_wnew", 1), reg("f_1n", 1), reg("f_2n", 1), reg("f_on", 1)]);
+    b.push(comment("The dI of the last span offered, and whether the output register could load (f_free):"));
+    b.push(comment("a span on the output is new when it is valid and f_free."));
+    b.extend([reg("f_pdi", dw), reg("f_free", 1)]);
+    b.push(Item::Always(vec![set("f_free", "rst || !out_valid || out_ready"), when("out_valid", vec![set("f_pdi", "out_di")])]));
+    b.push(comment("The error pulse owed, and counts: triangles accepted, flagged (at the port), culled,"));
+    b.push(comment("walked; spans the walker produced (covered rows) and spans taken at the port."));
     b.extend([reg("f_errp", 1), reg("f_nacc", cw), reg("f_nerr", cw), reg("f_ncull", cw), reg("f_nwalk", cw)]);
+    b.extend([reg("f_nrow", cw), reg("f_nout", cw)]);
 
     b.push(wire("f_adv", 1, "!out_valid || out_ready"));
     b.push(wire("f_wend", 1, "f_wrow == f_wlast"));
@@ -800,22 +816,29 @@ pub fn frontend_properties(s: &FrontendShape) -> Item {
             set("f_wlast", "s_last"),
             set("f_wymin", "f_symin"),
             set("f_wymax", "f_symax"),
+            set("f_wnew", "1'b1"),
             inc1("f_nwalk"),
         ],
-        vec![when(
-            "f_adv && f_wv",
-            vec![Stmt::If("f_wend".into(), vec![set("f_wv", "1'b0")], vec![set("f_wrow", format!("f_wrow + {}", one(yw)))])],
-        )],
+        vec![
+            when("f_adv && f_wv && f_cover", vec![set("f_wnew", "1'b0")]),
+            when(
+                "f_adv && f_wv",
+                vec![Stmt::If("f_wend".into(), vec![set("f_wv", "1'b0")], vec![set("f_wrow", format!("f_wrow + {}", one(yw)))])],
+            ),
+        ],
     );
     let spans = when(
         "f_adv",
         vec![
             set("f_1v", "f_wv && f_cover"),
             set("f_1y", "f_wrow"),
+            set("f_1n", "f_wnew"),
             set("f_2v", "f_1v"),
             set("f_2y", "f_1y"),
+            set("f_2n", "f_1n"),
             set("f_ov", "f_2v"),
             set("f_oy", "f_2y"),
+            set("f_on", "f_2n"),
         ],
     );
     let input = Stmt::If(
@@ -838,8 +861,20 @@ pub fn frontend_properties(s: &FrontendShape) -> Item {
             set("f_nerr", zero.clone()),
             set("f_ncull", zero.clone()),
             set("f_nwalk", zero.clone()),
+            set("f_nrow", zero.clone()),
+            set("f_nout", zero.clone()),
         ],
-        vec![set("f_errp", "1'b0"), inc("f_nacc", "f_acc"), inc("f_nerr", "err"), input, setup, walker, spans],
+        vec![
+            set("f_errp", "1'b0"),
+            inc("f_nacc", "f_acc"),
+            inc("f_nerr", "err"),
+            inc("f_nrow", "f_adv && f_wv && f_cover"),
+            inc("f_nout", "out_valid && out_ready"),
+            input,
+            setup,
+            walker,
+            spans,
+        ],
     )]));
 
     b.push(comment("The front-end is the reference at its ports: it takes a triangle exactly when the"));
@@ -863,6 +898,9 @@ pub fn frontend_properties(s: &FrontendShape) -> Item {
         when("f_ov", vec![assert("out_y == f_oy")]),
     ];
     ports.push(on_screen("out_valid", "out_x", "out_len"));
+    ports.push(Stmt::Comment("dI once per triangle: a new span that is not its triangle's first carries the dI of".into()));
+    ports.push(Stmt::Comment("the span before it (the same triangle's).".into()));
+    ports.push(when("out_valid && f_free && !f_on", vec![assert("out_di == f_pdi")]));
     b.push(Item::Comb(vec![when("f_past", ports)]));
     b.push(comment("Rate (SPEC §6), in the design's terms: the walker takes a row every clock the output is"));
     b.push(comment("free; a set-up result waiting when the walker is on its last row follows it with no"));
@@ -885,6 +923,11 @@ pub fn frontend_properties(s: &FrontendShape) -> Item {
             zext("f_vf", 1, cw),
             zext("f_sb", 1, cw)
         ))],
+    )]));
+    b.push(comment("Every span the walker produced is offered once: taken at the port, or still in a stage."));
+    b.push(Item::Comb(vec![when(
+        "f_past",
+        vec![assert(format!("f_nrow == f_nout + {} + {} + {}", zext("f_1v", 1, cw), zext("f_2v", 1, cw), zext("f_ov", 1, cw)))],
     )]));
 
     b.push(comment("Linking invariants: every stage's registers are the reference's; a row's centre"));
@@ -920,6 +963,11 @@ pub fn frontend_properties(s: &FrontendShape) -> Item {
         assert("p2_v == f_2v"),
         when("f_2v", vec![assert("p2_y == f_2y")]),
     ];
+    link.push(Stmt::Comment("A span that is not its triangle's first has the dI of the span ahead of it.".into()));
+    link.push(when("f_ov && !f_free", vec![assert("out_di == f_pdi")]));
+    link.push(when("f_2v && !f_2n", vec![assert("p2_di == (f_ov ? out_di : f_pdi)")]));
+    link.push(when("f_1v && !f_1n", vec![assert("p1_di == (f_2v ? p2_di : f_ov ? out_di : f_pdi)")]));
+    link.push(when("f_wv && !f_wnew", vec![assert("w_di == (f_1v ? p1_di : f_2v ? p2_di : f_ov ? out_di : f_pdi)")]));
     link.push(on_screen("p1_v", "p1_x", "p1_len"));
     link.push(on_screen("p2_v", "p2_x", "p2_len"));
     b.push(Item::Comb(vec![when("f_past", link)]));

@@ -737,12 +737,14 @@ pub fn module(hw: &Hw, names: &Names) -> Module {
             cx,
             cy,
             xw,
+            dw,
             width: w as u64,
             height: h as u64,
             cnt_w,
             bits,
             rw,
             div_clocks: hw.div_clocks(),
+            div_regs: divs.iter().flat_map(|d| ["p", "d", "q"].map(|r| format!("{}_{r}", d.name))).collect(),
         }));
     }
 
