@@ -780,7 +780,7 @@ module tri_frontend (
 `ifdef FORMAL
   // scripts/prove: cutpoint t:$mul w:ei0_p w:ei0_d w:ei0_q w:es0_p w:es0_d w:es0_q w:ei1_p w:ei1_d w:ei1_q w:es1_p w:es1_d w:es1_q w:ei2_p w:ei2_d w:ei2_q w:es2_p w:es2_d w:es2_q w:ddi_p w:ddi_d w:ddi_q w:drn_p w:drn_d w:drn_q
   // (the multipliers: area, edges, plane, I0; and the set-up dividers' registers, free every clock:
-  // the control never reads them, and their values are left to co-simulation)
+  // only the coverage decision, taken as given, depends on them; values are left to co-simulation)
   // Clocks since the start: $past is meaningful once f_past is set.
   reg f_past = 1'b0;
   reg f_past2 = 1'b0;

@@ -700,9 +700,10 @@ pub struct FrontendShape {
 /// `out_valid` and `out_y` equal the reference's (no triangle dropped or invented, spans top
 /// to bottom in order, a triangle's spans before the next one's, `err` exactly once per
 /// triangle outside the band and never otherwise); the triangle count (accepted = flagged +
-/// culled + walked + in flight); the rate (a row every free clock, no bubble between triangles
-/// when the set-up is done, a dropped triangle costs one clock); reset and stability; and the
-/// linking invariants. Every multiplier is cut (area, edge and plane products, I0's product and
+/// culled + walked + in flight) and the span count (every covered row's span offered once);
+/// `dI` once per triangle (a span that is not its triangle's first carries the `dI` of the one
+/// before it); the rate (a row every free clock, no bubble between triangles when the set-up is
+/// done, a dropped triangle costs one clock); reset and stability; and the linking invariants. Every multiplier is cut (area, edge and plane products, I0's product and
 /// correction) and so are the set-up dividers' registers (free every clock): their values never
 /// decide the control beyond what the reference takes as given, and the values are
 /// co-simulated bit-exactly against golden. The dividers' cut is for speed: a run from reset
@@ -717,7 +718,7 @@ pub fn frontend_properties(s: &FrontendShape) -> Item {
     let mut b = vec![
         comment(format!("{CUT_TAG}cutpoint t:$mul {}", div_regs.iter().map(|r| format!("w:{r}")).collect::<Vec<_>>().join(" "))),
         comment("(the multipliers: area, edges, plane, I0; and the set-up dividers' registers, free every clock:"),
-        comment("the control never reads them, and their values are left to co-simulation)"),
+        comment("only the coverage decision, taken as given, depends on them; values are left to co-simulation)"),
     ];
     b.extend(past_flags());
     b.extend(reset_and_stability("span", OUT, &["out_y", "out_x", "out_len", "out_i0", "out_di"]));
