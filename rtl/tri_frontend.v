@@ -777,6 +777,325 @@ module tri_frontend (
       out_di <= p2_di;
     end
   end
+`ifdef FORMAL
+  // scripts/prove: cutpoint t:$mul w:ei0_p w:ei0_d w:ei0_q w:es0_p w:es0_d w:es0_q w:ei1_p w:ei1_d w:ei1_q w:es1_p w:es1_d w:es1_q w:ei2_p w:ei2_d w:ei2_q w:es2_p w:es2_d w:es2_q w:ddi_p w:ddi_d w:ddi_q w:drn_p w:drn_d w:drn_q
+  // (the multipliers: area, edges, plane, I0; and the set-up dividers' registers, free every clock:
+  // only the coverage decision, taken as given, depends on them; values are left to co-simulation)
+  // Clocks since the start: $past is meaningful once f_past is set.
+  reg f_past = 1'b0;
+  reg f_past2 = 1'b0;
+  always @(posedge clk) begin
+    f_past <= 1'b1;
+    f_past2 <= f_past;
+  end
+  // The one rule the environment keeps: reset in the first clock.
+  always @(*) begin
+    if (!f_past) begin
+      assume(rst);
+    end
+  end
+  // Reset: no span out of reset.
+  always @(posedge clk) begin
+    if (f_past && $past(rst)) begin
+      assert(!out_valid);
+    end
+  end
+  // Stability: a span offered and not taken stays, unchanged.
+  always @(posedge clk) begin
+    if (f_past && !$past(rst) && $past(out_valid && !out_ready)) begin
+      assert(out_valid);
+      assert(out_y == $past(out_y));
+      assert(out_x == $past(out_x));
+      assert(out_len == $past(out_len));
+      assert(out_i0 == $past(out_i0));
+      assert(out_di == $past(out_di));
+    end
+  end
+  // Reset: no error pulse out of reset either.
+  always @(posedge clk) begin
+    if (f_past && $past(rst)) begin
+      assert(!err);
+    end
+  end
+  // The reference. The input stage: the triangle waiting for the set-up, whether its
+  // vertices lie in SPEC §6's guard band (decided here from the ports), its vertical extent.
+  reg f_vf;
+  reg f_vg;
+  reg signed [18:0] f_vymin;
+  reg signed [18:0] f_vymax;
+  wire signed [23:0] f_ix0 = {{2{in_x0[21]}}, in_x0};
+  wire signed [20:0] f_iy0 = {{2{in_y0[18]}}, in_y0};
+  wire signed [23:0] f_ix1 = {{2{in_x1[21]}}, in_x1};
+  wire signed [20:0] f_iy1 = {{2{in_y1[18]}}, in_y1};
+  wire signed [23:0] f_ix2 = {{2{in_x2[21]}}, in_x2};
+  wire signed [20:0] f_iy2 = {{2{in_y2[18]}}, in_y2};
+  wire f_band = f_ix0 >= -24'sd163840 && f_ix0 < 24'sd327680 && f_iy0 >= -21'sd122880 && f_iy0 < 21'sd245760 && f_ix1 >= -24'sd163840 && f_ix1 < 24'sd327680 && f_iy1 >= -21'sd122880 && f_iy1 < 21'sd245760 && f_ix2 >= -24'sd163840 && f_ix2 < 24'sd327680 && f_iy2 >= -21'sd122880 && f_iy2 < 21'sd245760;
+  wire signed [18:0] f_iymin = ((in_y0 < in_y1) ? ((in_y0 < in_y2) ? in_y0 : in_y2) : ((in_y1 < in_y2) ? in_y1 : in_y2));
+  wire signed [18:0] f_iymax = ((in_y0 > in_y1) ? ((in_y0 > in_y2) ? in_y0 : in_y2) : ((in_y1 > in_y2) ? in_y1 : in_y2));
+  // The set-up: busy (dividing, f_sn + 1 clocks left, or holding its result: f_sh), its extent.
+  reg f_sb;
+  reg f_sh;
+  reg [2:0] f_sn;
+  reg signed [18:0] f_symin;
+  reg signed [18:0] f_symax;
+  // The walker: the triangle being walked, its row and last row, its extent.
+  reg f_wv;
+  reg [8:0] f_wrow;
+  reg [8:0] f_wlast;
+  reg signed [18:0] f_wymin;
+  reg signed [18:0] f_wymax;
+  // The spans: the walker's row in the two I0 stages and the output (valid, row).
+  reg f_1v;
+  reg [8:0] f_1y;
+  reg f_2v;
+  reg [8:0] f_2y;
+  reg f_ov;
+  reg [8:0] f_oy;
+  // Each span's tag: its triangle's first (the walker has emitted none of it yet: f_wnew).
+  reg f_wnew;
+  reg f_1n;
+  reg f_2n;
+  reg f_on;
+  // The dI of the last span offered, and whether the output register could load (f_free):
+  // a span on the output is new when it is valid and f_free.
+  reg [20:0] f_pdi;
+  reg f_free;
+  always @(posedge clk) begin
+    f_free <= rst || !out_valid || out_ready;
+    if (out_valid) begin
+      f_pdi <= out_di;
+    end
+  end
+  // The error pulse owed, and counts: triangles accepted, flagged (at the port), culled,
+  // walked; spans the walker produced (covered rows) and spans taken at the port.
+  reg f_errp;
+  reg [3:0] f_nacc;
+  reg [3:0] f_nerr;
+  reg [3:0] f_ncull;
+  reg [3:0] f_nwalk;
+  reg [3:0] f_nrow;
+  reg [3:0] f_nout;
+  wire f_adv = !out_valid || out_ready;
+  wire f_wend = f_wrow == f_wlast;
+  wire f_take = f_sb && f_sh && f_adv && (!f_wv || f_wend);
+  wire f_calc = f_vf && (!f_sb || f_take);
+  wire f_rdy = !f_vf || f_calc;
+  wire f_acc = in_valid && f_rdy;
+  // The design's data decisions, taken as given: culled, and a walked row's covered pixels.
+  wire f_cull = cull;
+  wire f_cover = lo3 <= hi3;
+  always @(posedge clk) begin
+    if (rst) begin
+      f_vf <= 1'b0;
+      f_sb <= 1'b0;
+      f_wv <= 1'b0;
+      f_1v <= 1'b0;
+      f_2v <= 1'b0;
+      f_ov <= 1'b0;
+      f_errp <= 1'b0;
+      f_nacc <= 4'd0;
+      f_nerr <= 4'd0;
+      f_ncull <= 4'd0;
+      f_nwalk <= 4'd0;
+      f_nrow <= 4'd0;
+      f_nout <= 4'd0;
+    end else begin
+      f_errp <= 1'b0;
+      if (f_acc) begin
+        f_nacc <= f_nacc + 4'd1;
+      end
+      if (err) begin
+        f_nerr <= f_nerr + 4'd1;
+      end
+      if (f_adv && f_wv && f_cover) begin
+        f_nrow <= f_nrow + 4'd1;
+      end
+      if (out_valid && out_ready) begin
+        f_nout <= f_nout + 4'd1;
+      end
+      if (f_acc) begin
+        f_vf <= 1'b1;
+        f_vg <= f_band;
+        f_vymin <= f_iymin;
+        f_vymax <= f_iymax;
+      end else if (f_calc) begin
+        f_vf <= 1'b0;
+      end
+      if (f_calc) begin
+        if (!f_vg) begin
+          f_errp <= 1'b1;
+          f_sb <= 1'b0;
+        end else if (f_cull) begin
+          f_sb <= 1'b0;
+          f_ncull <= f_ncull + 4'd1;
+        end else begin
+          f_sb <= 1'b1;
+          f_sh <= 1'b0;
+          f_sn <= 3'd5;
+          f_symin <= f_vymin;
+          f_symax <= f_vymax;
+        end
+      end else if (f_take) begin
+        f_sb <= 1'b0;
+      end else if (f_sb && !f_sh) begin
+        if (f_sn == 3'd0) begin
+          f_sh <= 1'b1;
+        end else begin
+          f_sn <= f_sn - 3'd1;
+        end
+      end
+      if (f_take) begin
+        f_wv <= 1'b1;
+        f_wrow <= s_first;
+        f_wlast <= s_last;
+        f_wymin <= f_symin;
+        f_wymax <= f_symax;
+        f_wnew <= 1'b1;
+        f_nwalk <= f_nwalk + 4'd1;
+      end else begin
+        if (f_adv && f_wv && f_cover) begin
+          f_wnew <= 1'b0;
+        end
+        if (f_adv && f_wv) begin
+          if (f_wend) begin
+            f_wv <= 1'b0;
+          end else begin
+            f_wrow <= f_wrow + 9'd1;
+          end
+        end
+      end
+      if (f_adv) begin
+        f_1v <= f_wv && f_cover;
+        f_1y <= f_wrow;
+        f_1n <= f_wnew;
+        f_2v <= f_1v;
+        f_2y <= f_1y;
+        f_2n <= f_1n;
+        f_ov <= f_2v;
+        f_oy <= f_2y;
+        f_on <= f_2n;
+      end
+    end
+  end
+  // The front-end is the reference at its ports: it takes a triangle exactly when the
+  // vertex register is free or handing its triangle to the set-up, pulses err once per
+  // triangle outside the guard band and never otherwise, and offers exactly the reference's
+  // spans, row by row: a triangle's rows top to bottom, then the next triangle's.
+  always @(*) begin
+    if (f_past) begin
+      assert(in_ready == f_rdy);
+      assert(err == f_errp);
+      assert(out_valid == f_ov);
+      if (f_ov) begin
+        assert(out_y == f_oy);
+      end
+      if (out_valid) begin
+        assert(out_len != 13'd0);
+        assert({2'd0, out_x} + {1'd0, out_len} <= 14'd640);
+      end
+      // dI once per triangle: a new span that is not its triangle's first carries the dI of
+      // the span before it (the same triangle's).
+      if (out_valid && f_free && !f_on) begin
+        assert(out_di == f_pdi);
+      end
+    end
+  end
+  // Rate (SPEC §6), in the design's terms: the walker takes a row every clock the output is
+  // free; a set-up result waiting when the walker is on its last row follows it with no
+  // bubble (set-up overlapped with the walk); a dropped or culled triangle costs its CALC clock.
+  always @(posedge clk) begin
+    if (f_past && !$past(rst)) begin
+      if ($past(w_valid && adv && !w_end)) begin
+        assert(w_valid);
+        assert(w_row == $past(w_row) + 9'd1);
+      end
+      if ($past(w_valid && adv && w_end && st == HOLD)) begin
+        assert(w_valid);
+        assert(w_row == $past(s_first));
+      end
+      if ($past(calc && (!guard_ok || cull))) begin
+        assert(in_ready);
+      end
+    end
+  end
+  // Nothing lost or invented: every accepted triangle was flagged, culled or walked, or is
+  // still waiting or in set-up (counts modulo 16).
+  always @(*) begin
+    if (f_past) begin
+      assert(f_nacc == f_nerr + {3'd0, err} + f_ncull + f_nwalk + {3'd0, f_vf} + {3'd0, f_sb});
+    end
+  end
+  // Every span the walker produced is offered once: taken at the port, or still in a stage.
+  always @(*) begin
+    if (f_past) begin
+      assert(f_nrow == f_nout + {3'd0, f_1v} + {3'd0, f_2v} + {3'd0, f_ov});
+    end
+  end
+  // Linking invariants: every stage's registers are the reference's; a row's centre
+  // (256 r + 128 sub-pixels) lies within its triangle's vertical extent and on the screen.
+  always @(*) begin
+    if (f_past) begin
+      assert(v_full == f_vf);
+      if (f_vf) begin
+        assert(guard_ok == f_vg);
+        assert(ymin == f_vymin);
+        assert(ymax == f_vymax);
+      end
+      assert(st == (f_sb ? (f_sh ? HOLD : DIV) : IDLE));
+      if (f_sb && !f_sh) begin
+        assert(div_cnt == ({2'd0, f_sn} << 2) + 5'd2);
+      end
+      if (f_sn > 3'd5) begin
+        assert(!(f_sb && !f_sh));
+      end
+      if (f_sb) begin
+        assert($signed({2'b00, s_last, 8'd128}) <= f_symax);
+        assert($signed({2'b00, s_first, 8'd128}) >= f_symin);
+        assert(s_first <= s_last);
+        assert(s_last <= 9'd479);
+      end
+      assert(w_valid == f_wv);
+      if (f_wv) begin
+        assert(w_row == f_wrow);
+        assert(w_last == f_wlast);
+        assert(f_wrow <= f_wlast);
+        assert($signed({2'b00, f_wrow, 8'd128}) >= f_wymin);
+        assert($signed({2'b00, f_wrow, 8'd128}) <= f_wymax);
+        assert($signed({2'b00, f_wlast, 8'd128}) <= f_wymax);
+        assert(f_wlast <= 9'd479);
+      end
+      assert(p1_v == f_1v);
+      if (f_1v) begin
+        assert(p1_y == f_1y);
+      end
+      assert(p2_v == f_2v);
+      if (f_2v) begin
+        assert(p2_y == f_2y);
+      end
+      // A span that is not its triangle's first has the dI of the span ahead of it.
+      if (f_ov && !f_free) begin
+        assert(out_di == f_pdi);
+      end
+      if (f_2v && !f_2n) begin
+        assert(p2_di == (f_ov ? out_di : f_pdi));
+      end
+      if (f_1v && !f_1n) begin
+        assert(p1_di == (f_2v ? p2_di : f_ov ? out_di : f_pdi));
+      end
+      if (f_wv && !f_wnew) begin
+        assert(w_di == (f_1v ? p1_di : f_2v ? p2_di : f_ov ? out_di : f_pdi));
+      end
+      if (p1_v) begin
+        assert(p1_len != 13'd0);
+        assert({2'd0, p1_x} + {1'd0, p1_len} <= 14'd640);
+      end
+      if (p2_v) begin
+        assert(p2_len != 13'd0);
+        assert({2'd0, p2_x} + {1'd0, p2_len} <= 14'd640);
+      end
+    end
+  end
+`endif
 
 endmodule
 

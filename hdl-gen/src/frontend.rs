@@ -729,6 +729,25 @@ pub fn module(hw: &Hw, names: &Names) -> Module {
         )],
     )]));
 
+    // The formal properties (scripts/prove): the per-triangle dI's control. The scanline
+    // comparison option's divider adds a stall of its own and is left to co-simulation.
+    if !scan {
+        body.push(crate::formal::frontend_properties(&crate::formal::FrontendShape {
+            yw,
+            cx,
+            cy,
+            xw,
+            dw,
+            width: w as u64,
+            height: h as u64,
+            cnt_w,
+            bits,
+            rw,
+            div_clocks: hw.div_clocks(),
+            div_regs: divs.iter().flat_map(|d| ["p", "d", "q"].map(|r| format!("{}_{r}", d.name))).collect(),
+        }));
+    }
+
     Module {
         name: names.frontend.clone(),
         header,
