@@ -335,7 +335,13 @@ pub fn writer_properties(w: &golden::writer::Writer) -> Item {
     b.push(comment("The reference: each pixel placed by its screen x."));
     b.push(wire("f_free", 1, "!mem_valid || mem_ready"));
     b.push(wire("f_take", 1, "in_valid && in_ready"));
-    let blk = if xw > l { zext(&format!("in_x[{}:{l}]", xw - 1), xw - l, aw) } else { lit(aw, 0) };
+    // The block number of x, as an address term; on a screen narrower than 2^XW it is narrower
+    // than the port (x < W).
+    let blk_of = |x: &str| match (xw - l).min(aw) {
+        0 => lit(aw, 0),
+        bw => zext(&format!("{x}[{}:{l}]", l + bw - 1), bw, aw),
+    };
+    let blk = blk_of("in_x");
     b.push(wire("f_addr", aw, format!("{} * {} + {blk}", zext("in_y", yw, aw), lit(aw, w.blocks_per_row() as u64))));
     // The expected write; its pixels are all P lanes without the glue, the tracked lane with it.
     for (n, wd) in [("f_mv", 1), ("f_ma", aw), ("f_md", 8), ("f_mwe", p)] {
@@ -427,7 +433,7 @@ pub fn writer_properties(w: &golden::writer::Writer) -> Item {
                         "f_pa == {} * {} + {} + {}",
                         zext("f_py", yw, aw),
                         lit(aw, w.blocks_per_row() as u64),
-                        if xw > l { zext(&format!("f_px[{}:{l}]", xw - 1), xw - l, aw) } else { lit(aw, 0) },
+                        blk_of("f_px"),
                         lit(aw, 1)
                     )),
                 ],

@@ -82,8 +82,19 @@ pub fn module(w: &Writer, names: &Names) -> Module {
     // P = 2^XW: one block a row, and x says nothing about the block.
     match cfg.xbits > l {
         true => {
-            body.push(wire("blk", cfg.xbits - l, format!("in_x[{}:{l}]", cfg.xbits - 1)));
-            body.push(wire("addr", aw, format!("row + {}", zext("blk", cfg.xbits - l, aw))));
+            let bw = cfg.xbits - l;
+            body.push(wire("blk", bw, format!("in_x[{}:{l}]", cfg.xbits - 1)));
+            match bw > aw {
+                // A screen narrower than 2^XW: x < W, so the block number fits the address's
+                // width and the port's high bits are zero.
+                true => {
+                    body.push(wire("addr", aw, format!("row + blk[{}:0]", aw - 1)));
+                    body.push(comment("verilator lint_off UNUSEDSIGNAL"));
+                    body.push(wire("unused_blk", bw - aw, format!("blk[{}:{aw}]", bw - 1)));
+                    body.push(comment("verilator lint_on UNUSEDSIGNAL"));
+                }
+                false => body.push(wire("addr", aw, format!("row + {}", zext("blk", bw, aw)))),
+            }
         }
         false => body.push(wire("addr", aw, "row")),
     }

@@ -254,3 +254,25 @@ fn lint_one(
         std::fs::write(&marker, &what).unwrap();
     }
 }
+
+/// Screens narrower than 2^XW (the front-end's small test screens, e.g. 16 x 8 at XW = 12): the
+/// writer's block number is wider than its memory address there. Generating panicked ("zext
+/// narrows blk") before the address took only the bits a block number on that screen can have.
+#[test]
+fn writers_on_screens_narrower_than_the_x_port_generate_and_lint_clean() {
+    for (width, height) in [(16, 8), (24, 8), (1, 1)] {
+        for (p, align) in [(1, Align::Span), (8, Align::Span), (8, Align::Screen), (64, Align::Span)] {
+            let cfg = Config { p, align, ..Config::default() };
+            let screen = golden::setup::Screen { width, height };
+            let opts = Options { cfg, screen: Some(screen), ..Default::default() };
+            let dir = std::env::temp_dir().join(format!("hdl-gen-lint-narrow-{}-{width}x{height}-{p}-{align}", std::process::id()));
+            let _ = std::fs::remove_dir_all(&dir);
+            let files = generate(&opts);
+            output::write_all(&dir, &files).unwrap();
+            let sources: Vec<String> =
+                files.iter().filter(|f| f.name.ends_with(".v")).map(|f| dir.join(&f.name).display().to_string()).collect();
+            lint(&sources, &hdl_gen::Names::new("", &cfg).writer);
+            let _ = std::fs::remove_dir_all(&dir);
+        }
+    }
+}
