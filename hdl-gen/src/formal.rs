@@ -427,17 +427,11 @@ pub fn writer_properties(w: &golden::writer::Writer) -> Item {
             Stmt::Comment("(on some lane, so on f_lane for some choice), and whenever f_lane's pixel is owed there.".into()),
             when("flush", vec![assert("!f_cont"), assert(format!("pend_we != {}", lit(p, 0)))]),
             when("f_pl && !f_cont", vec![assert("flush")]),
-            when(
-                "f_cont || flush",
-                vec![assert("pend_addr == f_pa"), assert(format!("pend_we[{lane}] == f_pl"))],
-            ),
+            when("f_cont || flush", vec![assert("pend_addr == f_pa"), assert(format!("pend_we[{lane}] == f_pl"))]),
             when("f_pl", vec![assert(format!("pend_pix[{at} +: 8] == f_pp"))]),
             // The reference's own: a pending tail lies below the span's lane offset, in the block after
             // the last segment's.
-            when(
-                "f_pl",
-                vec![assert(format!("{lane} < f_px[{}:0]", l - 1))],
-            ),
+            when("f_pl", vec![assert(format!("{lane} < f_px[{}:0]", l - 1))]),
             when(
                 "f_cont || flush",
                 vec![assert(format!(
@@ -494,10 +488,7 @@ pub fn writer_properties(w: &golden::writer::Writer) -> Item {
     b.push(Item::Always(vec![Stmt::If(
         "rst".into(),
         vec![set("f_owed", "2'd0")],
-        vec![set(
-            "f_owed",
-            format!("f_owed + (f_take && f_in ? 2'd1 : 2'd0) - (mem_valid && mem_ready && mem_we[{lane}] ? 2'd1 : 2'd0)"),
-        )],
+        vec![set("f_owed", format!("f_owed + (f_take && f_in ? 2'd1 : 2'd0) - (mem_valid && mem_ready && mem_we[{lane}] ? 2'd1 : 2'd0)"))],
     )]));
     link.push(assert(format!("f_owed == (mem_valid && mem_we[{lane}] ? 2'd1 : 2'd0) + {held}")));
     b.push(comment("Linking invariants: the writer's registers are the reference's."));
