@@ -83,6 +83,7 @@ module fb_writer_p8 (
     end
   end
 `ifdef FORMAL
+  // scripts/prove: depth 2
   // Clocks since the start: $past is meaningful once f_past is set.
   reg f_past = 1'b0;
   reg f_past2 = 1'b0;
@@ -121,26 +122,27 @@ module fb_writer_p8 (
   wire f_free = !mem_valid || mem_ready;
   wire f_take = in_valid && in_ready;
   wire [15:0] f_addr = {7'd0, in_y} * 16'd80 + {7'd0, in_x[11:3]};
-  reg f_mv;
-  reg [15:0] f_ma;
-  reg [7:0] f_md;
-  reg [7:0] f_mwe;
-  // Pixels are checked on one lane of the block, f_lane, that the solver picks freely, so the
-  // proof holds for every lane; tracking one lane keeps the reference free of wide shifters.
+  // Everything lane-wise is checked on one lane of the block, f_lane, that the solver picks
+  // freely, so it holds for every lane; following one lane keeps the reference free of
+  // shifters and counts over all lanes.
   wire [2:0] f_lane = $anyconst;
+  reg f_wr;
+  reg [15:0] f_ma;
+  reg f_ml;
+  reg [7:0] f_md;
   wire [2:0] f_r = in_x[2:0];
-  // Head: input lane j lands on block lane r + j; tail: lanes beyond P, on lane r + j - P of the next block.
-  wire [7:0] f_hwe = in_mask << f_r;
-  wire [7:0] f_twe = in_mask >> (4'd8 - {1'd0, f_r});
-  // f_lane's pixel comes from input lane f_lane - r (mod P): in the head block when f_lane >= r, else the tail.
+  // Input lane j lands on block lane (r + j) mod P: f_lane gets input lane f_lane - r (mod P),
+  // in the segment's head block when f_lane >= r, else in its tail (the next block).
   wire [2:0] f_src = f_lane - f_r;
+  wire f_in = in_mask[f_src];
+  wire f_head = f_lane >= f_r;
   wire [7:0] f_pix = in_pix[{f_src, 3'b000} +: 8];
-  // The pending tail (f_pwe lanes of block f_pa, f_pp on f_lane) and whether it waits for a merge or its own write.
+  // The pending tail: f_pl, f_lane's pixel f_pp is in it and not yet written; block f_pa; the
+  // segment that left it (f_px, f_py) and whether its span goes on (f_cont).
   reg f_cont;
-  reg f_flush;
+  reg f_pl;
   reg [15:0] f_pa;
   reg [7:0] f_pp;
-  reg [7:0] f_pwe;
   reg [11:0] f_px;
   reg [8:0] f_py;
   // What the shader guarantees: a span's next segment is P pixels on, on its scanline.
@@ -151,83 +153,97 @@ module fb_writer_p8 (
   end
   always @(posedge clk) begin
     if (rst) begin
-      f_mv <= 1'b0;
+      f_wr <= 1'b0;
+      f_ml <= 1'b0;
       f_cont <= 1'b0;
-      f_flush <= 1'b0;
+      f_pl <= 1'b0;
     end else if (f_free) begin
-      if (f_flush) begin
-        f_mv <= 1'b1;
+      if (flush) begin
+        f_wr <= 1'b1;
         f_ma <= f_pa;
+        f_ml <= f_pl;
         f_md <= f_pp;
-        f_mwe <= f_pwe;
-        f_flush <= 1'b0;
+        f_pl <= 1'b0;
       end else if (in_valid) begin
-        f_mv <= (f_hwe | (f_cont ? f_pwe : 8'd0)) != 8'd0;
+        f_wr <= 1'b1;
         f_ma <= f_addr;
-        f_md <= f_hwe[f_lane] ? f_pix : f_pp;
-        f_mwe <= f_hwe | (f_cont ? f_pwe : 8'd0);
+        f_ml <= (f_in && f_head) || (f_cont && f_pl);
+        f_md <= f_in && f_head ? f_pix : f_pp;
+        f_pl <= f_in && !f_head;
         f_pa <= f_addr + 16'd1;
         f_pp <= f_pix;
-        f_pwe <= f_twe;
         f_px <= in_x;
         f_py <= in_y;
         f_cont <= !in_last;
-        f_flush <= in_last && f_twe != 8'd0;
       end else begin
-        f_mv <= 1'b0;
+        f_wr <= 1'b0;
+        f_ml <= 1'b0;
       end
     end
   end
-  // The writer takes a segment exactly when its write register is free and no tail owes its own write.
+  // The writer takes a segment exactly when its write register is free and no tail owes its
+  // own write (flush: the reference's, by the links below).
   always @(*) begin
     if (f_past) begin
-      assert(in_ready == (f_free && !f_flush));
+      assert(in_ready == (f_free && !flush));
     end
   end
-  // Every write is the reference's: address, enables, and the pixels under the enables.
+  // Every write is the reference's: offered when f_lane is enabled in it, only when one was
+  // attempted (with "no write without an enable" and every lane: exactly when the reference's
+  // write enables some lane); its address, f_lane's enable and, under it, f_lane's pixel.
   always @(*) begin
     if (f_past) begin
-      assert(mem_valid == f_mv);
+      if (f_ml) begin
+        assert(mem_valid);
+      end
       if (mem_valid) begin
+        assert(f_wr);
         assert(mem_addr == f_ma);
-        assert(mem_we == f_mwe);
+        assert(mem_we[f_lane] == f_ml);
         if (mem_we[f_lane]) begin
           assert(mem_data[{f_lane, 3'b000} +: 8] == f_md);
         end
       end
     end
   end
-  // Pixels owed: accepted, not yet taken by memory. They are exactly the write register's
-  // and the pending tail's, so no pixel is lost, invented or written twice.
-  reg [5:0] f_owed;
+  // Pixels owed on lane f_lane of the block: accepted, not yet taken by memory. They are
+  // exactly the write register's and the pending tail's, so no pixel is lost, invented or
+  // written twice on any lane.
+  reg [1:0] f_owed;
   always @(posedge clk) begin
     if (rst) begin
-      f_owed <= 6'd0;
+      f_owed <= 2'd0;
     end else begin
-      f_owed <= f_owed + (f_take ? $countones(in_mask) : 0) - ((mem_valid && mem_ready) ? $countones(mem_we) : 0);
+      f_owed <= f_owed + (f_take && f_in ? 2'd1 : 2'd0) - (mem_valid && mem_ready && mem_we[f_lane] ? 2'd1 : 2'd0);
     end
   end
   // Linking invariants: the writer's registers are the reference's.
   always @(*) begin
     if (f_past) begin
       assert(cont == f_cont);
-      assert(flush == f_flush);
-      if (f_cont || f_flush) begin
-        assert(pend_addr == f_pa);
-        assert(pend_we == f_pwe);
-        if (f_pwe[f_lane]) begin
-          assert(pend_pix[{f_lane, 3'b000} +: 8] == f_pp);
-        end
-      end
-      if (f_flush) begin
-        assert(f_pwe != 8'd0);
+      // flush is the reference's: only after a span's last segment, only for a tail with a pixel
+      // (on some lane, so on f_lane for some choice), and whenever f_lane's pixel is owed there.
+      if (flush) begin
         assert(!f_cont);
+        assert(pend_we != 8'd0);
       end
-      if (f_cont || f_flush) begin
-        assert((f_pwe >> f_px[2:0]) == 8'd0);
+      if (f_pl && !f_cont) begin
+        assert(flush);
+      end
+      if (f_cont || flush) begin
+        assert(pend_addr == f_pa);
+        assert(pend_we[f_lane] == f_pl);
+      end
+      if (f_pl) begin
+        assert(pend_pix[{f_lane, 3'b000} +: 8] == f_pp);
+      end
+      if (f_pl) begin
+        assert(f_lane < f_px[2:0]);
+      end
+      if (f_cont || flush) begin
         assert(f_pa == {7'd0, f_py} * 16'd80 + {7'd0, f_px[11:3]} + 16'd1);
       end
-      assert(f_owed == (mem_valid ? $countones(mem_we) : 0) + ((f_cont || f_flush) ? $countones(f_pwe) : 0));
+      assert(f_owed == (mem_valid && mem_we[f_lane] ? 2'd1 : 2'd0) + (f_pl ? 2'd1 : 2'd0));
     end
   end
 `endif
