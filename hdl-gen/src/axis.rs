@@ -134,7 +134,7 @@ impl Packing {
             }
             expected += f.bits;
         }
-        if !self.bits.is_multiple_of(8) || self.bits == 0 {
+        if self.bits % 8 != 0 || self.bits == 0 {
             return Err(LayoutError::NotBytes { signal, bits: self.bits });
         }
         if expected != self.bits {
