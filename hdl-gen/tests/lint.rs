@@ -13,12 +13,17 @@ use hdl_gen::{generate, output, wrapper, BfpiArch, Bus, Options};
 use std::path::Path;
 use std::process::Command;
 
-fn run(tool: &str, args: &[String]) -> String {
+/// Runs `tool`: whether it exited 0, and what it printed (stdout, then stderr).
+fn tool_output(tool: &str, args: &[String]) -> (bool, String) {
     let out = Command::new(tool).args(args).output().unwrap_or_else(|e| {
         panic!("{tool} could not be run ({e}); install it with: apt-get install -y {}", if tool == "iverilog" { "iverilog" } else { tool })
     });
-    let text = format!("{}{}", String::from_utf8_lossy(&out.stdout), String::from_utf8_lossy(&out.stderr));
-    assert!(out.status.success(), "{tool} {}:\n{text}", args.join(" "));
+    (out.status.success(), format!("{}{}", String::from_utf8_lossy(&out.stdout), String::from_utf8_lossy(&out.stderr)))
+}
+
+fn run(tool: &str, args: &[String]) -> String {
+    let (ok, text) = tool_output(tool, args);
+    assert!(ok, "{tool} {}:\n{text}", args.join(" "));
     text
 }
 
@@ -77,10 +82,8 @@ fn cache_key(files: &[hdl_gen::GeneratedFile], what: &str, fe_first: bool, chain
 fn lint_text(sources: &[String], top: &str) -> (bool, String) {
     let mut args = vec!["--lint-only".to_string(), "-Wall".into(), "--top-module".into(), top.into()];
     args.extend(sources.iter().cloned());
-    let out =
-        Command::new("verilator").args(&args).output().expect("verilator could not be run; install it with: apt-get install -y verilator");
-    let text = format!("{}{}", String::from_utf8_lossy(&out.stdout), String::from_utf8_lossy(&out.stderr));
-    (out.status.success() && !text.contains("%Warning"), text)
+    let (ok, text) = tool_output("verilator", &args);
+    (ok && !text.contains("%Warning"), text)
 }
 
 fn lint(sources: &[String], top: &str) {
