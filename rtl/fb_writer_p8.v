@@ -137,6 +137,19 @@ module fb_writer_p8 (
   wire f_in = in_mask[f_src];
   wire f_head = f_lane >= f_r;
   wire [7:0] f_pix = in_pix[{f_src, 3'b000} +: 8];
+  // The rotation on lane f_lane, a lemma: asserted in a proof of its own, which sees the
+  // rotation for every input, lane and offset, and assumed here, where the rotation is cut (the
+  // solver would otherwise redo that proof inside the induction: minutes at P = 128).
+  // scripts/prove: cutpoint w:rot_pix
+`ifdef FORMAL_LEMMAS
+  always @(*) begin
+    assert(rot_pix[{f_lane, 3'b000} +: 8] == f_pix);
+  end
+`else
+  always @(*) begin
+    assume(rot_pix[{f_lane, 3'b000} +: 8] == f_pix);
+  end
+`endif
   // The pending tail: f_pl, f_lane's pixel f_pp is in it and not yet written; block f_pa; the
   // segment that left it (f_px, f_py) and whether its span goes on (f_cont).
   reg f_cont;

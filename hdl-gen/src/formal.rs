@@ -26,6 +26,13 @@ use golden::{Align, Config};
 /// applies only what the module asks for.
 pub const CUT_TAG: &str = "scripts/prove: ";
 
+/// The define under which a module's lemmas are asserted: `scripts/prove` first proves them on
+/// their own (`read_verilog -D`, every assumption removed, step 0: a lemma is a combinational
+/// fact about the module's inputs, free there), then proves the module with them assumed and
+/// what they describe cut. A fact the induction would otherwise rediscover in every step (the
+/// writer's 256-lane rotation: over 30 min at P = 256) is proven once, in ~2 min.
+pub const LEMMA_DEFINE: &str = "FORMAL_LEMMAS";
+
 /// The output stream of the shader and the specular unit (SPEC §3).
 const OUT: (&str, &str) = ("out_valid", "out_ready");
 
@@ -330,6 +337,12 @@ pub fn specular_properties(lw: u32, stages: &[(&str, &str)]) -> Item {
 /// when the reference's has an enabled lane, and the tail's own write (`flush`) is owed exactly
 /// when a span's last segment left a pixel in its tail.
 ///
+/// The pixel path of the span-aligned writer, its rotation (`rot_pix`, a 16P-bit shift by 8r)
+/// against the reference's lane select, is a lemma ([`LEMMA_DEFINE`]): for every input, offset
+/// and lane, lane `f_lane` of `rot_pix` is input lane `f_lane - r`. Proven on its own and then
+/// assumed with `rot_pix` cut, it keeps the induction from re-proving it in each step, which grew
+/// ~30-fold per doubling of P past 32 (P = 128: 379 s; P = 256 unfinished after 30 min).
+///
 /// The environment is held to what the shader's own proof guarantees (assume-guarantee):
 /// the segments of a span follow each other at x + P on one scanline.
 pub fn writer_properties(w: &golden::writer::Writer) -> Item {
@@ -381,6 +394,15 @@ pub fn writer_properties(w: &golden::writer::Writer) -> Item {
             wire("f_in", 1, "in_mask[f_src]"),
             wire("f_head", 1, "f_lane >= f_r"),
             wire("f_pix", 8, "in_pix[{f_src, 3'b000} +: 8]"),
+            comment("The rotation on lane f_lane, a lemma: asserted in a proof of its own, which sees the"),
+            comment("rotation for every input, lane and offset, and assumed here, where the rotation is cut (the"),
+            comment("solver would otherwise redo that proof inside the induction: minutes at P = 128)."),
+            comment(format!("{CUT_TAG}cutpoint w:rot_pix")),
+            Item::IfDef {
+                name: LEMMA_DEFINE.into(),
+                then: vec![Item::Comb(vec![assert(format!("rot_pix[{at} +: 8] == f_pix"))])],
+                els: vec![Item::Comb(vec![Stmt::Assume(format!("rot_pix[{at} +: 8] == f_pix"))])],
+            },
             comment("The pending tail: f_pl, f_lane's pixel f_pp is in it and not yet written; block f_pa; the"),
             comment("segment that left it (f_px, f_py) and whether its span goes on (f_cont)."),
             reg("f_cont", 1),

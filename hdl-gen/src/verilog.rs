@@ -165,6 +165,14 @@ pub enum Item {
     /// `` `ifdef FORMAL `` ... `` `endif ``: properties read by `read_verilog -formal` (Yosys
     /// defines FORMAL), invisible to every other tool, so the product stays Verilog-2005.
     Formal(Vec<Item>),
+    /// Formal only: `` `ifdef name `` `then` `` `else `` `els` `` `endif ``, a choice a proof
+    /// script makes with `read_verilog -Dname` (e.g. a lemma asserted in its own proof and
+    /// assumed in the proof that uses it).
+    IfDef {
+        name: String,
+        then: Vec<Item>,
+        els: Vec<Item>,
+    },
 }
 
 pub fn wire(name: &str, width: u32, value: impl Into<String>) -> Item {
@@ -417,6 +425,16 @@ fn render_items(o: &mut String, items: &[Item], level: usize) {
                 o.truncate(o.trim_end_matches(' ').len());
                 o.push_str("`ifdef FORMAL\n");
                 render_items(o, items, level);
+                o.push_str("`endif\n");
+            }
+            Item::IfDef { name, then, els } => {
+                o.truncate(o.trim_end_matches(' ').len());
+                writeln!(o, "`ifdef {name}").unwrap();
+                render_items(o, then, level);
+                if !els.is_empty() {
+                    o.push_str("`else\n");
+                    render_items(o, els, level);
+                }
                 o.push_str("`endif\n");
             }
         }
