@@ -93,6 +93,13 @@ impl Writer {
         bits(self.blocks() - 1).max(1)
     }
 
+    /// Bits of x's block number (`x div P`) the address uses: the port's XW - log2(P), or fewer
+    /// on a screen narrower than 2^XW, where x < W leaves the port's high bits zero. 0 when
+    /// P = 2^XW: one block a row.
+    pub fn block_bits(&self) -> u32 {
+        (self.cfg.xbits - self.cfg.log2p()).min(self.addr_bits())
+    }
+
     /// Width of the scanline port (`in_y`): the same as the front-end's `out_y`.
     pub fn y_bits(&self) -> u32 {
         self.screen.y_bits()

@@ -363,7 +363,7 @@ pub fn writer_properties(w: &golden::writer::Writer) -> Item {
     b.push(wire("f_take", 1, "in_valid && in_ready"));
     // The block number of x, as an address term; on a screen narrower than 2^XW it is narrower
     // than the port (x < W).
-    let blk_of = |x: &str| match (xw - l).min(aw) {
+    let blk_of = |x: &str| match w.block_bits() {
         0 => lit(aw, 0),
         bw => zext(&format!("{x}[{}:{l}]", l + bw - 1), bw, aw),
     };

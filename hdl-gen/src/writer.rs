@@ -80,23 +80,22 @@ pub fn module(w: &Writer, names: &Names) -> Module {
         wire("row", aw, format!("{} * {}", zext("in_y", w.y_bits(), aw), lit(aw, b as u64))),
     ];
     // P = 2^XW: one block a row, and x says nothing about the block.
-    match cfg.xbits > l {
-        true => {
+    match w.block_bits() {
+        0 => body.push(wire("addr", aw, "row")),
+        used => {
             let bw = cfg.xbits - l;
             body.push(wire("blk", bw, format!("in_x[{}:{l}]", cfg.xbits - 1)));
-            match bw > aw {
-                // A screen narrower than 2^XW: x < W, so the block number fits the address's
-                // width and the port's high bits are zero.
+            match bw > used {
+                // A screen narrower than 2^XW: x < W, so the port's high bits are zero.
                 true => {
-                    body.push(wire("addr", aw, format!("row + blk[{}:0]", aw - 1)));
+                    body.push(wire("addr", aw, format!("row + blk[{}:0]", used - 1)));
                     body.push(comment("verilator lint_off UNUSEDSIGNAL"));
-                    body.push(wire("unused_blk", bw - aw, format!("blk[{}:{aw}]", bw - 1)));
+                    body.push(wire("unused_blk", bw - used, format!("blk[{}:{used}]", bw - 1)));
                     body.push(comment("verilator lint_on UNUSEDSIGNAL"));
                 }
                 false => body.push(wire("addr", aw, format!("row + {}", zext("blk", bw, aw)))),
             }
         }
-        false => body.push(wire("addr", aw, "row")),
     }
     if !glued(w) {
         body.push(assign("in_ready", "free"));
