@@ -386,6 +386,7 @@ pub fn writer_properties(w: &golden::writer::Writer) -> Item {
     }
     let mut link = vec![];
     if glued {
+        let rotation = format!("rot_pix[{at} +: 8] == f_pix");
         b.extend([
             wire("f_r", l, format!("in_x[{}:0]", l - 1)),
             comment("Input lane j lands on block lane (r + j) mod P: f_lane gets input lane f_lane - r (mod P),"),
@@ -400,8 +401,8 @@ pub fn writer_properties(w: &golden::writer::Writer) -> Item {
             comment(format!("{CUT_TAG}cutpoint w:rot_pix")),
             Item::IfDef {
                 name: LEMMA_DEFINE.into(),
-                then: vec![Item::Comb(vec![assert(format!("rot_pix[{at} +: 8] == f_pix"))])],
-                els: vec![Item::Comb(vec![Stmt::Assume(format!("rot_pix[{at} +: 8] == f_pix"))])],
+                then: vec![Item::Comb(vec![assert(rotation.clone())])],
+                els: vec![Item::Comb(vec![Stmt::Assume(rotation)])],
             },
             comment("The pending tail: f_pl, f_lane's pixel f_pp is in it and not yet written; block f_pa; the"),
             comment("segment that left it (f_px, f_py) and whether its span goes on (f_cont)."),

@@ -420,25 +420,23 @@ fn render_items(o: &mut String, items: &[Item], level: usize) {
                 o.push_str("end\n");
             }
             Item::RegInit { name, width, value } => writeln!(o, "reg {}{name} = {value};", range(*width)).unwrap(),
-            Item::Formal(items) => {
-                // Preprocessor lines start at column 0, like the file's `default_nettype.
-                o.truncate(o.trim_end_matches(' ').len());
-                o.push_str("`ifdef FORMAL\n");
-                render_items(o, items, level);
-                o.push_str("`endif\n");
-            }
-            Item::IfDef { name, then, els } => {
-                o.truncate(o.trim_end_matches(' ').len());
-                writeln!(o, "`ifdef {name}").unwrap();
-                render_items(o, then, level);
-                if !els.is_empty() {
-                    o.push_str("`else\n");
-                    render_items(o, els, level);
-                }
-                o.push_str("`endif\n");
-            }
+            Item::Formal(items) => render_ifdef(o, "FORMAL", items, &[], level),
+            Item::IfDef { name, then, els } => render_ifdef(o, name, then, els, level),
         }
     }
+}
+
+/// `` `ifdef name `` `then` [`` `else `` `els`] `` `endif ``; preprocessor lines start at column 0,
+/// like the file's `default_nettype.
+fn render_ifdef(o: &mut String, name: &str, then: &[Item], els: &[Item], level: usize) {
+    o.truncate(o.trim_end_matches(' ').len());
+    writeln!(o, "`ifdef {name}").unwrap();
+    render_items(o, then, level);
+    if !els.is_empty() {
+        o.push_str("`else\n");
+        render_items(o, els, level);
+    }
+    o.push_str("`endif\n");
 }
 
 fn render_stmts(o: &mut String, stmts: &[Stmt], level: usize) {
