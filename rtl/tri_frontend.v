@@ -7,7 +7,7 @@
 // Coverage: exactly golden::setup's (top-left rule, pixel centres, clipped), by an integer DDA per edge.
 // Spans: (y, x0, m, I0, dI) in SPEC §2's formats; I0 correctly rounded, dI rounded once per triangle;
 // every pixel within 1/2 + W 2^-(F+1) <= 1 of the plane through the vertex intensities.
-// Set-up: CALC 1 clock, 6 divider clocks (8 restoring dividers in parallel, 4 quotient bit(s) a clock), hand-off;
+// Set-up: CALC 1 clock(s), 6 divider clocks (8 restoring dividers in parallel, 4 quotient bit(s) a clock), hand-off;
 // 7 clocks per walked triangle, 1 per dropped one; the next triangle is latched meanwhile.
 // Latency: first span valid 11 clocks after the triangle's transfer when the walker is idle.
 // Walker: one row per clock (rows with no covered pixel make a bubble); the next triangle's set-up overlaps it.
@@ -59,138 +59,54 @@ module tri_frontend (
   wire take;
   wire calc = v_full && (st == IDLE || take);
   assign in_ready = !v_full || calc;
+  // verilator lint_off UNUSEDSIGNAL
 
-  // Guard band, on the registered vertices.
+  // CALC: guard band; vertex differences; bounding box and each edge's row extent, offset to pixel centres.
   wire guard_ok = (vx0 >= -22'sd163840 && vx0 < 22'sd327680) && (vy0 >= -19'sd122880 && vy0 < 19'sd245760) && (vx1 >= -22'sd163840 && vx1 < 22'sd327680) && (vy1 >= -19'sd122880 && vy1 < 19'sd245760) && (vx2 >= -22'sd163840 && vx2 < 22'sd327680) && (vy2 >= -19'sd122880 && vy2 < 19'sd245760);
-
-  // Twice the signed area, its orientation and magnitude.
+  // Edge k runs from vertex k+1 to vertex k+2; u, v span the area, d the intensities.
   wire signed [22:0] u1 = {{1{vx1[21]}}, vx1} - {{1{vx0[21]}}, vx0};
   wire signed [22:0] u2 = {{1{vx2[21]}}, vx2} - {{1{vx0[21]}}, vx0};
   wire signed [19:0] v1 = {{1{vy1[18]}}, vy1} - {{1{vy0[18]}}, vy0};
   wire signed [19:0] v2 = {{1{vy2[18]}}, vy2} - {{1{vy0[18]}}, vy0};
+  wire signed [22:0] rdx0 = {{1{vx2[21]}}, vx2} - {{1{vx1[21]}}, vx1};
+  wire signed [19:0] rdy0 = {{1{vy2[18]}}, vy2} - {{1{vy1[18]}}, vy1};
+  wire signed [22:0] rdx1 = {{1{vx0[21]}}, vx0} - {{1{vx2[21]}}, vx2};
+  wire signed [19:0] rdy1 = {{1{vy0[18]}}, vy0} - {{1{vy2[18]}}, vy2};
+  wire signed [22:0] rdx2 = {{1{vx1[21]}}, vx1} - {{1{vx0[21]}}, vx0};
+  wire signed [19:0] rdy2 = {{1{vy1[18]}}, vy1} - {{1{vy0[18]}}, vy0};
+  wire signed [20:0] d1 = {1'd0, vi1} - {1'd0, vi0};
+  wire signed [20:0] d2 = {1'd0, vi2} - {1'd0, vi0};
+  // Bounding box in rows and columns (centres at +128 sub-pixels); each edge's rows.
+  wire signed [18:0] ymin = ((vy0 < vy1) ? ((vy0 < vy2) ? vy0 : vy2) : ((vy1 < vy2) ? vy1 : vy2));
+  wire signed [18:0] ymax = ((vy0 > vy1) ? ((vy0 > vy2) ? vy0 : vy2) : ((vy1 > vy2) ? vy1 : vy2));
+  wire signed [21:0] xmin = ((vx0 < vx1) ? ((vx0 < vx2) ? vx0 : vx2) : ((vx1 < vx2) ? vx1 : vx2));
+  wire signed [21:0] xmax = ((vx0 > vx1) ? ((vx0 > vx2) ? vx0 : vx2) : ((vx1 > vx2) ? vx1 : vx2));
+  wire signed [22:0] xmin_c = {{1{xmin[21]}}, xmin} + 23'sd127;
+  wire signed [22:0] xmax_c = {{1{xmax[21]}}, xmax} - 23'sd128;
+  wire signed [18:0] yt0 = vy1 < vy2 ? vy1 : vy2;
+  wire signed [18:0] yb0 = vy1 < vy2 ? vy2 : vy1;
+  wire signed [19:0] ytc0 = {{1{yt0[18]}}, yt0} + 20'sd127;
+  wire signed [19:0] ybc0 = {{1{yb0[18]}}, yb0} - 20'sd128;
+  wire signed [23:0] rx0 = 24'd128 - {{2{vx1[21]}}, vx1};
+  wire signed [18:0] yt1 = vy2 < vy0 ? vy2 : vy0;
+  wire signed [18:0] yb1 = vy2 < vy0 ? vy0 : vy2;
+  wire signed [19:0] ytc1 = {{1{yt1[18]}}, yt1} + 20'sd127;
+  wire signed [19:0] ybc1 = {{1{yb1[18]}}, yb1} - 20'sd128;
+  wire signed [23:0] rx1 = 24'd128 - {{2{vx2[21]}}, vx2};
+  wire signed [18:0] yt2 = vy0 < vy1 ? vy0 : vy1;
+  wire signed [18:0] yb2 = vy0 < vy1 ? vy1 : vy0;
+  wire signed [19:0] ytc2 = {{1{yt2[18]}}, yt2} + 20'sd127;
+  wire signed [19:0] ybc2 = {{1{yb2[18]}}, yb2} - 20'sd128;
+  wire signed [23:0] rx2 = 24'd128 - {{2{vx0[21]}}, vx0};
+  wire signed [23:0] xo = 24'd128 - {{2{vx0[21]}}, vx0};
+
+  // CALC: guard band; vertex differences; bounding box and each edge's row extent, offset to pixel centres.
   // verilator lint_off WIDTH
   wire signed [42:0] m_a1 = u1 * v2;
   // verilator lint_on WIDTH
   // verilator lint_off WIDTH
   wire signed [42:0] m_a2 = v1 * u2;
   // verilator lint_on WIDTH
-  wire signed [42:0] area = m_a1 - m_a2;
-  wire neg = area[42];
-  // verilator lint_off UNUSEDSIGNAL
-  wire [42:0] area_n = neg ? -area : area;
-  wire [41:0] aabs = area_n[41:0];
-  // verilator lint_on UNUSEDSIGNAL
-
-  // Edge k runs from vertex k+1 to vertex k+2, oriented so the interior is positive.
-  wire signed [22:0] rdx0 = {{1{vx2[21]}}, vx2} - {{1{vx1[21]}}, vx1};
-  wire signed [19:0] rdy0 = {{1{vy2[18]}}, vy2} - {{1{vy1[18]}}, vy1};
-  wire signed [22:0] dx0 = neg ? -rdx0 : rdx0;
-  wire signed [19:0] dy0 = neg ? -rdy0 : rdy0;
-  wire tl0 = dy0[19] || (dy0 == 20'sd0 && dx0 > 23'sd0);
-  wire signed [22:0] rdx1 = {{1{vx0[21]}}, vx0} - {{1{vx2[21]}}, vx2};
-  wire signed [19:0] rdy1 = {{1{vy0[18]}}, vy0} - {{1{vy2[18]}}, vy2};
-  wire signed [22:0] dx1 = neg ? -rdx1 : rdx1;
-  wire signed [19:0] dy1 = neg ? -rdy1 : rdy1;
-  wire tl1 = dy1[19] || (dy1 == 20'sd0 && dx1 > 23'sd0);
-  wire signed [22:0] rdx2 = {{1{vx1[21]}}, vx1} - {{1{vx0[21]}}, vx0};
-  wire signed [19:0] rdy2 = {{1{vy1[18]}}, vy1} - {{1{vy0[18]}}, vy0};
-  wire signed [22:0] dx2 = neg ? -rdx2 : rdx2;
-  wire signed [19:0] dy2 = neg ? -rdy2 : rdy2;
-  wire tl2 = dy2[19] || (dy2 == 20'sd0 && dx2 > 23'sd0);
-  // A horizontal edge that is not top-left is a bottom edge: centres on it are not covered.
-  wire kill = (dy0 == 20'sd0 && !tl0) || (dy1 == 20'sd0 && !tl1) || (dy2 == 20'sd0 && !tl2);
-
-  // Bounding box in rows and columns (centres at +128 sub-pixels), clipped.
-  wire signed [18:0] ymin = ((vy0 < vy1) ? ((vy0 < vy2) ? vy0 : vy2) : ((vy1 < vy2) ? vy1 : vy2));
-  wire signed [18:0] ymax = ((vy0 > vy1) ? ((vy0 > vy2) ? vy0 : vy2) : ((vy1 > vy2) ? vy1 : vy2));
-  wire signed [21:0] xmin = ((vx0 < vx1) ? ((vx0 < vx2) ? vx0 : vx2) : ((vx1 < vx2) ? vx1 : vx2));
-  wire signed [21:0] xmax = ((vx0 > vx1) ? ((vx0 > vx2) ? vx0 : vx2) : ((vx1 > vx2) ? vx1 : vx2));
-  // verilator lint_off UNUSEDSIGNAL
-  wire signed [19:0] ymin_c = {{1{ymin[18]}}, ymin} + 20'sd127;
-  wire signed [19:0] ymax_c = {{1{ymax[18]}}, ymax} - 20'sd128 - {19'd0, kill};
-  wire signed [22:0] xmin_c = {{1{xmin[21]}}, xmin} + 23'sd127;
-  wire signed [22:0] xmax_c = {{1{xmax[21]}}, xmax} - 23'sd128;
-  // verilator lint_on UNUSEDSIGNAL
-  wire signed [11:0] first_raw = ymin_c[19:8];
-  wire signed [11:0] last_raw = ymax_c[19:8];
-  wire signed [14:0] cfirst = xmin_c[22:8];
-  wire signed [14:0] clast = xmax_c[22:8];
-  wire signed [11:0] first_s = first_raw[11] ? 12'sd0 : first_raw;
-  wire signed [11:0] last_s = last_raw > 12'sd479 ? 12'sd479 : last_raw;
-  wire cull = area == 43'sd0 || first_s > last_s || cfirst > clast || cfirst > 15'sd639 || clast[14];
-
-  // Per edge: its active rows, and the dividends of its first bound and of its step, offset by
-  // B = 2^(GW-1) divisors so both quotients are non-negative (q = g + B).
-  // verilator lint_off UNUSEDSIGNAL
-  wire signed [18:0] yt0 = vy1 < vy2 ? vy1 : vy2;
-  wire signed [18:0] yb0 = vy1 < vy2 ? vy2 : vy1;
-  wire signed [19:0] ytc0 = {{1{yt0[18]}}, yt0} + 20'sd127;
-  wire signed [19:0] ybc0 = {{1{yb0[18]}}, yb0} - 20'sd128;
-  wire signed [11:0] rs_raw0 = ytc0[19:8];
-  wire signed [11:0] re_raw0 = ybc0[19:8];
-  wire signed [11:0] rs0 = rs_raw0 > first_s ? rs_raw0 : first_s;
-  wire signed [11:0] re0 = re_raw0 < last_s ? re_raw0 : last_s;
-  wire act0 = dy0 != 20'sd0 && rs0 <= re0;
-  wire [18:0] ady0 = dy0[19] ? -dy0[18:0] : dy0[18:0];
-  wire [8:0] rsu0 = rs0[8:0];
-  wire signed [20:0] ry0 = {4'd0, {rsu0, 8'd128}} - {{2{vy1[18]}}, vy1};
-  wire signed [23:0] rx0 = 24'd128 - {{2{vx1[21]}}, vx1};
-  // verilator lint_off WIDTH
-  wire signed [43:0] m_e0 = dx0 * ry0;
-  // verilator lint_on WIDTH
-  // verilator lint_off WIDTH
-  wire signed [43:0] m_f0 = dy0 * rx0;
-  // verilator lint_on WIDTH
-  wire [45:0] n0 = {{2{m_e0[43]}}, m_e0} - {{2{m_f0[43]}}, m_f0} - {45'd0, !tl0} + ({27'd0, ady0} << 22);
-  wire [34:0] sn0 = {{12{dx0[22]}}, dx0} + ({16'd0, ady0} << 14);
-  wire signed [18:0] yt1 = vy2 < vy0 ? vy2 : vy0;
-  wire signed [18:0] yb1 = vy2 < vy0 ? vy0 : vy2;
-  wire signed [19:0] ytc1 = {{1{yt1[18]}}, yt1} + 20'sd127;
-  wire signed [19:0] ybc1 = {{1{yb1[18]}}, yb1} - 20'sd128;
-  wire signed [11:0] rs_raw1 = ytc1[19:8];
-  wire signed [11:0] re_raw1 = ybc1[19:8];
-  wire signed [11:0] rs1 = rs_raw1 > first_s ? rs_raw1 : first_s;
-  wire signed [11:0] re1 = re_raw1 < last_s ? re_raw1 : last_s;
-  wire act1 = dy1 != 20'sd0 && rs1 <= re1;
-  wire [18:0] ady1 = dy1[19] ? -dy1[18:0] : dy1[18:0];
-  wire [8:0] rsu1 = rs1[8:0];
-  wire signed [20:0] ry1 = {4'd0, {rsu1, 8'd128}} - {{2{vy2[18]}}, vy2};
-  wire signed [23:0] rx1 = 24'd128 - {{2{vx2[21]}}, vx2};
-  // verilator lint_off WIDTH
-  wire signed [43:0] m_e1 = dx1 * ry1;
-  // verilator lint_on WIDTH
-  // verilator lint_off WIDTH
-  wire signed [43:0] m_f1 = dy1 * rx1;
-  // verilator lint_on WIDTH
-  wire [45:0] n1 = {{2{m_e1[43]}}, m_e1} - {{2{m_f1[43]}}, m_f1} - {45'd0, !tl1} + ({27'd0, ady1} << 22);
-  wire [34:0] sn1 = {{12{dx1[22]}}, dx1} + ({16'd0, ady1} << 14);
-  wire signed [18:0] yt2 = vy0 < vy1 ? vy0 : vy1;
-  wire signed [18:0] yb2 = vy0 < vy1 ? vy1 : vy0;
-  wire signed [19:0] ytc2 = {{1{yt2[18]}}, yt2} + 20'sd127;
-  wire signed [19:0] ybc2 = {{1{yb2[18]}}, yb2} - 20'sd128;
-  wire signed [11:0] rs_raw2 = ytc2[19:8];
-  wire signed [11:0] re_raw2 = ybc2[19:8];
-  wire signed [11:0] rs2 = rs_raw2 > first_s ? rs_raw2 : first_s;
-  wire signed [11:0] re2 = re_raw2 < last_s ? re_raw2 : last_s;
-  wire act2 = dy2 != 20'sd0 && rs2 <= re2;
-  wire [18:0] ady2 = dy2[19] ? -dy2[18:0] : dy2[18:0];
-  wire [8:0] rsu2 = rs2[8:0];
-  wire signed [20:0] ry2 = {4'd0, {rsu2, 8'd128}} - {{2{vy0[18]}}, vy0};
-  wire signed [23:0] rx2 = 24'd128 - {{2{vx0[21]}}, vx0};
-  // verilator lint_off WIDTH
-  wire signed [43:0] m_e2 = dx2 * ry2;
-  // verilator lint_on WIDTH
-  // verilator lint_off WIDTH
-  wire signed [43:0] m_f2 = dy2 * rx2;
-  // verilator lint_on WIDTH
-  wire [45:0] n2 = {{2{m_e2[43]}}, m_e2} - {{2{m_f2[43]}}, m_f2} - {45'd0, !tl2} + ({27'd0, ady2} << 22);
-  wire [34:0] sn2 = {{12{dx2[22]}}, dx2} + ({16'd0, ady2} << 14);
-  // verilator lint_on UNUSEDSIGNAL
-
-  // The plane: Nx, Ny (oriented), dI's dividend 2*256|Nx| + |A| and its saturation.
-  // verilator lint_off UNUSEDSIGNAL
-  wire signed [20:0] d1 = {1'd0, vi1} - {1'd0, vi0};
-  wire signed [20:0] d2 = {1'd0, vi2} - {1'd0, vi0};
   // verilator lint_off WIDTH
   wire signed [40:0] m_x1 = d1 * v2;
   // verilator lint_on WIDTH
@@ -203,41 +119,123 @@ module tri_frontend (
   // verilator lint_off WIDTH
   wire signed [43:0] m_y2 = d1 * u2;
   // verilator lint_on WIDTH
-  wire [41:0] nx = {{1{m_x1[40]}}, m_x1} - {{1{m_x2[40]}}, m_x2};
-  wire [44:0] ny = {{1{m_y1[43]}}, m_y1} - {{1{m_y2[43]}}, m_y2};
+  wire signed [19:0] ymin_c = {{1{ymin[18]}}, ymin} + 20'sd127;
+  wire signed [11:0] first_raw = ymin_c[19:8];
+  wire signed [11:0] first_s = first_raw[11] ? 12'sd0 : first_raw;
+  wire signed [14:0] cfirst = xmin_c[22:8];
+  wire signed [14:0] clast = xmax_c[22:8];
+  wire signed [20:0] yo = {4'd0, {first_s[8:0], 8'd128}} - {{2{vy0[18]}}, vy0};
+  // Per edge: its rows on the screen, and the y distance from vertex a to its first row's centre.
+  wire signed [11:0] rs_raw0 = ytc0[19:8];
+  wire signed [11:0] re_raw0 = ybc0[19:8];
+  wire signed [11:0] rs0 = rs_raw0 > first_s ? rs_raw0 : first_s;
+  wire [8:0] rsu0 = rs0[8:0];
+  wire signed [20:0] ry0 = {4'd0, {rsu0, 8'd128}} - {{2{vy1[18]}}, vy1};
+  wire [18:0] ady0 = rdy0[19] ? -rdy0[18:0] : rdy0[18:0];
+  wire signed [11:0] rs_raw1 = ytc1[19:8];
+  wire signed [11:0] re_raw1 = ybc1[19:8];
+  wire signed [11:0] rs1 = rs_raw1 > first_s ? rs_raw1 : first_s;
+  wire [8:0] rsu1 = rs1[8:0];
+  wire signed [20:0] ry1 = {4'd0, {rsu1, 8'd128}} - {{2{vy2[18]}}, vy2};
+  wire [18:0] ady1 = rdy1[19] ? -rdy1[18:0] : rdy1[18:0];
+  wire signed [11:0] rs_raw2 = ytc2[19:8];
+  wire signed [11:0] re_raw2 = ybc2[19:8];
+  wire signed [11:0] rs2 = rs_raw2 > first_s ? rs_raw2 : first_s;
+  wire [8:0] rsu2 = rs2[8:0];
+  wire signed [20:0] ry2 = {4'd0, {rsu2, 8'd128}} - {{2{vy0[18]}}, vy0};
+  wire [18:0] ady2 = rdy2[19] ? -rdy2[18:0] : rdy2[18:0];
+
+  // CALC: guard band; vertex differences; bounding box and each edge's row extent, offset to pixel centres.
+  // Twice the signed area: its sign orients the edges and the plane (interior positive).
+  wire signed [42:0] area = m_a1 - m_a2;
+  wire neg = area[42];
+  wire [42:0] area_n = neg ? -area : area;
+  wire [41:0] aabs = area_n[41:0];
+  // The plane's normal, unoriented, and |Nx| (the orientation does not change it).
+  wire signed [41:0] nx = {{1{m_x1[40]}}, m_x1} - {{1{m_x2[40]}}, m_x2};
+  wire signed [44:0] ny = {{1{m_y1[43]}}, m_y1} - {{1{m_y2[43]}}, m_y2};
+  wire [41:0] mag = nx[41] ? -nx : nx;
+  // verilator lint_off WIDTH
+  wire signed [43:0] m_e0 = rdx0 * ry0;
+  // verilator lint_on WIDTH
+  // verilator lint_off WIDTH
+  wire signed [43:0] m_f0 = rdy0 * rx0;
+  // verilator lint_on WIDTH
+  // verilator lint_off WIDTH
+  wire signed [43:0] m_e1 = rdx1 * ry1;
+  // verilator lint_on WIDTH
+  // verilator lint_off WIDTH
+  wire signed [43:0] m_f1 = rdy1 * rx1;
+  // verilator lint_on WIDTH
+  // verilator lint_off WIDTH
+  wire signed [43:0] m_e2 = rdx2 * ry2;
+  // verilator lint_on WIDTH
+  // verilator lint_off WIDTH
+  wire signed [43:0] m_f2 = rdy2 * rx2;
+  // verilator lint_on WIDTH
+
+  // CALC: guard band; vertex differences; bounding box and each edge's row extent, offset to pixel centres.
+  // Orientation: edge k's direction with the interior on its left; the top-left rule.
+  wire signed [22:0] dx0 = neg ? -rdx0 : rdx0;
+  wire signed [19:0] dy0 = neg ? -rdy0 : rdy0;
+  wire tl0 = dy0[19] || (dy0 == 20'sd0 && dx0 > 23'sd0);
+  wire signed [22:0] dx1 = neg ? -rdx1 : rdx1;
+  wire signed [19:0] dy1 = neg ? -rdy1 : rdy1;
+  wire tl1 = dy1[19] || (dy1 == 20'sd0 && dx1 > 23'sd0);
+  wire signed [22:0] dx2 = neg ? -rdx2 : rdx2;
+  wire signed [19:0] dy2 = neg ? -rdy2 : rdy2;
+  wire tl2 = dy2[19] || (dy2 == 20'sd0 && dx2 > 23'sd0);
+  // A horizontal edge that is not top-left is a bottom edge: centres on it are not covered.
+  wire kill = (dy0 == 20'sd0 && !tl0) || (dy1 == 20'sd0 && !tl1) || (dy2 == 20'sd0 && !tl2);
+  wire signed [19:0] ymax_c = {{1{ymax[18]}}, ymax} - 20'sd128 - {19'd0, kill};
+  wire signed [11:0] last_raw = ymax_c[19:8];
+  wire signed [11:0] last_s = last_raw > 12'sd479 ? 12'sd479 : last_raw;
+  wire cull = area == 43'sd0 || first_s > last_s || cfirst > clast || cfirst > 15'sd639 || clast[14];
+  // Per edge: its active rows; the dividends of its first bound and of its step.
+  wire signed [11:0] re0 = re_raw0 < last_s ? re_raw0 : last_s;
+  wire act0 = dy0 != 20'sd0 && rs0 <= re0;
+  wire [45:0] e0 = {{2{m_e0[43]}}, m_e0} - {{2{m_f0[43]}}, m_f0};
+  wire [45:0] n0 = (neg ? -e0 : e0) - {45'd0, !tl0} + ({27'd0, ady0} << 22);
+  wire [34:0] sn0 = {{12{dx0[22]}}, dx0} + ({16'd0, ady0} << 14);
+  wire signed [11:0] re1 = re_raw1 < last_s ? re_raw1 : last_s;
+  wire act1 = dy1 != 20'sd0 && rs1 <= re1;
+  wire [45:0] e1 = {{2{m_e1[43]}}, m_e1} - {{2{m_f1[43]}}, m_f1};
+  wire [45:0] n1 = (neg ? -e1 : e1) - {45'd0, !tl1} + ({27'd0, ady1} << 22);
+  wire [34:0] sn1 = {{12{dx1[22]}}, dx1} + ({16'd0, ady1} << 14);
+  wire signed [11:0] re2 = re_raw2 < last_s ? re_raw2 : last_s;
+  wire act2 = dy2 != 20'sd0 && rs2 <= re2;
+  wire [45:0] e2 = {{2{m_e2[43]}}, m_e2} - {{2{m_f2[43]}}, m_f2};
+  wire [45:0] n2 = (neg ? -e2 : e2) - {45'd0, !tl2} + ({27'd0, ady2} << 22);
+  wire [34:0] sn2 = {{12{dx2[22]}}, dx2} + ({16'd0, ady2} << 14);
+  // The plane: Nx, Ny oriented; dI's dividend 2*256|Nx| + |A| and its saturation.
   wire signed [41:0] onx = neg ? -nx : nx;
   wire signed [44:0] ony = neg ? -ny : ny;
   wire nx_neg = onx[41];
-  wire [41:0] mag = nx_neg ? -onx : onx;
   wire [50:0] x2 = ({9'd0, mag} << 9) + {9'd0, aabs};
   wire di_sat = {12'd0, x2} >= ({21'd0, aabs} << 21);
-  // verilator lint_on UNUSEDSIGNAL
-
-  // Normalisation: s leading zeros of |A|, An = |A| << s, and the sums S(0, first), 256 Nx, 256 Ny,
-  // each shifted by s and kept modulo 2^K.
+  // Normalisation: s leading zeros of |A|, An = |A| << s.
   wire [5:0] lz = aabs[41] ? 6'd0 : aabs[40] ? 6'd1 : aabs[39] ? 6'd2 : aabs[38] ? 6'd3 : aabs[37] ? 6'd4 : aabs[36] ? 6'd5 : aabs[35] ? 6'd6 : aabs[34] ? 6'd7 : aabs[33] ? 6'd8 : aabs[32] ? 6'd9 : aabs[31] ? 6'd10 : aabs[30] ? 6'd11 : aabs[29] ? 6'd12 : aabs[28] ? 6'd13 : aabs[27] ? 6'd14 : aabs[26] ? 6'd15 : aabs[25] ? 6'd16 : aabs[24] ? 6'd17 : aabs[23] ? 6'd18 : aabs[22] ? 6'd19 : aabs[21] ? 6'd20 : aabs[20] ? 6'd21 : aabs[19] ? 6'd22 : aabs[18] ? 6'd23 : aabs[17] ? 6'd24 : aabs[16] ? 6'd25 : aabs[15] ? 6'd26 : aabs[14] ? 6'd27 : aabs[13] ? 6'd28 : aabs[12] ? 6'd29 : aabs[11] ? 6'd30 : aabs[10] ? 6'd31 : aabs[9] ? 6'd32 : aabs[8] ? 6'd33 : aabs[7] ? 6'd34 : aabs[6] ? 6'd35 : aabs[5] ? 6'd36 : aabs[4] ? 6'd37 : aabs[3] ? 6'd38 : aabs[2] ? 6'd39 : aabs[1] ? 6'd40 : 6'd41;
   wire [41:0] an = aabs << lz;
-  // verilator lint_off UNUSEDSIGNAL
-  wire [8:0] first_u = first_s[8:0];
-  wire [8:0] last_u = last_s[8:0];
-  // verilator lint_on UNUSEDSIGNAL
-  wire signed [23:0] xo = 24'd128 - {{2{vx0[21]}}, vx0};
-  wire signed [20:0] yo = {4'd0, {first_u, 8'd128}} - {{2{vy0[18]}}, vy0};
+  // The first row's sum S(0, first) = I0 |A| + Nx xo + Ny yo: its products, unoriented.
   // verilator lint_off WIDTH
   wire [61:0] m_s1 = vi0 * aabs;
   // verilator lint_on WIDTH
-  // verilator lint_off UNUSEDSIGNAL
   // verilator lint_off WIDTH
-  wire signed [65:0] m_s2 = onx * xo;
+  wire signed [65:0] m_s2 = nx * xo;
   // verilator lint_on WIDTH
   // verilator lint_off WIDTH
-  wire signed [65:0] m_s3 = ony * yo;
+  wire signed [65:0] m_s3 = ny * yo;
   // verilator lint_on WIDTH
-  // verilator lint_on UNUSEDSIGNAL
-  wire [63:0] s0 = {2'd0, m_s1} + m_s2[63:0] + m_s3[63:0];
+
+  // CALC: guard band; vertex differences; bounding box and each edge's row extent, offset to pixel centres.
+  wire [63:0] s0 = {2'd0, m_s1} + (neg ? -m_s2[63:0] : m_s2[63:0]) + (neg ? -m_s3[63:0] : m_s3[63:0]);
   wire [63:0] tn0 = s0 << lz;
+  // The rows, once the triangle is not culled: first_s >= 0, first_s <= last_s < height.
+  wire [8:0] first_u = first_s[8:0];
+  wire [8:0] last_u = last_s[8:0];
   wire [63:0] gxn0 = ({{22{onx[41]}}, onx} << 8) << lz;
   wire [63:0] dyn0 = ({{19{ony[44]}}, ony} << 8) << lz;
+  // verilator lint_on UNUSEDSIGNAL
 
   // Eight restoring dividers, one quotient bit per clock, sharing one counter: per edge its first
   // bound (ei) and its step (es), then dI (ddi) and the reciprocal Rn = 2^K / (2 An) (drn).

@@ -43,8 +43,8 @@ def level(tag):
 
 def block_form(r):
     """The block and form columns of a row: 'shift-add+pl2/p8' reads P = 8, shift-add, --pipeline 2."""
-    if r["label"] == "frontend":
-        return r["top"], "—"
+    if r["label"].startswith("frontend"):
+        return r["top"], level(r["label"][len("frontend"):]) or "—"
     if r["label"].startswith("specular"):
         return r["top"], level(r["label"][len("specular"):]) or "—"
     if r["label"].startswith("ref/"):

@@ -325,6 +325,21 @@ fn generated_models() -> Vec<Model> {
                         axis: None,
                         sources: vec![(format!("{}.v", m.name), m.render())],
                     });
+                    // The set-up's CALC in stages (`--pipeline 1` and above: one front-end for them all).
+                    let staged = hdl_gen::frontend::Hw { pipeline: Pipeline::at(1), ..hw };
+                    let m = hdl_gen::frontend::module(&staged, &names);
+                    models.push(Model {
+                        tag: "fe_pl1".into(),
+                        kind: Kind::Frontend,
+                        cfg,
+                        di: DiMode::Triangle,
+                        screen: fe.screen,
+                        top: m.name.clone(),
+                        latency: staged.latency(),
+                        pipeline: staged.pipeline,
+                        axis: None,
+                        sources: vec![(format!("{}.v", m.name), m.render())],
+                    });
                     // The other divider rates (`--fe-div-bits`), so co-simulation covers every option.
                     for div_bits in hdl_gen::frontend::DIV_BITS.into_iter().filter(|&b| b != hw.div_bits) {
                         let hw = hdl_gen::frontend::Hw { div_bits, ..hw };
@@ -508,7 +523,7 @@ fn models_from_dir(dir: &Path, m: &Manifest) -> Vec<Model> {
         let mut all = sources.clone();
         all.extend(fe_src.iter().cloned());
         all.extend(files_of(&[Role::TriangleShader]));
-        models.push(model(Kind::Frontend, "fe".into(), fe_mod, screen, di, none, fe_src));
+        models.push(model(Kind::Frontend, "fe".into(), fe_mod, screen, di, pipeline, fe_src));
         models.push(model(Kind::TriShader, format!("tris_p{}_{}", cfg.p, cfg.align), tri, screen, di, pipeline, all.clone()));
         if let (Some(wr), Some(fb)) = (m.by_role(Role::Writer), m.by_role(Role::TriangleWriter)) {
             let wr_src = files_of(&[Role::Writer]);
@@ -556,7 +571,7 @@ fn axis_models(
             }
         };
         // The configuration's own model: a default build also has other alignments and pipeline
-        // levels of a top (the front-end has only level 0's, as it has no pipelined form).
+        // levels of a top (the front-end level 0's and level 1's, which every level above shares).
         let p = &m.parameters;
         let core = models
             .iter()

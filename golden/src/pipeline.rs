@@ -43,12 +43,12 @@ pub fn numbered(body: Vec<(&str, String, Vec<PipeReg>)>) -> Vec<PipeStage> {
 
 /// How many register stages the generator adds for clock rate, the same level for every block:
 ///
-/// | level | segment shader | specular unit |
-/// |--:|---|---|
-/// | 0 | as SPEC's seed: 2 stages | 5 stages |
-/// | 1 | + a span register; the BFPI's multiples and the last-segment flag registered | + both multiplies split into registered 4-bit partial products and their sum; the BRDF address registered before the ROM, both ROMs' words registered before any arithmetic: 10 stages |
-/// | 2 | + the lane sums registered before round and clamp | as level 1 |
-/// | 3 | + no clock with two adders in a row: the BFPI's first adder level formed as the span enters its register, the rest when it starts; each lane's sum split at the binary point (high part and the fraction's carry registered, joined before the clamp) | as level 1 |
+/// | level | segment shader | specular unit | front-end set-up |
+/// |--:|---|---|---|
+/// | 0 | as SPEC's seed: 2 stages | 5 stages | CALC in one clock |
+/// | 1 | + a span register; the BFPI's multiples and the last-segment flag registered | + both multiplies split into registered 4-bit partial products and their sum; the BRDF address registered before the ROM, both ROMs' words registered before any arithmetic: 10 stages | CALC in five clocks ([`SETUP_STAGES`]), overlapped with the dividers |
+/// | 2 | + the lane sums registered before round and clamp | as level 1 | as level 1 |
+/// | 3 | + no clock with two adders in a row: the BFPI's first adder level formed as the span enters its register, the rest when it starts; each lane's sum split at the binary point (high part and the fraction's carry registered, joined before the clamp) | as level 1 | as level 1 |
 ///
 /// Level 0 is the default: the smallest circuit and the shortest latency, byte for byte the
 /// RTL every earlier release generated. `docs/fpga.md` gives each level's area and Fmax.
@@ -129,7 +129,30 @@ impl Pipeline {
     pub fn split_multiplies(self) -> bool {
         self.0 >= 1
     }
+
+    /// Front-end: the set-up's CALC (area, orientation, rows, edge and plane terms, the
+    /// dividers' operands) as [`SETUP_STAGES`] register stages instead of one clock. The stages
+    /// form a queue in front of the dividers, so the next triangle's CALC overlaps the current
+    /// one's division: the set-up's rate is unchanged and only the latency grows.
+    pub fn calc_clocks(self) -> u32 {
+        if self.0 >= 1 {
+            SETUP_STAGES.len() as u32
+        } else {
+            1
+        }
+    }
 }
+
+/// The front-end set-up's CALC stages when it is pipelined, in order: what each clock computes
+/// from the registers of the one before (the first from the vertex registers). At level 0 the
+/// five are one clock. The last loads the dividers, drops or culls.
+pub const SETUP_STAGES: [&str; 5] = [
+    "guard band; vertex differences; bounding box and each edge's row extent, offset to pixel centres",
+    "the area's and the plane's products; the first row, clipped; each edge's first row and its distance to the edge's vertex",
+    "the area, its sign and magnitude; the plane's normal and |Nx|; the edge terms' products, unoriented",
+    "orientation: edges, top-left rule, last row, cull; the edge dividers' dividends; |A|'s leading zeros; dI's dividend; the first-row sum's products",
+    "the first-row sum and the plane terms, normalised; the dividers loaded, or the triangle dropped or culled",
+];
 
 impl std::fmt::Display for Pipeline {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
@@ -156,7 +179,7 @@ mod tests {
 
     #[test]
     fn each_level_adds_to_the_one_before() {
-        let flags = |p: Pipeline| [p.span_stage(), p.sum_stage(), p.split_multiplies(), p.split_adds()];
+        let flags = |p: Pipeline| [p.span_stage(), p.sum_stage(), p.split_multiplies(), p.split_adds(), p.calc_clocks() > 1];
         let levels: Vec<_> = Pipeline::all().collect();
         for w in levels.windows(2) {
             let (a, b) = (flags(w[0]), flags(w[1]));

@@ -723,6 +723,24 @@ pub struct FrontendShape {
     pub div_clocks: u32,
     /// The set-up dividers' registers (partial remainder, divisor, quotient of each): cut.
     pub div_regs: Vec<String>,
+    /// CALC's stages after the vertex register (none at level 0), in order.
+    pub calc_stages: Vec<CalcStage>,
+    /// The names under which the last CALC stage holds the guard-band check and the cull.
+    pub guard: String,
+    pub cull: String,
+}
+
+/// A CALC stage of the pipelined set-up: its valid register and where it holds what the
+/// reference follows (the guard-band check; the vertical extent, or the rows made of it).
+pub struct CalcStage {
+    pub valid: String,
+    pub guard: String,
+    pub ymin: Option<String>,
+    pub ymax: Option<String>,
+    /// The first and last rows, signed (`ryw` bits) and clipped, and the cull decision.
+    pub first_s: Option<String>,
+    pub last_s: Option<String>,
+    pub cull: Option<String>,
 }
 
 /// Properties of `tri_frontend` (SPEC §6; names as `frontend::module` declares them), with the
@@ -753,7 +771,30 @@ pub struct FrontendShape {
 /// co-simulated bit-exactly against golden. The dividers' cut is for speed: a run from reset
 /// through their restoring steps (66 bits wide at 640x480) is more than twice as slow.
 pub fn frontend_properties(s: &FrontendShape) -> Item {
-    let FrontendShape { yw, cx, cy, xw, dw, width, height, cnt_w, bits, rw, div_clocks, ref div_regs } = *s;
+    let FrontendShape {
+        yw,
+        cx,
+        cy,
+        xw,
+        dw,
+        width,
+        height,
+        cnt_w,
+        bits,
+        rw,
+        div_clocks,
+        ref div_regs,
+        ref calc_stages,
+        ref guard,
+        ref cull,
+    } = *s;
+    // CALC's stages: 0 is the vertex register, 1.. the pipelined set-up's (none at level 0).
+    let last = calc_stages.len();
+    let f_v = |j: usize| if j == 0 { "f_vf".to_string() } else { format!("f_c{j}v") };
+    let f_g = |j: usize| if j == 0 { "f_vg".to_string() } else { format!("f_c{j}g") };
+    let f_ymin = |j: usize| if j == 0 { "f_vymin".to_string() } else { format!("f_c{j}ymin") };
+    let f_ymax = |j: usize| if j == 0 { "f_vymax".to_string() } else { format!("f_c{j}ymax") };
+    let f_mv = |j: usize| if j == last { "f_calc".to_string() } else { format!("f_mv{j}") };
     // No `*` below: the proof cuts every multiplier, the properties' own too.
     assert!(bits.is_power_of_two(), "divider bits per clock: {bits}");
     // Reference counters: wide enough for the stages they count through, modulo 2^cw.
@@ -792,6 +833,14 @@ pub fn frontend_properties(s: &FrontendShape) -> Item {
     b.push(Item::Wire { name: "f_iymin".into(), width: cy, signed: true, value: Some(min3("<")) });
     b.push(Item::Wire { name: "f_iymax".into(), width: cy, signed: true, value: Some(min3(">")) });
 
+    for j in 1..=last {
+        if j == 1 {
+            b.push(comment("CALC's stages: each triangle's guard-band check and vertical extent, as the vertex register's."));
+        }
+        b.extend([reg(&f_v(j), 1), reg(&f_g(j), 1)]);
+        b.push(Item::Reg { name: f_ymin(j), width: cy, signed: true });
+        b.push(Item::Reg { name: f_ymax(j), width: cy, signed: true });
+    }
     b.push(comment("The set-up: busy (dividing, f_sn + 1 clocks left, or holding its result: f_sh), its extent."));
     b.extend([reg("f_sb", 1), reg("f_sh", 1), reg("f_sn", nw)]);
     b.push(Item::Reg { name: "f_symin".into(), width: cy, signed: true });
@@ -816,11 +865,14 @@ pub fn frontend_properties(s: &FrontendShape) -> Item {
     b.push(wire("f_adv", 1, "!out_valid || out_ready"));
     b.push(wire("f_wend", 1, "f_wrow == f_wlast"));
     b.push(wire("f_take", 1, "f_sb && f_sh && f_adv && (!f_wv || f_wend)"));
-    b.push(wire("f_calc", 1, "f_vf && (!f_sb || f_take)"));
-    b.push(wire("f_rdy", 1, "!f_vf || f_calc"));
+    b.push(wire("f_calc", 1, format!("{} && (!f_sb || f_take)", f_v(last))));
+    for j in (0..last).rev() {
+        b.push(wire(&f_mv(j), 1, format!("{} && (!{} || {})", f_v(j), f_v(j + 1), f_mv(j + 1))));
+    }
+    b.push(wire("f_rdy", 1, format!("!f_vf || {}", f_mv(0))));
     b.push(wire("f_acc", 1, "in_valid && f_rdy"));
     b.push(comment("The design's data decisions, taken as given: culled, and a walked row's covered pixels."));
-    b.push(wire("f_cull", 1, "cull"));
+    b.push(wire("f_cull", 1, cull.as_str()));
     b.push(wire("f_cover", 1, "lo3 <= hi3"));
 
     let one = |w: u32| lit(w, 1);
@@ -830,13 +882,13 @@ pub fn frontend_properties(s: &FrontendShape) -> Item {
         set("f_sb", "1'b1"),
         set("f_sh", "1'b0"),
         set("f_sn", lit(nw, (div_clocks - 1) as u64)),
-        set("f_symin", "f_vymin"),
-        set("f_symax", "f_vymax"),
+        set("f_symin", f_ymin(last)),
+        set("f_symax", f_ymax(last)),
     ];
     let setup = Stmt::If(
         "f_calc".into(),
         vec![Stmt::If(
-            "!f_vg".into(),
+            format!("!{}", f_g(last)),
             vec![set("f_errp", "1'b1"), set("f_sb", "1'b0")],
             vec![Stmt::If("f_cull".into(), vec![set("f_sb", "1'b0"), inc1("f_ncull")], calc_go)],
         )],
@@ -889,26 +941,38 @@ pub fn frontend_properties(s: &FrontendShape) -> Item {
     let input = Stmt::If(
         "f_acc".into(),
         vec![set("f_vf", "1'b1"), set("f_vg", "f_band"), set("f_vymin", "f_iymin"), set("f_vymax", "f_iymax")],
-        vec![when("f_calc", vec![set("f_vf", "1'b0")])],
+        vec![when(f_mv(0), vec![set("f_vf", "1'b0")])],
     );
+    let stages: Vec<Stmt> = (1..=last)
+        .map(|j| {
+            Stmt::If(
+                f_mv(j - 1),
+                vec![set(f_v(j), "1'b1"), set(f_g(j), f_g(j - 1)), set(f_ymin(j), f_ymin(j - 1)), set(f_ymax(j), f_ymax(j - 1))],
+                vec![when(f_mv(j), vec![set(f_v(j), "1'b0")])],
+            )
+        })
+        .collect();
     let zero = lit(cw, 0);
     b.push(Item::Always(vec![Stmt::If(
         "rst".into(),
-        vec![
-            set("f_vf", "1'b0"),
-            set("f_sb", "1'b0"),
-            set("f_wv", "1'b0"),
-            set("f_1v", "1'b0"),
-            set("f_2v", "1'b0"),
-            set("f_ov", "1'b0"),
-            set("f_errp", "1'b0"),
-            set("f_nacc", zero.clone()),
-            set("f_nerr", zero.clone()),
-            set("f_ncull", zero.clone()),
-            set("f_nwalk", zero.clone()),
-            set("f_nrow", zero.clone()),
-            set("f_nout", zero.clone()),
-        ],
+        vec![set("f_vf", "1'b0")]
+            .into_iter()
+            .chain((1..=last).map(|j| set(f_v(j), "1'b0")))
+            .chain([
+                set("f_sb", "1'b0"),
+                set("f_wv", "1'b0"),
+                set("f_1v", "1'b0"),
+                set("f_2v", "1'b0"),
+                set("f_ov", "1'b0"),
+                set("f_errp", "1'b0"),
+                set("f_nacc", zero.clone()),
+                set("f_nerr", zero.clone()),
+                set("f_ncull", zero.clone()),
+                set("f_nwalk", zero.clone()),
+                set("f_nrow", zero.clone()),
+                set("f_nout", zero.clone()),
+            ])
+            .collect(),
         vec![
             set("f_errp", "1'b0"),
             inc("f_nacc", "f_acc"),
@@ -916,10 +980,11 @@ pub fn frontend_properties(s: &FrontendShape) -> Item {
             inc("f_nrow", "f_adv && f_wv && f_cover"),
             inc("f_nout", "out_valid && out_ready"),
             input,
-            setup,
-            walker,
-            spans,
-        ],
+        ]
+        .into_iter()
+        .chain(stages)
+        .chain([setup, walker, spans])
+        .collect(),
     )]));
 
     b.push(comment("The front-end is the reference at its ports: it takes a triangle exactly when the"));
@@ -955,19 +1020,26 @@ pub fn frontend_properties(s: &FrontendShape) -> Item {
         vec![
             when("$past(w_valid && adv && !w_end)", vec![assert("w_valid"), assert(format!("w_row == $past(w_row) + {}", one(yw)))]),
             when("$past(w_valid && adv && w_end && st == HOLD)", vec![assert("w_valid"), assert("w_row == $past(s_first)")]),
-            when("$past(calc && (!guard_ok || cull))", vec![assert("in_ready")]),
+            // The triangle behind a dropped one moves up in the same clock: into the last CALC
+            // stage, or (CALC in one clock) straight into it from the port.
+            when(
+                format!("$past(calc && (!{guard} || {cull}))"),
+                vec![match last {
+                    0 => assert("in_ready"),
+                    1 => assert(format!("!$past(v_full) || {}", calc_stages[0].valid)),
+                    _ => assert(format!("!$past({}) || {}", calc_stages[last - 2].valid, calc_stages[last - 1].valid)),
+                }],
+            ),
         ],
     )]));
     b.push(comment("Nothing lost or invented: every accepted triangle was flagged, culled or walked, or is"));
     b.push(comment("still waiting or in set-up (counts modulo 16)."));
     b.push(Item::Comb(vec![when(
         "f_past",
-        vec![assert(format!(
-            "f_nacc == f_nerr + {} + f_ncull + f_nwalk + {} + {}",
-            zext("err", 1, cw),
-            zext("f_vf", 1, cw),
-            zext("f_sb", 1, cw)
-        ))],
+        vec![assert(
+            format!("f_nacc == f_nerr + {} + f_ncull + f_nwalk + {} + {}", zext("err", 1, cw), zext("f_vf", 1, cw), zext("f_sb", 1, cw))
+                + &(1..=last).map(|j| format!(" + {}", zext(&f_v(j), 1, cw))).collect::<String>(),
+        )],
     )]));
     b.push(comment("Every span the walker produced is offered once: taken at the port, or still in a stage."));
     b.push(Item::Comb(vec![when(
@@ -989,6 +1061,31 @@ pub fn frontend_properties(s: &FrontendShape) -> Item {
     let mut link = vec![
         assert("v_full == f_vf"),
         when("f_vf", vec![assert("guard_ok == f_vg"), assert("ymin == f_vymin"), assert("ymax == f_vymax")]),
+    ];
+    let ryc = |r: &str| format!("$signed({{{r}, 8'd128}})");
+    for (j, c) in calc_stages.iter().enumerate().map(|(i, c)| (i + 1, c)) {
+        let mut held = vec![assert(format!("{} == {}", c.guard, f_g(j)))];
+        if let Some(r) = &c.ymin {
+            held.push(assert(format!("{r} == {}", f_ymin(j))));
+        }
+        if let Some(r) = &c.ymax {
+            held.push(assert(format!("{r} == {}", f_ymax(j))));
+        }
+        if let Some(r) = &c.first_s {
+            held.push(assert(format!("!{r}[{}]", cy - 8)));
+            held.push(assert(format!("{} >= {}", ryc(r), f_ymin(j))));
+        }
+        if let Some(r) = &c.last_s {
+            held.push(assert(format!("{r} <= {}", slit(cy - 7, height as i64 - 1))));
+            held.push(assert(format!("{} <= {}", ryc(r), f_ymax(j))));
+        }
+        if let (Some(k), Some(a), Some(z)) = (&c.cull, &c.first_s, &c.last_s) {
+            held.push(when(format!("!{k}"), vec![assert(format!("{a} <= {z}"))]));
+        }
+        link.push(assert(format!("{} == {}", c.valid, f_v(j))));
+        link.push(when(f_v(j), held));
+    }
+    link.extend([
         assert(format!("st == {st_is}")),
         when(
             "f_sb && !f_sh",
@@ -1007,7 +1104,7 @@ pub fn frontend_properties(s: &FrontendShape) -> Item {
         when("f_1v", vec![assert("p1_y == f_1y")]),
         assert("p2_v == f_2v"),
         when("f_2v", vec![assert("p2_y == f_2y")]),
-    ];
+    ]);
     link.push(Stmt::Comment("A span that is not its triangle's first has the dI of the span ahead of it.".into()));
     link.push(when("f_ov && !f_free", vec![assert("out_di == f_pdi")]));
     link.push(when("f_2v && !f_2n", vec![assert("p2_di == (f_ov ? out_di : f_pdi)")]));

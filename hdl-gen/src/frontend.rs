@@ -8,13 +8,20 @@
 //!   clock CALC checks the guard band, computes the area, orients the edges, finds the rows,
 //!   culls, and loads eight restoring dividers (`--fe-div-bits` quotient bits a clock); `DIV`
 //!   runs them together; `HOLD` offers the result to the walker. The hand-off clock is also the
-//!   next triangle's CALC, and the next triangle is latched while the dividers run.
+//!   next triangle's CALC, and the next triangle is latched while the dividers run. At
+//!   `--pipeline 1` and above CALC is five register stages ([`golden::pipeline::SETUP_STAGES`],
+//!   written once through [`stager`]), a queue in front of the dividers: the triangles behind
+//!   move through it while the dividers run, so only the latency grows.
 //! - **edge walker**: one row per clock. Per active edge one DDA step (add, compare, subtract);
 //!   `lo` and `hi` are the max and min of the active bounds, clipped to the screen. It loads the
 //!   next triangle in the clock its current one finishes, so set-up overlaps the walk.
 //! - **I0 pipeline** (two stages after the walker): `S2n = 2 (Tn + Gxn lo) + An` in the
 //!   walker's clock, then `q~ = (S2n Rn) >> K`, then the correction `q~ + (S2n - 2 An q~ >= 2 An)`.
 //!   One stall signal holds the walker and every stage while the output waits.
+
+mod stager;
+
+use stager::Stager;
 
 use crate::verilog::{assign, comment, lit, net, reg, set, sext, sreg, swire, wire, zext, Item, Module, Port, Stmt};
 use crate::Names;
@@ -30,7 +37,7 @@ pub struct Hw {
     pub fe: FrontEnd,
     /// Quotient bits per clock of every set-up divider (one of [`DIV_BITS`]).
     pub div_bits: u32,
-    /// The chain's register stages (`--pipeline`): the shader's; the front-end has none yet.
+    /// The chain's register stages (`--pipeline`): the shader's, and the set-up's CALC stages.
     pub pipeline: golden::pipeline::Pipeline,
 }
 
@@ -49,11 +56,16 @@ impl Hw {
         }
     }
 
+    /// Clocks CALC takes: 1, or its stages at `--pipeline 1` and above.
+    pub fn calc_clocks(&self) -> u32 {
+        self.pipeline.calc_clocks()
+    }
+
     /// Clocks from a triangle's transfer to the first span's `out_valid` when the walker is
     /// idle: CALC, the dividers, the hand-off, the walker's clock, two pipeline stages (and, per
     /// scanline, the span's division when it has two pixels or more).
     pub fn latency(&self) -> u32 {
-        self.div_clocks() + 5 + self.span_div_clocks()
+        self.calc_clocks() + self.div_clocks() + 4 + self.span_div_clocks()
     }
 
     /// Clocks from a triangle's transfer to the first segment out of `tri_shader_p<P>` when idle:
@@ -63,8 +75,9 @@ impl Hw {
     }
 
     /// Set-up clocks per triangle that is walked (the rate limit for tiny triangles: the
-    /// dividers, then the hand-off clock, which is also the next triangle's CALC), and per
-    /// triangle dropped in set-up (its CALC).
+    /// dividers, then the hand-off clock, which is also the next triangle's last CALC clock),
+    /// and per triangle dropped in set-up (its last CALC clock). CALC's earlier stages overlap
+    /// the triangle ahead's division, so neither depends on the pipeline level.
     pub fn setup_clocks(&self) -> (u32, u32) {
         (self.div_clocks() + 1, 1)
     }
@@ -76,13 +89,6 @@ fn slit(w: u32, v: i64) -> String {
     } else {
         format!("{w}'sd{v}")
     }
-}
-
-/// `out = a * b` at the product's natural width. Both operands are signed names of their own
-/// widths: the language extends them to the result, and synthesis builds a `wa` x `wb`
-/// multiplier (extending them by hand would make it as wide as the result on both sides).
-fn smul(out: &str, a: &str, wa: u32, b: &str, wb: u32) -> Vec<Item> {
-    vec![comment("verilator lint_off WIDTH"), swire(out, wa + wb, format!("{a} * {b}")), comment("verilator lint_on WIDTH")]
 }
 
 pub fn ports(fe: &FrontEnd, wd: &Widths) -> Vec<Port> {
@@ -168,18 +174,275 @@ fn div_iter(d: &Div, bits: u32) -> Vec<Stmt> {
     ]
 }
 
+/// The register stages of a pipelined CALC, for the manifest (none at level 0): stage j holds
+/// what CALC's clock j - 1 computed for the clocks after it.
+pub fn calc_stages(hw: &Hw) -> Vec<golden::pipeline::PipeStage> {
+    let st = calc(hw);
+    (1..=st.stage())
+        .map(|j| golden::pipeline::PipeStage {
+            stage: j as u32,
+            name: format!("calc{j}"),
+            logic: golden::pipeline::SETUP_STAGES[j - 1].into(),
+            regs: st
+                .regs(j - 1)
+                .into_iter()
+                .map(|(n, bits, signed)| golden::pipeline::PipeReg::new(&n, bits, if signed { "signed" } else { "unsigned" }))
+                .collect(),
+        })
+        .collect()
+}
+
+/// CALC (SPEC §6's set-up arithmetic), written once as its stages ([`golden::pipeline::SETUP_STAGES`]):
+/// one clock at level 0, a register boundary after each stage above it. Values are computed
+/// where their operands are ready, so a sign decided late (the area's) is applied to products
+/// formed early: the products are taken of unoriented differences and negated with the
+/// orientation. What the last stage hands on is read at its end, so every carrying register
+/// exists when the caller declares them.
+fn calc(hw: &Hw) -> Stager {
+    let fe = &hw.fe;
+    let cfg = &fe.cfg;
+    let Widths { yw, cx, cy, aw, gw, k: kk, sw, .. } = fe.widths();
+    let (xw, iw) = (cfg.xbits, cfg.iw());
+    let (w, h) = (fe.screen.width as i64, fe.screen.height as i64);
+    let (nxw, nyw, rxw, ryw) = (iw + cy + 3, iw + cx + 3, xw + 3, cy - 7);
+    let cuts = hw.pipeline.calc_clocks() as usize - 1;
+    let mut st = Stager::new(cuts);
+    for k in 0..3 {
+        st.input(&format!("vx{k}"), cx, true);
+        st.input(&format!("vy{k}"), cy, true);
+        st.input(&format!("vi{k}"), iw, false);
+    }
+    let section = |st: &mut Stager| {
+        let j = st.stage();
+        let what = golden::pipeline::SETUP_STAGES[if cuts == 0 { 0 } else { j }];
+        let head = if cuts == 0 { "CALC".to_string() } else { format!("CALC stage {j}") };
+        st.note(Item::Blank);
+        st.note(comment(format!("{head}: {what}.")));
+    };
+    let min3 = |a: &str, b: &str, c: &str, less: bool| {
+        let op = if less { "<" } else { ">" };
+        format!("(({a} {op} {b}) ? (({a} {op} {c}) ? {a} : {c}) : (({b} {op} {c}) ? {b} : {c}))")
+    };
+    let edge = |k: usize| ((k + 1) % 3, (k + 2) % 3);
+
+    // Stage 0, from the vertex registers.
+    section(&mut st);
+    let gx = |v: &str| {
+        let hi = 2 * w * 256;
+        let below = if hi > (1i64 << (cx - 1)) - 1 { String::new() } else { format!(" && {v} < {}", slit(cx, hi)) };
+        format!("({v} >= {}{below})", slit(cx, -w * 256))
+    };
+    let gy = |v: &str| {
+        let hi = 2 * h * 256;
+        let below = if hi > (1i64 << (cy - 1)) - 1 { String::new() } else { format!(" && {v} < {}", slit(cy, hi)) };
+        format!("({v} >= {}{below})", slit(cy, -h * 256))
+    };
+    let guard: Vec<String> = (0..3).flat_map(|k| [gx(&format!("vx{k}")), gy(&format!("vy{k}"))]).collect();
+    st.def("guard_ok", 1, false, guard.join(" && "));
+    st.note(comment("Edge k runs from vertex k+1 to vertex k+2; u, v span the area, d the intensities."));
+    for (n, a, b, ww) in [("u1", "vx1", "vx0", cx), ("u2", "vx2", "vx0", cx), ("v1", "vy1", "vy0", cy), ("v2", "vy2", "vy0", cy)] {
+        st.def(n, ww + 1, true, format!("{} - {}", sext(a, ww, ww + 1), sext(b, ww, ww + 1)));
+    }
+    for k in 0..3 {
+        let (a, b) = edge(k);
+        st.def(
+            &format!("rdx{k}"),
+            cx + 1,
+            true,
+            format!("{} - {}", sext(&format!("vx{b}"), cx, cx + 1), sext(&format!("vx{a}"), cx, cx + 1)),
+        );
+        st.def(
+            &format!("rdy{k}"),
+            cy + 1,
+            true,
+            format!("{} - {}", sext(&format!("vy{b}"), cy, cy + 1), sext(&format!("vy{a}"), cy, cy + 1)),
+        );
+    }
+    let iz = |v: &str, to: u32| zext(v, iw, to);
+    st.def("d1", iw + 1, true, format!("{} - {}", iz("vi1", iw + 1), iz("vi0", iw + 1)));
+    st.def("d2", iw + 1, true, format!("{} - {}", iz("vi2", iw + 1), iz("vi0", iw + 1)));
+    st.note(comment("Bounding box in rows and columns (centres at +128 sub-pixels); each edge's rows."));
+    st.def("ymin", cy, true, min3("vy0", "vy1", "vy2", true));
+    st.def("ymax", cy, true, min3("vy0", "vy1", "vy2", false));
+    st.def("xmin", cx, true, min3("vx0", "vx1", "vx2", true));
+    st.def("xmax", cx, true, min3("vx0", "vx1", "vx2", false));
+    st.def("xmin_c", cx + 1, true, format!("{} + {}", sext("xmin", cx, cx + 1), slit(cx + 1, 127)));
+    st.def("xmax_c", cx + 1, true, format!("{} - {}", sext("xmax", cx, cx + 1), slit(cx + 1, 128)));
+    for k in 0..3 {
+        let (a, b) = edge(k);
+        let (ya, yb2) = (format!("vy{a}"), format!("vy{b}"));
+        st.def(&format!("yt{k}"), cy, true, format!("{ya} < {yb2} ? {ya} : {yb2}"));
+        st.def(&format!("yb{k}"), cy, true, format!("{ya} < {yb2} ? {yb2} : {ya}"));
+        st.def(&format!("ytc{k}"), cy + 1, true, format!("{} + {}", sext(&format!("yt{k}"), cy, cy + 1), slit(cy + 1, 127)));
+        st.def(&format!("ybc{k}"), cy + 1, true, format!("{} - {}", sext(&format!("yb{k}"), cy, cy + 1), slit(cy + 1, 128)));
+        // x distance from vertex a to the first column's centre, for e(128, .) below.
+        st.def(&format!("rx{k}"), cx + 2, true, format!("{} - {}", lit(cx + 2, 128), sext(&format!("vx{a}"), cx, cx + 2)));
+    }
+    st.def("xo", cx + 2, true, format!("{} - {}", lit(cx + 2, 128), sext("vx0", cx, cx + 2)));
+    st.cut();
+
+    // Stage 1.
+    section(&mut st);
+    st.mul("m_a1", "u1", cx + 1, "v2", cy + 1);
+    st.mul("m_a2", "v1", cy + 1, "u2", cx + 1);
+    st.mul("m_x1", "d1", iw + 1, "v2", cy + 1);
+    st.mul("m_x2", "d2", iw + 1, "v1", cy + 1);
+    st.mul("m_y1", "d2", iw + 1, "u1", cx + 1);
+    st.mul("m_y2", "d1", iw + 1, "u2", cx + 1);
+    st.def("ymin_c", cy + 1, true, format!("{} + {}", sext(&st.at("ymin"), cy, cy + 1), slit(cy + 1, 127)));
+    st.def("first_raw", ryw, true, format!("ymin_c[{cy}:8]"));
+    st.def("first_s", ryw, true, format!("first_raw[{}] ? {} : first_raw", ryw - 1, slit(ryw, 0)));
+    st.def("cfirst", rxw, true, format!("{}[{cx}:8]", st.at("xmin_c")));
+    st.def("clast", rxw, true, format!("{}[{cx}:8]", st.at("xmax_c")));
+    let first_centre = format!("{{first_s[{}:0], 8'd128}}", yw - 1);
+    st.def("yo", cy + 2, true, format!("{} - {}", zext(&first_centre, yw + 8, cy + 2), sext(&st.at("vy0"), cy, cy + 2)));
+    st.note(comment("Per edge: its rows on the screen, and the y distance from vertex a to its first row's centre."));
+    for k in 0..3 {
+        let (a, _) = edge(k);
+        st.def(&format!("rs_raw{k}"), ryw, true, format!("{}[{cy}:8]", st.at(&format!("ytc{k}"))));
+        st.def(&format!("re_raw{k}"), ryw, true, format!("{}[{cy}:8]", st.at(&format!("ybc{k}"))));
+        st.def(&format!("rs{k}"), ryw, true, format!("rs_raw{k} > first_s ? rs_raw{k} : first_s"));
+        st.def(&format!("rsu{k}"), yw, false, format!("rs{k}[{}:0]", yw - 1));
+        st.def(
+            &format!("ry{k}"),
+            cy + 2,
+            true,
+            format!("{} - {}", zext(&format!("{{rsu{k}, 8'd128}}"), yw + 8, cy + 2), sext(&st.at(&format!("vy{a}")), cy, cy + 2)),
+        );
+        let r = st.at(&format!("rdy{k}"));
+        st.def(&format!("ady{k}"), cy, false, format!("{r}[{cy}] ? -{r}[{}:0] : {r}[{}:0]", cy - 1, cy - 1));
+    }
+    st.cut();
+
+    // Stage 2.
+    section(&mut st);
+    st.note(comment("Twice the signed area: its sign orients the edges and the plane (interior positive)."));
+    st.def("area", aw + 1, true, format!("{} - {}", st.at("m_a1"), st.at("m_a2")));
+    st.def("neg", 1, false, format!("area[{aw}]"));
+    st.def("area_n", aw + 1, false, "neg ? -area : area");
+    st.def("aabs", aw, false, format!("area_n[{}:0]", aw - 1));
+    st.note(comment("The plane's normal, unoriented, and |Nx| (the orientation does not change it)."));
+    st.def("nx", nxw, true, format!("{} - {}", sext(&st.at("m_x1"), nxw - 1, nxw), sext(&st.at("m_x2"), nxw - 1, nxw)));
+    st.def("ny", nyw, true, format!("{} - {}", sext(&st.at("m_y1"), nyw - 1, nyw), sext(&st.at("m_y2"), nyw - 1, nyw)));
+    st.def("mag", nxw, false, format!("nx[{}] ? -nx : nx", nxw - 1));
+    for k in 0..3 {
+        st.mul(&format!("m_e{k}"), &format!("rdx{k}"), cx + 1, &format!("ry{k}"), cy + 2);
+        st.mul(&format!("m_f{k}"), &format!("rdy{k}"), cy + 1, &format!("rx{k}"), cx + 2);
+    }
+    st.cut();
+
+    // Stage 3.
+    section(&mut st);
+    let neg = st.at("neg");
+    st.note(comment("Orientation: edge k's direction with the interior on its left; the top-left rule."));
+    for k in 0..3 {
+        st.def(&format!("dx{k}"), cx + 1, true, format!("{neg} ? -{r} : {r}", r = st.at(&format!("rdx{k}"))));
+        st.def(&format!("dy{k}"), cy + 1, true, format!("{neg} ? -{r} : {r}", r = st.at(&format!("rdy{k}"))));
+        st.def(&format!("tl{k}"), 1, false, format!("dy{k}[{cy}] || (dy{k} == {} && dx{k} > {})", slit(cy + 1, 0), slit(cx + 1, 0)));
+    }
+    st.note(comment("A horizontal edge that is not top-left is a bottom edge: centres on it are not covered."));
+    st.def("kill", 1, false, (0..3).map(|k| format!("(dy{k} == {} && !tl{k})", slit(cy + 1, 0))).collect::<Vec<_>>().join(" || "));
+    st.def("ymax_c", cy + 1, true, format!("{} - {} - {}", sext(&st.at("ymax"), cy, cy + 1), slit(cy + 1, 128), zext("kill", 1, cy + 1)));
+    st.def("last_raw", ryw, true, format!("ymax_c[{cy}:8]"));
+    st.def("last_s", ryw, true, format!("last_raw > {} ? {} : last_raw", slit(ryw, h - 1), slit(ryw, h - 1)));
+    let (first_s, cfirst, clast) = (st.at("first_s"), st.at("cfirst"), st.at("clast"));
+    st.def(
+        "cull",
+        1,
+        false,
+        format!(
+            "{} == {} || {first_s} > last_s || {cfirst} > {clast} || {cfirst} > {} || {clast}[{}]",
+            st.at("area"),
+            slit(aw + 1, 0),
+            slit(rxw, w - 1),
+            rxw - 1
+        ),
+    );
+    // e(128, 256 rs + 128) - t + B D from vertex a on the edge's line: the oriented products'
+    // difference, 1 less off a top-left edge, offset by B = 2^(GW-1) divisors so both quotients
+    // are non-negative (q = g + B).
+    st.note(comment("Per edge: its active rows; the dividends of its first bound and of its step."));
+    let (nw, snw) = (cx + cy + 5, (cx + 2).max(gw + cy + 1));
+    for k in 0..3 {
+        let re_raw = st.at(&format!("re_raw{k}"));
+        st.def(&format!("re{k}"), ryw, true, format!("{re_raw} < last_s ? {re_raw} : last_s"));
+        st.def(&format!("act{k}"), 1, false, format!("dy{k} != {} && {} <= re{k}", slit(cy + 1, 0), st.at(&format!("rs{k}"))));
+        let (me, mf, ady) = (st.at(&format!("m_e{k}")), st.at(&format!("m_f{k}")), st.at(&format!("ady{k}")));
+        st.def(&format!("e{k}"), nw, false, format!("{} - {}", sext(&me, nw - 2, nw), sext(&mf, nw - 2, nw)));
+        st.def(
+            &format!("n{k}"),
+            nw,
+            false,
+            format!("({neg} ? -e{k} : e{k}) - {} + ({} << {})", zext(&format!("!tl{k}"), 1, nw), zext(&ady, cy, nw), gw + 7),
+        );
+        st.def(
+            &format!("sn{k}"),
+            snw,
+            false,
+            format!("{} + ({} << {})", sext(&format!("dx{k}"), cx + 1, snw), zext(&ady, cy, snw), gw - 1),
+        );
+    }
+    st.note(comment("The plane: Nx, Ny oriented; dI's dividend 2*256|Nx| + |A| and its saturation."));
+    let aabs = st.at("aabs");
+    st.def("onx", nxw, true, format!("{neg} ? -{nx} : {nx}", nx = st.at("nx")));
+    st.def("ony", nyw, true, format!("{neg} ? -{ny} : {ny}", ny = st.at("ny")));
+    st.def("nx_neg", 1, false, format!("onx[{}]", nxw - 1));
+    let x2w = (nxw + 9).max(aw + 1);
+    let cmpw = x2w.max(aw + iw + 1);
+    st.def("x2", x2w, false, format!("({} << 9) + {}", zext(&st.at("mag"), nxw, x2w), zext(&aabs, aw, x2w)));
+    st.def("di_sat", 1, false, format!("{} >= ({} << {})", zext("x2", x2w, cmpw), zext(&aabs, aw, cmpw), iw + 1));
+    st.note(comment("Normalisation: s leading zeros of |A|, An = |A| << s."));
+    let mut chain = lit(sw, (aw - 1) as u64);
+    for bit in 1..aw {
+        chain = format!("{aabs}[{bit}] ? {} : {chain}", lit(sw, (aw - 1 - bit) as u64));
+    }
+    st.def("lz", sw, false, chain);
+    st.def("an", aw, false, format!("{aabs} << lz"));
+    st.note(comment("The first row's sum S(0, first) = I0 |A| + Nx xo + Ny yo: its products, unoriented."));
+    st.note(comment("verilator lint_off WIDTH"));
+    st.def("m_s1", iw + aw, false, format!("{} * {aabs}", st.at("vi0")));
+    st.note(comment("verilator lint_on WIDTH"));
+    st.mul("m_s2", "nx", nxw, "xo", cx + 2);
+    st.mul("m_s3", "ny", nyw, "yo", cy + 2);
+    st.cut();
+
+    // Stage 4: the sum modulo 2^K, oriented, and everything normalised by the shift s.
+    section(&mut st);
+    let low = |m: &str, w: u32| if w > kk { format!("{m}[{}:0]", kk - 1) } else { sext(m, w, kk) };
+    let neg = st.at("neg");
+    let (s2, s3) = (low(&st.at("m_s2"), nxw + cx + 2), low(&st.at("m_s3"), nyw + cy + 2));
+    st.def("s0", kk, false, format!("{} + ({neg} ? -{s2} : {s2}) + ({neg} ? -{s3} : {s3})", zext(&st.at("m_s1"), iw + aw, kk)));
+    let lz = st.at("lz");
+    st.def("tn0", kk, false, format!("s0 << {lz}"));
+    st.note(comment("The rows, once the triangle is not culled: first_s >= 0, first_s <= last_s < height."));
+    st.def("first_u", yw, false, format!("{}[{}:0]", st.at("first_s"), yw - 1));
+    st.def("last_u", yw, false, format!("{}[{}:0]", st.at("last_s"), yw - 1));
+    st.def("gxn0", kk, false, format!("({} << 8) << {lz}", sext(&st.at("onx"), nxw, kk)));
+    st.def("dyn0", kk, false, format!("({} << 8) << {lz}", sext(&st.at("ony"), nyw, kk)));
+    // What the last stage hands on (the dividers' loads, the result registers, the decision), read
+    // here so that every register carrying it is declared with the others.
+    let mut handed = vec!["guard_ok", "cull", "x2", "aabs", "an", "first_u", "last_u", "tn0", "gxn0", "dyn0", "di_sat", "nx_neg"]
+        .into_iter()
+        .map(String::from)
+        .collect::<Vec<_>>();
+    for k in 0..3 {
+        handed.extend(["n", "sn", "ady", "act", "dy", "rsu", "re"].map(|v| format!("{v}{k}")));
+    }
+    for v in &handed {
+        st.at(v);
+    }
+    st
+}
+
 pub fn module(hw: &Hw, names: &Names) -> Module {
     let fe = &hw.fe;
     let bits = hw.div_bits;
     let cfg = &fe.cfg;
     let wd = fe.widths();
-    let Widths { yw, cx, cy, aw, gw, dw_edge: de, k: kk, rw, sw } = wd;
+    let Widths { yw, cx, cy, aw, gw, dw_edge: de, k: kk, rw, .. } = wd;
     let (xw, iw, dw) = (cfg.xbits, cfg.iw(), cfg.dw());
     let (w, h) = (fe.screen.width as i64, fe.screen.height as i64);
     let nxw = iw + cy + 3; // Nx, signed
-    let nyw = iw + cx + 3; // Ny, signed
-    let rxw = xw + 3; // column numbers, signed
-    let ryw = cy - 7; // row numbers, signed (= YW + 3)
     let cnt_w = 32 - rw.leading_zeros();
 
     let header = vec![
@@ -193,10 +456,19 @@ pub fn module(hw: &Hw, names: &Names) -> Module {
         format!("Spans: (y, x0, m, I0, dI) in SPEC §2's formats; I0 correctly rounded, dI rounded once per triangle;"),
         format!("every pixel within 1/2 + W 2^-(F+1) <= 1 of the plane through the vertex intensities."),
         format!(
-            "Set-up: CALC 1 clock, {} divider clocks (8 restoring dividers in parallel, {bits} quotient bit(s) a clock), hand-off;",
+            "Set-up: CALC {} clock(s), {} divider clocks (8 restoring dividers in parallel, {bits} quotient bit(s) a clock), hand-off;",
+            hw.calc_clocks(),
             hw.div_clocks()
         ),
-        format!("{} clocks per walked triangle, 1 per dropped one; the next triangle is latched meanwhile.", hw.setup_clocks().0),
+        format!(
+            "{} clocks per walked triangle, 1 per dropped one; {}",
+            hw.setup_clocks().0,
+            if hw.calc_clocks() > 1 {
+                "the next triangles move through CALC's stages meanwhile."
+            } else {
+                "the next triangle is latched meanwhile."
+            }
+        ),
         format!("Latency: first span valid {} clocks after the triangle's transfer when the walker is idle.", hw.latency()),
         "Walker: one row per clock (rows with no covered pixel make a bubble); the next triangle's set-up overlaps it.".into(),
         format!("Widths: |A| {aw}, edge bound {gw} signed, edge divisor {de}, intensity sums modulo 2^{kk}, reciprocal {rw}."),
@@ -219,193 +491,40 @@ pub fn module(hw: &Hw, names: &Names) -> Module {
     }
     body.push(reg("v_full", 1));
     body.push(net("take", 1));
-    body.push(wire("calc", 1, "v_full && (st == IDLE || take)"));
-    body.push(assign("in_ready", "!v_full || calc"));
-    body.push(Item::Blank);
 
-    // ---- CALC: everything from the vertex registers, combinational.
-    body.push(comment("Guard band, on the registered vertices."));
-    let gx = |v: &str| {
-        let hi = 2 * w * 256;
-        let below = if hi > (1i64 << (cx - 1)) - 1 { String::new() } else { format!(" && {v} < {}", slit(cx, hi)) };
-        format!("({v} >= {}{below})", slit(cx, -w * 256))
-    };
-    let gy = |v: &str| {
-        let hi = 2 * h * 256;
-        let below = if hi > (1i64 << (cy - 1)) - 1 { String::new() } else { format!(" && {v} < {}", slit(cy, hi)) };
-        format!("({v} >= {}{below})", slit(cy, -h * 256))
-    };
-    let guard: Vec<String> = (0..3).flat_map(|k| [gx(&format!("vx{k}")), gy(&format!("vy{k}"))]).collect();
-    body.push(wire("guard_ok", 1, guard.join(" && ")));
-    body.push(Item::Blank);
-    body.push(comment("Twice the signed area, its orientation and magnitude."));
-    for (n, a, b, ww) in [("u1", "vx1", "vx0", cx), ("u2", "vx2", "vx0", cx), ("v1", "vy1", "vy0", cy), ("v2", "vy2", "vy0", cy)] {
-        body.push(swire(n, ww + 1, format!("{} - {}", sext(a, ww, ww + 1), sext(b, ww, ww + 1))));
-    }
-    body.extend(smul("m_a1", "u1", cx + 1, "v2", cy + 1));
-    body.extend(smul("m_a2", "v1", cy + 1, "u2", cx + 1));
-    body.push(swire("area", aw + 1, "m_a1 - m_a2"));
-    body.push(wire("neg", 1, format!("area[{aw}]")));
-    body.push(comment("verilator lint_off UNUSEDSIGNAL"));
-    body.push(wire("area_n", aw + 1, "neg ? -area : area"));
-    body.push(wire("aabs", aw, format!("area_n[{}:0]", aw - 1)));
-    body.push(comment("verilator lint_on UNUSEDSIGNAL"));
-    body.push(Item::Blank);
-
-    body.push(comment("Edge k runs from vertex k+1 to vertex k+2, oriented so the interior is positive."));
-    for k in 0..3 {
-        let (a, b) = ((k + 1) % 3, (k + 2) % 3);
-        body.push(swire(
-            &format!("rdx{k}"),
-            cx + 1,
-            format!("{} - {}", sext(&format!("vx{b}"), cx, cx + 1), sext(&format!("vx{a}"), cx, cx + 1)),
-        ));
-        body.push(swire(
-            &format!("rdy{k}"),
-            cy + 1,
-            format!("{} - {}", sext(&format!("vy{b}"), cy, cy + 1), sext(&format!("vy{a}"), cy, cy + 1)),
-        ));
-        body.push(swire(&format!("dx{k}"), cx + 1, format!("neg ? -rdx{k} : rdx{k}")));
-        body.push(swire(&format!("dy{k}"), cy + 1, format!("neg ? -rdy{k} : rdy{k}")));
-        body.push(wire(&format!("tl{k}"), 1, format!("dy{k}[{cy}] || (dy{k} == {} && dx{k} > {})", slit(cy + 1, 0), slit(cx + 1, 0))));
-    }
-    body.push(comment("A horizontal edge that is not top-left is a bottom edge: centres on it are not covered."));
-    body.push(wire("kill", 1, (0..3).map(|k| format!("(dy{k} == {} && !tl{k})", slit(cy + 1, 0))).collect::<Vec<_>>().join(" || ")));
-    body.push(Item::Blank);
-
-    body.push(comment("Bounding box in rows and columns (centres at +128 sub-pixels), clipped."));
-    let min3 = |a: &str, b: &str, c: &str, less: bool| {
-        let op = if less { "<" } else { ">" };
-        format!("(({a} {op} {b}) ? (({a} {op} {c}) ? {a} : {c}) : (({b} {op} {c}) ? {b} : {c}))")
-    };
-    body.push(swire("ymin", cy, min3("vy0", "vy1", "vy2", true)));
-    body.push(swire("ymax", cy, min3("vy0", "vy1", "vy2", false)));
-    body.push(swire("xmin", cx, min3("vx0", "vx1", "vx2", true)));
-    body.push(swire("xmax", cx, min3("vx0", "vx1", "vx2", false)));
-    body.push(comment("verilator lint_off UNUSEDSIGNAL"));
-    body.push(swire("ymin_c", cy + 1, format!("{} + {}", sext("ymin", cy, cy + 1), slit(cy + 1, 127))));
-    body.push(swire("ymax_c", cy + 1, format!("{} - {} - {}", sext("ymax", cy, cy + 1), slit(cy + 1, 128), zext("kill", 1, cy + 1))));
-    body.push(swire("xmin_c", cx + 1, format!("{} + {}", sext("xmin", cx, cx + 1), slit(cx + 1, 127))));
-    body.push(swire("xmax_c", cx + 1, format!("{} - {}", sext("xmax", cx, cx + 1), slit(cx + 1, 128))));
-    body.push(comment("verilator lint_on UNUSEDSIGNAL"));
-    body.push(swire("first_raw", ryw, format!("ymin_c[{cy}:8]")));
-    body.push(swire("last_raw", ryw, format!("ymax_c[{cy}:8]")));
-    body.push(swire("cfirst", rxw, format!("xmin_c[{cx}:8]")));
-    body.push(swire("clast", rxw, format!("xmax_c[{cx}:8]")));
-    body.push(swire("first_s", ryw, format!("first_raw[{}] ? {} : first_raw", ryw - 1, slit(ryw, 0))));
-    body.push(swire("last_s", ryw, format!("last_raw > {} ? {} : last_raw", slit(ryw, h - 1), slit(ryw, h - 1))));
-    body.push(wire(
-        "cull",
-        1,
-        format!("area == {} || first_s > last_s || cfirst > clast || cfirst > {} || clast[{}]", slit(aw + 1, 0), slit(rxw, w - 1), rxw - 1),
-    ));
-    body.push(Item::Blank);
-
-    // ---- Edge dividers' inputs. Arithmetic is done at the full target width on sign- or
-    // zero-extended operands (right modulo 2^width); only named signed wires are compared.
-    let pw_init = gw + de;
-    let pw_step = gw + cy;
-    let nw = cx + cy + 5;
-    let snw = (cx + 2).max(gw + cy + 1);
-    body.push(comment("Per edge: its active rows, and the dividends of its first bound and of its step, offset by"));
-    body.push(comment("B = 2^(GW-1) divisors so both quotients are non-negative (q = g + B)."));
-    body.push(comment("verilator lint_off UNUSEDSIGNAL"));
-    for k in 0..3 {
-        let (a, bb) = ((k + 1) % 3, (k + 2) % 3);
-        let (ya, yb2, xa) = (format!("vy{a}"), format!("vy{bb}"), format!("vx{a}"));
-        body.push(swire(&format!("yt{k}"), cy, format!("{ya} < {yb2} ? {ya} : {yb2}")));
-        body.push(swire(&format!("yb{k}"), cy, format!("{ya} < {yb2} ? {yb2} : {ya}")));
-        body.push(swire(&format!("ytc{k}"), cy + 1, format!("{} + {}", sext(&format!("yt{k}"), cy, cy + 1), slit(cy + 1, 127))));
-        body.push(swire(&format!("ybc{k}"), cy + 1, format!("{} - {}", sext(&format!("yb{k}"), cy, cy + 1), slit(cy + 1, 128))));
-        body.push(swire(&format!("rs_raw{k}"), ryw, format!("ytc{k}[{cy}:8]")));
-        body.push(swire(&format!("re_raw{k}"), ryw, format!("ybc{k}[{cy}:8]")));
-        body.push(swire(&format!("rs{k}"), ryw, format!("rs_raw{k} > first_s ? rs_raw{k} : first_s")));
-        body.push(swire(&format!("re{k}"), ryw, format!("re_raw{k} < last_s ? re_raw{k} : last_s")));
-        body.push(wire(&format!("act{k}"), 1, format!("dy{k} != {} && rs{k} <= re{k}", slit(cy + 1, 0))));
-        body.push(wire(&format!("ady{k}"), cy, format!("dy{k}[{cy}] ? -dy{k}[{}:0] : dy{k}[{}:0]", cy - 1, cy - 1)));
-        body.push(wire(&format!("rsu{k}"), yw, format!("rs{k}[{}:0]", yw - 1)));
-        // e(128, 256 rs + 128) - t + B D, from vertex a on the edge's line.
-        body.push(swire(
-            &format!("ry{k}"),
-            cy + 2,
-            format!("{} - {}", zext(&format!("{{rsu{k}, 8'd128}}"), yw + 8, cy + 2), sext(&ya, cy, cy + 2)),
-        ));
-        body.push(swire(&format!("rx{k}"), cx + 2, format!("{} - {}", lit(cx + 2, 128), sext(&xa, cx, cx + 2))));
-        body.extend(smul(&format!("m_e{k}"), &format!("dx{k}"), cx + 1, &format!("ry{k}"), cy + 2));
-        body.extend(smul(&format!("m_f{k}"), &format!("dy{k}"), cy + 1, &format!("rx{k}"), cx + 2));
-        body.push(wire(
-            &format!("n{k}"),
-            nw,
-            format!(
-                "{} - {} - {} + ({} << {})",
-                sext(&format!("m_e{k}"), nw - 2, nw),
-                sext(&format!("m_f{k}"), nw - 2, nw),
-                zext(&format!("!tl{k}"), 1, nw),
-                zext(&format!("ady{k}"), cy, nw),
-                gw + 7
-            ),
-        ));
-        body.push(wire(
-            &format!("sn{k}"),
-            snw,
-            format!("{} + ({} << {})", sext(&format!("dx{k}"), cx + 1, snw), zext(&format!("ady{k}"), cy, snw), gw - 1),
-        ));
-    }
-    body.push(comment("verilator lint_on UNUSEDSIGNAL"));
-    body.push(Item::Blank);
-
-    // ---- The plane.
-    body.push(comment("The plane: Nx, Ny (oriented), dI's dividend 2*256|Nx| + |A| and its saturation."));
-    body.push(comment("verilator lint_off UNUSEDSIGNAL"));
-    let iz = |v: &str, to: u32| zext(v, iw, to);
-    body.push(swire("d1", iw + 1, format!("{} - {}", iz("vi1", iw + 1), iz("vi0", iw + 1))));
-    body.push(swire("d2", iw + 1, format!("{} - {}", iz("vi2", iw + 1), iz("vi0", iw + 1))));
-    body.extend(smul("m_x1", "d1", iw + 1, "v2", cy + 1));
-    body.extend(smul("m_x2", "d2", iw + 1, "v1", cy + 1));
-    body.extend(smul("m_y1", "d2", iw + 1, "u1", cx + 1));
-    body.extend(smul("m_y2", "d1", iw + 1, "u2", cx + 1));
-    body.push(wire("nx", nxw, format!("{} - {}", sext("m_x1", nxw - 1, nxw), sext("m_x2", nxw - 1, nxw))));
-    body.push(wire("ny", nyw, format!("{} - {}", sext("m_y1", nyw - 1, nyw), sext("m_y2", nyw - 1, nyw))));
-    body.push(swire("onx", nxw, "neg ? -nx : nx"));
-    body.push(swire("ony", nyw, "neg ? -ny : ny"));
-    body.push(wire("nx_neg", 1, format!("onx[{}]", nxw - 1)));
-    body.push(wire("mag", nxw, "nx_neg ? -onx : onx"));
+    let st = calc(hw);
     let x2w = (nxw + 9).max(aw + 1);
-    let cmpw = x2w.max(aw + iw + 1);
-    body.push(wire("x2", x2w, format!("({} << 9) + {}", zext("mag", nxw, x2w), zext("aabs", aw, x2w))));
-    body.push(wire("di_sat", 1, format!("{} >= ({} << {})", zext("x2", x2w, cmpw), zext("aabs", aw, cmpw), iw + 1)));
-    body.push(comment("verilator lint_on UNUSEDSIGNAL"));
-    body.push(Item::Blank);
-
-    body.push(comment("Normalisation: s leading zeros of |A|, An = |A| << s, and the sums S(0, first), 256 Nx, 256 Ny,"));
-    body.push(comment("each shifted by s and kept modulo 2^K."));
-    let mut chain = lit(sw, (aw - 1) as u64);
-    for bit in 1..aw {
-        chain = format!("aabs[{bit}] ? {} : {chain}", lit(sw, (aw - 1 - bit) as u64));
+    let last = st.stage();
+    // The stages' moves: stage j's triangle moves into stage j + 1 when that one is empty or
+    // moving on; the last stage moves on into the dividers (calc).
+    let valid = |j: usize| if j == 0 { "v_full".to_string() } else { format!("c{j}_v") };
+    let mv = |j: usize| if j == last { "calc".to_string() } else { format!("c{j}_mv") };
+    let v_go = mv(0);
+    for j in 1..=last {
+        body.push(reg(&valid(j), 1));
     }
-    body.push(wire("lz", sw, chain));
-    body.push(wire("an", aw, "aabs << lz"));
+    body.push(wire("calc", 1, format!("{} && (st == IDLE || take)", valid(last))));
+    for j in (0..last).rev() {
+        body.push(wire(&mv(j), 1, format!("{} && (!{} || {})", valid(j), valid(j + 1), mv(j + 1))));
+    }
+    body.push(assign("in_ready", format!("!v_full || {}", mv(0))));
+    // Stages hand on whole values and read slices of some: unused bits are expected here.
     body.push(comment("verilator lint_off UNUSEDSIGNAL"));
-    body.push(wire("first_u", yw, format!("first_s[{}:0]", yw - 1)));
-    body.push(wire("last_u", yw, format!("last_s[{}:0]", yw - 1)));
+    body.extend(st.items());
     body.push(comment("verilator lint_on UNUSEDSIGNAL"));
-    body.push(swire("xo", cx + 2, format!("{} - {}", lit(cx + 2, 128), sext("vx0", cx, cx + 2))));
-    body.push(swire("yo", cy + 2, format!("{} - {}", zext("{first_u, 8'd128}", yw + 8, cy + 2), sext("vy0", cy, cy + 2))));
-    body.push(comment("verilator lint_off WIDTH"));
-    body.push(wire("m_s1", iw + aw, "vi0 * aabs"));
-    body.push(comment("verilator lint_on WIDTH"));
-    body.push(comment("verilator lint_off UNUSEDSIGNAL"));
-    body.extend(smul("m_s2", "onx", nxw, "xo", cx + 2));
-    body.extend(smul("m_s3", "ony", nyw, "yo", cy + 2));
-    body.push(comment("verilator lint_on UNUSEDSIGNAL"));
-    let low = |m: &str, w: u32| if w > kk { format!("{m}[{}:0]", kk - 1) } else { sext(m, w, kk) };
-    body.push(wire("s0", kk, format!("{} + {} + {}", zext("m_s1", iw + aw, kk), low("m_s2", nxw + cx + 2), low("m_s3", nyw + cy + 2))));
-    body.push(wire("tn0", kk, "s0 << lz"));
-    body.push(wire("gxn0", kk, format!("({} << 8) << lz", sext("onx", nxw, kk))));
-    body.push(wire("dyn0", kk, format!("({} << 8) << lz", sext("ony", nyw, kk))));
+    if last > 0 {
+        let mut moves = Vec::new();
+        let mut data = Vec::new();
+        for j in 1..=last {
+            moves.push(Stmt::If(mv(j - 1), vec![set(valid(j), "1'b1")], vec![Stmt::If(mv(j), vec![set(valid(j), "1'b0")], vec![])]));
+            data.push(Stmt::If(mv(j - 1), st.loads(j - 1), vec![]));
+        }
+        body.push(Item::Always(vec![Stmt::If("rst".into(), (1..=last).map(|j| set(valid(j), "1'b0")).collect(), moves)]));
+        body.push(Item::Always(data));
+    }
     body.push(Item::Blank);
-
     // ---- Dividers and the set-up result registers.
+    let (pw_init, pw_step) = (gw + de, gw + cy);
     let divs: Vec<Div> = (0..3)
         .flat_map(|k| {
             [Div { name: ["ei0", "ei1", "ei2"][k], pw: pw_init, qb: gw }, Div { name: ["es0", "es1", "es2"][k], pw: pw_step, qb: gw }]
@@ -439,40 +558,44 @@ pub fn module(hw: &Hw, names: &Names) -> Module {
     for k in 0..3 {
         let ei = &divs[2 * k];
         let es = &divs[2 * k + 1];
+        let ady = st.at(&format!("ady{k}"));
         calc_load.extend(div_load(
             ei,
-            &format!("n{k}[{}:0]", pw_init - 1),
-            &format!("{} << {}", zext(&format!("ady{k}"), cy, pw_init), gw + 7),
+            &format!("{}[{}:0]", st.at(&format!("n{k}")), pw_init - 1),
+            &format!("{} << {}", zext(&ady, cy, pw_init), gw + 7),
         ));
         calc_load.extend(div_load(
             es,
-            &format!("sn{k}[{}:0]", pw_step - 1),
-            &format!("{} << {}", zext(&format!("ady{k}"), cy, pw_step), gw - 1),
+            &format!("{}[{}:0]", st.at(&format!("sn{k}")), pw_step - 1),
+            &format!("{} << {}", zext(&ady, cy, pw_step), gw - 1),
         ));
-        calc_load.push(set(format!("s_act{k}"), format!("act{k}")));
-        calc_load.push(set(format!("s_right{k}"), format!("!dy{k}[{cy}]")));
-        calc_load.push(set(format!("s_rs{k}"), format!("rsu{k}")));
-        calc_load.push(set(format!("s_re{k}"), format!("re{k}[{}:0]", yw - 1)));
-        calc_load.push(set(format!("s_d{k}"), format!("{{ady{k}, 8'd0}}")));
+        calc_load.push(set(format!("s_act{k}"), st.at(&format!("act{k}"))));
+        calc_load.push(set(format!("s_right{k}"), format!("!{}[{cy}]", st.at(&format!("dy{k}")))));
+        calc_load.push(set(format!("s_rs{k}"), st.at(&format!("rsu{k}"))));
+        calc_load.push(set(format!("s_re{k}"), format!("{}[{}:0]", st.at(&format!("re{k}")), yw - 1)));
+        calc_load.push(set(format!("s_d{k}"), format!("{{{ady}, 8'd0}}")));
     }
     let ddi_pw = iw + aw + 1;
-    let x2_fit = if x2w >= ddi_pw { format!("x2[{}:0]", ddi_pw - 1) } else { zext("x2", x2w, ddi_pw) };
-    calc_load.extend(div_load(&divs[6], &x2_fit, &format!("{} << {}", zext("aabs", aw, ddi_pw), iw)));
+    let x2 = st.at("x2");
+    let x2_fit = if x2w >= ddi_pw { format!("{x2}[{}:0]", ddi_pw - 1) } else { zext(&x2, x2w, ddi_pw) };
+    calc_load.extend(div_load(&divs[6], &x2_fit, &format!("{} << {}", zext(&st.at("aabs"), aw, ddi_pw), iw)));
     calc_load.extend(div_load(
         &divs[7],
         &format!("{} << {}", lit(aw + rw + 1, 1), kk),
-        &format!("{} << {}", zext("an", aw, aw + rw + 1), rw),
+        &format!("{} << {}", zext(&st.at("an"), aw, aw + rw + 1), rw),
     ));
-    calc_load.extend([
-        set("s_first", "first_u"),
-        set("s_last", "last_u"),
-        set("s_an", "an"),
-        set("s_tn", "tn0"),
-        set("s_gxn", "gxn0"),
-        set("s_dyn", "dyn0"),
-        set("s_sat", "di_sat"),
-        set("s_dineg", "nx_neg"),
-    ]);
+    for (r, v) in [
+        ("s_first", "first_u"),
+        ("s_last", "last_u"),
+        ("s_an", "an"),
+        ("s_tn", "tn0"),
+        ("s_gxn", "gxn0"),
+        ("s_dyn", "dyn0"),
+        ("s_sat", "di_sat"),
+        ("s_dineg", "nx_neg"),
+    ] {
+        calc_load.push(set(r, st.at(v)));
+    }
     let mut div_run: Vec<Stmt> = divs.iter().flat_map(|d| div_iter(d, bits)).collect();
     div_run.push(Stmt::If(
         format!("div_cnt < {}", lit(cnt_w, bits as u64)),
@@ -490,13 +613,13 @@ pub fn module(hw: &Hw, names: &Names) -> Module {
         vec![set("st", "IDLE"), set("v_full", "1'b0"), set("err", "1'b0")],
         vec![
             set("err", "1'b0"),
-            Stmt::If("in_valid && in_ready".into(), take_in, vec![Stmt::If("calc".into(), vec![set("v_full", "1'b0")], vec![])]),
+            Stmt::If("in_valid && in_ready".into(), take_in, vec![Stmt::If(v_go, vec![set("v_full", "1'b0")], vec![])]),
             Stmt::If(
                 "calc".into(),
                 vec![Stmt::If(
-                    "!guard_ok".into(),
+                    format!("!{}", st.at("guard_ok")),
                     vec![set("err", "1'b1"), set("st", "IDLE")],
-                    vec![Stmt::If("cull".into(), vec![set("st", "IDLE")], calc_load)],
+                    vec![Stmt::If(st.at("cull"), vec![set("st", "IDLE")], calc_load)],
                 )],
                 vec![Stmt::If("st == DIV".into(), div_run, vec![]), Stmt::If("take".into(), vec![set("st", "IDLE")], vec![])],
             ),
@@ -745,6 +868,19 @@ pub fn module(hw: &Hw, names: &Names) -> Module {
             rw,
             div_clocks: hw.div_clocks(),
             div_regs: divs.iter().flat_map(|d| ["p", "d", "q"].map(|r| format!("{}_{r}", d.name))).collect(),
+            calc_stages: (1..=last)
+                .map(|j| crate::formal::CalcStage {
+                    valid: valid(j),
+                    guard: st.held("guard_ok", j).expect("the guard-band check reaches the last stage"),
+                    ymin: st.held("ymin", j),
+                    ymax: st.held("ymax", j),
+                    first_s: st.held("first_s", j),
+                    last_s: st.held("last_s", j),
+                    cull: st.held("cull", j),
+                })
+                .collect(),
+            guard: st.at("guard_ok"),
+            cull: st.at("cull"),
         }));
     }
 

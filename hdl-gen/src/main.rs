@@ -47,8 +47,9 @@ enum Command {
         #[arg(long = "fe-di", value_enum, default_value_t = DiMode::Triangle)]
         fe_di: DiMode,
         /// Register stages added for clock rate, 0..3 (golden::pipeline): 1 registers the span and
-        /// the shader's increments, 2 also its lane sums, 3 cuts the shader's adders so no clock
-        /// has two in a row (same stages as 2). Values and throughput are the same at every
+        /// the shader's increments, splits the specular unit's multiplies and the front-end's
+        /// set-up (CALC in five clocks), 2 also the shader's lane sums, 3 cuts the shader's adders
+        /// so no clock has two in a row (same stages as 2). Values and throughput are the same at every
         /// level; latency grows (manifest.json). 0, the default: SPEC's seed structure, smallest
         /// and shortest (docs/fpga.md compares the levels).
         #[arg(long, default_value_t = 0, value_parser = clap::value_parser!(u32).range(0..=golden::pipeline::Pipeline::MAX as i64))]

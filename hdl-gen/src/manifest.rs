@@ -170,8 +170,9 @@ pub struct ModuleEntry {
     pub latency: u32,
     pub throughput: String,
     pub ports: Vec<PortEntry>,
-    /// The register stages (`golden::segment::stages`) of a pipelined segment shader; absent at
-    /// level 0, whose two stages SPEC's seed fixes (the specular unit's are in `specular`).
+    /// The register stages of a pipelined segment shader (`golden::segment::stages`) or of the
+    /// front-end's CALC (`frontend::calc_stages`); absent at level 0, whose stages SPEC's seed
+    /// fixes (the specular unit's are in `specular`).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub stages: Vec<golden::pipeline::PipeStage>,
 }
@@ -270,10 +271,10 @@ pub fn render(opts: &Options, names: &Names, modules: &[Module], unit: &Specular
             (Role::Rom, 1, "one word per clock")
         };
         let role = if name == &m.name { role } else { Role::Axis };
-        let stages = if role == Role::SegmentShader && opts.pipeline != golden::pipeline::Pipeline::NONE {
-            golden::segment::stages(cfg, opts.pipeline)
-        } else {
-            Vec::new()
+        let stages = match (role, &fe) {
+            (Role::SegmentShader, _) if opts.pipeline != golden::pipeline::Pipeline::NONE => golden::segment::stages(cfg, opts.pipeline),
+            (Role::Frontend, Some(hw)) => crate::frontend::calc_stages(hw),
+            _ => Vec::new(),
         };
         ModuleEntry {
             name: m.name.clone(),
