@@ -10,6 +10,7 @@
 // Set-up: CALC 1 clock(s), 6 divider clocks (8 restoring dividers in parallel, 4 quotient bit(s) a clock), hand-off;
 // 7 clocks per walked triangle, 1 per dropped one; the next triangle is latched meanwhile.
 // Latency: first span valid 11 clocks after the triangle's transfer when the walker is idle.
+// Spans: the walker, then 2 register stages to the output register (I0's path).
 // Walker: one row per clock (rows with no covered pixel make a bubble); the next triangle's set-up overlaps it.
 // Widths: |A| 42, edge bound 15 signed, edge divisor 27, intensity sums modulo 2^64, reciprocal 23.
 
@@ -61,7 +62,7 @@ module tri_frontend (
   assign in_ready = !v_full || calc;
   // verilator lint_off UNUSEDSIGNAL
 
-  // CALC: guard band; vertex differences; bounding box and each edge's row extent, offset to pixel centres.
+  // CALC, step 0 of the clock: guard band; vertex differences; bounding box and each edge's row extent, offset to pixel centres.
   wire guard_ok = (vx0 >= -22'sd163840 && vx0 < 22'sd327680) && (vy0 >= -19'sd122880 && vy0 < 19'sd245760) && (vx1 >= -22'sd163840 && vx1 < 22'sd327680) && (vy1 >= -19'sd122880 && vy1 < 19'sd245760) && (vx2 >= -22'sd163840 && vx2 < 22'sd327680) && (vy2 >= -19'sd122880 && vy2 < 19'sd245760);
   // Edge k runs from vertex k+1 to vertex k+2; u, v span the area, d the intensities.
   wire signed [22:0] u1 = {{1{vx1[21]}}, vx1} - {{1{vx0[21]}}, vx0};
@@ -100,7 +101,7 @@ module tri_frontend (
   wire signed [23:0] rx2 = 24'd128 - {{2{vx0[21]}}, vx0};
   wire signed [23:0] xo = 24'd128 - {{2{vx0[21]}}, vx0};
 
-  // CALC: guard band; vertex differences; bounding box and each edge's row extent, offset to pixel centres.
+  // CALC, step 1 of the clock: the area's and the plane's products; the first row, clipped; each edge's first row and its distance to the edge's vertex.
   // verilator lint_off WIDTH
   wire signed [42:0] m_a1 = u1 * v2;
   // verilator lint_on WIDTH
@@ -145,7 +146,7 @@ module tri_frontend (
   wire signed [20:0] ry2 = {4'd0, {rsu2, 8'd128}} - {{2{vy0[18]}}, vy0};
   wire [18:0] ady2 = rdy2[19] ? -rdy2[18:0] : rdy2[18:0];
 
-  // CALC: guard band; vertex differences; bounding box and each edge's row extent, offset to pixel centres.
+  // CALC, step 2 of the clock: the area, its sign and magnitude; the plane's normal and |Nx|; the edge terms' products, unoriented.
   // Twice the signed area: its sign orients the edges and the plane (interior positive).
   wire signed [42:0] area = m_a1 - m_a2;
   wire neg = area[42];
@@ -174,7 +175,7 @@ module tri_frontend (
   wire signed [43:0] m_f2 = rdy2 * rx2;
   // verilator lint_on WIDTH
 
-  // CALC: guard band; vertex differences; bounding box and each edge's row extent, offset to pixel centres.
+  // CALC, step 3 of the clock: orientation: edges, top-left rule, last row, cull; the edge dividers' dividends; |A|'s leading zeros; dI's dividend; the first-row sum's products.
   // Orientation: edge k's direction with the interior on its left; the top-left rule.
   wire signed [22:0] dx0 = neg ? -rdx0 : rdx0;
   wire signed [19:0] dy0 = neg ? -rdy0 : rdy0;
@@ -227,7 +228,7 @@ module tri_frontend (
   wire signed [65:0] m_s3 = ny * yo;
   // verilator lint_on WIDTH
 
-  // CALC: guard band; vertex differences; bounding box and each edge's row extent, offset to pixel centres.
+  // CALC, step 4 of the clock: the first-row sum and the plane terms, normalised; the dividers loaded, or the triangle dropped or culled.
   wire [63:0] s0 = {2'd0, m_s1} + (neg ? -m_s2[63:0] : m_s2[63:0]) + (neg ? -m_s3[63:0] : m_s3[63:0]);
   wire [63:0] tn0 = s0 << lz;
   // The rows, once the triangle is not culled: first_s >= 0, first_s <= last_s < height.
@@ -644,7 +645,6 @@ module tri_frontend (
   wire [15:0] len_w = hi3 - lo3 + 1;
   // verilator lint_on UNUSEDSIGNAL
   wire [11:0] lo_u = lo3[11:0];
-  wire [63:0] s2n = ((w_tn + w_gxn * {52'd0, lo_u}) << 1) + {22'd0, w_an};
   wire [27:0] rsum0 = {1'd0, w_rem0} + {1'd0, w_rs256_0};
   wire cy0 = rsum0 >= {1'd0, w_d0};
   // verilator lint_off UNUSEDSIGNAL
@@ -722,28 +722,48 @@ module tri_frontend (
     end
   end
 
-  // I0: q~ = (S2n Rn) >> K is the quotient or one below it; one compare corrects it.
   reg p1_v;
+  reg p2_v;
+  // Stage registers: p<j>_<name> holds <name> in stage j (whole values: a stage
+  // may read a slice only).
+  reg [63:0] p1_s2n;
+  reg [22:0] p1_rn;
+  reg [41:0] p1_an;
   reg [8:0] p1_y;
   reg [11:0] p1_x;
   reg [12:0] p1_len;
   reg [20:0] p1_di;
-  reg [63:0] p1_s2n;
-  reg [22:0] p1_rn;
-  reg [41:0] p1_an;
-  reg p2_v;
+  reg [41:0] p2_an;
+  reg [19:0] p2_qt;
+  reg [43:0] p2_lo;
   reg [8:0] p2_y;
   reg [11:0] p2_x;
   reg [12:0] p2_len;
   reg [20:0] p2_di;
-  reg [43:0] p2_lo;
-  reg [19:0] p2_qt;
-  reg [41:0] p2_an;
+
+  // Span path, step 0 (stage p0): the walker: the row's bounds, clipped, and whether it has a covered pixel.
+
+  // Span path, step 1 (stage p0): Gxn lo, the plane's step to the first pixel.
+  wire [63:0] gx = w_gxn * {52'd0, lo_u};
+
+  // Span path, step 2 (stage p0): S2n = 2 (Tn + Gxn lo) + An.
+  wire [63:0] s2n = ((w_tn + gx) << 1) + {22'd0, w_an};
+
+  // Span path, step 3 (stage p1): S2n Rn, as two partial products when registered apart.
+  wire [43:0] lo = p1_s2n[43:0];
+
+  // Span path, step 4 (stage p1): the quotient estimate q~ = (S2n Rn) >> K, the quotient or one below it.
   // verilator lint_off UNUSEDSIGNAL
   wire [86:0] prod = {23'd0, p1_s2n} * {64'd0, p1_rn};
   // verilator lint_on UNUSEDSIGNAL
+  wire [19:0] qt = prod[83:64];
+
+  // Span path, step 5 (stage p2): q~ 2An.
   wire [43:0] an2 = {2'd0, p2_an} << 1;
-  wire [43:0] corr = p2_lo - {24'd0, p2_qt} * an2;
+  wire [43:0] m = {24'd0, p2_qt} * an2;
+
+  // Span path, step 6 (stage p2): I0 = q~ + (S2n - 2 An q~ >= 2 An), the correction.
+  wire [43:0] corr = p2_lo - m;
   wire [19:0] i0 = p2_qt + {19'd0, corr >= an2};
   always @(posedge clk) begin
     if (rst) begin
@@ -752,21 +772,21 @@ module tri_frontend (
       out_valid <= 1'b0;
     end else if (adv) begin
       p1_v <= emit;
+      p2_v <= p1_v;
+      p1_s2n <= s2n;
+      p1_rn <= w_rn;
+      p1_an <= w_an;
       p1_y <= w_row;
       p1_x <= lo_u;
       p1_len <= len_w[12:0];
       p1_di <= w_di;
-      p1_s2n <= s2n;
-      p1_rn <= w_rn;
-      p1_an <= w_an;
-      p2_v <= p1_v;
+      p2_an <= p1_an;
+      p2_qt <= qt;
+      p2_lo <= lo;
       p2_y <= p1_y;
       p2_x <= p1_x;
       p2_len <= p1_len;
       p2_di <= p1_di;
-      p2_lo <= p1_s2n[43:0];
-      p2_qt <= prod[83:64];
-      p2_an <= p1_an;
       out_valid <= p2_v;
       out_y <= p2_y;
       out_x <= p2_x;

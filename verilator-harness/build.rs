@@ -325,21 +325,24 @@ fn generated_models() -> Vec<Model> {
                         axis: None,
                         sources: vec![(format!("{}.v", m.name), m.render())],
                     });
-                    // The set-up's CALC in stages (`--pipeline 1` and above: one front-end for them all).
-                    let staged = hdl_gen::frontend::Hw { pipeline: Pipeline::at(1), ..hw };
-                    let m = hdl_gen::frontend::module(&staged, &names);
-                    models.push(Model {
-                        tag: "fe_pl1".into(),
-                        kind: Kind::Frontend,
-                        cfg,
-                        di: DiMode::Triangle,
-                        screen: fe.screen,
-                        top: m.name.clone(),
-                        latency: staged.latency(),
-                        pipeline: staged.pipeline,
-                        axis: None,
-                        sources: vec![(format!("{}.v", m.name), m.render())],
-                    });
+                    // The set-up and the span path in stages (`--pipeline 1` and above: one
+                    // front-end for them all), with each dI mode.
+                    for (tag, di) in [("fe_pl1", DiMode::Triangle), ("fe_scan_pl1", DiMode::Scanline)] {
+                        let staged = hdl_gen::frontend::Hw { fe: fe.with_di(di), pipeline: Pipeline::at(1), ..hw };
+                        let m = hdl_gen::frontend::module(&staged, &names);
+                        models.push(Model {
+                            tag: tag.into(),
+                            kind: Kind::Frontend,
+                            cfg,
+                            di,
+                            screen: fe.screen,
+                            top: m.name.clone(),
+                            latency: staged.latency(),
+                            pipeline: staged.pipeline,
+                            axis: None,
+                            sources: vec![(format!("{}.v", m.name), m.render())],
+                        });
+                    }
                     // The other divider rates (`--fe-div-bits`), so co-simulation covers every option.
                     for div_bits in hdl_gen::frontend::DIV_BITS.into_iter().filter(|&b| b != hw.div_bits) {
                         let hw = hdl_gen::frontend::Hw { div_bits, ..hw };

@@ -46,7 +46,7 @@ pub fn numbered(body: Vec<(&str, String, Vec<PipeReg>)>) -> Vec<PipeStage> {
 /// | level | segment shader | specular unit | front-end set-up |
 /// |--:|---|---|---|
 /// | 0 | as SPEC's seed: 2 stages | 5 stages | CALC in one clock |
-/// | 1 | + a span register; the BFPI's multiples and the last-segment flag registered | + both multiplies split into registered 4-bit partial products and their sum; the BRDF address registered before the ROM, both ROMs' words registered before any arithmetic: 10 stages | CALC in five clocks ([`SETUP_STAGES`]), overlapped with the dividers |
+/// | 1 | + a span register; the BFPI's multiples and the last-segment flag registered | + both multiplies split into registered 4-bit partial products and their sum; the BRDF address registered before the ROM, both ROMs' words registered before any arithmetic: 10 stages | CALC in five clocks ([`SETUP_STAGES`]), overlapped with the dividers; the span path in six ([`I0_STAGES`]) instead of two |
 /// | 2 | + the lane sums registered before round and clamp | as level 1 | as level 1 |
 /// | 3 | + no clock with two adders in a row: the BFPI's first adder level formed as the span enters its register, the rest when it starts; each lane's sum split at the binary point (high part and the fraction's carry registered, joined before the clamp) | as level 1 | as level 1 |
 ///
@@ -142,6 +142,29 @@ impl Pipeline {
         }
     }
 }
+
+/// The front-end's spans from the walker to the output, in logical stages: which boundaries
+/// between them are registered. SPEC's seed structure (level 0) registers two, after `S2n` and
+/// after the quotient estimate; from level 1 every one is, so each clock has one multiply or
+/// two adders at most ([`I0_STAGES`]).
+pub fn i0_registers(level: Pipeline) -> [bool; I0_STAGES.len() - 1] {
+    if level.0 >= 1 {
+        [true; I0_STAGES.len() - 1]
+    } else {
+        [false, false, true, false, true, false]
+    }
+}
+
+/// The front-end's span path in logical stages, walker first, the output register after the last.
+pub const I0_STAGES: [&str; 7] = [
+    "the walker: the row's bounds, clipped, and whether it has a covered pixel",
+    "Gxn lo, the plane's step to the first pixel",
+    "S2n = 2 (Tn + Gxn lo) + An",
+    "S2n Rn, as two partial products when registered apart",
+    "the quotient estimate q~ = (S2n Rn) >> K, the quotient or one below it",
+    "q~ 2An",
+    "I0 = q~ + (S2n - 2 An q~ >= 2 An), the correction",
+];
 
 /// The front-end set-up's CALC stages when it is pipelined, in order: what each clock computes
 /// from the registers of the one before (the first from the vertex registers). At level 0 the

@@ -728,6 +728,18 @@ pub struct FrontendShape {
     /// The names under which the last CALC stage holds the guard-band check and the cull.
     pub guard: String,
     pub cull: String,
+    /// The span path's register stages between the walker and the output, in order.
+    pub span_stages: Vec<SpanStage>,
+}
+
+/// A register stage of the front-end's span path: where it holds a span's valid, row, columns
+/// and `dI`.
+pub struct SpanStage {
+    pub valid: String,
+    pub y: String,
+    pub x: String,
+    pub len: String,
+    pub di: String,
 }
 
 /// A CALC stage of the pipelined set-up: its valid register and where it holds what the
@@ -787,7 +799,10 @@ pub fn frontend_properties(s: &FrontendShape) -> Item {
         ref calc_stages,
         ref guard,
         ref cull,
+        ref span_stages,
     } = *s;
+    // The span path's stages: the reference's f_<i>v, f_<i>y, f_<i>n for i = 1..=nsp.
+    let nsp = span_stages.len();
     // CALC's stages: 0 is the vertex register, 1.. the pipelined set-up's (none at level 0).
     let last = calc_stages.len();
     let f_v = |j: usize| if j == 0 { "f_vf".to_string() } else { format!("f_c{j}v") };
@@ -850,9 +865,16 @@ pub fn frontend_properties(s: &FrontendShape) -> Item {
     b.push(Item::Reg { name: "f_wymin".into(), width: cy, signed: true });
     b.push(Item::Reg { name: "f_wymax".into(), width: cy, signed: true });
     b.push(comment("The spans: the walker's row in the two I0 stages and the output (valid, row)."));
-    b.extend([reg("f_1v", 1), reg("f_1y", yw), reg("f_2v", 1), reg("f_2y", yw), reg("f_ov", 1), reg("f_oy", yw)]);
+    for i in 1..=nsp {
+        b.extend([reg(&format!("f_{i}v"), 1), reg(&format!("f_{i}y"), yw)]);
+    }
+    b.extend([reg("f_ov", 1), reg("f_oy", yw)]);
     b.push(comment("Each span's tag: its triangle's first (the walker has emitted none of it yet: f_wnew)."));
-    b.extend([reg("f_wnew", 1), reg("f_1n", 1), reg("f_2n", 1), reg("f_on", 1)]);
+    b.push(reg("f_wnew", 1));
+    for i in 1..=nsp {
+        b.push(reg(&format!("f_{i}n"), 1));
+    }
+    b.push(reg("f_on", 1));
     b.push(comment("The dI of the last span offered, and whether the output register could load (f_free):"));
     b.push(comment("a span on the output is new when it is valid and f_free."));
     b.extend([reg("f_pdi", dw), reg("f_free", 1)]);
@@ -926,17 +948,11 @@ pub fn frontend_properties(s: &FrontendShape) -> Item {
     );
     let spans = when(
         "f_adv",
-        vec![
-            set("f_1v", "f_wv && f_cover"),
-            set("f_1y", "f_wrow"),
-            set("f_1n", "f_wnew"),
-            set("f_2v", "f_1v"),
-            set("f_2y", "f_1y"),
-            set("f_2n", "f_1n"),
-            set("f_ov", "f_2v"),
-            set("f_oy", "f_2y"),
-            set("f_on", "f_2n"),
-        ],
+        vec![set("f_1v", "f_wv && f_cover"), set("f_1y", "f_wrow"), set("f_1n", "f_wnew")]
+            .into_iter()
+            .chain((2..=nsp).flat_map(|i| ["v", "y", "n"].map(|f| set(format!("f_{i}{f}"), format!("f_{}{f}", i - 1)))))
+            .chain(["v", "y", "n"].map(|f| set(format!("f_o{f}"), format!("f_{nsp}{f}"))))
+            .collect(),
     );
     let input = Stmt::If(
         "f_acc".into(),
@@ -958,11 +974,9 @@ pub fn frontend_properties(s: &FrontendShape) -> Item {
         vec![set("f_vf", "1'b0")]
             .into_iter()
             .chain((1..=last).map(|j| set(f_v(j), "1'b0")))
+            .chain([set("f_sb", "1'b0"), set("f_wv", "1'b0")])
+            .chain((1..=nsp).map(|i| set(format!("f_{i}v"), "1'b0")))
             .chain([
-                set("f_sb", "1'b0"),
-                set("f_wv", "1'b0"),
-                set("f_1v", "1'b0"),
-                set("f_2v", "1'b0"),
                 set("f_ov", "1'b0"),
                 set("f_errp", "1'b0"),
                 set("f_nacc", zero.clone()),
@@ -1044,7 +1058,11 @@ pub fn frontend_properties(s: &FrontendShape) -> Item {
     b.push(comment("Every span the walker produced is offered once: taken at the port, or still in a stage."));
     b.push(Item::Comb(vec![when(
         "f_past",
-        vec![assert(format!("f_nrow == f_nout + {} + {} + {}", zext("f_1v", 1, cw), zext("f_2v", 1, cw), zext("f_ov", 1, cw)))],
+        vec![assert(format!(
+            "f_nrow == f_nout{} + {}",
+            (1..=nsp).map(|i| format!(" + {}", zext(&format!("f_{i}v"), 1, cw))).collect::<String>(),
+            zext("f_ov", 1, cw)
+        ))],
     )]));
 
     b.push(comment("Linking invariants: every stage's registers are the reference's; a row's centre"));
@@ -1100,18 +1118,25 @@ pub fn frontend_properties(s: &FrontendShape) -> Item {
         when("f_sb", su),
         assert("w_valid == f_wv"),
         when("f_wv", wk),
-        assert("p1_v == f_1v"),
-        when("f_1v", vec![assert("p1_y == f_1y")]),
-        assert("p2_v == f_2v"),
-        when("f_2v", vec![assert("p2_y == f_2y")]),
     ]);
+    for (i, sp) in span_stages.iter().enumerate().map(|(k, sp)| (k + 1, sp)) {
+        link.push(assert(format!("{} == f_{i}v", sp.valid)));
+        link.push(when(format!("f_{i}v"), vec![assert(format!("{} == f_{i}y", sp.y))]));
+    }
     link.push(Stmt::Comment("A span that is not its triangle's first has the dI of the span ahead of it.".into()));
     link.push(when("f_ov && !f_free", vec![assert("out_di == f_pdi")]));
-    link.push(when("f_2v && !f_2n", vec![assert("p2_di == (f_ov ? out_di : f_pdi)")]));
-    link.push(when("f_1v && !f_1n", vec![assert("p1_di == (f_2v ? p2_di : f_ov ? out_di : f_pdi)")]));
-    link.push(when("f_wv && !f_wnew", vec![assert("w_di == (f_1v ? p1_di : f_2v ? p2_di : f_ov ? out_di : f_pdi)")]));
-    link.push(on_screen("p1_v", "p1_x", "p1_len"));
-    link.push(on_screen("p2_v", "p2_x", "p2_len"));
+    // The dI ahead of stage i (i = nsp + 1: the output's): the nearest valid stage's, else the
+    // output's or the last span offered.
+    let ahead = |i: usize| {
+        (i..=nsp).rev().fold("f_ov ? out_di : f_pdi".to_string(), |acc, k| format!("f_{k}v ? {} : {acc}", span_stages[k - 1].di))
+    };
+    for (i, sp) in span_stages.iter().enumerate().map(|(k, sp)| (k + 1, sp)).rev() {
+        link.push(when(format!("f_{i}v && !f_{i}n"), vec![assert(format!("{} == ({})", sp.di, ahead(i + 1)))]));
+    }
+    link.push(when("f_wv && !f_wnew", vec![assert(format!("w_di == ({})", ahead(1)))]));
+    for sp in span_stages {
+        link.push(on_screen(&sp.valid, &sp.x, &sp.len));
+    }
     b.push(Item::Comb(vec![when("f_past", link)]));
     Item::Formal(b)
 }

@@ -17,6 +17,8 @@
 //!   next triangle in the clock its current one finishes, so set-up overlaps the walk.
 //! - **I0 pipeline** (two stages after the walker): `S2n = 2 (Tn + Gxn lo) + An` in the
 //!   walker's clock, then `q~ = (S2n Rn) >> K`, then the correction `q~ + (S2n - 2 An q~ >= 2 An)`.
+//!   At `--pipeline 1` and above six stages, one multiply or two adders each
+//!   ([`golden::pipeline::I0_STAGES`]), the product by `Rn` in two registered halves.
 //!   One stall signal holds the walker and every stage while the output waits.
 
 mod stager;
@@ -61,11 +63,17 @@ impl Hw {
         self.pipeline.calc_clocks()
     }
 
+    /// Register stages between the walker and the output register: 2, or 6 at `--pipeline 1`
+    /// and above ([`golden::pipeline::i0_registers`]).
+    pub fn i0_stages(&self) -> u32 {
+        golden::pipeline::i0_registers(self.pipeline).iter().filter(|&&r| r).count() as u32
+    }
+
     /// Clocks from a triangle's transfer to the first span's `out_valid` when the walker is
-    /// idle: CALC, the dividers, the hand-off, the walker's clock, two pipeline stages (and, per
-    /// scanline, the span's division when it has two pixels or more).
+    /// idle: CALC, the dividers, the hand-off, the walker's clock, the span path's stages (and,
+    /// per scanline, the span's division when it has two pixels or more).
     pub fn latency(&self) -> u32 {
-        self.calc_clocks() + self.div_clocks() + 4 + self.span_div_clocks()
+        self.calc_clocks() + self.div_clocks() + 2 + self.i0_stages() + self.span_div_clocks()
     }
 
     /// Clocks from a triangle's transfer to the first segment out of `tri_shader_p<P>` when idle:
@@ -206,16 +214,15 @@ fn calc(hw: &Hw) -> Stager {
     let (w, h) = (fe.screen.width as i64, fe.screen.height as i64);
     let (nxw, nyw, rxw, ryw) = (iw + cy + 3, iw + cx + 3, xw + 3, cy - 7);
     let cuts = hw.pipeline.calc_clocks() as usize - 1;
-    let mut st = Stager::new(cuts);
+    let mut st = Stager::new("c", vec![cuts > 0; golden::pipeline::SETUP_STAGES.len() - 1]);
     for k in 0..3 {
         st.input(&format!("vx{k}"), cx, true);
         st.input(&format!("vy{k}"), cy, true);
         st.input(&format!("vi{k}"), iw, false);
     }
     let section = |st: &mut Stager| {
-        let j = st.stage();
-        let what = golden::pipeline::SETUP_STAGES[if cuts == 0 { 0 } else { j }];
-        let head = if cuts == 0 { "CALC".to_string() } else { format!("CALC stage {j}") };
+        let what = golden::pipeline::SETUP_STAGES[st.logical()];
+        let head = if cuts == 0 { format!("CALC, step {} of the clock", st.logical()) } else { format!("CALC stage {}", st.stage()) };
         st.note(Item::Blank);
         st.note(comment(format!("{head}: {what}.")));
     };
@@ -470,6 +477,7 @@ pub fn module(hw: &Hw, names: &Names) -> Module {
             }
         ),
         format!("Latency: first span valid {} clocks after the triangle's transfer when the walker is idle.", hw.latency()),
+        format!("Spans: the walker, then {} register stages to the output register (I0's path).", hw.i0_stages()),
         "Walker: one row per clock (rows with no covered pixel make a bubble); the next triangle's set-up overlaps it.".into(),
         format!("Widths: |A| {aw}, edge bound {gw} signed, edge divisor {de}, intensity sums modulo 2^{kk}, reciprocal {rw}."),
     ];
@@ -691,7 +699,6 @@ pub fn module(hw: &Hw, names: &Names) -> Module {
     body.push(wire("len_w", bw, "hi3 - lo3 + 1"));
     body.push(comment("verilator lint_on UNUSEDSIGNAL"));
     body.push(wire("lo_u", xw, format!("lo3[{}:0]", xw - 1)));
-    body.push(wire("s2n", kk, format!("((w_tn + w_gxn * {}) << 1) + {}", zext("lo_u", xw, kk), zext("w_an", aw, kk))));
     for k in 0..3 {
         body.push(wire(
             &format!("rsum{k}"),
@@ -749,47 +756,150 @@ pub fn module(hw: &Hw, names: &Names) -> Module {
     )]));
     body.push(Item::Blank);
 
-    // ---- I0 pipeline.
-    body.push(comment("I0: q~ = (S2n Rn) >> K is the quotient or one below it; one compare corrects it."));
-    for (n, ww) in
-        [("p1_v", 1), ("p1_y", yw), ("p1_x", xw), ("p1_len", xw + 1), ("p1_di", dw), ("p1_s2n", kk), ("p1_rn", rw), ("p1_an", aw)]
-    {
-        body.push(reg(n, ww));
-    }
-    for (n, ww) in
-        [("p2_v", 1), ("p2_y", yw), ("p2_x", xw), ("p2_len", xw + 1), ("p2_di", dw), ("p2_lo", aw + 2), ("p2_qt", iw), ("p2_an", aw)]
-    {
-        body.push(reg(n, ww));
-    }
-    if scan {
-        body.push(comment("The same for the span's last pixel: its intensity, as the edge gives it."));
-        body.push(wire("hi_u", xw, format!("hi3[{}:0]", xw - 1)));
-        body.push(wire("s2h", kk, format!("((w_tn + w_gxn * {}) << 1) + {}", zext("hi_u", xw, kk), zext("w_an", aw, kk))));
-        body.extend([reg("p1_s2h", kk), reg("p2_hi", aw + 2), reg("p2_qh", iw)]);
-    }
+    // ---- I0: the span path, written once as its logical stages (`I0_STAGES`), registered where
+    // the pipeline level asks; every register moves on `adv`, so one stall holds them all.
+    let mut sp = Stager::new("p", golden::pipeline::i0_registers(hw.pipeline).to_vec());
+    let i0_section = |sp: &mut Stager| {
+        let what = golden::pipeline::I0_STAGES[sp.logical()];
+        sp.note(Item::Blank);
+        sp.note(comment(format!("Span path, step {} (stage p{}): {what}.", sp.logical(), sp.stage())));
+    };
     let pr = kk + rw;
-    body.push(comment("verilator lint_off UNUSEDSIGNAL"));
-    body.push(wire("prod", pr, format!("{} * {}", zext("p1_s2n", kk, pr), zext("p1_rn", rw, pr))));
-    body.push(comment("verilator lint_on UNUSEDSIGNAL"));
     let cw = aw + 2;
-    body.push(wire("an2", cw, format!("{} << 1", zext("p2_an", aw, cw))));
-    body.push(wire("corr", cw, format!("p2_lo - {} * an2", zext("p2_qt", iw, cw))));
-    body.push(wire("i0", iw, format!("p2_qt + {}", zext("corr >= an2", 1, iw))));
-    let mut p_scan = Vec::new();
+    let half = rw / 2;
+    // The span's first pixel's intensity and, per scanline, its last pixel's, the edge's value
+    // there: the same path twice, under these names.
+    struct End {
+        x: &'static str,
+        gx: &'static str,
+        s2: &'static str,
+        lo: &'static str,
+        pl: &'static str,
+        ph: &'static str,
+        prod: &'static str,
+        qt: &'static str,
+        m: &'static str,
+        corr: &'static str,
+        out: &'static str,
+    }
+    let head = End { x: "x", gx: "gx", s2: "s2n", lo: "lo", pl: "pl", ph: "ph", prod: "prod", qt: "qt", m: "m", corr: "corr", out: "i0" };
+    let tail = End {
+        x: "xh",
+        gx: "gxh",
+        s2: "s2h",
+        lo: "hi",
+        pl: "plh",
+        ph: "phh",
+        prod: "prodh",
+        qt: "qh",
+        m: "mh",
+        corr: "corrh",
+        out: "ilast",
+    };
+    let ends: Vec<&End> = if scan { vec![&head, &tail] } else { vec![&head] };
+    i0_section(&mut sp);
+    for (n, ww, src) in [
+        ("y", yw, "w_row".to_string()),
+        ("x", xw, "lo_u".into()),
+        ("len", xw + 1, format!("len_w[{xw}:0]")),
+        ("tn", kk, "w_tn".into()),
+        ("gxn", kk, "w_gxn".into()),
+        ("an", aw, "w_an".into()),
+        ("rn", rw, "w_rn".into()),
+    ] {
+        sp.input_as(n, ww, false, &src);
+    }
     if scan {
+        sp.input_as("xh", xw, false, &format!("hi3[{}:0]", xw - 1));
         body.push(comment("verilator lint_off UNUSEDSIGNAL"));
-        body.push(wire("prodh", pr, format!("{} * {}", zext("p1_s2h", kk, pr), zext("p1_rn", rw, pr))));
+        body.push(wire("unused_di", dw, "w_di"));
         body.push(comment("verilator lint_on UNUSEDSIGNAL"));
-        body.push(wire("corrh", cw, format!("p2_hi - {} * an2", zext("p2_qh", iw, cw))));
-        body.push(wire("ilast", iw, format!("p2_qh + {}", zext("corrh >= an2", 1, iw))));
-        body.push(comment("dI = round(|I_last - I0| / (m - 1)), its sign apart: (2 |N| + D) / 2D, D = m - 1."));
-        body.push(wire("p2_div", 1, format!("p2_len > {}", lit(xw + 1, 1))));
-        body.push(wire("nabs", iw, "ilast >= i0 ? ilast - i0 : i0 - ilast"));
-        body.push(wire("dm1", xw + 1, format!("p2_len - {}", lit(xw + 1, 1))));
-        body.extend(div_chain(&sdv, "sd_cnt", sd_cw, hw.div_bits));
-        body.push(wire("sd_fin", 1, format!("sd_cnt < {}", lit(sd_cw, hw.div_bits as u64))));
+    } else {
+        sp.input_as("di", dw, false, "w_di");
+    }
+    sp.cut();
+    i0_section(&mut sp);
+    for e in &ends {
+        sp.def(e.gx, kk, false, format!("{} * {}", sp.at("gxn"), zext(&sp.at(e.x), xw, kk)));
+    }
+    sp.cut();
+    i0_section(&mut sp);
+    for e in &ends {
+        sp.def(e.s2, kk, false, format!("(({} + {}) << 1) + {}", sp.at("tn"), sp.at(e.gx), zext(&sp.at("an"), aw, kk)));
+    }
+    sp.cut();
+    i0_section(&mut sp);
+    let split = sp.registered_next();
+    for e in &ends {
+        let s2 = sp.at(e.s2);
+        sp.def(e.lo, cw, false, format!("{s2}[{}:0]", cw - 1));
+        if split {
+            let rn = sp.at("rn");
+            sp.def(
+                e.pl,
+                kk + half,
+                false,
+                format!("{} * {}", zext(&s2, kk, kk + half), zext(&format!("{rn}[{}:0]", half - 1), half, kk + half)),
+            );
+            sp.def(
+                e.ph,
+                kk + rw - half,
+                false,
+                format!("{} * {}", zext(&s2, kk, kk + rw - half), zext(&format!("{rn}[{}:{half}]", rw - 1), rw - half, kk + rw - half)),
+            );
+        }
+    }
+    sp.cut();
+    i0_section(&mut sp);
+    sp.note(comment("verilator lint_off UNUSEDSIGNAL"));
+    for e in &ends {
+        let prod = if split {
+            let (pl, ph) = (sp.at(e.pl), sp.at(e.ph));
+            format!("{} + ({} << {half})", zext(&pl, kk + half, pr), zext(&ph, kk + rw - half, pr))
+        } else {
+            format!("{} * {}", zext(&sp.at(e.s2), kk, pr), zext(&sp.at("rn"), rw, pr))
+        };
+        sp.def(e.prod, pr, false, prod);
+    }
+    sp.note(comment("verilator lint_on UNUSEDSIGNAL"));
+    for e in &ends {
+        sp.def(e.qt, iw, false, format!("{}[{}:{kk}]", e.prod, kk + iw - 1));
+    }
+    sp.cut();
+    i0_section(&mut sp);
+    sp.def("an2", cw, false, format!("{} << 1", zext(&sp.at("an"), aw, cw)));
+    for e in &ends {
+        sp.def(e.m, cw, false, format!("{} * an2", zext(&sp.at(e.qt), iw, cw)));
+    }
+    sp.cut();
+    i0_section(&mut sp);
+    let an2 = sp.at("an2");
+    for e in &ends {
+        let (lo, m, qt) = (sp.at(e.lo), sp.at(e.m), sp.at(e.qt));
+        sp.def(e.corr, cw, false, format!("{lo} - {m}"));
+        sp.def(e.out, iw, false, format!("{qt} + {}", zext(&format!("{} >= {an2}", e.corr), 1, iw)));
+    }
+    let (oy, ox, olen) = (sp.at("y"), sp.at("x"), sp.at("len"));
+    let odi = if scan { lit(dw, 0) } else { sp.at("di") };
+    let nsp = sp.stage();
+    let pv = |j: usize| format!("p{j}_v");
+    for j in 1..=nsp {
+        body.push(reg(&pv(j), 1));
+    }
+    let mut p_scan = Vec::new();
+    let mut ostall = vec![];
+    if scan {
+        sp.note(comment("dI = round(|I_last - I0| / (m - 1)), its sign apart: (2 |N| + D) / 2D, D = m - 1."));
+        sp.def("p_div", 1, false, format!("{olen} > {}", lit(xw + 1, 1)));
+        sp.def("nabs", iw, false, "ilast >= i0 ? ilast - i0 : i0 - ilast");
+        sp.def("dm1", xw + 1, false, format!("{olen} - {}", lit(xw + 1, 1)));
+        sp.note(Item::Blank);
+        for item in div_chain(&sdv, "sd_cnt", sd_cw, hw.div_bits) {
+            sp.note(item);
+        }
+        sp.def("sd_fin", 1, false, format!("sd_cnt < {}", lit(sd_cw, hw.div_bits as u64)));
         let q = format!("sdv_q{}", hw.div_bits);
-        body.push(wire("sd_di", dw, format!("sd_neg ? -{} : {}", zext(&q, iw, dw), zext(&q, iw, dw))));
+        sp.def("sd_di", dw, false, format!("sd_neg ? -{} : {}", zext(&q, iw, dw), zext(&q, iw, dw)));
         let mut start = vec![set("sd_busy", "1'b1"), set("sd_cnt", lit(sd_cw, (sq - 1) as u64)), set("sd_neg", "ilast < i0")];
         start.extend(div_load(
             &sdv,
@@ -802,55 +912,31 @@ pub fn module(hw: &Hw, names: &Names) -> Module {
             vec![set("sd_busy", "1'b0")],
             vec![set("sd_cnt", format!("sd_cnt - {}", lit(sd_cw, hw.div_bits as u64)))],
         ));
-        body.push(Item::Always(vec![Stmt::If(
+        p_scan.push(Item::Always(vec![Stmt::If(
             "rst".into(),
             vec![set("sd_busy", "1'b0")],
-            vec![Stmt::If("adv && p2_v && p2_div".into(), start, vec![Stmt::If("sd_busy".into(), run, vec![])])],
+            vec![Stmt::If(format!("adv && {} && p_div", pv(nsp)), start, vec![Stmt::If("sd_busy".into(), run, vec![])])],
         )]));
-        body.push(comment("verilator lint_off UNUSEDSIGNAL"));
-        body.push(wire("unused_di", dw, "p2_di"));
-        body.push(comment("verilator lint_on UNUSEDSIGNAL"));
-        p_scan =
-            vec![set("p1_s2h", "s2h"), set("p2_hi", format!("p1_s2h[{}:0]", cw - 1)), set("p2_qh", format!("prodh[{}:{kk}]", kk + iw - 1))];
+        ostall = vec![Stmt::If("sd_busy && sd_fin".into(), vec![set("out_valid", "1'b1"), set("out_di", "sd_di")], vec![])];
     }
-    body.push(Item::Always(vec![Stmt::If(
-        "rst".into(),
-        vec![set("p1_v", "1'b0"), set("p2_v", "1'b0"), set("out_valid", "1'b0")],
-        vec![Stmt::If(
-            "adv".into(),
-            vec![
-                set("p1_v", "emit"),
-                set("p1_y", "w_row"),
-                set("p1_x", "lo_u"),
-                set("p1_len", format!("len_w[{xw}:0]")),
-                set("p1_di", "w_di"),
-                set("p1_s2n", "s2n"),
-                set("p1_rn", "w_rn"),
-                set("p1_an", "w_an"),
-                set("p2_v", "p1_v"),
-                set("p2_y", "p1_y"),
-                set("p2_x", "p1_x"),
-                set("p2_len", "p1_len"),
-                set("p2_di", "p1_di"),
-                set("p2_lo", format!("p1_s2n[{}:0]", cw - 1)),
-                set("p2_qt", format!("prod[{}:{kk}]", kk + iw - 1)),
-                set("p2_an", "p1_an"),
-                set("out_valid", if scan { "p2_v && !p2_div" } else { "p2_v" }),
-                set("out_y", "p2_y"),
-                set("out_x", "p2_x"),
-                set("out_len", "p2_len"),
-                set("out_i0", "i0"),
-                set("out_di", if scan { lit(dw, 0) } else { "p2_di".into() }),
-            ]
-            .into_iter()
-            .chain(p_scan)
-            .collect(),
-            match scan {
-                true => vec![Stmt::If("sd_busy && sd_fin".into(), vec![set("out_valid", "1'b1"), set("out_di", "sd_di")], vec![])],
-                false => vec![],
-            },
-        )],
-    )]));
+    body.extend(sp.items());
+    body.extend(p_scan);
+    let mut moves: Vec<Stmt> = vec![set(pv(1), "emit")];
+    moves.extend((2..=nsp).map(|j| set(pv(j), pv(j - 1))));
+    for j in 0..nsp {
+        moves.extend(sp.loads(j));
+    }
+    moves.extend([
+        set("out_valid", if scan { format!("{} && !p_div", pv(nsp)) } else { pv(nsp) }),
+        set("out_y", oy.clone()),
+        set("out_x", ox.clone()),
+        set("out_len", olen.clone()),
+        set("out_i0", "i0"),
+        set("out_di", odi.clone()),
+    ]);
+    let mut resets: Vec<Stmt> = (1..=nsp).map(|j| set(pv(j), "1'b0")).collect();
+    resets.push(set("out_valid", "1'b0"));
+    body.push(Item::Always(vec![Stmt::If("rst".into(), resets, vec![Stmt::If("adv".into(), moves, ostall)])]));
 
     // The formal properties (scripts/prove): the per-triangle dI's control. The scanline
     // comparison option's divider adds a stall of its own and is left to co-simulation.
@@ -881,6 +967,12 @@ pub fn module(hw: &Hw, names: &Names) -> Module {
                 .collect(),
             guard: st.at("guard_ok"),
             cull: st.at("cull"),
+            span_stages: (1..=nsp)
+                .map(|j| {
+                    let held = |n: &str| sp.held(n, j).expect("a span's fields reach the output");
+                    crate::formal::SpanStage { valid: pv(j), y: held("y"), x: held("x"), len: held("len"), di: held("di") }
+                })
+                .collect(),
         }));
     }
 

@@ -1,108 +1,140 @@
-//! The set-up's CALC as register stages (`--pipeline 1` and above, [`golden::pipeline::SETUP_STAGES`]).
+//! A computation written once as a sequence of stages, registered where the pipeline level asks:
+//! the set-up's CALC ([`golden::pipeline::SETUP_STAGES`]) and the spans' I0 path
+//! ([`golden::pipeline::I0_STAGES`]).
 //!
-//! CALC is written once, as a sequence of stages: each value is defined in one stage and read by
-//! name in any later one. With the stages on, a value read after the stage that defines it is
-//! carried there through one register per boundary (`c<j>_<name>`, loaded as the triangle moves
-//! into stage j); with them off, every stage is the same clock and a name is just its wire. So
-//! level 0 and the pipelined levels are one description and compute the same values.
+//! Each value is defined in one stage and read by name in any later one. Between two stages is
+//! a boundary, registered or not: a value read after a registered boundary is carried through
+//! one register per registered boundary (`<prefix><j>_<name>` in physical stage j, loaded as the
+//! stage moves on); across an unregistered one a name is just its wire. So every level is one
+//! description and computes the same values.
 
 use std::cell::{Cell, RefCell};
 use std::collections::{BTreeSet, HashMap};
 
 use crate::verilog::{comment, reg, set, sreg, swire, wire, Item, Stmt};
 
-#[derive(Clone, Copy)]
+#[derive(Clone)]
 struct Def {
     stage: usize,
     width: u32,
     signed: bool,
+    /// What the name reads as in its own stage: its wire, or the signal it stands for.
+    here: String,
 }
 
+type Carry = (String, u32, bool, String);
+
 pub(super) struct Stager {
-    /// Register boundaries: 0 (one clock) or `SETUP_STAGES.len() - 1`.
-    cuts: usize,
-    /// The stage being written.
+    /// Register names: `<prefix><j>_<name>`.
+    prefix: &'static str,
+    /// Per boundary between two logical stages: registered or not.
+    cuts: Vec<bool>,
+    /// The logical stage being written, and the physical one (registered boundaries behind it).
+    logical: usize,
     cur: usize,
     defs: HashMap<String, Def>,
     logic: Vec<Item>,
-    /// Per boundary j (into stage j + 1): the registers it loads, `(name, width, signed, from)`.
-    /// Reading a value adds them, so that reads can sit inside the expression being defined.
+    /// Per registered boundary j (into physical stage j + 1): the registers it loads, `(name,
+    /// width, signed, from)`. Reading a value adds them, so reads can sit inside the expression
+    /// being defined.
     carries: RefCell<Vec<Vec<Carry>>>,
     carried: RefCell<BTreeSet<String>>,
     /// Set once the registers are declared ([`Stager::items`]): no register may be added after.
     declared: Cell<bool>,
 }
 
-type Carry = (String, u32, bool, String);
-
 impl Stager {
-    pub fn new(cuts: usize) -> Stager {
+    pub fn new(prefix: &'static str, cuts: Vec<bool>) -> Stager {
+        let regs = cuts.iter().filter(|&&c| c).count();
         Stager {
+            prefix,
             cuts,
+            logical: 0,
             cur: 0,
             defs: HashMap::new(),
             logic: Vec::new(),
-            carries: RefCell::new(vec![Vec::new(); cuts]),
+            carries: RefCell::new(vec![Vec::new(); regs]),
             carried: RefCell::default(),
             declared: Cell::new(false),
         }
     }
 
-    /// A value that exists before the first stage (a vertex register).
-    pub fn input(&mut self, name: &str, width: u32, signed: bool) {
-        self.defs.insert(name.into(), Def { stage: 0, width, signed });
+    /// A value of the stage being written that is an existing signal (a vertex register, the
+    /// walker's): no wire of its own; its first register loads `src`.
+    pub fn input_as(&mut self, name: &str, width: u32, signed: bool, src: &str) {
+        let d = Def { stage: self.cur, width, signed, here: src.into() };
+        assert!(self.defs.insert(name.into(), d).is_none(), "staged value {name} defined twice");
     }
 
-    /// Ends the stage being written: with the stages on, what follows is the next clock.
+    /// [`Stager::input_as`] under its own name.
+    pub fn input(&mut self, name: &str, width: u32, signed: bool) {
+        self.input_as(name, width, signed, name);
+    }
+
+    /// Ends the logical stage being written; a registered boundary starts the next clock.
     pub fn cut(&mut self) {
-        if self.cur < self.cuts {
+        if self.cuts[self.logical] {
             self.cur += 1;
         }
+        self.logical += 1;
     }
 
-    /// The stage being written (0 with the stages off).
+    /// Whether the boundary after the logical stage being written is registered.
+    pub fn registered_next(&self) -> bool {
+        self.cuts.get(self.logical).copied().unwrap_or(false)
+    }
+
+    /// The physical stage being written: registered boundaries behind it.
     pub fn stage(&self) -> usize {
         self.cur
+    }
+
+    /// The logical stage being written.
+    pub fn logical(&self) -> usize {
+        self.logical
     }
 
     /// The name under which `name` reads in the stage being written, adding the registers that
     /// carry it there.
     pub fn at(&self, name: &str) -> String {
-        let d = *self.defs.get(name).unwrap_or_else(|| panic!("set-up value {name} read before it is defined"));
+        let d = self.defs.get(name).unwrap_or_else(|| panic!("staged value {name} read before it is defined"));
+        let reg = |j: usize| format!("{}{j}_{name}", self.prefix);
         for j in d.stage + 1..=self.cur {
-            let r = format!("c{j}_{name}");
-            if self.carried.borrow_mut().insert(r.clone()) {
-                assert!(!self.declared.get(), "set-up value {name} carried to stage {j} after the registers were declared");
-                let from = if j - 1 == d.stage { name.to_string() } else { format!("c{}_{name}", j - 1) };
-                self.carries.borrow_mut()[j - 1].push((r, d.width, d.signed, from));
+            if self.carried.borrow_mut().insert(reg(j)) {
+                assert!(!self.declared.get(), "staged value {name} carried to stage {j} after the registers were declared");
+                let from = if j - 1 == d.stage { d.here.clone() } else { reg(j - 1) };
+                self.carries.borrow_mut()[j - 1].push((reg(j), d.width, d.signed, from));
             }
         }
         if d.stage == self.cur {
-            name.to_string()
+            d.here.clone()
         } else {
-            format!("c{}_{name}", self.cur)
+            reg(self.cur)
         }
     }
 
-    /// Where `name` is held in stage `j`, if it is there: its wire in the stage that defines
-    /// it, or a register carrying it (for the proof's linking invariants).
+    /// Where `name` is held in physical stage `j`, if it is there: its wire in the stage that
+    /// defines it, or a register carrying it (for the proof's linking invariants).
     pub fn held(&self, name: &str, j: usize) -> Option<String> {
         let d = self.defs.get(name)?;
-        let r = format!("c{j}_{name}");
+        let r = format!("{}{j}_{name}", self.prefix);
         if self.carried.borrow().contains(&r) {
             Some(r)
         } else {
-            (d.stage == j).then(|| name.to_string())
+            (d.stage == j).then(|| d.here.clone())
         }
     }
 
     /// Defines `name` in the stage being written.
     pub fn def(&mut self, name: &str, width: u32, signed: bool, value: impl Into<String>) {
-        assert!(self.defs.insert(name.into(), Def { stage: self.cur, width, signed }).is_none(), "set-up value {name} defined twice");
+        let d = Def { stage: self.cur, width, signed, here: name.into() };
+        assert!(self.defs.insert(name.into(), d).is_none(), "staged value {name} defined twice");
         self.logic.push(if signed { swire(name, width, value) } else { wire(name, width, value) });
     }
 
-    /// `out = a * b` at the product's natural width from two signed names (see `smul`).
+    /// `out = a * b` at the product's natural width from two signed names: the language extends
+    /// them to the result, and synthesis builds a `wa` x `wb` multiplier (extending them by hand
+    /// would make it as wide as the result on both sides).
     pub fn mul(&mut self, out: &str, a: &str, wa: u32, b: &str, wb: u32) {
         let (a, b) = (self.at(a), self.at(b));
         self.logic.push(comment("verilator lint_off WIDTH"));
@@ -119,9 +151,10 @@ impl Stager {
     pub fn items(&self) -> Vec<Item> {
         self.declared.set(true);
         let mut v = Vec::new();
-        if self.cuts > 0 {
-            v.push(comment("Stage registers: c<j>_<name> holds <name> for stage j (whole values: a stage may read"));
-            v.push(comment("a slice only)."));
+        if self.carries.borrow().iter().any(|c| !c.is_empty()) {
+            let p = self.prefix;
+            v.push(comment(format!("Stage registers: {p}<j>_<name> holds <name> in stage j (whole values: a stage")));
+            v.push(comment("may read a slice only)."));
             for (n, w, s, _) in self.carries.borrow().iter().flatten() {
                 v.push(if *s { sreg(n, *w) } else { reg(n, *w) });
             }
@@ -130,12 +163,13 @@ impl Stager {
         v
     }
 
-    /// The registers boundary j loads (into stage j + 1): `(name, width, signed)`.
+    /// The registers registered boundary j loads (into physical stage j + 1): `(name, width,
+    /// signed)`.
     pub fn regs(&self, j: usize) -> Vec<(String, u32, bool)> {
         self.carries.borrow()[j].iter().map(|(n, w, s, _)| (n.clone(), *w, *s)).collect()
     }
 
-    /// The loads of boundary j's registers (into stage j + 1), for an `if (move) ...`.
+    /// The loads of registered boundary j's registers, for an `if (move) ...`.
     pub fn loads(&self, j: usize) -> Vec<Stmt> {
         self.carries.borrow()[j].iter().map(|(n, _, _, from)| set(n.clone(), from.clone())).collect()
     }
