@@ -101,7 +101,7 @@ module tri_frontend (
   wire signed [23:0] rx2 = 24'd128 - {{2{vx0[21]}}, vx0};
   wire signed [23:0] xo = 24'd128 - {{2{vx0[21]}}, vx0};
 
-  // CALC, step 1 of the clock: the area's and the plane's products; the first row, clipped; each edge's first row and its distance to the edge's vertex.
+  // CALC, step 1 of the clock: the area's and the plane's products; the first row, clipped; each edge's first row and its distance to the edge's vertex; the edges' signs; the last row with and without a bottom edge.
   // verilator lint_off WIDTH
   wire signed [42:0] m_a1 = u1 * v2;
   // verilator lint_on WIDTH
@@ -133,20 +133,36 @@ module tri_frontend (
   wire [8:0] rsu0 = rs0[8:0];
   wire signed [20:0] ry0 = {4'd0, {rsu0, 8'd128}} - {{2{vy1[18]}}, vy1};
   wire [18:0] ady0 = rdy0[19] ? -rdy0[18:0] : rdy0[18:0];
+  wire rdz0 = rdy0 == 20'sd0;
+  wire rdxp0 = rdx0 > 23'sd0;
+  wire rdxn0 = rdx0[22];
   wire signed [11:0] rs_raw1 = ytc1[19:8];
   wire signed [11:0] re_raw1 = ybc1[19:8];
   wire signed [11:0] rs1 = rs_raw1 > first_s ? rs_raw1 : first_s;
   wire [8:0] rsu1 = rs1[8:0];
   wire signed [20:0] ry1 = {4'd0, {rsu1, 8'd128}} - {{2{vy2[18]}}, vy2};
   wire [18:0] ady1 = rdy1[19] ? -rdy1[18:0] : rdy1[18:0];
+  wire rdz1 = rdy1 == 20'sd0;
+  wire rdxp1 = rdx1 > 23'sd0;
+  wire rdxn1 = rdx1[22];
   wire signed [11:0] rs_raw2 = ytc2[19:8];
   wire signed [11:0] re_raw2 = ybc2[19:8];
   wire signed [11:0] rs2 = rs_raw2 > first_s ? rs_raw2 : first_s;
   wire [8:0] rsu2 = rs2[8:0];
   wire signed [20:0] ry2 = {4'd0, {rsu2, 8'd128}} - {{2{vy0[18]}}, vy0};
   wire [18:0] ady2 = rdy2[19] ? -rdy2[18:0] : rdy2[18:0];
+  wire rdz2 = rdy2 == 20'sd0;
+  wire rdxp2 = rdx2 > 23'sd0;
+  wire rdxn2 = rdx2[22];
+  // The last row both ways: as it is, and one sub-pixel up for a bottom edge on a row's centres.
+  wire signed [19:0] ymax_c0 = {{1{ymax[18]}}, ymax} - 20'sd128;
+  wire signed [11:0] last_raw0 = ymax_c0[19:8];
+  wire signed [11:0] last_s0 = last_raw0 > 12'sd479 ? 12'sd479 : last_raw0;
+  wire signed [19:0] ymax_c1 = {{1{ymax[18]}}, ymax} - 20'sd129;
+  wire signed [11:0] last_raw1 = ymax_c1[19:8];
+  wire signed [11:0] last_s1 = last_raw1 > 12'sd479 ? 12'sd479 : last_raw1;
 
-  // CALC, step 2 of the clock: the area, its sign and magnitude; the plane's normal and |Nx|; the edge terms' products, unoriented.
+  // CALC, step 2 of the clock: the area, its sign and magnitude; the plane's normal and |Nx|; the edge terms' products, unoriented; the top-left rule from the signs, and the last row.
   // Twice the signed area: its sign orients the edges and the plane (interior positive).
   wire signed [42:0] area = m_a1 - m_a2;
   wire neg = area[42];
@@ -174,39 +190,42 @@ module tri_frontend (
   // verilator lint_off WIDTH
   wire signed [43:0] m_f2 = rdy2 * rx2;
   // verilator lint_on WIDTH
-
-  // CALC, step 3 of the clock: orientation: edges, top-left rule, last row, cull; the edge dividers' dividends; |A|'s leading zeros; dI's dividend; the first-row sum's products.
-  // Orientation: edge k's direction with the interior on its left; the top-left rule.
-  wire signed [22:0] dx0 = neg ? -rdx0 : rdx0;
-  wire signed [19:0] dy0 = neg ? -rdy0 : rdy0;
-  wire tl0 = dy0[19] || (dy0 == 20'sd0 && dx0 > 23'sd0);
-  wire signed [22:0] dx1 = neg ? -rdx1 : rdx1;
-  wire signed [19:0] dy1 = neg ? -rdy1 : rdy1;
-  wire tl1 = dy1[19] || (dy1 == 20'sd0 && dx1 > 23'sd0);
-  wire signed [22:0] dx2 = neg ? -rdx2 : rdx2;
-  wire signed [19:0] dy2 = neg ? -rdy2 : rdy2;
-  wire tl2 = dy2[19] || (dy2 == 20'sd0 && dx2 > 23'sd0);
+  // Orientation: edge k's direction with the interior on its left (dy < 0: going up); the
+  // top-left rule. From the signs alone: the orientation flips them.
+  wire dyneg0 = !rdz0 && (neg ? !rdy0[19] : rdy0[19]);
+  wire tl0 = dyneg0 || (rdz0 && (neg ? rdxn0 : rdxp0));
+  wire dyneg1 = !rdz1 && (neg ? !rdy1[19] : rdy1[19]);
+  wire tl1 = dyneg1 || (rdz1 && (neg ? rdxn1 : rdxp1));
+  wire dyneg2 = !rdz2 && (neg ? !rdy2[19] : rdy2[19]);
+  wire tl2 = dyneg2 || (rdz2 && (neg ? rdxn2 : rdxp2));
   // A horizontal edge that is not top-left is a bottom edge: centres on it are not covered.
-  wire kill = (dy0 == 20'sd0 && !tl0) || (dy1 == 20'sd0 && !tl1) || (dy2 == 20'sd0 && !tl2);
-  wire signed [19:0] ymax_c = {{1{ymax[18]}}, ymax} - 20'sd128 - {19'd0, kill};
-  wire signed [11:0] last_raw = ymax_c[19:8];
-  wire signed [11:0] last_s = last_raw > 12'sd479 ? 12'sd479 : last_raw;
+  wire kill = (rdz0 && !tl0) || (rdz1 && !tl1) || (rdz2 && !tl2);
+  wire signed [11:0] last_s = kill ? last_s1 : last_s0;
+  // Per edge, the offset of its first bound's dividend: B D, 1 less off a top-left edge.
+  wire [45:0] base0 = ({27'd0, ady0} << 22) - {45'd0, !tl0};
+  wire [45:0] base1 = ({27'd0, ady1} << 22) - {45'd0, !tl1};
+  wire [45:0] base2 = ({27'd0, ady2} << 22) - {45'd0, !tl2};
+
+  // CALC, step 3 of the clock: each edge's active rows; cull; the edge dividers' dividends; |A|'s leading zeros; dI's dividend; the first-row sum's products.
+  wire signed [22:0] dx0 = neg ? -rdx0 : rdx0;
+  wire signed [22:0] dx1 = neg ? -rdx1 : rdx1;
+  wire signed [22:0] dx2 = neg ? -rdx2 : rdx2;
   wire cull = area == 43'sd0 || first_s > last_s || cfirst > clast || cfirst > 15'sd639 || clast[14];
   // Per edge: its active rows; the dividends of its first bound and of its step.
   wire signed [11:0] re0 = re_raw0 < last_s ? re_raw0 : last_s;
-  wire act0 = dy0 != 20'sd0 && rs0 <= re0;
-  wire [45:0] e0 = {{2{m_e0[43]}}, m_e0} - {{2{m_f0[43]}}, m_f0};
-  wire [45:0] n0 = (neg ? -e0 : e0) - {45'd0, !tl0} + ({27'd0, ady0} << 22);
+  wire act0 = !rdz0 && rs0 <= re0;
+  wire [45:0] e0 = (neg ? {{2{m_f0[43]}}, m_f0} : {{2{m_e0[43]}}, m_e0}) - (neg ? {{2{m_e0[43]}}, m_e0} : {{2{m_f0[43]}}, m_f0});
+  wire [45:0] n0 = e0 + base0;
   wire [34:0] sn0 = {{12{dx0[22]}}, dx0} + ({16'd0, ady0} << 14);
   wire signed [11:0] re1 = re_raw1 < last_s ? re_raw1 : last_s;
-  wire act1 = dy1 != 20'sd0 && rs1 <= re1;
-  wire [45:0] e1 = {{2{m_e1[43]}}, m_e1} - {{2{m_f1[43]}}, m_f1};
-  wire [45:0] n1 = (neg ? -e1 : e1) - {45'd0, !tl1} + ({27'd0, ady1} << 22);
+  wire act1 = !rdz1 && rs1 <= re1;
+  wire [45:0] e1 = (neg ? {{2{m_f1[43]}}, m_f1} : {{2{m_e1[43]}}, m_e1}) - (neg ? {{2{m_e1[43]}}, m_e1} : {{2{m_f1[43]}}, m_f1});
+  wire [45:0] n1 = e1 + base1;
   wire [34:0] sn1 = {{12{dx1[22]}}, dx1} + ({16'd0, ady1} << 14);
   wire signed [11:0] re2 = re_raw2 < last_s ? re_raw2 : last_s;
-  wire act2 = dy2 != 20'sd0 && rs2 <= re2;
-  wire [45:0] e2 = {{2{m_e2[43]}}, m_e2} - {{2{m_f2[43]}}, m_f2};
-  wire [45:0] n2 = (neg ? -e2 : e2) - {45'd0, !tl2} + ({27'd0, ady2} << 22);
+  wire act2 = !rdz2 && rs2 <= re2;
+  wire [45:0] e2 = (neg ? {{2{m_f2[43]}}, m_f2} : {{2{m_e2[43]}}, m_e2}) - (neg ? {{2{m_e2[43]}}, m_e2} : {{2{m_f2[43]}}, m_f2});
+  wire [45:0] n2 = e2 + base2;
   wire [34:0] sn2 = {{12{dx2[22]}}, dx2} + ({16'd0, ady2} << 14);
   // The plane: Nx, Ny oriented; dI's dividend 2*256|Nx| + |A| and its saturation.
   wire signed [41:0] onx = neg ? -nx : nx;
@@ -216,7 +235,6 @@ module tri_frontend (
   wire di_sat = {12'd0, x2} >= ({21'd0, aabs} << 21);
   // Normalisation: s leading zeros of |A|, An = |A| << s.
   wire [5:0] lz = aabs[41] ? 6'd0 : aabs[40] ? 6'd1 : aabs[39] ? 6'd2 : aabs[38] ? 6'd3 : aabs[37] ? 6'd4 : aabs[36] ? 6'd5 : aabs[35] ? 6'd6 : aabs[34] ? 6'd7 : aabs[33] ? 6'd8 : aabs[32] ? 6'd9 : aabs[31] ? 6'd10 : aabs[30] ? 6'd11 : aabs[29] ? 6'd12 : aabs[28] ? 6'd13 : aabs[27] ? 6'd14 : aabs[26] ? 6'd15 : aabs[25] ? 6'd16 : aabs[24] ? 6'd17 : aabs[23] ? 6'd18 : aabs[22] ? 6'd19 : aabs[21] ? 6'd20 : aabs[20] ? 6'd21 : aabs[19] ? 6'd22 : aabs[18] ? 6'd23 : aabs[17] ? 6'd24 : aabs[16] ? 6'd25 : aabs[15] ? 6'd26 : aabs[14] ? 6'd27 : aabs[13] ? 6'd28 : aabs[12] ? 6'd29 : aabs[11] ? 6'd30 : aabs[10] ? 6'd31 : aabs[9] ? 6'd32 : aabs[8] ? 6'd33 : aabs[7] ? 6'd34 : aabs[6] ? 6'd35 : aabs[5] ? 6'd36 : aabs[4] ? 6'd37 : aabs[3] ? 6'd38 : aabs[2] ? 6'd39 : aabs[1] ? 6'd40 : 6'd41;
-  wire [41:0] an = aabs << lz;
   // The first row's sum S(0, first) = I0 |A| + Nx xo + Ny yo: its products, unoriented.
   // verilator lint_off WIDTH
   wire [61:0] m_s1 = vi0 * aabs;
@@ -228,8 +246,9 @@ module tri_frontend (
   wire signed [65:0] m_s3 = ny * yo;
   // verilator lint_on WIDTH
 
-  // CALC, step 4 of the clock: the first-row sum and the plane terms, normalised; the dividers loaded, or the triangle dropped or culled.
+  // CALC, step 4 of the clock: the first-row sum and the plane terms, normalised, and An; the dividers loaded, or the triangle dropped or culled.
   wire [63:0] s0 = {2'd0, m_s1} + (neg ? -m_s2[63:0] : m_s2[63:0]) + (neg ? -m_s3[63:0] : m_s3[63:0]);
+  wire [41:0] an = aabs << lz;
   wire [63:0] tn0 = s0 << lz;
   // The rows, once the triangle is not culled: first_s >= 0, first_s <= last_s < height.
   wire [8:0] first_u = first_s[8:0];
@@ -486,7 +505,7 @@ module tri_frontend (
           es0_d <= {15'd0, ady0} << 14;
           es0_q <= 15'd0;
           s_act0 <= act0;
-          s_right0 <= !dy0[19];
+          s_right0 <= !dyneg0;
           s_rs0 <= rsu0;
           s_re0 <= re0[8:0];
           s_d0 <= {ady0, 8'd0};
@@ -497,7 +516,7 @@ module tri_frontend (
           es1_d <= {15'd0, ady1} << 14;
           es1_q <= 15'd0;
           s_act1 <= act1;
-          s_right1 <= !dy1[19];
+          s_right1 <= !dyneg1;
           s_rs1 <= rsu1;
           s_re1 <= re1[8:0];
           s_d1 <= {ady1, 8'd0};
@@ -508,7 +527,7 @@ module tri_frontend (
           es2_d <= {15'd0, ady2} << 14;
           es2_q <= 15'd0;
           s_act2 <= act2;
-          s_right2 <= !dy2[19];
+          s_right2 <= !dyneg2;
           s_rs2 <= rsu2;
           s_re2 <= re2[8:0];
           s_d2 <= {ady2, 8'd0};

@@ -171,10 +171,10 @@ pub const I0_STAGES: [&str; 7] = [
 /// five are one clock. The last loads the dividers, drops or culls.
 pub const SETUP_STAGES: [&str; 5] = [
     "guard band; vertex differences; bounding box and each edge's row extent, offset to pixel centres",
-    "the area's and the plane's products; the first row, clipped; each edge's first row and its distance to the edge's vertex",
-    "the area, its sign and magnitude; the plane's normal and |Nx|; the edge terms' products, unoriented",
-    "orientation: edges, top-left rule, last row, cull; the edge dividers' dividends; |A|'s leading zeros; dI's dividend; the first-row sum's products",
-    "the first-row sum and the plane terms, normalised; the dividers loaded, or the triangle dropped or culled",
+    "the area's and the plane's products; the first row, clipped; each edge's first row and its distance to the edge's vertex; the edges' signs; the last row with and without a bottom edge",
+    "the area, its sign and magnitude; the plane's normal and |Nx|; the edge terms' products, unoriented; the top-left rule from the signs, and the last row",
+    "each edge's active rows; cull; the edge dividers' dividends; |A|'s leading zeros; dI's dividend; the first-row sum's products",
+    "the first-row sum and the plane terms, normalised, and An; the dividers loaded, or the triangle dropped or culled",
 ];
 
 impl std::fmt::Display for Pipeline {

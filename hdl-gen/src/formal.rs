@@ -753,6 +753,8 @@ pub struct CalcStage {
     pub first_s: Option<String>,
     pub last_s: Option<String>,
     pub cull: Option<String>,
+    /// Candidates for the last row held before the choice between them (each as `last_s`).
+    pub last_alt: Vec<String>,
 }
 
 /// Properties of `tri_frontend` (SPEC §6; names as `frontend::module` declares them), with the
@@ -1093,7 +1095,7 @@ pub fn frontend_properties(s: &FrontendShape) -> Item {
             held.push(assert(format!("!{r}[{}]", cy - 8)));
             held.push(assert(format!("{} >= {}", ryc(r), f_ymin(j))));
         }
-        if let Some(r) = &c.last_s {
+        for r in c.last_s.iter().chain(&c.last_alt) {
             held.push(assert(format!("{r} <= {}", slit(cy - 7, height as i64 - 1))));
             held.push(assert(format!("{} <= {}", ryc(r), f_ymax(j))));
         }

@@ -318,6 +318,18 @@ fn calc(hw: &Hw) -> Stager {
         );
         let r = st.at(&format!("rdy{k}"));
         st.def(&format!("ady{k}"), cy, false, format!("{r}[{cy}] ? -{r}[{}:0] : {r}[{}:0]", cy - 1, cy - 1));
+        // The signs the orientation needs, before it is known: it only flips them.
+        st.def(&format!("rdz{k}"), 1, false, format!("{r} == {}", slit(cy + 1, 0)));
+        let x = st.at(&format!("rdx{k}"));
+        st.def(&format!("rdxp{k}"), 1, false, format!("{x} > {}", slit(cx + 1, 0)));
+        st.def(&format!("rdxn{k}"), 1, false, format!("{x}[{cx}]"));
+    }
+    st.note(comment("The last row both ways: as it is, and one sub-pixel up for a bottom edge on a row's centres."));
+    let ymax = st.at("ymax");
+    for (n, off) in [("0", 128), ("1", 129)] {
+        st.def(&format!("ymax_c{n}"), cy + 1, true, format!("{} - {}", sext(&ymax, cy, cy + 1), slit(cy + 1, off)));
+        st.def(&format!("last_raw{n}"), ryw, true, format!("ymax_c{n}[{cy}:8]"));
+        st.def(&format!("last_s{n}"), ryw, true, format!("last_raw{n} > {} ? {} : last_raw{n}", slit(ryw, h - 1), slit(ryw, h - 1)));
     }
     st.cut();
 
@@ -336,29 +348,38 @@ fn calc(hw: &Hw) -> Stager {
         st.mul(&format!("m_e{k}"), &format!("rdx{k}"), cx + 1, &format!("ry{k}"), cy + 2);
         st.mul(&format!("m_f{k}"), &format!("rdy{k}"), cy + 1, &format!("rx{k}"), cx + 2);
     }
+    st.note(comment("Orientation: edge k's direction with the interior on its left (dy < 0: going up); the"));
+    st.note(comment("top-left rule. From the signs alone: the orientation flips them."));
+    for k in 0..3 {
+        let (z, xp, xn) = (st.at(&format!("rdz{k}")), st.at(&format!("rdxp{k}")), st.at(&format!("rdxn{k}")));
+        let ry = st.at(&format!("rdy{k}"));
+        st.def(&format!("dyneg{k}"), 1, false, format!("!{z} && (neg ? !{ry}[{cy}] : {ry}[{cy}])"));
+        st.def(&format!("tl{k}"), 1, false, format!("dyneg{k} || ({z} && (neg ? {xn} : {xp}))"));
+    }
+    st.note(comment("A horizontal edge that is not top-left is a bottom edge: centres on it are not covered."));
+    st.def("kill", 1, false, (0..3).map(|k| format!("({} && !tl{k})", st.at(&format!("rdz{k}")))).collect::<Vec<_>>().join(" || "));
+    st.def("last_s", ryw, true, format!("kill ? {} : {}", st.at("last_s1"), st.at("last_s0")));
+    let nw = cx + cy + 5;
+    st.note(comment("Per edge, the offset of its first bound's dividend: B D, 1 less off a top-left edge."));
+    for k in 0..3 {
+        let ady = st.at(&format!("ady{k}"));
+        st.def(&format!("base{k}"), nw, false, format!("({} << {}) - {}", zext(&ady, cy, nw), gw + 7, zext(&format!("!tl{k}"), 1, nw)));
+    }
     st.cut();
 
     // Stage 3.
     section(&mut st);
     let neg = st.at("neg");
-    st.note(comment("Orientation: edge k's direction with the interior on its left; the top-left rule."));
     for k in 0..3 {
         st.def(&format!("dx{k}"), cx + 1, true, format!("{neg} ? -{r} : {r}", r = st.at(&format!("rdx{k}"))));
-        st.def(&format!("dy{k}"), cy + 1, true, format!("{neg} ? -{r} : {r}", r = st.at(&format!("rdy{k}"))));
-        st.def(&format!("tl{k}"), 1, false, format!("dy{k}[{cy}] || (dy{k} == {} && dx{k} > {})", slit(cy + 1, 0), slit(cx + 1, 0)));
     }
-    st.note(comment("A horizontal edge that is not top-left is a bottom edge: centres on it are not covered."));
-    st.def("kill", 1, false, (0..3).map(|k| format!("(dy{k} == {} && !tl{k})", slit(cy + 1, 0))).collect::<Vec<_>>().join(" || "));
-    st.def("ymax_c", cy + 1, true, format!("{} - {} - {}", sext(&st.at("ymax"), cy, cy + 1), slit(cy + 1, 128), zext("kill", 1, cy + 1)));
-    st.def("last_raw", ryw, true, format!("ymax_c[{cy}:8]"));
-    st.def("last_s", ryw, true, format!("last_raw > {} ? {} : last_raw", slit(ryw, h - 1), slit(ryw, h - 1)));
-    let (first_s, cfirst, clast) = (st.at("first_s"), st.at("cfirst"), st.at("clast"));
+    let (first_s, cfirst, clast, last_s) = (st.at("first_s"), st.at("cfirst"), st.at("clast"), st.at("last_s"));
     st.def(
         "cull",
         1,
         false,
         format!(
-            "{} == {} || {first_s} > last_s || {cfirst} > {clast} || {cfirst} > {} || {clast}[{}]",
+            "{} == {} || {first_s} > {last_s} || {cfirst} > {clast} || {cfirst} > {} || {clast}[{}]",
             st.at("area"),
             slit(aw + 1, 0),
             slit(rxw, w - 1),
@@ -366,22 +387,18 @@ fn calc(hw: &Hw) -> Stager {
         ),
     );
     // e(128, 256 rs + 128) - t + B D from vertex a on the edge's line: the oriented products'
-    // difference, 1 less off a top-left edge, offset by B = 2^(GW-1) divisors so both quotients
-    // are non-negative (q = g + B).
+    // difference (one subtraction, its operands swapped by the orientation), 1 less off a
+    // top-left edge, offset by B = 2^(GW-1) divisors so both quotients are non-negative (q = g + B).
     st.note(comment("Per edge: its active rows; the dividends of its first bound and of its step."));
-    let (nw, snw) = (cx + cy + 5, (cx + 2).max(gw + cy + 1));
+    let snw = (cx + 2).max(gw + cy + 1);
     for k in 0..3 {
         let re_raw = st.at(&format!("re_raw{k}"));
-        st.def(&format!("re{k}"), ryw, true, format!("{re_raw} < last_s ? {re_raw} : last_s"));
-        st.def(&format!("act{k}"), 1, false, format!("dy{k} != {} && {} <= re{k}", slit(cy + 1, 0), st.at(&format!("rs{k}"))));
+        st.def(&format!("re{k}"), ryw, true, format!("{re_raw} < {last_s} ? {re_raw} : {last_s}"));
+        st.def(&format!("act{k}"), 1, false, format!("!{} && {} <= re{k}", st.at(&format!("rdz{k}")), st.at(&format!("rs{k}"))));
         let (me, mf, ady) = (st.at(&format!("m_e{k}")), st.at(&format!("m_f{k}")), st.at(&format!("ady{k}")));
-        st.def(&format!("e{k}"), nw, false, format!("{} - {}", sext(&me, nw - 2, nw), sext(&mf, nw - 2, nw)));
-        st.def(
-            &format!("n{k}"),
-            nw,
-            false,
-            format!("({neg} ? -e{k} : e{k}) - {} + ({} << {})", zext(&format!("!tl{k}"), 1, nw), zext(&ady, cy, nw), gw + 7),
-        );
+        let (me, mf) = (sext(&me, nw - 2, nw), sext(&mf, nw - 2, nw));
+        st.def(&format!("e{k}"), nw, false, format!("({neg} ? {mf} : {me}) - ({neg} ? {me} : {mf})"));
+        st.def(&format!("n{k}"), nw, false, format!("e{k} + {}", st.at(&format!("base{k}"))));
         st.def(
             &format!("sn{k}"),
             snw,
@@ -404,7 +421,6 @@ fn calc(hw: &Hw) -> Stager {
         chain = format!("{aabs}[{bit}] ? {} : {chain}", lit(sw, (aw - 1 - bit) as u64));
     }
     st.def("lz", sw, false, chain);
-    st.def("an", aw, false, format!("{aabs} << lz"));
     st.note(comment("The first row's sum S(0, first) = I0 |A| + Nx xo + Ny yo: its products, unoriented."));
     st.note(comment("verilator lint_off WIDTH"));
     st.def("m_s1", iw + aw, false, format!("{} * {aabs}", st.at("vi0")));
@@ -420,6 +436,7 @@ fn calc(hw: &Hw) -> Stager {
     let (s2, s3) = (low(&st.at("m_s2"), nxw + cx + 2), low(&st.at("m_s3"), nyw + cy + 2));
     st.def("s0", kk, false, format!("{} + ({neg} ? -{s2} : {s2}) + ({neg} ? -{s3} : {s3})", zext(&st.at("m_s1"), iw + aw, kk)));
     let lz = st.at("lz");
+    st.def("an", aw, false, format!("{} << {lz}", st.at("aabs")));
     st.def("tn0", kk, false, format!("s0 << {lz}"));
     st.note(comment("The rows, once the triangle is not culled: first_s >= 0, first_s <= last_s < height."));
     st.def("first_u", yw, false, format!("{}[{}:0]", st.at("first_s"), yw - 1));
@@ -433,7 +450,7 @@ fn calc(hw: &Hw) -> Stager {
         .map(String::from)
         .collect::<Vec<_>>();
     for k in 0..3 {
-        handed.extend(["n", "sn", "ady", "act", "dy", "rsu", "re"].map(|v| format!("{v}{k}")));
+        handed.extend(["n", "sn", "ady", "act", "dyneg", "rsu", "re"].map(|v| format!("{v}{k}")));
     }
     for v in &handed {
         st.at(v);
@@ -578,7 +595,7 @@ pub fn module(hw: &Hw, names: &Names) -> Module {
             &format!("{} << {}", zext(&ady, cy, pw_step), gw - 1),
         ));
         calc_load.push(set(format!("s_act{k}"), st.at(&format!("act{k}"))));
-        calc_load.push(set(format!("s_right{k}"), format!("!{}[{cy}]", st.at(&format!("dy{k}")))));
+        calc_load.push(set(format!("s_right{k}"), format!("!{}", st.at(&format!("dyneg{k}")))));
         calc_load.push(set(format!("s_rs{k}"), st.at(&format!("rsu{k}"))));
         calc_load.push(set(format!("s_re{k}"), format!("{}[{}:0]", st.at(&format!("re{k}")), yw - 1)));
         calc_load.push(set(format!("s_d{k}"), format!("{{{ady}, 8'd0}}")));
@@ -963,6 +980,7 @@ pub fn module(hw: &Hw, names: &Names) -> Module {
                     first_s: st.held("first_s", j),
                     last_s: st.held("last_s", j),
                     cull: st.held("cull", j),
+                    last_alt: ["last_s0", "last_s1"].iter().filter_map(|n| st.held(n, j)).collect(),
                 })
                 .collect(),
             guard: st.at("guard_ok"),
