@@ -182,15 +182,19 @@ fn div_iter(d: &Div, bits: u32) -> Vec<Stmt> {
     ]
 }
 
-/// The register stages of a pipelined CALC, for the manifest (none at level 0): stage j holds
-/// what CALC's clock j - 1 computed for the clocks after it.
-pub fn calc_stages(hw: &Hw) -> Vec<golden::pipeline::PipeStage> {
-    let st = calc(hw);
+/// The register stages of a pipelined front-end, for the manifest (none at level 0, whose
+/// structure SPEC's seed fixes): CALC's (`calc<j>`), then the span path's (`span<j>`); stage j
+/// holds what the logical step before it computed, for the clocks after it.
+pub fn stages(hw: &Hw) -> Vec<golden::pipeline::PipeStage> {
+    build(hw, &Names::new("", &hw.fe.cfg)).1
+}
+
+fn stage_list(st: &Stager, name: &str, logic: &[&str]) -> Vec<golden::pipeline::PipeStage> {
     (1..=st.stage())
         .map(|j| golden::pipeline::PipeStage {
             stage: j as u32,
-            name: format!("calc{j}"),
-            logic: golden::pipeline::SETUP_STAGES[j - 1].into(),
+            name: format!("{name}{j}"),
+            logic: logic[j - 1].into(),
             regs: st
                 .regs(j - 1)
                 .into_iter()
@@ -459,6 +463,11 @@ fn calc(hw: &Hw) -> Stager {
 }
 
 pub fn module(hw: &Hw, names: &Names) -> Module {
+    build(hw, names).0
+}
+
+/// The module, and its register stages when it is pipelined ([`stages`]).
+fn build(hw: &Hw, names: &Names) -> (Module, Vec<golden::pipeline::PipeStage>) {
     let fe = &hw.fe;
     let bits = hw.div_bits;
     let cfg = &fe.cfg;
@@ -994,13 +1003,22 @@ pub fn module(hw: &Hw, names: &Names) -> Module {
         }));
     }
 
-    Module {
+    // Every boundary is registered above level 0, so stage j's logic is logical step j - 1's.
+    let stages = if hw.calc_clocks() > 1 {
+        let mut v = stage_list(&st, "calc", &golden::pipeline::SETUP_STAGES);
+        v.extend(stage_list(&sp, "span", &golden::pipeline::I0_STAGES));
+        v
+    } else {
+        Vec::new()
+    };
+    let module = Module {
         name: names.frontend.clone(),
         header,
         params: vec![],
         ports: ports(fe, &wd).into_iter().chain(span_ports(fe, &wd)).collect(),
         body,
-    }
+    };
+    (module, stages)
 }
 
 /// `tri_shader_p<P>`: the front-end, then the segment shader; `y` waits in a four-entry FIFO

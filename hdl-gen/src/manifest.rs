@@ -171,7 +171,7 @@ pub struct ModuleEntry {
     pub throughput: String,
     pub ports: Vec<PortEntry>,
     /// The register stages of a pipelined segment shader (`golden::segment::stages`) or of the
-    /// front-end's CALC (`frontend::calc_stages`); absent at level 0, whose stages SPEC's seed
+    /// front-end (`frontend::stages`: its CALC and span path); absent at level 0, whose stages SPEC's seed
     /// fixes (the specular unit's are in `specular`).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub stages: Vec<golden::pipeline::PipeStage>,
@@ -273,7 +273,7 @@ pub fn render(opts: &Options, names: &Names, modules: &[Module], unit: &Specular
         let role = if name == &m.name { role } else { Role::Axis };
         let stages = match (role, &fe) {
             (Role::SegmentShader, _) if opts.pipeline != golden::pipeline::Pipeline::NONE => golden::segment::stages(cfg, opts.pipeline),
-            (Role::Frontend, Some(hw)) => crate::frontend::calc_stages(hw),
+            (Role::Frontend, Some(hw)) => crate::frontend::stages(hw),
             _ => Vec::new(),
         };
         ModuleEntry {
