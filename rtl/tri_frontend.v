@@ -881,7 +881,7 @@ module tri_frontend (
   reg [8:0] f_wlast;
   reg signed [18:0] f_wymin;
   reg signed [18:0] f_wymax;
-  // The spans: the walker's row in the two I0 stages and the output (valid, row).
+  // The spans: the walker's row in the I0 stages and the output (valid, row).
   reg f_1v;
   reg [8:0] f_1y;
   reg f_2v;

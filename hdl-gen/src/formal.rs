@@ -767,7 +767,9 @@ pub struct CalcStage {
 /// clocks and holds the result until the walker is free (idle, or on its last row with the
 /// output free: the next triangle's set-up overlaps the walk); the walker walks the rows from
 /// first to last, one per free clock, and each row with covered pixels becomes a span that
-/// moves through two I0 stages to the output, every stage moving when the output is free.
+/// moves through the I0 stages (two, or six when pipelined) to the output, every stage moving
+/// when the output is free. With CALC in stages, a triangle moves through them as a queue
+/// between the vertex register and the set-up.
 /// Whether a row has covered pixels (the walker's `lo <= hi`), whether a triangle is culled
 /// (its area and row range) and the rows' first and last are the design's data decisions the
 /// reference takes as given; it checks them where SPEC constrains them: every walked row's
@@ -866,7 +868,7 @@ pub fn frontend_properties(s: &FrontendShape) -> Item {
     b.extend([reg("f_wv", 1), reg("f_wrow", yw), reg("f_wlast", yw)]);
     b.push(Item::Reg { name: "f_wymin".into(), width: cy, signed: true });
     b.push(Item::Reg { name: "f_wymax".into(), width: cy, signed: true });
-    b.push(comment("The spans: the walker's row in the two I0 stages and the output (valid, row)."));
+    b.push(comment("The spans: the walker's row in the I0 stages and the output (valid, row)."));
     for i in 1..=nsp {
         b.extend([reg(&format!("f_{i}v"), 1), reg(&format!("f_{i}y"), yw)]);
     }
