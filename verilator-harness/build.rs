@@ -326,8 +326,15 @@ fn generated_models() -> Vec<Model> {
                         sources: vec![(format!("{}.v", m.name), m.render())],
                     });
                     // The set-up and the span path in stages (`--pipeline 1` and above: one
-                    // front-end for them all), with each dI mode.
-                    for (tag, di) in [("fe_pl1", DiMode::Triangle), ("fe_scan_pl1", DiMode::Scanline)] {
+                    // front-end for them all); with the per-scanline dI too on request (a
+                    // comparison option's, as `sweep`'s chains; `scripts/check-rtl-dir` also
+                    // checks one such folder through COSIM_RTL_DIR).
+                    let staged_di: &[(&str, DiMode)] = if std::env::var_os("SEGSHADE_ALL_CHAINS").is_some() {
+                        &[("fe_pl1", DiMode::Triangle), ("fe_scan_pl1", DiMode::Scanline)]
+                    } else {
+                        &[("fe_pl1", DiMode::Triangle)]
+                    };
+                    for &(tag, di) in staged_di {
                         let staged = hdl_gen::frontend::Hw { fe: fe.with_di(di), pipeline: Pipeline::at(1), ..hw };
                         let m = hdl_gen::frontend::module(&staged, &names);
                         models.push(Model {
