@@ -50,8 +50,10 @@ pub fn numbered(body: Vec<(&str, String, Vec<PipeReg>)>) -> Vec<PipeStage> {
 /// | 2 | + the lane sums registered before round and clamp | as level 1 | as level 1 |
 /// | 3 | + no clock with two adders in a row: the BFPI's first adder level formed as the span enters its register, the rest when it starts; each lane's sum split at the binary point (high part and the fraction's carry registered, joined before the clamp) | as level 1 | as level 1 |
 ///
-/// Level 0 is the default: the smallest circuit and the shortest latency, byte for byte the
-/// RTL every earlier release generated. `docs/fpga.md` gives each level's area and Fmax.
+/// Level 0 is the default: the smallest circuit and the shortest latency, for the shader and
+/// the specular unit byte for byte the RTL every earlier release generated (the front-end's is
+/// the staged description with no register between its steps). `docs/fpga.md` gives each
+/// level's area and Fmax.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize, Deserialize)]
 #[serde(try_from = "u32", into = "u32")]
 pub struct Pipeline(u32);
