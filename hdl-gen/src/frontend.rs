@@ -208,8 +208,8 @@ fn stage_list(st: &Stager, name: &str, logic: &[&str]) -> Vec<golden::pipeline::
 /// one clock at level 0, a register boundary after each stage above it. Values are computed
 /// where their operands are ready, so a sign decided late (the area's) is applied to products
 /// formed early: the products are taken of unoriented differences and negated with the
-/// orientation. What the last stage hands on is read at its end, so every carrying register
-/// exists when the caller declares them.
+/// orientation. The caller reads what the last stage hands on before it declares the stage
+/// registers ([`Stager::items`] refuses a register added after).
 fn calc(hw: &Hw) -> Stager {
     let fe = &hw.fe;
     let cfg = &fe.cfg;
@@ -447,18 +447,6 @@ fn calc(hw: &Hw) -> Stager {
     st.def("last_u", yw, false, format!("{}[{}:0]", st.at("last_s"), yw - 1));
     st.def("gxn0", kk, false, format!("({} << 8) << {lz}", sext(&st.at("onx"), nxw, kk)));
     st.def("dyn0", kk, false, format!("({} << 8) << {lz}", sext(&st.at("ony"), nyw, kk)));
-    // What the last stage hands on (the dividers' loads, the result registers, the decision), read
-    // here so that every register carrying it is declared with the others.
-    let mut handed = vec!["guard_ok", "cull", "x2", "aabs", "an", "first_u", "last_u", "tn0", "gxn0", "dyn0", "di_sat", "nx_neg"]
-        .into_iter()
-        .map(String::from)
-        .collect::<Vec<_>>();
-    for k in 0..3 {
-        handed.extend(["n", "sn", "ady", "act", "dyneg", "rsu", "re"].map(|v| format!("{v}{k}")));
-    }
-    for v in &handed {
-        st.at(v);
-    }
     st
 }
 
@@ -475,7 +463,6 @@ fn build(hw: &Hw, names: &Names) -> (Module, Vec<golden::pipeline::PipeStage>) {
     let Widths { yw, cx, cy, aw, gw, dw_edge: de, k: kk, rw, .. } = wd;
     let (xw, iw, dw) = (cfg.xbits, cfg.iw(), cfg.dw());
     let (w, h) = (fe.screen.width as i64, fe.screen.height as i64);
-    let nxw = iw + cy + 3; // Nx, signed
     let cnt_w = 32 - rw.leading_zeros();
 
     let header = vec![
@@ -527,7 +514,58 @@ fn build(hw: &Hw, names: &Names) -> (Module, Vec<golden::pipeline::PipeStage>) {
     body.push(net("take", 1));
 
     let st = calc(hw);
-    let x2w = (nxw + 9).max(aw + 1);
+    // What the last CALC stage hands on (the dividers' loads, the set-up's result, the decision)
+    // is read before the stage registers are declared, so every register carrying it is among them.
+    let (pw_init, pw_step) = (gw + de, gw + cy);
+    let divs: Vec<Div> = (0..3)
+        .flat_map(|k| {
+            [Div { name: ["ei0", "ei1", "ei2"][k], pw: pw_init, qb: gw }, Div { name: ["es0", "es1", "es2"][k], pw: pw_step, qb: gw }]
+        })
+        .chain([Div { name: "ddi", pw: iw + aw + 1, qb: iw }, Div { name: "drn", pw: aw + rw + 1, qb: rw }])
+        .collect();
+    let mut calc_load = vec![set("div_cnt", lit(cnt_w, (rw - 1) as u64)), set("st", "DIV")];
+    for k in 0..3 {
+        let ei = &divs[2 * k];
+        let es = &divs[2 * k + 1];
+        let ady = st.at(&format!("ady{k}"));
+        calc_load.extend(div_load(
+            ei,
+            &format!("{}[{}:0]", st.at(&format!("n{k}")), pw_init - 1),
+            &format!("{} << {}", zext(&ady, cy, pw_init), gw + 7),
+        ));
+        calc_load.extend(div_load(
+            es,
+            &format!("{}[{}:0]", st.at(&format!("sn{k}")), pw_step - 1),
+            &format!("{} << {}", zext(&ady, cy, pw_step), gw - 1),
+        ));
+        calc_load.push(set(format!("s_act{k}"), st.at(&format!("act{k}"))));
+        calc_load.push(set(format!("s_right{k}"), format!("!{}", st.at(&format!("dyneg{k}")))));
+        calc_load.push(set(format!("s_rs{k}"), st.at(&format!("rsu{k}"))));
+        calc_load.push(set(format!("s_re{k}"), format!("{}[{}:0]", st.at(&format!("re{k}")), yw - 1)));
+        calc_load.push(set(format!("s_d{k}"), format!("{{{ady}, 8'd0}}")));
+    }
+    let ddi_pw = iw + aw + 1;
+    let (x2, x2w) = (st.at("x2"), st.width("x2"));
+    let x2_fit = if x2w >= ddi_pw { format!("{x2}[{}:0]", ddi_pw - 1) } else { zext(&x2, x2w, ddi_pw) };
+    calc_load.extend(div_load(&divs[6], &x2_fit, &format!("{} << {}", zext(&st.at("aabs"), aw, ddi_pw), iw)));
+    calc_load.extend(div_load(
+        &divs[7],
+        &format!("{} << {}", lit(aw + rw + 1, 1), kk),
+        &format!("{} << {}", zext(&st.at("an"), aw, aw + rw + 1), rw),
+    ));
+    for (r, v) in [
+        ("s_first", "first_u"),
+        ("s_last", "last_u"),
+        ("s_an", "an"),
+        ("s_tn", "tn0"),
+        ("s_gxn", "gxn0"),
+        ("s_dyn", "dyn0"),
+        ("s_sat", "di_sat"),
+        ("s_dineg", "nx_neg"),
+    ] {
+        calc_load.push(set(r, st.at(v)));
+    }
+    let (guard, cull) = (st.at("guard_ok"), st.at("cull"));
     let last = st.stage();
     // The stages' moves: stage j's triangle moves into stage j + 1 when that one is empty or
     // moving on; the last stage moves on into the dividers (calc).
@@ -558,13 +596,6 @@ fn build(hw: &Hw, names: &Names) -> (Module, Vec<golden::pipeline::PipeStage>) {
     }
     body.push(Item::Blank);
     // ---- Dividers and the set-up result registers.
-    let (pw_init, pw_step) = (gw + de, gw + cy);
-    let divs: Vec<Div> = (0..3)
-        .flat_map(|k| {
-            [Div { name: ["ei0", "ei1", "ei2"][k], pw: pw_init, qb: gw }, Div { name: ["es0", "es1", "es2"][k], pw: pw_step, qb: gw }]
-        })
-        .chain([Div { name: "ddi", pw: iw + aw + 1, qb: iw }, Div { name: "drn", pw: aw + rw + 1, qb: rw }])
-        .collect();
     body.push(comment("Eight restoring dividers, one quotient bit per clock, sharing one counter: per edge its first"));
     body.push(comment("bound (ei) and its step (es), then dI (ddi) and the reciprocal Rn = 2^K / (2 An) (drn)."));
     for d in &divs {
@@ -588,48 +619,6 @@ fn build(hw: &Hw, names: &Names) -> (Module, Vec<golden::pipeline::PipeStage>) {
     body.push(reg("s_dineg", 1));
     body.push(Item::Blank);
 
-    let mut calc_load = vec![set("div_cnt", lit(cnt_w, (rw - 1) as u64)), set("st", "DIV")];
-    for k in 0..3 {
-        let ei = &divs[2 * k];
-        let es = &divs[2 * k + 1];
-        let ady = st.at(&format!("ady{k}"));
-        calc_load.extend(div_load(
-            ei,
-            &format!("{}[{}:0]", st.at(&format!("n{k}")), pw_init - 1),
-            &format!("{} << {}", zext(&ady, cy, pw_init), gw + 7),
-        ));
-        calc_load.extend(div_load(
-            es,
-            &format!("{}[{}:0]", st.at(&format!("sn{k}")), pw_step - 1),
-            &format!("{} << {}", zext(&ady, cy, pw_step), gw - 1),
-        ));
-        calc_load.push(set(format!("s_act{k}"), st.at(&format!("act{k}"))));
-        calc_load.push(set(format!("s_right{k}"), format!("!{}", st.at(&format!("dyneg{k}")))));
-        calc_load.push(set(format!("s_rs{k}"), st.at(&format!("rsu{k}"))));
-        calc_load.push(set(format!("s_re{k}"), format!("{}[{}:0]", st.at(&format!("re{k}")), yw - 1)));
-        calc_load.push(set(format!("s_d{k}"), format!("{{{ady}, 8'd0}}")));
-    }
-    let ddi_pw = iw + aw + 1;
-    let x2 = st.at("x2");
-    let x2_fit = if x2w >= ddi_pw { format!("{x2}[{}:0]", ddi_pw - 1) } else { zext(&x2, x2w, ddi_pw) };
-    calc_load.extend(div_load(&divs[6], &x2_fit, &format!("{} << {}", zext(&st.at("aabs"), aw, ddi_pw), iw)));
-    calc_load.extend(div_load(
-        &divs[7],
-        &format!("{} << {}", lit(aw + rw + 1, 1), kk),
-        &format!("{} << {}", zext(&st.at("an"), aw, aw + rw + 1), rw),
-    ));
-    for (r, v) in [
-        ("s_first", "first_u"),
-        ("s_last", "last_u"),
-        ("s_an", "an"),
-        ("s_tn", "tn0"),
-        ("s_gxn", "gxn0"),
-        ("s_dyn", "dyn0"),
-        ("s_sat", "di_sat"),
-        ("s_dineg", "nx_neg"),
-    ] {
-        calc_load.push(set(r, st.at(v)));
-    }
     let mut div_run: Vec<Stmt> = divs.iter().flat_map(|d| div_iter(d, bits)).collect();
     div_run.push(Stmt::If(
         format!("div_cnt < {}", lit(cnt_w, bits as u64)),
@@ -651,9 +640,9 @@ fn build(hw: &Hw, names: &Names) -> (Module, Vec<golden::pipeline::PipeStage>) {
             Stmt::If(
                 "calc".into(),
                 vec![Stmt::If(
-                    format!("!{}", st.at("guard_ok")),
+                    format!("!{guard}"),
                     vec![set("err", "1'b1"), set("st", "IDLE")],
-                    vec![Stmt::If(st.at("cull"), vec![set("st", "IDLE")], calc_load)],
+                    vec![Stmt::If(cull.clone(), vec![set("st", "IDLE")], calc_load)],
                 )],
                 vec![Stmt::If("st == DIV".into(), div_run, vec![]), Stmt::If("take".into(), vec![set("st", "IDLE")], vec![])],
             ),
@@ -992,8 +981,8 @@ fn build(hw: &Hw, names: &Names) -> (Module, Vec<golden::pipeline::PipeStage>) {
                     last_alt: ["last_s0", "last_s1"].iter().filter_map(|n| st.held(n, j)).collect(),
                 })
                 .collect(),
-            guard: st.at("guard_ok"),
-            cull: st.at("cull"),
+            guard,
+            cull,
             span_stages: (1..=nsp)
                 .map(|j| {
                     let held = |n: &str| sp.held(n, j).expect("a span's fields reach the output");

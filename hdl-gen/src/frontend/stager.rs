@@ -113,6 +113,11 @@ impl Stager {
         }
     }
 
+    /// The width `name` was defined with.
+    pub fn width(&self, name: &str) -> u32 {
+        self.defs.get(name).unwrap_or_else(|| panic!("staged value {name} read before it is defined")).width
+    }
+
     /// Where `name` is held in physical stage `j`, if it is there: its wire in the stage that
     /// defines it, or a register carrying it (for the proof's linking invariants).
     pub fn held(&self, name: &str, j: usize) -> Option<String> {
