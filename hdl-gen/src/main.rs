@@ -89,6 +89,10 @@ enum Command {
         /// The Verilog file to write; the harness module is `<module>_synth`.
         #[arg(long)]
         out: PathBuf,
+        /// Register the block's outputs before the XOR tree, or fold them directly (a flip-flop
+        /// fewer per output bit, for a design that only fits without them; never a better Fmax).
+        #[arg(long, value_enum, default_value_t)]
+        outputs: hdl_gen::wrapper::Outputs,
     },
     /// Write a self-checking Verilog-2005 testbench of the segment shader and of the specular
     /// unit, with vectors from the golden model, beside the generated RTL (runs in Icarus).
@@ -243,11 +247,11 @@ fn run(command: Command) -> anyhow::Result<()> {
                 None => print!("{text}"),
             }
         }
-        Command::SynthWrapper { rtl, module, out } => {
+        Command::SynthWrapper { rtl, module, out, outputs } => {
             let path = rtl.join(hdl_gen::manifest::MANIFEST_FILE);
             let text = std::fs::read_to_string(&path).with_context(|| format!("cannot read {}", path.display()))?;
             let ports = hdl_gen::wrapper::ports_from_manifest(&text, &module)?;
-            output::write_one(&out, hdl_gen::wrapper::module(&module, &ports)?.render().as_bytes())?;
+            output::write_one(&out, hdl_gen::wrapper::module(&module, &ports, outputs)?.render().as_bytes())?;
             eprintln!("wrote {}", out.display());
         }
         Command::Testbench { config, brdf, vectors, seed, out } => {

@@ -108,7 +108,7 @@ fn a_warning_inside_a_wrapped_module_fails_its_wrapper_lint() {
     let mut sources: Vec<String> =
         files.iter().filter(|f| f.name.ends_with(".v")).map(|f| dir.join(&f.name).display().to_string()).collect();
     let manifest = &files.iter().find(|f| f.name == "manifest.json").unwrap().contents;
-    let w = wrapper::module(&module, &wrapper::ports_from_manifest(manifest, &module).unwrap()).unwrap();
+    let w = wrapper::module(&module, &wrapper::ports_from_manifest(manifest, &module).unwrap(), wrapper::Outputs::Registered).unwrap();
     let wfile = dir.join(format!("{}.v", w.name));
     std::fs::write(&wfile, w.render()).unwrap();
     sources.push(wfile.display().to_string());
@@ -239,8 +239,12 @@ fn lint_one(
             }
         }
         let mut with_wrappers = sources.clone();
+        // The harness without output registers is what scripts/synth --harness folded uses for
+        // the deepest level's widest blocks; it is linted there, the registered one elsewhere.
+        let outputs =
+            if pipeline == Pipeline::new(Pipeline::MAX).unwrap() { wrapper::Outputs::Folded } else { wrapper::Outputs::Registered };
         for (module, ports) in wrapped {
-            let w = wrapper::module(&module, &ports).unwrap();
+            let w = wrapper::module(&module, &ports, outputs).unwrap();
             let file = path(&format!("{}.v", w.name));
             std::fs::write(&file, w.render()).unwrap();
             let mut srcs = sources.clone();
