@@ -5,6 +5,9 @@ import re
 
 def stem(cell):
     """The RTL name behind a mapped cell: cut the techmap suffix (_TRELLIS_FF_Q_3, _CCU2C_.., $..)."""
+    if cell.startswith("$gbuf"):
+        # nextpnr-ice40's global buffer for a high-fanout net (`$gbuf_<net>_$glb_ce`).
+        return "(global buffer)"
     s = re.split(r"\$|_(?=[A-Z])", cell)[0]
     s = re.sub(r"(\.\d+)+$", "", s)
     s = {"in_q": "(input regs)", "out_q": "(output regs)"}.get(s, s)
