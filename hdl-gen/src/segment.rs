@@ -144,12 +144,18 @@ pub fn module_with(cfg: &Config, names: &Names, arch: BfpiArch, pipe: Pipeline) 
     }
     body.extend([wire("out_free", 1, "!out_valid || out_ready"), wire("fire", 1, "cur_valid && out_free")]);
     if pipe.span_stage() {
-        body.extend([
-            wire("take", 1, "!cur_valid || (fire && cur_last)"),
-            assign("in_ready", "!sp_valid || take"),
-            wire("load", 1, "in_valid && in_ready"),
-            wire("start", 1, "sp_valid && take"),
-        ]);
+        body.extend([wire("take", 1, "!cur_valid || (fire && cur_last)"), assign("in_ready", "!sp_valid || take")]);
+        if !split {
+            body.extend([wire("load", 1, "in_valid && in_ready"), wire("start", 1, "sp_valid && take")]);
+        } else {
+            // Level 3: out_ready reaches the span and current stages through their enables alone,
+            // each as few LUTs from it as the handshake allows: the span register loads
+            // whenever it may (in_ready; sp_valid takes in_valid), and the current stage, at its
+            // last segment, loads the span register whether or not a span waits (cur_valid
+            // takes sp_valid), so its data select comes from registers only. Registers behind
+            // a clear valid hold don't-cares. (The iCE40's critical paths at p <= 16.)
+            body.push(wire("cur_en", 1, "cur_valid ? out_free : sp_valid"));
+        }
     } else {
         body.extend([assign("in_ready", "!cur_valid || (fire && cur_last)"), wire("load", 1, "in_valid && in_ready")]);
     }
@@ -377,9 +383,9 @@ pub fn module_with(cfg: &Config, names: &Names, arch: BfpiArch, pipe: Pipeline) 
             "rst".into(),
             vec![set("sp_valid", "1'b0")],
             vec![Stmt::If(
-                "load".into(),
+                if split { "in_ready" } else { "load" }.into(),
                 [
-                    set("sp_valid", "in_len != 0"),
+                    set("sp_valid", if split { "in_valid && in_len != 0" } else { "in_len != 0" }),
                     set("sp_x", "in_x"),
                     set("sp_len", "in_len"),
                     set("sp_i0", "in_i0"),
@@ -388,23 +394,26 @@ pub fn module_with(cfg: &Config, names: &Names, arch: BfpiArch, pipe: Pipeline) 
                 .into_iter()
                 .chain(first_level.iter().map(|(c, e)| set(format!("sp_m{c}"), e.as_str())))
                 .collect(),
-                vec![Stmt::If("start".into(), vec![set("sp_valid", "1'b0")], vec![])],
+                // At level 3 the register loads whenever a span starts (start implies in_ready).
+                if split { vec![] } else { vec![Stmt::If("start".into(), vec![set("sp_valid", "1'b0")], vec![])] },
             )],
         )]));
         body.push(Item::Blank);
     } else {
         body.push(comment("A span of length 0 is consumed and yields nothing."));
     }
-    let begin = if pipe.span_stage() { "start" } else { "load" };
-    body.push(Item::Always(vec![Stmt::If(
-        "rst".into(),
-        vec![set("cur_valid", "1'b0")],
-        vec![Stmt::If(
+    let moves = if split {
+        load[0] = set("cur_valid", "sp_valid");
+        Stmt::If("cur_en".into(), vec![Stmt::If("!cur_valid || cur_last".into(), load, advance)], vec![])
+    } else {
+        let begin = if pipe.span_stage() { "start" } else { "load" };
+        Stmt::If(
             begin.into(),
             load,
             vec![Stmt::If("fire".into(), vec![Stmt::If("cur_last".into(), vec![set("cur_valid", "1'b0")], advance)], vec![])],
-        )],
-    )]));
+        )
+    };
+    body.push(Item::Always(vec![Stmt::If("rst".into(), vec![set("cur_valid", "1'b0")], vec![moves])]));
     body.push(Item::Blank);
     // The stages behind the current one: (valid, x, mask, last) and the lanes move together.
     let from = if sum {
