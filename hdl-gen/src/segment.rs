@@ -145,15 +145,14 @@ pub fn module_with(cfg: &Config, names: &Names, arch: BfpiArch, pipe: Pipeline) 
     body.extend([wire("out_free", 1, "!out_valid || out_ready"), wire("fire", 1, "cur_valid && out_free")]);
     if pipe.span_stage() {
         body.extend([wire("take", 1, "!cur_valid || (fire && cur_last)"), assign("in_ready", "!sp_valid || take")]);
-        if !split {
-            body.extend([wire("load", 1, "in_valid && in_ready"), wire("start", 1, "sp_valid && take")]);
-        } else {
-            // Level 3: out_ready reaches the span and current stages through their enables alone,
-            // each as few LUTs from it as the handshake allows: the span register loads
-            // whenever it may (in_ready; sp_valid takes in_valid), and the current stage, at its
-            // last segment, loads the span register whether or not a span waits (cur_valid
-            // takes sp_valid), so its data select comes from registers only. Registers behind
-            // a clear valid hold don't-cares. (The iCE40's critical paths at p <= 16.)
+        body.extend([wire("load", 1, "in_valid && in_ready"), wire("start", 1, "sp_valid && take")]);
+        if split {
+            // Level 3: the current stage's enable is one LUT from out_ready, and its data select
+            // comes from registers only: at its last segment it loads the span register whether
+            // or not a span waits (cur_valid takes sp_valid), so out_ready reaches the stage
+            // through its enable alone (the iCE40's critical path at p = 8). Registers behind a
+            // clear valid bit hold don't-cares. Loading the span register on in_ready alone, the
+            // same idea one stage earlier, measured no faster (docs/fpga.md).
             body.push(wire("cur_en", 1, "cur_valid ? out_free : sp_valid"));
         }
     } else {
@@ -383,9 +382,9 @@ pub fn module_with(cfg: &Config, names: &Names, arch: BfpiArch, pipe: Pipeline) 
             "rst".into(),
             vec![set("sp_valid", "1'b0")],
             vec![Stmt::If(
-                if split { "in_ready" } else { "load" }.into(),
+                "load".into(),
                 [
-                    set("sp_valid", if split { "in_valid && in_len != 0" } else { "in_len != 0" }),
+                    set("sp_valid", "in_len != 0"),
                     set("sp_x", "in_x"),
                     set("sp_len", "in_len"),
                     set("sp_i0", "in_i0"),
@@ -395,7 +394,7 @@ pub fn module_with(cfg: &Config, names: &Names, arch: BfpiArch, pipe: Pipeline) 
                 .chain(first_level.iter().map(|(c, e)| set(format!("sp_m{c}"), e.as_str())))
                 .collect(),
                 // At level 3 the register loads whenever a span starts (start implies in_ready).
-                if split { vec![] } else { vec![Stmt::If("start".into(), vec![set("sp_valid", "1'b0")], vec![])] },
+                vec![Stmt::If("start".into(), vec![set("sp_valid", "1'b0")], vec![])],
             )],
         )]));
         body.push(Item::Blank);
