@@ -8,6 +8,9 @@ def stem(cell):
     if cell.startswith("$gbuf"):
         # nextpnr-ice40's global buffer for a high-fanout net (`$gbuf_<net>_$glb_ce`).
         return "(global buffer)"
+    if cell.startswith("$nextpnr_"):
+        # A logic cell nextpnr's packer added (on iCE40: to bring a signal into a carry chain).
+        return "(packer's cell)"
     s = re.split(r"\$|_(?=[A-Z])", cell)[0]
     s = re.sub(r"(\.\d+)+$", "", s)
     s = {"in_q": "(input regs)", "out_q": "(output regs)"}.get(s, s)
