@@ -647,18 +647,20 @@ module tri_frontend (
   wire in0 = w_act0 && w_row >= w_rs0 && w_row <= w_re0;
   wire signed [15:0] ng0 = -{{1{w_g0[14]}}, w_g0};
   wire signed [15:0] gg0 = {{1{w_g0[14]}}, w_g0};
-  wire signed [15:0] lo1 = (in0 && !w_right0 && ng0 > lo0) ? ng0 : lo0;
-  wire signed [15:0] hi1 = (in0 && w_right0 && gg0 < hi0) ? gg0 : hi0;
+  wire signed [15:0] la0 = (in0 && !w_right0 && ng0 > lo0) ? ng0 : lo0;
+  wire signed [15:0] ha0 = (in0 && w_right0 && gg0 < hi0) ? gg0 : hi0;
   wire in1 = w_act1 && w_row >= w_rs1 && w_row <= w_re1;
   wire signed [15:0] ng1 = -{{1{w_g1[14]}}, w_g1};
   wire signed [15:0] gg1 = {{1{w_g1[14]}}, w_g1};
-  wire signed [15:0] lo2 = (in1 && !w_right1 && ng1 > lo1) ? ng1 : lo1;
-  wire signed [15:0] hi2 = (in1 && w_right1 && gg1 < hi1) ? gg1 : hi1;
+  wire signed [15:0] la1 = (in1 && !w_right1 && ng1 > lo0) ? ng1 : lo0;
+  wire signed [15:0] ha1 = (in1 && w_right1 && gg1 < hi0) ? gg1 : hi0;
   wire in2 = w_act2 && w_row >= w_rs2 && w_row <= w_re2;
   wire signed [15:0] ng2 = -{{1{w_g2[14]}}, w_g2};
   wire signed [15:0] gg2 = {{1{w_g2[14]}}, w_g2};
-  wire signed [15:0] lo3 = (in2 && !w_right2 && ng2 > lo2) ? ng2 : lo2;
-  wire signed [15:0] hi3 = (in2 && w_right2 && gg2 < hi2) ? gg2 : hi2;
+  wire signed [15:0] la2 = (in2 && !w_right2 && ng2 > lo0) ? ng2 : lo0;
+  wire signed [15:0] ha2 = (in2 && w_right2 && gg2 < hi0) ? gg2 : hi0;
+  wire signed [15:0] lo3 = (la0 >= la1 && la0 >= la2) ? la0 : (la1 >= la2) ? la1 : la2;
+  wire signed [15:0] hi3 = (ha0 <= ha1 && ha0 <= ha2) ? ha0 : (ha1 <= ha2) ? ha1 : ha2;
   wire emit = w_valid && lo3 <= hi3;
   // verilator lint_off UNUSEDSIGNAL
   wire [15:0] len_w = hi3 - lo3 + 1;

@@ -705,9 +705,15 @@ fn build(hw: &Hw, names: &Names) -> (Module, Vec<golden::pipeline::PipeStage>) {
         body.push(wire(&format!("in{k}"), 1, format!("w_act{k} && w_row >= w_rs{k} && w_row <= w_re{k}")));
         body.push(swire(&format!("ng{k}"), bw, format!("-{}", sext(&format!("w_g{k}"), gw, bw))));
         body.push(swire(&format!("gg{k}"), bw, sext(&format!("w_g{k}"), gw, bw)));
-        let (l, h2) = (k + 1, k + 1);
-        body.push(swire(&format!("lo{l}"), bw, format!("(in{k} && !w_right{k} && ng{k} > lo{k}) ? ng{k} : lo{k}")));
-        body.push(swire(&format!("hi{h2}"), bw, format!("(in{k} && w_right{k} && gg{k} < hi{k}) ? gg{k} : hi{k}")));
+        // This edge's bound on its side of the row, or the screen's where it bounds none here.
+        body.push(swire(&format!("la{k}"), bw, format!("(in{k} && !w_right{k} && ng{k} > lo0) ? ng{k} : lo0")));
+        body.push(swire(&format!("ha{k}"), bw, format!("(in{k} && w_right{k} && gg{k} < hi0) ? gg{k} : hi0")));
+    }
+    // The span's ends: the largest left bound and the smallest right bound, the three edges
+    // compared side by side rather than in a chain (the walker's row clock).
+    for (end, side, op) in [("lo3", "la", ">="), ("hi3", "ha", "<=")] {
+        let c = |i: u32, j: u32| format!("{side}{i} {op} {side}{j}");
+        body.push(swire(end, bw, format!("({} && {}) ? {side}0 : ({}) ? {side}1 : {side}2", c(0, 1), c(0, 2), c(1, 2))));
     }
     body.push(wire("emit", 1, "w_valid && lo3 <= hi3"));
     body.push(comment("verilator lint_off UNUSEDSIGNAL"));
