@@ -645,26 +645,25 @@ module tri_frontend (
   wire signed [15:0] lo0 = 16'sd0;
   wire signed [15:0] hi0 = 16'sd639;
   wire in0 = w_act0 && w_row >= w_rs0 && w_row <= w_re0;
-  wire signed [15:0] ng0 = -{{1{w_g0[14]}}, w_g0};
   wire signed [15:0] gg0 = {{1{w_g0[14]}}, w_g0};
-  wire signed [15:0] la0 = (in0 && !w_right0 && ng0 > lo0) ? ng0 : lo0;
+  wire signed [15:0] lg0 = (in0 && !w_right0 && gg0 < lo0) ? gg0 : lo0;
   wire signed [15:0] ha0 = (in0 && w_right0 && gg0 < hi0) ? gg0 : hi0;
   wire in1 = w_act1 && w_row >= w_rs1 && w_row <= w_re1;
-  wire signed [15:0] ng1 = -{{1{w_g1[14]}}, w_g1};
   wire signed [15:0] gg1 = {{1{w_g1[14]}}, w_g1};
-  wire signed [15:0] la1 = (in1 && !w_right1 && ng1 > lo0) ? ng1 : lo0;
+  wire signed [15:0] lg1 = (in1 && !w_right1 && gg1 < lo0) ? gg1 : lo0;
   wire signed [15:0] ha1 = (in1 && w_right1 && gg1 < hi0) ? gg1 : hi0;
   wire in2 = w_act2 && w_row >= w_rs2 && w_row <= w_re2;
-  wire signed [15:0] ng2 = -{{1{w_g2[14]}}, w_g2};
   wire signed [15:0] gg2 = {{1{w_g2[14]}}, w_g2};
-  wire signed [15:0] la2 = (in2 && !w_right2 && ng2 > lo0) ? ng2 : lo0;
+  wire signed [15:0] lg2 = (in2 && !w_right2 && gg2 < lo0) ? gg2 : lo0;
   wire signed [15:0] ha2 = (in2 && w_right2 && gg2 < hi0) ? gg2 : hi0;
-  wire signed [15:0] lo3 = (la0 >= la1 && la0 >= la2) ? la0 : (la1 >= la2) ? la1 : la2;
+  wire signed [15:0] mg = (lg0 <= lg1 && lg0 <= lg2) ? lg0 : (lg1 <= lg2) ? lg1 : lg2;
   wire signed [15:0] hi3 = (ha0 <= ha1 && ha0 <= ha2) ? ha0 : (ha1 <= ha2) ? ha1 : ha2;
-  wire emit = w_valid && lo3 <= hi3;
   // verilator lint_off UNUSEDSIGNAL
-  wire [15:0] len_w = hi3 - lo3 + 1;
+  wire signed [15:0] lo3 = -mg;
+  wire signed [16:0] room = {{1{hi3[15]}}, hi3} + {{1{mg[15]}}, mg};
+  wire [15:0] len_w = hi3 + mg + 1;
   // verilator lint_on UNUSEDSIGNAL
+  wire emit = w_valid && !room[16];
   wire [11:0] lo_u = lo3[11:0];
   wire [27:0] rsum0 = {1'd0, w_rem0} + {1'd0, w_rs256_0};
   wire cy0 = rsum0 >= {1'd0, w_d0};

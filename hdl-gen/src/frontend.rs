@@ -703,22 +703,25 @@ fn build(hw: &Hw, names: &Names) -> (Module, Vec<golden::pipeline::PipeStage>) {
     body.push(swire("hi0", bw, slit(bw, w - 1)));
     for k in 0..3 {
         body.push(wire(&format!("in{k}"), 1, format!("w_act{k} && w_row >= w_rs{k} && w_row <= w_re{k}")));
-        body.push(swire(&format!("ng{k}"), bw, format!("-{}", sext(&format!("w_g{k}"), gw, bw))));
         body.push(swire(&format!("gg{k}"), bw, sext(&format!("w_g{k}"), gw, bw)));
-        // This edge's bound on its side of the row, or the screen's where it bounds none here.
-        body.push(swire(&format!("la{k}"), bw, format!("(in{k} && !w_right{k} && ng{k} > lo0) ? ng{k} : lo0")));
+        // This edge's bound on its side of the row, or the screen's where it bounds none here;
+        // a left edge's bound is -g, kept as g (its smallest is the span's left end).
+        body.push(swire(&format!("lg{k}"), bw, format!("(in{k} && !w_right{k} && gg{k} < lo0) ? gg{k} : lo0")));
         body.push(swire(&format!("ha{k}"), bw, format!("(in{k} && w_right{k} && gg{k} < hi0) ? gg{k} : hi0")));
     }
-    // The span's ends: the largest left bound and the smallest right bound, the three edges
-    // compared side by side rather than in a chain (the walker's row clock).
-    for (end, side, op) in [("lo3", "la", ">="), ("hi3", "ha", "<=")] {
-        let c = |i: u32, j: u32| format!("{side}{i} {op} {side}{j}");
+    // The span's ends, the three edges compared side by side rather than in a chain (the walker's
+    // row clock): lo3 = -mg, mg the smallest left-edge g; hi3 the smallest right bound. Whether the
+    // row has a pixel and its length add mg to hi3, so no negation lies on their path.
+    for (end, side) in [("mg", "lg"), ("hi3", "ha")] {
+        let c = |i: u32, j: u32| format!("{side}{i} <= {side}{j}");
         body.push(swire(end, bw, format!("({} && {}) ? {side}0 : ({}) ? {side}1 : {side}2", c(0, 1), c(0, 2), c(1, 2))));
     }
-    body.push(wire("emit", 1, "w_valid && lo3 <= hi3"));
     body.push(comment("verilator lint_off UNUSEDSIGNAL"));
-    body.push(wire("len_w", bw, "hi3 - lo3 + 1"));
+    body.push(swire("lo3", bw, "-mg"));
+    body.push(swire("room", bw + 1, format!("{} + {}", sext("hi3", bw, bw + 1), sext("mg", bw, bw + 1))));
+    body.push(wire("len_w", bw, "hi3 + mg + 1"));
     body.push(comment("verilator lint_on UNUSEDSIGNAL"));
+    body.push(wire("emit", 1, format!("w_valid && !room[{bw}]")));
     body.push(wire("lo_u", xw, format!("lo3[{}:0]", xw - 1)));
     for k in 0..3 {
         body.push(wire(
