@@ -656,6 +656,8 @@ module tri_frontend (
   wire signed [15:0] gg2 = {{1{w_g2[14]}}, w_g2};
   wire signed [15:0] lg2 = (in2 && !w_right2 && gg2 < lo0) ? gg2 : lo0;
   wire signed [15:0] ha2 = (in2 && w_right2 && gg2 < hi0) ? gg2 : hi0;
+  // The span's ends, the edges compared side by side: x = lo3 = -mg (the smallest left-edge g),
+  // hi3 the smallest right bound; the row has a pixel when hi3 + mg >= 0.
   wire signed [15:0] mg = (lg0 <= lg1 && lg0 <= lg2) ? lg0 : (lg1 <= lg2) ? lg1 : lg2;
   wire signed [15:0] hi3 = (ha0 <= ha1 && ha0 <= ha2) ? ha0 : (ha1 <= ha2) ? ha1 : ha2;
   // verilator lint_off UNUSEDSIGNAL

@@ -709,9 +709,10 @@ fn build(hw: &Hw, names: &Names) -> (Module, Vec<golden::pipeline::PipeStage>) {
         body.push(swire(&format!("lg{k}"), bw, format!("(in{k} && !w_right{k} && gg{k} < lo0) ? gg{k} : lo0")));
         body.push(swire(&format!("ha{k}"), bw, format!("(in{k} && w_right{k} && gg{k} < hi0) ? gg{k} : hi0")));
     }
-    // The span's ends, the three edges compared side by side rather than in a chain (the walker's
-    // row clock): lo3 = -mg, mg the smallest left-edge g; hi3 the smallest right bound. Whether the
-    // row has a pixel and its length add mg to hi3, so no negation lies on their path.
+    // Side by side rather than in a chain, and no negation before the pixel test or the length:
+    // this is the walker's row clock, the staged front-end's limit at 2 and 1 quotient bits.
+    body.push(comment("The span's ends, the edges compared side by side: x = lo3 = -mg (the smallest left-edge g),"));
+    body.push(comment("hi3 the smallest right bound; the row has a pixel when hi3 + mg >= 0."));
     for (end, side) in [("mg", "lg"), ("hi3", "ha")] {
         let c = |i: u32, j: u32| format!("{side}{i} <= {side}{j}");
         body.push(swire(end, bw, format!("({} && {}) ? {side}0 : ({}) ? {side}1 : {side}2", c(0, 1), c(0, 2), c(1, 2))));

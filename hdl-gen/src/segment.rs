@@ -144,8 +144,12 @@ pub fn module_with(cfg: &Config, names: &Names, arch: BfpiArch, pipe: Pipeline) 
     }
     body.extend([wire("out_free", 1, "!out_valid || out_ready"), wire("fire", 1, "cur_valid && out_free")]);
     if pipe.span_stage() {
-        body.extend([wire("take", 1, "!cur_valid || (fire && cur_last)"), assign("in_ready", "!sp_valid || take")]);
-        body.extend([wire("load", 1, "in_valid && in_ready"), wire("start", 1, "sp_valid && take")]);
+        body.extend([
+            wire("take", 1, "!cur_valid || (fire && cur_last)"),
+            assign("in_ready", "!sp_valid || take"),
+            wire("load", 1, "in_valid && in_ready"),
+            wire("start", 1, "sp_valid && take"),
+        ]);
         if split {
             // Level 3: the current stage's enable is one LUT from out_ready, and its data select
             // comes from registers only: at its last segment it loads the span register whether
@@ -333,7 +337,14 @@ pub fn module_with(cfg: &Config, names: &Names, arch: BfpiArch, pipe: Pipeline) 
 
     let x_step = lit(xw, (p as u64) % (1u64 << xw));
     let (len, x) = (src("in_len"), src("in_x"));
-    let mut load = vec![set("cur_valid", if pipe.span_stage() { "1'b1".into() } else { format!("{len} != 0") })];
+    let valid = if split {
+        "sp_valid".to_string()
+    } else if pipe.span_stage() {
+        "1'b1".into()
+    } else {
+        format!("{len} != 0")
+    };
+    let mut load = vec![set("cur_valid", valid)];
     if pipe.span_stage() {
         load.push(set("cur_inc", "sp_inc"));
     } else {
@@ -393,7 +404,6 @@ pub fn module_with(cfg: &Config, names: &Names, arch: BfpiArch, pipe: Pipeline) 
                 .into_iter()
                 .chain(first_level.iter().map(|(c, e)| set(format!("sp_m{c}"), e.as_str())))
                 .collect(),
-                // At level 3 the register loads whenever a span starts (start implies in_ready).
                 vec![Stmt::If("start".into(), vec![set("sp_valid", "1'b0")], vec![])],
             )],
         )]));
@@ -402,7 +412,6 @@ pub fn module_with(cfg: &Config, names: &Names, arch: BfpiArch, pipe: Pipeline) 
         body.push(comment("A span of length 0 is consumed and yields nothing."));
     }
     let moves = if split {
-        load[0] = set("cur_valid", "sp_valid");
         Stmt::If("cur_en".into(), vec![Stmt::If("!cur_valid || cur_last".into(), load, advance)], vec![])
     } else {
         let begin = if pipe.span_stage() { "start" } else { "load" };
