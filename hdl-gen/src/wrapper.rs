@@ -34,7 +34,8 @@ pub struct BlockPort {
 /// What the harness does with the block's outputs.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, clap::ValueEnum)]
 pub enum Outputs {
-    /// Every output bit into a flip-flop, then the XOR tree (the default; every table so far).
+    /// Every output bit into a flip-flop, then the XOR tree (the default, and every table's harness
+    /// unless the table says otherwise).
     #[default]
     Registered,
     /// The XOR tree's first register level takes the block's outputs directly.
