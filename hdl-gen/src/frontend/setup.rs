@@ -60,7 +60,7 @@ pub(super) fn emit(hw: &Hw, body: &mut Vec<Item>) -> Setup {
 }
 
 fn state(hw: &Hw, cnt_w: u32, body: &mut Vec<Item>) {
-    let Widths { cx, cy, .. } = hw.fe.widths();
+    let Widths { cx: vx_w, cy: vy_w, .. } = hw.fe.widths();
     let iw = hw.fe.cfg.iw();
     body.extend([
         comment("Set-up: a triangle waits in the vertex registers (v_full) until the dividers are free: idle, or"),
@@ -73,8 +73,8 @@ fn state(hw: &Hw, cnt_w: u32, body: &mut Vec<Item>) {
     body.push(reg("st", 2));
     body.push(reg("div_cnt", cnt_w));
     for k in 0..3 {
-        body.push(sreg(&format!("vx{k}"), cx));
-        body.push(sreg(&format!("vy{k}"), cy));
+        body.push(sreg(&format!("vx{k}"), vx_w));
+        body.push(sreg(&format!("vy{k}"), vy_w));
         body.push(reg(&format!("vi{k}"), iw));
     }
     body.push(reg("v_full", 1));
@@ -83,23 +83,26 @@ fn state(hw: &Hw, cnt_w: u32, body: &mut Vec<Item>) {
 
 /// Per edge its first bound (ei) and its step (es), then dI (ddi) and the reciprocal (drn).
 fn dividers(hw: &Hw) -> Vec<Div> {
-    let Widths { cy, aw, gw, dw_edge: de, rw, .. } = hw.fe.widths();
+    let Widths { cy: vy_w, aw: area_w, gw: bound_w, dw_edge: ediv_w, rw: recip_w, .. } = hw.fe.widths();
     let iw = hw.fe.cfg.iw();
-    let (pw_init, pw_step) = (gw + de, gw + cy);
+    let (pw_init, pw_step) = (bound_w + ediv_w, bound_w + vy_w);
     (0..3)
         .flat_map(|k| {
-            [Div { name: ["ei0", "ei1", "ei2"][k], pw: pw_init, qb: gw }, Div { name: ["es0", "es1", "es2"][k], pw: pw_step, qb: gw }]
+            [
+                Div { name: ["ei0", "ei1", "ei2"][k], pw: pw_init, qb: bound_w },
+                Div { name: ["es0", "es1", "es2"][k], pw: pw_step, qb: bound_w },
+            ]
         })
-        .chain([Div { name: "ddi", pw: iw + aw + 1, qb: iw }, Div { name: "drn", pw: aw + rw + 1, qb: rw }])
+        .chain([Div { name: "ddi", pw: iw + area_w + 1, qb: iw }, Div { name: "drn", pw: area_w + recip_w + 1, qb: recip_w }])
         .collect()
 }
 
 /// CALC's last clock: load the dividers and the set-up result registers.
 fn calc_load(hw: &Hw, st: &Stager, divs: &[Div], cnt_w: u32) -> Vec<Stmt> {
-    let Widths { yw, cy, aw, gw, dw_edge: de, k: kk, rw, .. } = hw.fe.widths();
+    let Widths { yw: row_w, cy: vy_w, aw: area_w, gw: bound_w, dw_edge: ediv_w, k: sum_w, rw: recip_w, .. } = hw.fe.widths();
     let iw = hw.fe.cfg.iw();
-    let (pw_init, pw_step) = (gw + de, gw + cy);
-    let mut calc_load = vec![set("div_cnt", lit(cnt_w, (rw - 1) as u64)), set("st", "DIV")];
+    let (pw_init, pw_step) = (bound_w + ediv_w, bound_w + vy_w);
+    let mut calc_load = vec![set("div_cnt", lit(cnt_w, (recip_w - 1) as u64)), set("st", "DIV")];
     for k in 0..3 {
         let ei = &divs[2 * k];
         let es = &divs[2 * k + 1];
@@ -107,27 +110,27 @@ fn calc_load(hw: &Hw, st: &Stager, divs: &[Div], cnt_w: u32) -> Vec<Stmt> {
         calc_load.extend(div_load(
             ei,
             &format!("{}[{}:0]", st.at(&format!("n{k}")), pw_init - 1),
-            &format!("{} << {}", zext(&ady, cy, pw_init), gw + 7),
+            &format!("{} << {}", zext(&ady, vy_w, pw_init), bound_w + 7),
         ));
         calc_load.extend(div_load(
             es,
             &format!("{}[{}:0]", st.at(&format!("sn{k}")), pw_step - 1),
-            &format!("{} << {}", zext(&ady, cy, pw_step), gw - 1),
+            &format!("{} << {}", zext(&ady, vy_w, pw_step), bound_w - 1),
         ));
         calc_load.push(set(format!("s_act{k}"), st.at(&format!("act{k}"))));
         calc_load.push(set(format!("s_right{k}"), format!("!{}", st.at(&format!("dyneg{k}")))));
         calc_load.push(set(format!("s_rs{k}"), st.at(&format!("rsu{k}"))));
-        calc_load.push(set(format!("s_re{k}"), format!("{}[{}:0]", st.at(&format!("re{k}")), yw - 1)));
+        calc_load.push(set(format!("s_re{k}"), format!("{}[{}:0]", st.at(&format!("re{k}")), row_w - 1)));
         calc_load.push(set(format!("s_d{k}"), format!("{{{ady}, 8'd0}}")));
     }
-    let ddi_pw = iw + aw + 1;
+    let ddi_pw = iw + area_w + 1;
     let (x2, x2w) = (st.at("x2"), st.width("x2"));
     let x2_fit = if x2w >= ddi_pw { format!("{x2}[{}:0]", ddi_pw - 1) } else { zext(&x2, x2w, ddi_pw) };
-    calc_load.extend(div_load(&divs[6], &x2_fit, &format!("{} << {}", zext(&st.at("aabs"), aw, ddi_pw), iw)));
+    calc_load.extend(div_load(&divs[6], &x2_fit, &format!("{} << {}", zext(&st.at("aabs"), area_w, ddi_pw), iw)));
     calc_load.extend(div_load(
         &divs[7],
-        &format!("{} << {}", lit(aw + rw + 1, 1), kk),
-        &format!("{} << {}", zext(&st.at("an"), aw, aw + rw + 1), rw),
+        &format!("{} << {}", lit(area_w + recip_w + 1, 1), sum_w),
+        &format!("{} << {}", zext(&st.at("an"), area_w, area_w + recip_w + 1), recip_w),
     ));
     for (r, v) in [
         ("s_first", "first_u"),
@@ -178,7 +181,7 @@ fn calc_stages(st: &Stager, body: &mut Vec<Item>) -> String {
 }
 
 fn divider_regs(hw: &Hw, divs: &[Div], cnt_w: u32, body: &mut Vec<Item>) {
-    let Widths { yw, aw, dw_edge: de, k: kk, .. } = hw.fe.widths();
+    let Widths { yw: row_w, aw: area_w, dw_edge: ediv_w, k: sum_w, .. } = hw.fe.widths();
     let bits = hw.div_bits;
     body.push(comment("Eight restoring dividers, one quotient bit per clock, sharing one counter: per edge its first"));
     body.push(comment("bound (ei) and its step (es), then dI (ddi) and the reciprocal Rn = 2^K / (2 An) (drn)."));
@@ -192,11 +195,11 @@ fn divider_regs(hw: &Hw, divs: &[Div], cnt_w: u32, body: &mut Vec<Item>) {
     for k in 0..3 {
         body.push(reg(&format!("s_act{k}"), 1));
         body.push(reg(&format!("s_right{k}"), 1));
-        body.push(reg(&format!("s_rs{k}"), yw));
-        body.push(reg(&format!("s_re{k}"), yw));
-        body.push(reg(&format!("s_d{k}"), de));
+        body.push(reg(&format!("s_rs{k}"), row_w));
+        body.push(reg(&format!("s_re{k}"), row_w));
+        body.push(reg(&format!("s_d{k}"), ediv_w));
     }
-    for (n, ww) in [("s_first", yw), ("s_last", yw), ("s_an", aw), ("s_tn", kk), ("s_gxn", kk), ("s_dyn", kk)] {
+    for (n, ww) in [("s_first", row_w), ("s_last", row_w), ("s_an", area_w), ("s_tn", sum_w), ("s_gxn", sum_w), ("s_dyn", sum_w)] {
         body.push(reg(n, ww));
     }
     body.push(reg("s_sat", 1));
@@ -242,18 +245,18 @@ fn control(hw: &Hw, divs: &[Div], cnt_w: u32, calc_load: Vec<Stmt>, v_go: &str, 
 
 /// The dividers' results as the walker loads them.
 fn results(hw: &Hw, body: &mut Vec<Item>) {
-    let Widths { cy, gw, dw_edge: de, .. } = hw.fe.widths();
+    let Widths { cy: vy_w, gw: bound_w, dw_edge: ediv_w, .. } = hw.fe.widths();
     let (iw, dw) = (hw.fe.cfg.iw(), hw.fe.cfg.dw());
 
     // Results of the dividers.
     body.push(comment("Divider results: bounds and steps (q - B), the remainders, dI with its sign and saturation."));
     body.push(comment("verilator lint_off UNUSEDSIGNAL"));
     for k in 0..3 {
-        let flip = |q: &str| if gw == 1 { format!("~{q}") } else { format!("{{~{q}[{}], {q}[{}:0]}}", gw - 1, gw - 2) };
-        body.push(wire(&format!("r_g{k}"), gw, flip(&format!("ei{k}_q"))));
-        body.push(wire(&format!("r_rem{k}"), de, format!("ei{k}_p[{}:0]", de - 1)));
-        body.push(wire(&format!("r_qs{k}"), gw, flip(&format!("es{k}_q"))));
-        body.push(wire(&format!("r_rs256_{k}"), de, format!("{{es{k}_p[{}:0], 8'd0}}", cy - 1)));
+        let flip = |q: &str| if bound_w == 1 { format!("~{q}") } else { format!("{{~{q}[{}], {q}[{}:0]}}", bound_w - 1, bound_w - 2) };
+        body.push(wire(&format!("r_g{k}"), bound_w, flip(&format!("ei{k}_q"))));
+        body.push(wire(&format!("r_rem{k}"), ediv_w, format!("ei{k}_p[{}:0]", ediv_w - 1)));
+        body.push(wire(&format!("r_qs{k}"), bound_w, flip(&format!("es{k}_q"))));
+        body.push(wire(&format!("r_rs256_{k}"), ediv_w, format!("{{es{k}_p[{}:0], 8'd0}}", vy_w - 1)));
     }
     body.push(comment("verilator lint_on UNUSEDSIGNAL"));
     let max_pos = format!("{{1'b0, {{{iw}{{1'b1}}}}}}");

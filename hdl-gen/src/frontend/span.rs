@@ -35,7 +35,7 @@ pub(super) fn valid(j: usize) -> String {
 /// properties.
 pub(super) fn path(hw: &Hw, body: &mut Vec<Item>) -> Stager {
     let fe = &hw.fe;
-    let Widths { yw, aw, k: kk, rw, .. } = fe.widths();
+    let Widths { yw: row_w, aw: area_w, k: sum_w, rw: recip_w, .. } = fe.widths();
     let (xw, iw, dw) = (fe.cfg.xbits, fe.cfg.iw(), fe.cfg.dw());
     let scan = fe.di == DiMode::Scanline;
     let mut sp = Stager::new("p", golden::pipeline::i0_registers(hw.pipeline).to_vec());
@@ -44,9 +44,9 @@ pub(super) fn path(hw: &Hw, body: &mut Vec<Item>) -> Stager {
         sp.note(Item::Blank);
         sp.note(comment(format!("Span path, step {} (stage p{}): {what}.", sp.logical(), sp.stage())));
     };
-    let pr = kk + rw;
-    let cw = aw + 2;
-    let half = rw / 2;
+    let prod_w = sum_w + recip_w;
+    let corr_w = area_w + 2;
+    let half = recip_w / 2;
     // The span's first pixel's intensity and, per scanline, its last pixel's, the edge's value
     // there: the same path twice, under these names.
     let head = End { x: "x", gx: "gx", s2: "s2n", lo: "lo", pl: "pl", ph: "ph", prod: "prod", qt: "qt", m: "m", corr: "corr", out: "i0" };
@@ -66,13 +66,13 @@ pub(super) fn path(hw: &Hw, body: &mut Vec<Item>) -> Stager {
     let ends: Vec<&End> = if scan { vec![&head, &tail] } else { vec![&head] };
     i0_section(&mut sp);
     for (n, ww, src) in [
-        ("y", yw, "w_row".to_string()),
+        ("y", row_w, "w_row".to_string()),
         ("x", xw, "lo_u".into()),
         ("len", xw + 1, format!("len_w[{xw}:0]")),
-        ("tn", kk, "w_tn".into()),
-        ("gxn", kk, "w_gxn".into()),
-        ("an", aw, "w_an".into()),
-        ("rn", rw, "w_rn".into()),
+        ("tn", sum_w, "w_tn".into()),
+        ("gxn", sum_w, "w_gxn".into()),
+        ("an", area_w, "w_an".into()),
+        ("rn", recip_w, "w_rn".into()),
     ] {
         sp.input_as(n, ww, false, &src);
     }
@@ -87,32 +87,36 @@ pub(super) fn path(hw: &Hw, body: &mut Vec<Item>) -> Stager {
     sp.cut();
     i0_section(&mut sp);
     for e in &ends {
-        sp.def(e.gx, kk, false, format!("{} * {}", sp.at("gxn"), zext(&sp.at(e.x), xw, kk)));
+        sp.def(e.gx, sum_w, false, format!("{} * {}", sp.at("gxn"), zext(&sp.at(e.x), xw, sum_w)));
     }
     sp.cut();
     i0_section(&mut sp);
     for e in &ends {
-        sp.def(e.s2, kk, false, format!("(({} + {}) << 1) + {}", sp.at("tn"), sp.at(e.gx), zext(&sp.at("an"), aw, kk)));
+        sp.def(e.s2, sum_w, false, format!("(({} + {}) << 1) + {}", sp.at("tn"), sp.at(e.gx), zext(&sp.at("an"), area_w, sum_w)));
     }
     sp.cut();
     i0_section(&mut sp);
     let split = sp.registered_next();
     for e in &ends {
         let s2 = sp.at(e.s2);
-        sp.def(e.lo, cw, false, format!("{s2}[{}:0]", cw - 1));
+        sp.def(e.lo, corr_w, false, format!("{s2}[{}:0]", corr_w - 1));
         if split {
             let rn = sp.at("rn");
             sp.def(
                 e.pl,
-                kk + half,
+                sum_w + half,
                 false,
-                format!("{} * {}", zext(&s2, kk, kk + half), zext(&format!("{rn}[{}:0]", half - 1), half, kk + half)),
+                format!("{} * {}", zext(&s2, sum_w, sum_w + half), zext(&format!("{rn}[{}:0]", half - 1), half, sum_w + half)),
             );
             sp.def(
                 e.ph,
-                kk + rw - half,
+                sum_w + recip_w - half,
                 false,
-                format!("{} * {}", zext(&s2, kk, kk + rw - half), zext(&format!("{rn}[{}:{half}]", rw - 1), rw - half, kk + rw - half)),
+                format!(
+                    "{} * {}",
+                    zext(&s2, sum_w, sum_w + recip_w - half),
+                    zext(&format!("{rn}[{}:{half}]", recip_w - 1), recip_w - half, sum_w + recip_w - half)
+                ),
             );
         }
     }
@@ -122,28 +126,28 @@ pub(super) fn path(hw: &Hw, body: &mut Vec<Item>) -> Stager {
     for e in &ends {
         let prod = if split {
             let (pl, ph) = (sp.at(e.pl), sp.at(e.ph));
-            format!("{} + ({} << {half})", zext(&pl, kk + half, pr), zext(&ph, kk + rw - half, pr))
+            format!("{} + ({} << {half})", zext(&pl, sum_w + half, prod_w), zext(&ph, sum_w + recip_w - half, prod_w))
         } else {
-            format!("{} * {}", zext(&sp.at(e.s2), kk, pr), zext(&sp.at("rn"), rw, pr))
+            format!("{} * {}", zext(&sp.at(e.s2), sum_w, prod_w), zext(&sp.at("rn"), recip_w, prod_w))
         };
-        sp.def(e.prod, pr, false, prod);
+        sp.def(e.prod, prod_w, false, prod);
     }
     sp.note(comment("verilator lint_on UNUSEDSIGNAL"));
     for e in &ends {
-        sp.def(e.qt, iw, false, format!("{}[{}:{kk}]", e.prod, kk + iw - 1));
+        sp.def(e.qt, iw, false, format!("{}[{}:{sum_w}]", e.prod, sum_w + iw - 1));
     }
     sp.cut();
     i0_section(&mut sp);
-    sp.def("an2", cw, false, format!("{} << 1", zext(&sp.at("an"), aw, cw)));
+    sp.def("an2", corr_w, false, format!("{} << 1", zext(&sp.at("an"), area_w, corr_w)));
     for e in &ends {
-        sp.def(e.m, cw, false, format!("{} * an2", zext(&sp.at(e.qt), iw, cw)));
+        sp.def(e.m, corr_w, false, format!("{} * an2", zext(&sp.at(e.qt), iw, corr_w)));
     }
     sp.cut();
     i0_section(&mut sp);
     let an2 = sp.at("an2");
     for e in &ends {
         let (lo, m, qt) = (sp.at(e.lo), sp.at(e.m), sp.at(e.qt));
-        sp.def(e.corr, cw, false, format!("{lo} - {m}"));
+        sp.def(e.corr, corr_w, false, format!("{lo} - {m}"));
         sp.def(e.out, iw, false, format!("{qt} + {}", zext(&format!("{} >= {an2}", e.corr), 1, iw)));
     }
     sp
@@ -155,8 +159,8 @@ pub(super) fn output(hw: &Hw, mut sp: Stager, body: &mut Vec<Item>) -> Stager {
     let fe = &hw.fe;
     let (xw, iw, dw) = (fe.cfg.xbits, fe.cfg.iw(), fe.cfg.dw());
     let scan = fe.di == DiMode::Scanline;
-    let (sdv, sd_cw) = scanline_divider(hw);
-    let sq = sdv.qb;
+    let (sdv, sd_cnt_w) = scanline_divider(hw);
+    let sd_qbits = sdv.qb;
     let (oy, ox, olen) = (sp.at("y"), sp.at("x"), sp.at("len"));
     let odi = if scan { lit(dw, 0) } else { sp.at("di") };
     let nsp = sp.stage();
@@ -172,23 +176,23 @@ pub(super) fn output(hw: &Hw, mut sp: Stager, body: &mut Vec<Item>) -> Stager {
         sp.def("nabs", iw, false, "ilast >= i0 ? ilast - i0 : i0 - ilast");
         sp.def("dm1", xw + 1, false, format!("{olen} - {}", lit(xw + 1, 1)));
         sp.note(Item::Blank);
-        for item in div_chain(&sdv, "sd_cnt", sd_cw, hw.div_bits) {
+        for item in div_chain(&sdv, "sd_cnt", sd_cnt_w, hw.div_bits) {
             sp.note(item);
         }
-        sp.def("sd_fin", 1, false, format!("sd_cnt < {}", lit(sd_cw, hw.div_bits as u64)));
+        sp.def("sd_fin", 1, false, format!("sd_cnt < {}", lit(sd_cnt_w, hw.div_bits as u64)));
         let q = format!("sdv_q{}", hw.div_bits);
         sp.def("sd_di", dw, false, format!("sd_neg ? -{} : {}", zext(&q, iw, dw), zext(&q, iw, dw)));
-        let mut start = vec![set("sd_busy", "1'b1"), set("sd_cnt", lit(sd_cw, (sq - 1) as u64)), set("sd_neg", "ilast < i0")];
+        let mut start = vec![set("sd_busy", "1'b1"), set("sd_cnt", lit(sd_cnt_w, (sd_qbits - 1) as u64)), set("sd_neg", "ilast < i0")];
         start.extend(div_load(
             &sdv,
             &format!("({} << 1) + {}", zext("nabs", iw, sdv.pw), zext("dm1", xw + 1, sdv.pw)),
-            &format!("{} << {sq}", zext("dm1", xw + 1, sdv.pw)),
+            &format!("{} << {sd_qbits}", zext("dm1", xw + 1, sdv.pw)),
         ));
         let mut run = div_iter(&sdv, hw.div_bits);
         run.push(Stmt::If(
             "sd_fin".into(),
             vec![set("sd_busy", "1'b0")],
-            vec![set("sd_cnt", format!("sd_cnt - {}", lit(sd_cw, hw.div_bits as u64)))],
+            vec![set("sd_cnt", format!("sd_cnt - {}", lit(sd_cnt_w, hw.div_bits as u64)))],
         ));
         p_scan.push(Item::Always(vec![Stmt::If(
             "rst".into(),

@@ -15,27 +15,27 @@ pub(super) fn scanline_divider(hw: &Hw) -> (Div, u32) {
 
 pub(super) fn emit(hw: &Hw, body: &mut Vec<Item>) {
     let fe = &hw.fe;
-    let Widths { yw, aw, gw, dw_edge: de, k: kk, rw, .. } = fe.widths();
+    let Widths { yw: row_w, aw: area_w, gw: bound_w, dw_edge: ediv_w, k: sum_w, rw: recip_w, .. } = fe.widths();
     let (xw, dw) = (fe.cfg.xbits, fe.cfg.dw());
     let w = fe.screen.width as i64;
     body.push(comment("Walker: the triangle being walked, one row per clock."));
     body.push(reg("w_valid", 1));
-    body.push(reg("w_row", yw));
-    body.push(reg("w_last", yw));
+    body.push(reg("w_row", row_w));
+    body.push(reg("w_last", row_w));
     for k in 0..3 {
-        for (n, ww) in [("act", 1), ("right", 1), ("rs", yw), ("re", yw), ("d", de), ("rem", de), ("rs256_", de)] {
+        for (n, ww) in [("act", 1), ("right", 1), ("rs", row_w), ("re", row_w), ("d", ediv_w), ("rem", ediv_w), ("rs256_", ediv_w)] {
             body.push(reg(&format!("w_{n}{k}"), ww));
         }
-        body.push(sreg(&format!("w_g{k}"), gw));
-        body.push(sreg(&format!("w_qs{k}"), gw));
+        body.push(sreg(&format!("w_g{k}"), bound_w));
+        body.push(sreg(&format!("w_qs{k}"), bound_w));
     }
-    for (n, ww) in [("w_di", dw), ("w_an", aw), ("w_rn", rw), ("w_tn", kk), ("w_gxn", kk), ("w_dyn", kk)] {
+    for (n, ww) in [("w_di", dw), ("w_an", area_w), ("w_rn", recip_w), ("w_tn", sum_w), ("w_gxn", sum_w), ("w_dyn", sum_w)] {
         body.push(reg(n, ww));
     }
     if fe.di == DiMode::Scanline {
-        let (sdv, sd_cw) = scanline_divider(hw);
+        let (sdv, sd_cnt_w) = scanline_divider(hw);
         body.push(comment("Per-scanline dI (the comparison option): a restoring divider, busy for each span of m >= 2."));
-        body.extend([reg("sd_busy", 1), reg("sd_cnt", sd_cw), reg("sd_neg", 1)]);
+        body.extend([reg("sd_busy", 1), reg("sd_cnt", sd_cnt_w), reg("sd_neg", 1)]);
         body.extend(div_regs(&sdv));
         body.push(wire("adv", 1, "(!out_valid || out_ready) && !sd_busy"));
     } else {
@@ -43,16 +43,16 @@ pub(super) fn emit(hw: &Hw, body: &mut Vec<Item>) {
     }
     body.push(wire("w_end", 1, "w_row == w_last"));
     body.push(assign("take", "st == HOLD && adv && (!w_valid || w_end)"));
-    let bw = gw + 1;
-    body.push(swire("lo0", bw, slit(bw, 0)));
-    body.push(swire("hi0", bw, slit(bw, w - 1)));
+    let end_w = bound_w + 1;
+    body.push(swire("lo0", end_w, slit(end_w, 0)));
+    body.push(swire("hi0", end_w, slit(end_w, w - 1)));
     for k in 0..3 {
         body.push(wire(&format!("in{k}"), 1, format!("w_act{k} && w_row >= w_rs{k} && w_row <= w_re{k}")));
-        body.push(swire(&format!("gg{k}"), bw, sext(&format!("w_g{k}"), gw, bw)));
+        body.push(swire(&format!("gg{k}"), end_w, sext(&format!("w_g{k}"), bound_w, end_w)));
         // This edge's bound on its side of the row, or the screen's where it bounds none here;
         // a left edge's bound is -g, kept as g (its smallest is the span's left end).
-        body.push(swire(&format!("lg{k}"), bw, format!("(in{k} && !w_right{k} && gg{k} < lo0) ? gg{k} : lo0")));
-        body.push(swire(&format!("ha{k}"), bw, format!("(in{k} && w_right{k} && gg{k} < hi0) ? gg{k} : hi0")));
+        body.push(swire(&format!("lg{k}"), end_w, format!("(in{k} && !w_right{k} && gg{k} < lo0) ? gg{k} : lo0")));
+        body.push(swire(&format!("ha{k}"), end_w, format!("(in{k} && w_right{k} && gg{k} < hi0) ? gg{k} : hi0")));
     }
     // Side by side rather than in a chain, and no negation before the pixel test or the length:
     // this is the walker's row clock, the staged front-end's limit at 2 and 1 quotient bits.
@@ -60,24 +60,28 @@ pub(super) fn emit(hw: &Hw, body: &mut Vec<Item>) {
     body.push(comment("hi3 the smallest right bound; the row has a pixel when hi3 + mg >= 0."));
     for (end, side) in [("mg", "lg"), ("hi3", "ha")] {
         let c = |i: u32, j: u32| format!("{side}{i} <= {side}{j}");
-        body.push(swire(end, bw, format!("({} && {}) ? {side}0 : ({}) ? {side}1 : {side}2", c(0, 1), c(0, 2), c(1, 2))));
+        body.push(swire(end, end_w, format!("({} && {}) ? {side}0 : ({}) ? {side}1 : {side}2", c(0, 1), c(0, 2), c(1, 2))));
     }
     body.push(comment("verilator lint_off UNUSEDSIGNAL"));
-    body.push(swire("lo3", bw, "-mg"));
-    body.push(swire("room", bw + 1, format!("{} + {}", sext("hi3", bw, bw + 1), sext("mg", bw, bw + 1))));
-    body.push(wire("len_w", bw, "hi3 + mg + 1"));
+    body.push(swire("lo3", end_w, "-mg"));
+    body.push(swire("room", end_w + 1, format!("{} + {}", sext("hi3", end_w, end_w + 1), sext("mg", end_w, end_w + 1))));
+    body.push(wire("len_w", end_w, "hi3 + mg + 1"));
     body.push(comment("verilator lint_on UNUSEDSIGNAL"));
-    body.push(wire("emit", 1, format!("w_valid && !room[{bw}]")));
+    body.push(wire("emit", 1, format!("w_valid && !room[{end_w}]")));
     body.push(wire("lo_u", xw, format!("lo3[{}:0]", xw - 1)));
     for k in 0..3 {
         body.push(wire(
             &format!("rsum{k}"),
-            de + 1,
-            format!("{} + {}", zext(&format!("w_rem{k}"), de, de + 1), zext(&format!("w_rs256_{k}"), de, de + 1)),
+            ediv_w + 1,
+            format!("{} + {}", zext(&format!("w_rem{k}"), ediv_w, ediv_w + 1), zext(&format!("w_rs256_{k}"), ediv_w, ediv_w + 1)),
         ));
-        body.push(wire(&format!("cy{k}"), 1, format!("rsum{k} >= {}", zext(&format!("w_d{k}"), de, de + 1))));
+        body.push(wire(&format!("cy{k}"), 1, format!("rsum{k} >= {}", zext(&format!("w_d{k}"), ediv_w, ediv_w + 1))));
         body.push(comment("verilator lint_off UNUSEDSIGNAL"));
-        body.push(wire(&format!("rnext{k}"), de + 1, format!("cy{k} ? rsum{k} - {} : rsum{k}", zext(&format!("w_d{k}"), de, de + 1))));
+        body.push(wire(
+            &format!("rnext{k}"),
+            ediv_w + 1,
+            format!("cy{k} ? rsum{k} - {} : rsum{k}", zext(&format!("w_d{k}"), ediv_w, ediv_w + 1)),
+        ));
         body.push(comment("verilator lint_on UNUSEDSIGNAL"));
     }
     let mut load = vec![set("w_valid", "1'b1"), set("w_row", "s_first"), set("w_last", "s_last")];
@@ -104,13 +108,13 @@ pub(super) fn emit(hw: &Hw, body: &mut Vec<Item>) {
         set("w_gxn", "s_gxn"),
         set("w_dyn", "s_dyn"),
     ]);
-    let mut step = vec![set("w_row", format!("w_row + {}", lit(yw, 1))), set("w_tn", "w_tn + w_dyn")];
+    let mut step = vec![set("w_row", format!("w_row + {}", lit(row_w, 1))), set("w_tn", "w_tn + w_dyn")];
     for k in 0..3 {
         step.push(Stmt::If(
             format!("w_act{k} && w_row >= w_rs{k}"),
             vec![
-                set(format!("w_rem{k}"), format!("rnext{k}[{}:0]", de - 1)),
-                set(format!("w_g{k}"), format!("w_g{k} + w_qs{k} + {}", zext(&format!("cy{k}"), 1, gw))),
+                set(format!("w_rem{k}"), format!("rnext{k}[{}:0]", ediv_w - 1)),
+                set(format!("w_g{k}"), format!("w_g{k} + w_qs{k} + {}", zext(&format!("cy{k}"), 1, bound_w))),
             ],
             vec![],
         ));
