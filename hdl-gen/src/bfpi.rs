@@ -5,6 +5,8 @@
 //! naive designer or an HLS tool would) and `tree` (no increment block: the segment shader
 //! forms its lanes with a doubling tree, see `segment.rs`). They compute the same function.
 
+pub mod properties;
+
 use crate::verilog::{assign, comment, sext, swire, Item, Module, Port};
 use crate::Names;
 use golden::bfpi::BfpiPlan;

@@ -147,7 +147,7 @@ pub fn generate(opts: &Options) -> Vec<GeneratedFile> {
         modules.iter().map(|m| GeneratedFile { name: format!("{}.v", m.name), contents: m.render() }).collect();
     // The BFPI's proof reference rides in its file (scripts/prove).
     if let Some(f) = files.iter_mut().find(|f| f.name == format!("{}.v", names.bfpi)) {
-        f.contents.push_str(&formal::bfpi_reference(&opts.cfg, &names.bfpi).render_formal());
+        f.contents.push_str(&bfpi::properties::bfpi_reference(&opts.cfg, &names.bfpi).render_formal());
     }
     for (name, rom) in [(golden::rom::BRDF_HEX, unit.brdf_rom()), (golden::rom::NK_HEX, unit.nk_rom())] {
         files.push(GeneratedFile { name: name.into(), contents: rom.to_hex() });

@@ -12,6 +12,8 @@
 //! `dI << k`, a doubling tree of P - 1 accumulator-wide adders, and the step is `dI << log2 P`.
 
 use crate::bfpi::BfpiArch;
+mod properties;
+
 use crate::verilog::{assign, bit, bus, comment, lit, net, reg, set, sext, sreg, swire, wire, zext, Item, Module, Port, Stmt};
 use crate::Names;
 use golden::pipeline::Pipeline;
@@ -460,9 +462,9 @@ pub fn module_with(cfg: &Config, names: &Names, arch: BfpiArch, pipe: Pipeline) 
     )]));
     body.push(Item::Blank);
     if pipe.span_stage() {
-        body.push(crate::formal::segment_pipelined_properties(cfg, rw, pipe));
+        body.push(properties::segment_pipelined_properties(cfg, rw, pipe));
     } else {
-        body.push(crate::formal::segment_properties(cfg, rw));
+        body.push(properties::segment_properties(cfg, rw));
     }
 
     Module { name: names.segment.clone(), header, params: vec![], ports: ports(cfg), body }

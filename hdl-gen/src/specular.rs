@@ -8,6 +8,8 @@
 //! pipe keeps every pixel. The ROMs read on the same `adv`, which makes them ordinary
 //! enable-gated block RAM reads.
 
+mod properties;
+
 use crate::rom;
 use crate::verilog::{assign, comment, lit, reg, set, wire, zext, Item, Module, Param, Port, Stmt};
 use golden::rom::{BRDF_HEX, NK_HEX};
@@ -426,7 +428,7 @@ fn module(cfg: &Config, unit: &SpecularUnit, names: &SpecNames) -> Module {
     body.push(Item::Always(vec![Stmt::If("rst".into(), resets, vec![Stmt::If(adv.into(), stages.concat(), vec![])])]));
 
     body.push(Item::Blank);
-    body.push(crate::formal::specular_properties(lw, &order));
+    body.push(properties::specular_properties(lw, &order));
     Module {
         name: names.unit.clone(),
         header,

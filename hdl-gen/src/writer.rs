@@ -2,6 +2,8 @@
 //! (`tri_fb_p<P>`). `golden::writer` is the plan: which block each write addresses, with which
 //! enables, in which order; this module prints it.
 
+mod properties;
+
 use crate::verilog::{assign, comment, lit, reg, set, wire, zext, Item, Module, Port, Stmt};
 use crate::Names;
 use golden::writer::{Writer, LATENCY};
@@ -178,7 +180,7 @@ pub fn module(w: &Writer, names: &Names) -> Module {
             )],
         )]));
     }
-    body.push(crate::formal::writer_properties(w));
+    body.push(properties::writer_properties(w));
     Module { name: names.writer.clone(), header, params: vec![], ports: ports(w), body }
 }
 

@@ -6,8 +6,8 @@ use super::setup::{self, Setup};
 use super::span;
 use super::stager::Stager;
 use super::Hw;
-use crate::formal::{frontend_properties, CalcStage, FrontendShape, SpanStage};
-use crate::verilog::Item;
+use crate::formal::{assert, past_flags, reset_and_stability, slit, when, CUT_TAG, OUT};
+use crate::verilog::{comment, lit, reg, set, sext, wire, zext, Item, Stmt};
 
 pub(super) fn emit(hw: &Hw, set_up: Setup, sp: &Stager) -> Item {
     let fe = &hw.fe;
@@ -47,4 +47,529 @@ pub(super) fn emit(hw: &Hw, set_up: Setup, sp: &Stager) -> Item {
             })
             .collect(),
     })
+}
+
+/// What the front-end's proof needs from its generator: widths, screen, divider clocks.
+pub struct FrontendShape {
+    /// Row bits (`out_y`), vertex x and y bits.
+    pub yw: u32,
+    pub cx: u32,
+    pub cy: u32,
+    pub xw: u32,
+    /// `dI`'s bits (`out_di`).
+    pub dw: u32,
+    /// Screen width and height, pixels.
+    pub width: u64,
+    pub height: u64,
+    /// The dividers' counter width, quotient bits per clock, the reciprocal's quotient bits,
+    /// and the clocks they run (`Hw::div_clocks`).
+    pub cnt_w: u32,
+    pub bits: u32,
+    pub rw: u32,
+    pub div_clocks: u32,
+    /// The set-up dividers' registers (partial remainder, divisor, quotient of each): cut.
+    pub div_regs: Vec<String>,
+    /// CALC's stages after the vertex register (none at level 0), in order.
+    pub calc_stages: Vec<CalcStage>,
+    /// The names under which the last CALC stage holds the guard-band check and the cull.
+    pub guard: String,
+    pub cull: String,
+    /// The span path's register stages between the walker and the output, in order.
+    pub span_stages: Vec<SpanStage>,
+}
+
+/// A register stage of the front-end's span path: where it holds a span's valid, row, columns
+/// and `dI`.
+pub struct SpanStage {
+    pub valid: String,
+    pub y: String,
+    pub x: String,
+    pub len: String,
+    pub di: String,
+}
+
+/// A CALC stage of the pipelined set-up: its valid register and where it holds what the
+/// reference follows (the guard-band check; the vertical extent, or the rows made of it).
+pub struct CalcStage {
+    pub valid: String,
+    pub guard: String,
+    pub ymin: Option<String>,
+    pub ymax: Option<String>,
+    /// The first and last rows, signed (`ryw` bits) and clipped, and the cull decision.
+    pub first_s: Option<String>,
+    pub last_s: Option<String>,
+    pub cull: Option<String>,
+    /// Candidates for the last row held before the choice between them (each as `last_s`).
+    pub last_alt: Vec<String>,
+}
+
+/// Properties of `tri_frontend` (SPEC §6; names as `frontend::module` declares them), with the
+/// per-triangle `dI`: its control against a reference model of its stages kept at the ports.
+///
+/// The reference, written from SPEC §6: a triangle waits in the vertex register until the
+/// set-up is free; the set-up drops it with one `err` pulse when a vertex lies outside the
+/// guard band (decided by the reference itself from the ports, SPEC's `-W <= x < 2W`,
+/// `-H <= y < 2H`), yields nothing for a culled one, and otherwise divides for `div_clocks`
+/// clocks and holds the result until the walker is free (idle, or on its last row with the
+/// output free: the next triangle's set-up overlaps the walk); the walker walks the rows from
+/// first to last, one per free clock, and each row with covered pixels becomes a span that
+/// moves through the I0 stages (two, or six when pipelined) to the output, every stage moving
+/// when the output is free. With CALC in stages, a triangle moves through them as a queue
+/// between the vertex register and the set-up.
+/// Whether a row has covered pixels (the walker's `lo <= hi`), whether a triangle is culled
+/// (its area and row range) and the rows' first and last are the design's data decisions the
+/// reference takes as given; it checks them where SPEC constrains them: every walked row's
+/// centre lies within the triangle's vertical extent and on the screen, and every span is on
+/// the screen with at least one pixel (`out_x + out_len <= W`). Asserted: `in_ready`, `err`,
+/// `out_valid` and `out_y` equal the reference's (no triangle dropped or invented, spans top
+/// to bottom in order, a triangle's spans before the next one's, `err` exactly once per
+/// triangle outside the band and never otherwise); the triangle count (accepted = flagged +
+/// culled + walked + in flight) and the span count (every covered row's span offered once);
+/// `dI` once per triangle (a span that is not its triangle's first carries the `dI` of the one
+/// before it); the rate (a row every free clock, no bubble between triangles when the set-up is
+/// done, a dropped triangle costs one clock); reset and stability; and the linking invariants. Every multiplier is cut (area, edge and plane products, I0's product and
+/// correction) and so are the set-up dividers' registers (free every clock): their values never
+/// decide the control beyond what the reference takes as given, and the values are
+/// co-simulated bit-exactly against golden. The dividers' cut is for speed: a run from reset
+/// through their restoring steps (66 bits wide at 640x480) is more than twice as slow.
+pub fn frontend_properties(s: &FrontendShape) -> Item {
+    // No `*` below: the proof cuts every multiplier, the properties' own too.
+    assert!(s.bits.is_power_of_two(), "divider bits per clock: {}", s.bits);
+    let r = Reference {
+        s,
+        // The span path's stages: the reference's f_<i>v, f_<i>y, f_<i>n for i = 1..=nsp.
+        nsp: s.span_stages.len(),
+        // CALC's stages: 0 is the vertex register, 1.. the pipelined set-up's (none at level 0).
+        last: s.calc_stages.len(),
+        // Reference counters: wide enough for the stages they count through, modulo 2^cw.
+        cw: 4,
+        nw: 32 - s.div_clocks.leading_zeros(),
+    };
+    let mut b = r.declarations();
+    b.push(r.update());
+    b.extend(r.at_the_ports());
+    b.extend(r.linking());
+    Item::Formal(b)
+}
+
+/// The reference model's shape: the stages it follows and its counters' widths.
+#[derive(Clone, Copy)]
+struct Reference<'a> {
+    s: &'a FrontendShape,
+    nsp: usize,
+    last: usize,
+    cw: u32,
+    /// The divider-clock counter's width.
+    nw: u32,
+}
+
+/// The reference's CALC stage j: valid, guard-band check, vertical extent (0: the vertex register).
+fn f_v(j: usize) -> String {
+    if j == 0 {
+        "f_vf".to_string()
+    } else {
+        format!("f_c{j}v")
+    }
+}
+fn f_g(j: usize) -> String {
+    if j == 0 {
+        "f_vg".to_string()
+    } else {
+        format!("f_c{j}g")
+    }
+}
+fn f_ymin(j: usize) -> String {
+    if j == 0 {
+        "f_vymin".to_string()
+    } else {
+        format!("f_c{j}ymin")
+    }
+}
+fn f_ymax(j: usize) -> String {
+    if j == 0 {
+        "f_vymax".to_string()
+    } else {
+        format!("f_c{j}ymax")
+    }
+}
+/// Stage j's triangle moves on; the last stage's move is the set-up's load.
+fn f_mv(j: usize, last: usize) -> String {
+    if j == last {
+        "f_calc".to_string()
+    } else {
+        format!("f_mv{j}")
+    }
+}
+fn one(w: u32) -> String {
+    lit(w, 1)
+}
+/// A valid span (`v`) is on the screen with at least one pixel.
+fn on_screen(v: &str, x: &str, len: &str, xw: u32, width: u64) -> Stmt {
+    let wlim = lit(xw + 2, width);
+    when(
+        v,
+        vec![
+            assert(format!("{len} != {}", lit(xw + 1, 0))),
+            assert(format!("{} + {} <= {wlim}", zext(x, xw, xw + 2), zext(len, xw + 1, xw + 2))),
+        ],
+    )
+}
+
+impl Reference<'_> {
+    /// The reference's registers and the wires it reads.
+    fn declarations(&self) -> Vec<Item> {
+        let FrontendShape { yw, cx, cy, dw, width, height, ref div_regs, ref cull, .. } = *self.s;
+        let Reference { nsp, last, cw, nw, .. } = *self;
+        let f_mv = |j: usize| f_mv(j, last);
+        let mut b = vec![
+            comment(format!("{CUT_TAG}cutpoint t:$mul {}", div_regs.iter().map(|r| format!("w:{r}")).collect::<Vec<_>>().join(" "))),
+            comment("(the multipliers: area, edges, plane, I0; and the set-up dividers' registers, free every clock:"),
+            comment("only the coverage decision, taken as given, depends on them; values are left to co-simulation)"),
+        ];
+        b.extend(past_flags());
+        b.extend(reset_and_stability("span", OUT, &["out_y", "out_x", "out_len", "out_i0", "out_di"]));
+        b.push(comment("Reset: no error pulse out of reset either."));
+        b.push(Item::Always(vec![when("f_past && $past(rst)", vec![assert("!err")])]));
+
+        b.push(comment("The reference. The input stage: the triangle waiting for the set-up, whether its"));
+        b.push(comment("vertices lie in SPEC §6's guard band (decided here from the ports), its vertical extent."));
+        b.extend([reg("f_vf", 1), reg("f_vg", 1), Item::Reg { name: "f_vymin".into(), width: cy, signed: true }]);
+        b.push(Item::Reg { name: "f_vymax".into(), width: cy, signed: true });
+        let (gxl, gxh) = (-(width as i64) * 256, 2 * width as i64 * 256);
+        let (gyl, gyh) = (-(height as i64) * 256, 2 * height as i64 * 256);
+        let mut band = Vec::new();
+        for k in 0..3 {
+            b.push(Item::Wire {
+                name: format!("f_ix{k}"),
+                width: cx + 2,
+                signed: true,
+                value: Some(sext(&format!("in_x{k}"), cx, cx + 2)),
+            });
+            b.push(Item::Wire {
+                name: format!("f_iy{k}"),
+                width: cy + 2,
+                signed: true,
+                value: Some(sext(&format!("in_y{k}"), cy, cy + 2)),
+            });
+            band.push(format!(
+                "f_ix{k} >= {} && f_ix{k} < {} && f_iy{k} >= {} && f_iy{k} < {}",
+                slit(cx + 2, gxl),
+                slit(cx + 2, gxh),
+                slit(cy + 2, gyl),
+                slit(cy + 2, gyh)
+            ));
+        }
+        b.push(wire("f_band", 1, band.join(" && ")));
+        let min3 = |op: &str| format!("((in_y0 {op} in_y1) ? ((in_y0 {op} in_y2) ? in_y0 : in_y2) : ((in_y1 {op} in_y2) ? in_y1 : in_y2))");
+        b.push(Item::Wire { name: "f_iymin".into(), width: cy, signed: true, value: Some(min3("<")) });
+        b.push(Item::Wire { name: "f_iymax".into(), width: cy, signed: true, value: Some(min3(">")) });
+
+        for j in 1..=last {
+            if j == 1 {
+                b.push(comment("CALC's stages: each triangle's guard-band check and vertical extent, as the vertex register's."));
+            }
+            b.extend([reg(&f_v(j), 1), reg(&f_g(j), 1)]);
+            b.push(Item::Reg { name: f_ymin(j), width: cy, signed: true });
+            b.push(Item::Reg { name: f_ymax(j), width: cy, signed: true });
+        }
+        b.push(comment("The set-up: busy (dividing, f_sn + 1 clocks left, or holding its result: f_sh), its extent."));
+        b.extend([reg("f_sb", 1), reg("f_sh", 1), reg("f_sn", nw)]);
+        b.push(Item::Reg { name: "f_symin".into(), width: cy, signed: true });
+        b.push(Item::Reg { name: "f_symax".into(), width: cy, signed: true });
+        b.push(comment("The walker: the triangle being walked, its row and last row, its extent."));
+        b.extend([reg("f_wv", 1), reg("f_wrow", yw), reg("f_wlast", yw)]);
+        b.push(Item::Reg { name: "f_wymin".into(), width: cy, signed: true });
+        b.push(Item::Reg { name: "f_wymax".into(), width: cy, signed: true });
+        b.push(comment("The spans: the walker's row in the I0 stages and the output (valid, row)."));
+        for i in 1..=nsp {
+            b.extend([reg(&format!("f_{i}v"), 1), reg(&format!("f_{i}y"), yw)]);
+        }
+        b.extend([reg("f_ov", 1), reg("f_oy", yw)]);
+        b.push(comment("Each span's tag: its triangle's first (the walker has emitted none of it yet: f_wnew)."));
+        b.push(reg("f_wnew", 1));
+        for i in 1..=nsp {
+            b.push(reg(&format!("f_{i}n"), 1));
+        }
+        b.push(reg("f_on", 1));
+        b.push(comment("The dI of the last span offered, and whether the output register could load (f_free):"));
+        b.push(comment("a span on the output is new when it is valid and f_free."));
+        b.extend([reg("f_pdi", dw), reg("f_free", 1)]);
+        b.push(Item::Always(vec![set("f_free", "rst || !out_valid || out_ready"), when("out_valid", vec![set("f_pdi", "out_di")])]));
+        b.push(comment("The error pulse owed, and counts: triangles accepted, flagged (at the port), culled,"));
+        b.push(comment("walked; spans the walker produced (covered rows) and spans taken at the port."));
+        b.extend([reg("f_errp", 1), reg("f_nacc", cw), reg("f_nerr", cw), reg("f_ncull", cw), reg("f_nwalk", cw)]);
+        b.extend([reg("f_nrow", cw), reg("f_nout", cw)]);
+
+        b.push(wire("f_adv", 1, "!out_valid || out_ready"));
+        b.push(wire("f_wend", 1, "f_wrow == f_wlast"));
+        b.push(wire("f_take", 1, "f_sb && f_sh && f_adv && (!f_wv || f_wend)"));
+        b.push(wire("f_calc", 1, format!("{} && (!f_sb || f_take)", f_v(last))));
+        for j in (0..last).rev() {
+            b.push(wire(&f_mv(j), 1, format!("{} && (!{} || {})", f_v(j), f_v(j + 1), f_mv(j + 1))));
+        }
+        b.push(wire("f_rdy", 1, format!("!f_vf || {}", f_mv(0))));
+        b.push(wire("f_acc", 1, "in_valid && f_rdy"));
+        b.push(comment("The design's data decisions, taken as given: culled, and a walked row's covered pixels."));
+        b.push(wire("f_cull", 1, cull.as_str()));
+        b.push(wire("f_cover", 1, "lo3 <= hi3"));
+        b
+    }
+
+    /// The reference's clock: input, CALC's stages, set-up, walker, spans and the counts.
+    fn update(&self) -> Item {
+        let FrontendShape { yw, div_clocks, .. } = *self.s;
+        let Reference { nsp, last, cw, nw, .. } = *self;
+        let f_mv = |j: usize| f_mv(j, last);
+        let inc1 = |n: &str| set(n, format!("{n} + {}", one(cw)));
+        let inc = |n: &str, c: &str| when(c, vec![inc1(n)]);
+        let calc_go = vec![
+            set("f_sb", "1'b1"),
+            set("f_sh", "1'b0"),
+            set("f_sn", lit(nw, (div_clocks - 1) as u64)),
+            set("f_symin", f_ymin(last)),
+            set("f_symax", f_ymax(last)),
+        ];
+        let setup = Stmt::If(
+            "f_calc".into(),
+            vec![Stmt::If(
+                format!("!{}", f_g(last)),
+                vec![set("f_errp", "1'b1"), set("f_sb", "1'b0")],
+                vec![Stmt::If("f_cull".into(), vec![set("f_sb", "1'b0"), inc1("f_ncull")], calc_go)],
+            )],
+            vec![Stmt::If(
+                "f_take".into(),
+                vec![set("f_sb", "1'b0")],
+                vec![when(
+                    "f_sb && !f_sh",
+                    vec![Stmt::If(
+                        format!("f_sn == {}", lit(nw, 0)),
+                        vec![set("f_sh", "1'b1")],
+                        vec![set("f_sn", format!("f_sn - {}", one(nw)))],
+                    )],
+                )],
+            )],
+        );
+        let walker = Stmt::If(
+            "f_take".into(),
+            vec![
+                set("f_wv", "1'b1"),
+                set("f_wrow", "s_first"),
+                set("f_wlast", "s_last"),
+                set("f_wymin", "f_symin"),
+                set("f_wymax", "f_symax"),
+                set("f_wnew", "1'b1"),
+                inc1("f_nwalk"),
+            ],
+            vec![
+                when("f_adv && f_wv && f_cover", vec![set("f_wnew", "1'b0")]),
+                when(
+                    "f_adv && f_wv",
+                    vec![Stmt::If("f_wend".into(), vec![set("f_wv", "1'b0")], vec![set("f_wrow", format!("f_wrow + {}", one(yw)))])],
+                ),
+            ],
+        );
+        let spans = when(
+            "f_adv",
+            vec![set("f_1v", "f_wv && f_cover"), set("f_1y", "f_wrow"), set("f_1n", "f_wnew")]
+                .into_iter()
+                .chain((2..=nsp).flat_map(|i| ["v", "y", "n"].map(|f| set(format!("f_{i}{f}"), format!("f_{}{f}", i - 1)))))
+                .chain(["v", "y", "n"].map(|f| set(format!("f_o{f}"), format!("f_{nsp}{f}"))))
+                .collect(),
+        );
+        let input = Stmt::If(
+            "f_acc".into(),
+            vec![set("f_vf", "1'b1"), set("f_vg", "f_band"), set("f_vymin", "f_iymin"), set("f_vymax", "f_iymax")],
+            vec![when(f_mv(0), vec![set("f_vf", "1'b0")])],
+        );
+        let stages: Vec<Stmt> = (1..=last)
+            .map(|j| {
+                Stmt::If(
+                    f_mv(j - 1),
+                    vec![set(f_v(j), "1'b1"), set(f_g(j), f_g(j - 1)), set(f_ymin(j), f_ymin(j - 1)), set(f_ymax(j), f_ymax(j - 1))],
+                    vec![when(f_mv(j), vec![set(f_v(j), "1'b0")])],
+                )
+            })
+            .collect();
+        let zero = lit(cw, 0);
+        Item::Always(vec![Stmt::If(
+            "rst".into(),
+            vec![set("f_vf", "1'b0")]
+                .into_iter()
+                .chain((1..=last).map(|j| set(f_v(j), "1'b0")))
+                .chain([set("f_sb", "1'b0"), set("f_wv", "1'b0")])
+                .chain((1..=nsp).map(|i| set(format!("f_{i}v"), "1'b0")))
+                .chain([
+                    set("f_ov", "1'b0"),
+                    set("f_errp", "1'b0"),
+                    set("f_nacc", zero.clone()),
+                    set("f_nerr", zero.clone()),
+                    set("f_ncull", zero.clone()),
+                    set("f_nwalk", zero.clone()),
+                    set("f_nrow", zero.clone()),
+                    set("f_nout", zero.clone()),
+                ])
+                .collect(),
+            vec![
+                set("f_errp", "1'b0"),
+                inc("f_nacc", "f_acc"),
+                inc("f_nerr", "err"),
+                inc("f_nrow", "f_adv && f_wv && f_cover"),
+                inc("f_nout", "out_valid && out_ready"),
+                input,
+            ]
+            .into_iter()
+            .chain(stages)
+            .chain([setup, walker, spans])
+            .collect(),
+        )])
+    }
+
+    /// At the ports: the reference's stream, the rate, and nothing lost or invented.
+    fn at_the_ports(&self) -> Vec<Item> {
+        let FrontendShape { yw, xw, width, ref calc_stages, ref guard, ref cull, .. } = *self.s;
+        let Reference { nsp, last, cw, .. } = *self;
+
+        let mut b = vec![
+            comment("The front-end is the reference at its ports: it takes a triangle exactly when the"),
+            comment("vertex register is free or handing its triangle to the set-up, pulses err once per"),
+            comment("triangle outside the guard band and never otherwise, and offers exactly the reference's"),
+            comment("spans, row by row: a triangle's rows top to bottom, then the next triangle's."),
+        ];
+        let mut ports = vec![
+            assert("in_ready == f_rdy"),
+            assert("err == f_errp"),
+            assert("out_valid == f_ov"),
+            when("f_ov", vec![assert("out_y == f_oy")]),
+        ];
+        ports.push(on_screen("out_valid", "out_x", "out_len", xw, width));
+        ports.push(Stmt::Comment("dI once per triangle: a new span that is not its triangle's first carries the dI of".into()));
+        ports.push(Stmt::Comment("the span before it (the same triangle's).".into()));
+        ports.push(when("out_valid && f_free && !f_on", vec![assert("out_di == f_pdi")]));
+        b.push(Item::Comb(vec![when("f_past", ports)]));
+        b.push(comment("Rate (SPEC §6), in the design's terms: the walker takes a row every clock the output is"));
+        b.push(comment("free; a set-up result waiting when the walker is on its last row follows it with no"));
+        b.push(comment("bubble (set-up overlapped with the walk); a dropped or culled triangle costs its CALC clock."));
+        b.push(Item::Always(vec![when(
+            "f_past && !$past(rst)",
+            vec![
+                when("$past(w_valid && adv && !w_end)", vec![assert("w_valid"), assert(format!("w_row == $past(w_row) + {}", one(yw)))]),
+                when("$past(w_valid && adv && w_end && st == HOLD)", vec![assert("w_valid"), assert("w_row == $past(s_first)")]),
+                // The triangle behind a dropped one moves up in the same clock: into the last CALC
+                // stage, or (CALC in one clock) straight into it from the port.
+                when(
+                    format!("$past(calc && (!{guard} || {cull}))"),
+                    vec![match last {
+                        0 => assert("in_ready"),
+                        1 => assert(format!("!$past(v_full) || {}", calc_stages[0].valid)),
+                        _ => assert(format!("!$past({}) || {}", calc_stages[last - 2].valid, calc_stages[last - 1].valid)),
+                    }],
+                ),
+            ],
+        )]));
+        b.push(comment("Nothing lost or invented: every accepted triangle was flagged, culled or walked, or is"));
+        b.push(comment("still waiting or in set-up (counts modulo 16)."));
+        b.push(Item::Comb(vec![when(
+            "f_past",
+            vec![assert(
+                format!(
+                    "f_nacc == f_nerr + {} + f_ncull + f_nwalk + {} + {}",
+                    zext("err", 1, cw),
+                    zext("f_vf", 1, cw),
+                    zext("f_sb", 1, cw)
+                ) + &(1..=last).map(|j| format!(" + {}", zext(&f_v(j), 1, cw))).collect::<String>(),
+            )],
+        )]));
+        b.push(comment("Every span the walker produced is offered once: taken at the port, or still in a stage."));
+        b.push(Item::Comb(vec![when(
+            "f_past",
+            vec![assert(format!(
+                "f_nrow == f_nout{} + {}",
+                (1..=nsp).map(|i| format!(" + {}", zext(&format!("f_{i}v"), 1, cw))).collect::<String>(),
+                zext("f_ov", 1, cw)
+            ))],
+        )]));
+        b
+    }
+
+    /// Linking invariants: every stage's registers are the reference's.
+    fn linking(&self) -> Vec<Item> {
+        let FrontendShape { yw, cy, xw, width, height, cnt_w, bits, rw, div_clocks, ref calc_stages, ref span_stages, .. } = *self.s;
+        let Reference { nsp, nw, .. } = *self;
+
+        let mut b = Vec::new();
+        b.push(comment("Linking invariants: every stage's registers are the reference's; a row's centre"));
+        b.push(comment("(256 r + 128 sub-pixels) lies within its triangle's vertical extent and on the screen."));
+        let centre = |r: &str| format!("$signed({{2'b00, {r}, 8'd128}})");
+        let within = |r: &str, lo: &str, hi: &str| vec![assert(format!("{} >= {lo}", centre(r))), assert(format!("{} <= {hi}", centre(r)))];
+        let hmax = lit(yw, height - 1);
+        let st_is = "(f_sb ? (f_sh ? HOLD : DIV) : IDLE)";
+        let mut su = vec![assert(format!("{} <= f_symax", centre("s_last"))), assert(format!("{} >= f_symin", centre("s_first")))];
+        su.extend([assert("s_first <= s_last"), assert(format!("s_last <= {hmax}"))]);
+        let mut wk = vec![assert("w_row == f_wrow"), assert("w_last == f_wlast"), assert("f_wrow <= f_wlast")];
+        wk.extend(within("f_wrow", "f_wymin", "f_wymax"));
+        wk.extend([assert(format!("{} <= f_wymax", centre("f_wlast"))), assert(format!("f_wlast <= {hmax}"))]);
+        let mut link = vec![
+            assert("v_full == f_vf"),
+            when("f_vf", vec![assert("guard_ok == f_vg"), assert("ymin == f_vymin"), assert("ymax == f_vymax")]),
+        ];
+        let ryc = |r: &str| format!("$signed({{{r}, 8'd128}})");
+        for (j, c) in calc_stages.iter().enumerate().map(|(i, c)| (i + 1, c)) {
+            let mut held = vec![assert(format!("{} == {}", c.guard, f_g(j)))];
+            if let Some(r) = &c.ymin {
+                held.push(assert(format!("{r} == {}", f_ymin(j))));
+            }
+            if let Some(r) = &c.ymax {
+                held.push(assert(format!("{r} == {}", f_ymax(j))));
+            }
+            if let Some(r) = &c.first_s {
+                held.push(assert(format!("!{r}[{}]", cy - 8)));
+                held.push(assert(format!("{} >= {}", ryc(r), f_ymin(j))));
+            }
+            for r in c.last_s.iter().chain(&c.last_alt) {
+                held.push(assert(format!("{r} <= {}", slit(cy - 7, height as i64 - 1))));
+                held.push(assert(format!("{} <= {}", ryc(r), f_ymax(j))));
+            }
+            if let (Some(k), Some(a), Some(z)) = (&c.cull, &c.first_s, &c.last_s) {
+                held.push(when(format!("!{k}"), vec![assert(format!("{a} <= {z}"))]));
+            }
+            link.push(assert(format!("{} == {}", c.valid, f_v(j))));
+            link.push(when(f_v(j), held));
+        }
+        link.extend([
+            assert(format!("st == {st_is}")),
+            when(
+                "f_sb && !f_sh",
+                vec![assert(format!(
+                    "div_cnt == ({} << {}) + {}",
+                    zext("f_sn", nw, cnt_w.max(nw)),
+                    bits.trailing_zeros(),
+                    lit(cnt_w.max(nw), ((rw - 1) % bits) as u64)
+                ))],
+            ),
+            when(format!("f_sn > {}", lit(nw, (div_clocks - 1) as u64)), vec![assert("!(f_sb && !f_sh)")]),
+            when("f_sb", su),
+            assert("w_valid == f_wv"),
+            when("f_wv", wk),
+        ]);
+        for (i, sp) in span_stages.iter().enumerate().map(|(k, sp)| (k + 1, sp)) {
+            link.push(assert(format!("{} == f_{i}v", sp.valid)));
+            link.push(when(format!("f_{i}v"), vec![assert(format!("{} == f_{i}y", sp.y))]));
+        }
+        link.push(Stmt::Comment("A span that is not its triangle's first has the dI of the span ahead of it.".into()));
+        link.push(when("f_ov && !f_free", vec![assert("out_di == f_pdi")]));
+        // The dI ahead of stage i (i = nsp + 1: the output's): the nearest valid stage's, else the
+        // output's or the last span offered.
+        let ahead = |i: usize| {
+            (i..=nsp).rev().fold("f_ov ? out_di : f_pdi".to_string(), |acc, k| format!("f_{k}v ? {} : {acc}", span_stages[k - 1].di))
+        };
+        for (i, sp) in span_stages.iter().enumerate().map(|(k, sp)| (k + 1, sp)).rev() {
+            link.push(when(format!("f_{i}v && !f_{i}n"), vec![assert(format!("{} == ({})", sp.di, ahead(i + 1)))]));
+        }
+        link.push(when("f_wv && !f_wnew", vec![assert(format!("w_di == ({})", ahead(1)))]));
+        for sp in span_stages {
+            link.push(on_screen(&sp.valid, &sp.x, &sp.len, xw, width));
+        }
+        b.push(Item::Comb(vec![when("f_past", link)]));
+        b
+    }
 }
