@@ -1,0 +1,265 @@
+//! The front-end against the host set-up, the exact plane and itself (orders, windings, screens).
+
+use super::*;
+use crate::setup::Vertex;
+use crate::Align;
+
+/// xorshift64*: a small, stable generator (the test's sequence never changes with a crate).
+struct Rng(u64);
+impl Rng {
+    fn next(&mut self) -> u64 {
+        self.0 ^= self.0 >> 12;
+        self.0 ^= self.0 << 25;
+        self.0 ^= self.0 >> 27;
+        self.0.wrapping_mul(0x2545_F491_4F6C_DD1D)
+    }
+    fn range(&mut self, lo: i64, hi: i64) -> i64 {
+        lo + (self.next() % (hi - lo) as u64) as i64
+    }
+}
+
+/// A random port-level triangle of one of several kinds: anywhere in the guard band, small,
+/// slivers, vertices on centres, shared y (horizontal edges), at the band's edges.
+fn random_tri(rng: &mut Rng, fe: &FrontEnd) -> FixedTriangle {
+    let (w, h) = (fe.screen.width as i64 * 256, fe.screen.height as i64 * 256);
+    let imax = (1i64 << fe.cfg.iw()) - 1;
+    let kind = rng.range(0, 6);
+    let mut x = [0i64; 3];
+    let mut y = [0i64; 3];
+    let (cx, cy) = (rng.range(-w / 4, w + w / 4), rng.range(-h / 4, h + h / 4));
+    for k in 0..3 {
+        let (px, py) = match kind {
+            0 => (rng.range(-w, 2 * w), rng.range(-h, 2 * h)),
+            1 => (cx + rng.range(-2000, 2000), cy + rng.range(-2000, 2000)),
+            2 => (cx + rng.range(-20_000, 20_000), cy + rng.range(-300, 300)),
+            3 => ((cx / 256) * 256 + 128 + 256 * rng.range(-20, 20), (cy / 256) * 256 + 128 + 256 * rng.range(-20, 20)),
+            4 => (rng.range(-w, 2 * w), if k == 2 { rng.range(-h, 2 * h) } else { cy }),
+            _ => (if rng.range(0, 2) == 0 { -w } else { 2 * w - 1 }, rng.range(-h, 2 * h)),
+        };
+        (x[k], y[k]) = (px, py);
+    }
+    if kind == 2 && rng.range(0, 2) == 0 {
+        // A tall sliver instead of a wide one.
+        (x, y) = (y.map(|v| cx + (v - cy) / 16), x.map(|v| cy + (v - cx)));
+    }
+    let x = x.map(|v| v.clamp(-w, 2 * w - 1));
+    let y = y.map(|v| v.clamp(-h, 2 * h - 1));
+    let i = [0, 1, 2].map(|_| rng.range(0, imax + 1) as u32);
+    FixedTriangle { x, y, i }
+}
+
+fn check_against_host(fe: &FrontEnd, n: usize, seed: u64) {
+    let mut rng = Rng(seed);
+    let mut walked = 0;
+    for _ in 0..n {
+        let t = random_tri(&mut rng, fe);
+        let (outcome, spans) = fe.span_list(&t);
+        assert_ne!(outcome, Outcome::Guard);
+        let mut host = Vec::new();
+        t.snapped(fe.cfg.frac).spans(&fe.cfg, &fe.screen, |y, s| host.push((y, s.x0, s.len)));
+        let ours: Vec<_> = spans.iter().map(|&(y, s)| (y, s.x0, s.len)).collect();
+        if ours != host {
+            let diff = ours.iter().zip(&host).position(|(a, b)| a != b).unwrap_or(ours.len().min(host.len()));
+            panic!(
+                "coverage differs for {t:?} at span {diff}: {:?} vs {:?} ({} vs {} spans)",
+                ours.get(diff),
+                host.get(diff),
+                ours.len(),
+                host.len()
+            );
+        }
+        walked += (outcome == Outcome::Walked) as usize;
+        // Every pixel within 1 of the exact plane through the port intensities.
+        let (_, st) = fe.setup(&t);
+        for (y, s) in &spans {
+            let st = st.as_ref().unwrap();
+            s.check(&fe.cfg).unwrap();
+            // The error grows with j, so the last pixel is the one that matters; a stride
+            // through the rest keeps the huge screens' triangles affordable.
+            for j in (0..s.len).step_by(1 + s.len as usize / 64).chain([s.len - 1]) {
+                let exact = st.plane.value((s.x0 + j) as i64, *y as i64, fe.cfg.frac);
+                let got = s.pixel(j, fe.cfg.frac) as f64;
+                assert!((got - exact).abs() <= 1.0, "pixel {j} of row {y}: {got} vs {exact} for {t:?}");
+            }
+        }
+    }
+    assert!(walked > n / 4, "only {walked} of {n} triangles were walked");
+}
+
+#[test]
+fn coverage_equals_the_host_set_up_at_640x480() {
+    let fe = FrontEnd::new(Config::default(), Screen::default()).unwrap();
+    check_against_host(&fe, 8_000, 1);
+}
+
+#[test]
+fn coverage_and_accuracy_on_the_widest_screens() {
+    // The widest screen each configuration allows: 2^XW = 2^F = 4096 at the defaults, and
+    // a 65536-pixel screen with XW = 16, F = 16.
+    let fe = FrontEnd::new(Config::default(), Screen { width: 4096, height: 4096 }).unwrap();
+    check_against_host(&fe, 1_000, 2);
+    let wide = Config::new(8, 16, 16, Align::Span).unwrap();
+    let fe = FrontEnd::new(wide, Screen { width: 65536, height: 65536 }).unwrap();
+    check_against_host(&fe, 300, 3);
+    // Small screens: most triangles clip.
+    let fe = FrontEnd::new(Config::default(), Screen { width: 37, height: 23 }).unwrap();
+    check_against_host(&fe, 8_000, 4);
+}
+
+#[test]
+fn a_span_across_the_widest_screen_stays_within_one() {
+    // Full-width spans with the steepest gradient that still fits: the bound is tight here.
+    let fe = FrontEnd::new(Config::default(), Screen { width: 4096, height: 64 }).unwrap();
+    let mut rng = Rng(9);
+    let mut worst = 0.0f64;
+    for _ in 0..2000 {
+        let (a, b) = (rng.range(0, 1 << 20) as u32, rng.range(0, 1 << 20) as u32);
+        let t = FixedTriangle { x: [-256, 4096 * 256, -256], y: [-256, -256, 64 * 256], i: [a, b, a] };
+        let (_, st) = fe.setup(&t);
+        let st = st.unwrap();
+        fe.walk(&st, |y, s| {
+            for j in (0..s.len).step_by(97).chain([s.len - 1]) {
+                let exact = st.plane.value((s.x0 + j) as i64, y as i64, 12);
+                worst = worst.max((s.pixel(j, 12) as f64 - exact).abs());
+            }
+        });
+    }
+    eprintln!("widest screen (4096 px, F = 12): worst |pixel - plane| {worst:.4}");
+    assert!(worst <= 1.0, "{worst}");
+    assert!(worst > 0.5, "the test should reach past the rounding alone: {worst}");
+}
+
+/// The classical per-scanline `dI`: the same spans and `I0`, a `dI` per span that lands
+/// within `(m - 1)/2` units of the exactly rounded last pixel, every pixel within 1.
+#[test]
+fn per_scanline_di_keeps_coverage_and_accuracy() {
+    let tri = FrontEnd::new(Config::default(), Screen::default()).unwrap();
+    let scan = tri.with_di(DiMode::Scanline);
+    let mut rng = Rng(77);
+    let (mut spans, mut differ) = (0, 0);
+    for _ in 0..600 {
+        let t = random_tri(&mut rng, &tri);
+        let (o1, a) = tri.span_list(&t);
+        let (o2, b) = scan.span_list(&t);
+        assert_eq!((o1, a.len()), (o2, b.len()));
+        let (_, st) = tri.setup(&t);
+        for ((y, s), (y2, s2)) in a.iter().zip(&b) {
+            assert_eq!((y, s.x0, s.len, s.i0), (y2, s2.x0, s2.len, s2.i0));
+            let st = st.as_ref().unwrap();
+            let last = (2 * st.plane.s((s.x0 + s.len - 1) as i64, *y as i64) + st.plane.a) / (2 * st.plane.a);
+            let end = s2.i0 as i128 + (s2.len as i128 - 1) * s2.di as i128;
+            assert!(2 * (end - last).abs() < s2.len as i128, "{s2:?}: ends at {end}, the plane at {last}");
+            for j in 0..s2.len {
+                let exact = st.plane.value((s2.x0 + j) as i64, *y as i64, 12);
+                assert!((s2.pixel(j, 12) as f64 - exact).abs() <= 1.0, "{s2:?} pixel {j}");
+            }
+            spans += 1;
+            differ += (s.di != s2.di) as usize;
+        }
+    }
+    // Mostly the same dI (both are the plane's slope, rounded); where they differ, the test
+    // above holds the scanline's to its own bound.
+    assert!(spans > 10_000 && differ > 0, "{differ} of {spans} spans changed dI");
+}
+
+#[test]
+fn guard_band_and_culling() {
+    let fe = FrontEnd::new(Config::default(), Screen::default()).unwrap();
+    let ok = FixedTriangle { x: [0, 2560, 0], y: [0, 0, 2560], i: [0, 0, 0] };
+    assert_eq!(fe.span_list(&ok).0, Outcome::Walked);
+    let outside = [(Some(-640 * 256 - 1), None), (Some(1280 * 256), None), (None, Some(-480 * 256 - 1)), (None, Some(960 * 256))];
+    for (k, (bx, by)) in outside.into_iter().enumerate() {
+        let mut t = ok;
+        if let Some(v) = bx {
+            t.x[k % 3] = v;
+        }
+        if let Some(v) = by {
+            t.y[k % 3] = v;
+        }
+        assert_eq!(fe.span_list(&t), (Outcome::Guard, vec![]), "{t:?}");
+    }
+    // The band's own edges are inside it.
+    let edge = FixedTriangle { x: [-640 * 256, 1280 * 256 - 1, 0], y: [-480 * 256, 0, 960 * 256 - 1], i: [0; 3] };
+    assert_eq!(fe.span_list(&edge).0, Outcome::Walked);
+    // Zero area, and entirely off each side: culled in set-up.
+    let flat = FixedTriangle { x: [0, 2560, 5120], y: [0, 2560, 5120], i: [0; 3] };
+    assert_eq!(fe.span_list(&flat).0, Outcome::Culled);
+    for (dx, dy) in [(-620, 0), (700, 0), (0, -470), (0, 500)] {
+        let t = FixedTriangle { x: ok.x.map(|v| v + dx * 256), y: ok.y.map(|v| v + dy * 256), i: [0; 3] };
+        assert_eq!(fe.span_list(&t).0, Outcome::Culled, "{dx} {dy}");
+    }
+}
+
+#[test]
+fn di_is_rounded_once_per_triangle_and_saturates() {
+    let cfg = Config::default();
+    let fe = FrontEnd::new(cfg, Screen::default()).unwrap();
+    // dI/dx = 1 level per pixel exactly.
+    let t = FixedTriangle::from_triangle(
+        &Triangle {
+            v: [Vertex { x: 10.0, y: 10.0, i: 0.0 }, Vertex { x: 110.0, y: 10.0, i: 100.0 }, Vertex { x: 10.0, y: 60.0, i: 255.0 }],
+        },
+        12,
+    );
+    let (_, spans) = fe.span_list(&t);
+    assert!(spans.iter().all(|(_, s)| s.di == 1 << 12 && s.x0 == 10));
+    // 255 levels over 1/256 pixel saturates both ways.
+    let steep = FixedTriangle { x: [2688, 2689, 2688], y: [2560, 2560, 5120], i: [0, (1 << 20) - 1, 0] };
+    assert_eq!(fe.setup(&steep).1.unwrap().di, (1 << 20) - 1);
+    let steep = FixedTriangle { i: [(1 << 20) - 1, 0, (1 << 20) - 1], ..steep };
+    assert_eq!(fe.setup(&steep).1.unwrap().di, -(1 << 20));
+}
+
+#[test]
+fn every_order_and_winding_gives_the_same_coverage() {
+    let fe = FrontEnd::new(Config::default(), Screen::default()).unwrap();
+    let mut rng = Rng(5);
+    for _ in 0..2000 {
+        let t = random_tri(&mut rng, &fe);
+        let want: Vec<_> = fe.span_list(&t).1.iter().map(|&(y, s)| (y, s.x0, s.len)).collect();
+        for p in [[0, 2, 1], [1, 0, 2], [1, 2, 0], [2, 0, 1], [2, 1, 0]] {
+            let u = FixedTriangle { x: p.map(|k| t.x[k]), y: p.map(|k| t.y[k]), i: p.map(|k| t.i[k]) };
+            let got: Vec<_> = fe.span_list(&u).1.iter().map(|&(y, s)| (y, s.x0, s.len)).collect();
+            assert_eq!(got, want);
+        }
+    }
+}
+
+#[test]
+fn refuses_screens_it_cannot_shade_within_one() {
+    let cfg = Config::default();
+    assert!(FrontEnd::new(cfg, Screen { width: 4096, height: 1 }).is_ok());
+    let e = FrontEnd::new(Config::new(8, 8, 12, Align::Span).unwrap(), Screen { width: 257, height: 10 }).unwrap_err();
+    assert!(e.to_string().contains("2^F = 256"), "{e}");
+    assert!(FrontEnd::new(cfg, Screen { width: 4097, height: 1 }).is_err());
+    assert!(FrontEnd::new(cfg, Screen { width: 640, height: 0 }).is_err());
+}
+
+#[test]
+fn differs_from_the_host_set_up_only_where_f64_rounds_differently() {
+    // Same triangles, intensities on the UQ8.F grid: the host rounds f64 plane values, the
+    // front-end rounds exact rationals. They may part only at (near-)ties.
+    let fe = FrontEnd::new(Config::default(), Screen::default()).unwrap();
+    let mut rng = Rng(11);
+    let (mut spans, mut i0_diff, mut di_diff, mut px_diff) = (0u64, 0u64, 0u64, 0u64);
+    for _ in 0..5_000 {
+        let t = random_tri(&mut rng, &fe);
+        let t = FixedTriangle { i: t.i.map(|i| i.min(255 << 12)), ..t };
+        let mut host = Vec::new();
+        crate::setup::triangle_spans(&fe.cfg, &fe.screen, &t.to_triangle(12), |y, s| host.push((y, s))).unwrap();
+        let (_, ours) = fe.span_list(&t);
+        assert_eq!(ours.len(), host.len());
+        for ((_, a), (_, b)) in ours.iter().zip(&host) {
+            spans += 1;
+            i0_diff += (a.i0 != b.i0) as u64;
+            di_diff += (a.di != b.di) as u64;
+            for j in 0..a.len {
+                let d = (a.pixel(j, 12) as i32 - b.pixel(j, 12) as i32).abs();
+                assert!(d <= 1, "{t:?}");
+                px_diff += (d != 0) as u64;
+            }
+        }
+    }
+    eprintln!("host vs front-end: {spans} spans, I0 differs in {i0_diff}, dI in {di_diff}, {px_diff} pixels differ by 1");
+    assert!(i0_diff * 1000 <= spans, "I0 should differ only at rare near-ties: {i0_diff} of {spans}");
+}
