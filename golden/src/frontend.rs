@@ -53,6 +53,10 @@
 //! UQ8.F intensities the hardware receives; real-valued vertex intensities add at most
 //! `2^-(F+1)` more when they are rounded onto the port.
 
+mod incremental;
+
+pub use incremental::{Cost, Step, Steps};
+
 use crate::format::{Config, Span};
 use crate::setup::{is_top_left, snap, Screen, Snapped, Triangle, SUBPIXEL};
 use serde::{Deserialize, Serialize};
@@ -207,13 +211,20 @@ impl EdgeWalk {
     /// After row `r` was emitted: one DDA step, if the edge has started.
     fn step(&mut self, r: u32) {
         if self.active && r >= self.rs {
-            self.rem += self.rs256;
-            self.g += self.qs;
-            if self.rem >= self.d {
-                self.rem -= self.d;
-                self.g += 1;
-            }
+            self.step_carry();
         }
+    }
+
+    /// One DDA step; whether the remainder carried into the bound (`g` moved by `Qs + 1`).
+    fn step_carry(&mut self) -> bool {
+        self.rem += self.rs256;
+        self.g += self.qs;
+        let carry = self.rem >= self.d;
+        if carry {
+            self.rem -= self.d;
+            self.g += 1;
+        }
+        carry
     }
 }
 

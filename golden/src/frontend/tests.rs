@@ -21,9 +21,14 @@ impl Rng {
 /// A random port-level triangle of one of several kinds: anywhere in the guard band, small,
 /// slivers, vertices on centres, shared y (horizontal edges), at the band's edges.
 fn random_tri(rng: &mut Rng, fe: &FrontEnd) -> FixedTriangle {
+    let kind = rng.range(0, 6) as usize;
+    random_tri_of(rng, fe, kind)
+}
+
+/// A random triangle of one kind (0..6, as [`random_tri`] lists them).
+fn random_tri_of(rng: &mut Rng, fe: &FrontEnd, kind: usize) -> FixedTriangle {
     let (w, h) = (fe.screen.width as i64 * 256, fe.screen.height as i64 * 256);
     let imax = (1i64 << fe.cfg.iw()) - 1;
-    let kind = rng.range(0, 6);
     let mut x = [0i64; 3];
     let mut y = [0i64; 3];
     let (cx, cy) = (rng.range(-w / 4, w + w / 4), rng.range(-h / 4, h + h / 4));
@@ -262,4 +267,106 @@ fn differs_from_the_host_set_up_only_where_f64_rounds_differently() {
     }
     eprintln!("host vs front-end: {spans} spans, I0 differs in {i0_diff}, dI in {di_diff}, {px_diff} pixels differ by 1");
     assert!(i0_diff * 1000 <= spans, "I0 should differ only at rare near-ties: {i0_diff} of {spans}");
+}
+
+/// Issue 27's exact incremental I0 gives today's spans bit for bit: 10^6 spans of every kind at
+/// 640x480, and every kind on four more screens and formats and the scanline dI. It also prints how
+/// many reciprocal evaluations (starts) a triangle needs, the shared unit's load.
+#[test]
+fn incremental_i0_equals_the_per_row_formula_on_a_million_spans() {
+    let configs = [
+        (Config::default(), Screen::default(), DiMode::Triangle, 6_000_000u64),
+        (Config::default(), Screen { width: 37, height: 23 }, DiMode::Triangle, 120_000),
+        (Config::default(), Screen { width: 320, height: 240 }, DiMode::Scanline, 120_000),
+        (Config::new(8, 16, 16, Align::Span).unwrap(), Screen { width: 4096, height: 4096 }, DiMode::Triangle, 120_000),
+        (Config::new(8, 4, 4, Align::Span).unwrap(), Screen { width: 16, height: 8 }, DiMode::Triangle, 60_000),
+    ];
+    let mut rng = Rng(27);
+    let mut total = 0u64;
+    for (cfg, screen, di, want) in configs {
+        let fe = FrontEnd::new(cfg, screen).unwrap().with_di(di);
+        let (mut cost, mut walked, mut per_kind) = (Cost::default(), 0u64, [0u64; 6]);
+        // Every kind its share: the small ones (slivers, tiny triangles) make few spans each.
+        let mut kind = 0;
+        while per_kind.iter().any(|&n| n < want / 6) {
+            kind = (kind + 1) % 6;
+            if per_kind[kind] >= want / 6 {
+                continue;
+            }
+            let t = random_tri_of(&mut rng, &fe, kind);
+            let Some(st) = fe.setup(&t).1 else { continue };
+            let mut old = Vec::new();
+            fe.walk(&st, |y, s| old.push((y, s)));
+            let mut new = Vec::new();
+            let c = fe.walk_incremental(&st, |y, s| new.push((y, s)));
+            assert_eq!(new, old, "{t:?} on {screen:?}, {di:?}");
+            per_kind[kind] += c.spans;
+            walked += 1;
+            cost.rows += c.rows;
+            cost.spans += c.spans;
+            cost.starts += c.starts;
+            cost.most_starts = cost.most_starts.max(c.most_starts);
+        }
+        eprintln!(
+            "{}x{} F={} {di:?}: {} spans of {walked} triangles (per kind {per_kind:?}); starts {:.2} a triangle, at most {}, {:.3} a span",
+            screen.width,
+            screen.height,
+            cfg.frac,
+            cost.spans,
+            cost.starts as f64 / walked as f64,
+            cost.most_starts,
+            cost.starts as f64 / cost.spans as f64
+        );
+        assert!(per_kind.iter().all(|&n| n > 0), "every kind of triangle: {per_kind:?}");
+        total += cost.spans;
+    }
+    assert!(total >= 6_000_000);
+}
+
+/// The comparison above catches a wrong step: each planted fault (a quotient, a remainder, the
+/// carry's step, column 0's) makes some span differ.
+#[test]
+fn incremental_i0_negative_controls() {
+    let fe = FrontEnd::new(Config::default(), Screen::default()).unwrap();
+    let faults: [(&str, fn(&mut Steps)); 4] = [
+        ("edge quotient + 1", |s| {
+            for e in &mut s.edge {
+                if let Some(d) = &mut e[0] {
+                    d.q += 1;
+                }
+            }
+        }),
+        ("edge remainder + 1", |s| {
+            for e in &mut s.edge {
+                if let Some(d) = &mut e[0] {
+                    d.rn += 1 << 20;
+                }
+            }
+        }),
+        ("carry step taken for the plain one", |s| {
+            for e in &mut s.edge {
+                e[1] = e[0];
+            }
+        }),
+        ("column 0's quotient + 1", |s| {
+            if let Some(d) = &mut s.col0 {
+                d.q += 1;
+            }
+        }),
+    ];
+    for (what, plant) in faults {
+        let mut rng = Rng(270);
+        let caught = (0..20_000).any(|_| {
+            let t = random_tri(&mut rng, &fe);
+            let Some(st) = fe.setup(&t).1 else { return false };
+            let mut old = Vec::new();
+            fe.walk(&st, |y, s| old.push((y, s)));
+            let mut steps = fe.i0_steps(&st);
+            plant(&mut steps);
+            let mut new = Vec::new();
+            fe.walk_with_steps(&st, &steps, |y, s| new.push((y, s)));
+            new != old
+        });
+        assert!(caught, "planted fault not caught: {what}");
+    }
 }
