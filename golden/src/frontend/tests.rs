@@ -328,7 +328,8 @@ fn incremental_i0_equals_the_per_row_formula_on_a_million_spans() {
 #[test]
 fn incremental_i0_negative_controls() {
     let fe = FrontEnd::new(Config::default(), Screen::default()).unwrap();
-    let faults: [(&str, fn(&mut Steps)); 4] = [
+    type Plant = fn(&mut Steps);
+    let faults: [(&str, Plant); 4] = [
         ("edge quotient + 1", |s| {
             for e in &mut s.edge {
                 if let Some(d) = &mut e[0] {
