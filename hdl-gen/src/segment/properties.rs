@@ -161,7 +161,6 @@ pub fn segment_pipelined_properties(cfg: &Config, rw: u32, pipe: golden::pipelin
     let screen = cfg.align == Align::Screen && p > 1;
     let lw = log2p.max(1);
     let lat = golden::segment::latency(cfg, pipe);
-    let max_tot = (1u64 << (xw + 1)) - 1 + if screen { p as u64 - 1 } else { 0 };
     let pr = lit(rw, p as u64);
     // The throughput property looks `lat` clocks back: induction needs a window past that.
     let mut b = vec![comment(format!("{CUT_TAG}depth {}", lat + 2))];
@@ -273,6 +272,17 @@ pub fn segment_pipelined_properties(cfg: &Config, rw: u32, pipe: golden::pipelin
     b.push(Item::Always(vec![when(format!("{} && {}", past_k(lat - 1), waited.join(" && ")), vec![assert("out_valid")])]));
 
     b.push(comment("Linking invariants: every stage's registers are the reference's."));
+    b.push(Item::Comb(vec![when("f_past", pipelined_links(cfg, rw, pipe))]));
+    Item::Formal(b)
+}
+
+/// A pipelined shader's linking invariants: the current, span and sum stages' registers are
+/// the reference's, and a span's segments leave the current stage on consecutive moves.
+fn pipelined_links(cfg: &Config, rw: u32, pipe: golden::pipeline::Pipeline) -> Vec<Stmt> {
+    let (p, xw, log2p) = (cfg.p, cfg.xbits, cfg.log2p());
+    let screen = cfg.align == Align::Screen && p > 1;
+    let lw = log2p.max(1);
+    let max_tot = (1u64 << (xw + 1)) - 1 + if screen { p as u64 - 1 } else { 0 };
     let mut cur = vec![
         assert("cur_x == f_cx"),
         assert("cur_rem == f_ctot - f_coff"),
@@ -306,6 +316,5 @@ pub fn segment_pipelined_properties(cfg: &Config, rw: u32, pipe: golden::pipelin
         link.push(assert("s1_valid == f_1v"));
         link.push(when("f_1v", vec![assert("s1_x == f_1x"), assert("s1_mask == f_1m"), assert("s1_last == f_1l")]));
     }
-    b.push(Item::Comb(vec![when("f_past", link)]));
-    Item::Formal(b)
+    link
 }

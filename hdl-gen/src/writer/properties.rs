@@ -37,7 +37,7 @@ use golden::Align;
 /// the segments of a span follow each other at x + P on one scanline.
 pub fn writer_properties(w: &golden::writer::Writer) -> Item {
     let cfg = &w.cfg;
-    let (p, l, xw, yw) = (cfg.p, cfg.log2p(), cfg.xbits, w.y_bits());
+    let (p, l, yw) = (cfg.p, cfg.log2p(), w.y_bits());
     let aw = w.addr_bits();
     let glued = cfg.align == Align::Span && p > 1;
     // 2-inductive (stability looks one clock back); each further step of the base case and the
@@ -51,13 +51,7 @@ pub fn writer_properties(w: &golden::writer::Writer) -> Item {
     b.push(comment("The reference: each pixel placed by its screen x."));
     b.push(wire("f_free", 1, "!mem_valid || mem_ready"));
     b.push(wire("f_take", 1, "in_valid && in_ready"));
-    // The block number of x, as an address term; on a screen narrower than 2^XW it is narrower
-    // than the port (x < W).
-    let blk_of = |x: &str| match w.block_bits() {
-        0 => lit(aw, 0),
-        bw => zext(&format!("{x}[{}:{l}]", l + bw - 1), bw, aw),
-    };
-    let blk = blk_of("in_x");
+    let blk = block_of(w, "in_x");
     b.push(wire("f_addr", aw, format!("{} * {} + {blk}", zext("in_y", yw, aw), lit(aw, w.blocks_per_row() as u64))));
     b.push(comment("Everything lane-wise is checked on one lane of the block, f_lane, that the solver picks"));
     b.push(comment("freely, so it holds for every lane; following one lane keeps the reference free of"));
@@ -76,92 +70,7 @@ pub fn writer_properties(w: &golden::writer::Writer) -> Item {
     }
     let mut link = vec![];
     if glued {
-        let rotation = format!("rot_pix[{at} +: 8] == f_pix");
-        b.extend([
-            wire("f_r", l, format!("in_x[{}:0]", l - 1)),
-            comment("Input lane j lands on block lane (r + j) mod P: f_lane gets input lane f_lane - r (mod P),"),
-            comment("in the segment's head block when f_lane >= r, else in its tail (the next block)."),
-            wire("f_src", l, "f_lane - f_r"),
-            wire("f_in", 1, "in_mask[f_src]"),
-            wire("f_head", 1, "f_lane >= f_r"),
-            wire("f_pix", 8, "in_pix[{f_src, 3'b000} +: 8]"),
-            comment("The rotation on lane f_lane, a lemma: asserted in a proof of its own, which sees the"),
-            comment("rotation for every input, lane and offset, and assumed here, where the rotation is cut (the"),
-            comment("solver would otherwise redo that proof inside the induction: minutes at P = 128)."),
-            comment(format!("{CUT_TAG}cutpoint w:rot_pix")),
-            Item::IfDef {
-                name: LEMMA_DEFINE.into(),
-                then: vec![Item::Comb(vec![assert(rotation.clone())])],
-                els: vec![Item::Comb(vec![Stmt::Assume(rotation)])],
-            },
-            comment("The pending tail: f_pl, f_lane's pixel f_pp is in it and not yet written; block f_pa; the"),
-            comment("segment that left it (f_px, f_py) and whether its span goes on (f_cont)."),
-            reg("f_cont", 1),
-            reg("f_pl", 1),
-            reg("f_pa", aw),
-            reg("f_pp", 8),
-            reg("f_px", xw),
-            reg("f_py", yw),
-        ]);
-        b.push(comment("What the shader guarantees: a span's next segment is P pixels on, on its scanline."));
-        b.push(Item::Comb(vec![when(
-            "f_past && f_take && f_cont",
-            vec![Stmt::Assume(format!("in_x == f_px + {} && in_y == f_py", lit(xw, p as u64)))],
-        )]));
-        // The tail's own write follows the writer's `flush`, which the links below pin to the
-        // reference's: set exactly when a span's last segment left a pixel in its tail.
-        b.push(Item::Always(vec![Stmt::If(
-            "rst".into(),
-            vec![set("f_wr", "1'b0"), set("f_ml", "1'b0"), set("f_cont", "1'b0"), set("f_pl", "1'b0")],
-            vec![when(
-                "f_free",
-                vec![Stmt::If(
-                    "flush".into(),
-                    vec![set("f_wr", "1'b1"), set("f_ma", "f_pa"), set("f_ml", "f_pl"), set("f_md", "f_pp"), set("f_pl", "1'b0")],
-                    vec![Stmt::If(
-                        "in_valid".into(),
-                        vec![
-                            set("f_wr", "1'b1"),
-                            set("f_ma", "f_addr"),
-                            set("f_ml", "(f_in && f_head) || (f_cont && f_pl)"),
-                            set("f_md", "f_in && f_head ? f_pix : f_pp"),
-                            set("f_pl", "f_in && !f_head"),
-                            set("f_pa", format!("f_addr + {}", lit(aw, 1))),
-                            set("f_pp", "f_pix"),
-                            set("f_px", "in_x"),
-                            set("f_py", "in_y"),
-                            set("f_cont", "!in_last"),
-                        ],
-                        vec![set("f_wr", "1'b0"), set("f_ml", "1'b0")],
-                    )],
-                )],
-            )],
-        )]));
-        b.push(comment("The writer takes a segment exactly when its write register is free and no tail owes its"));
-        b.push(comment("own write (flush: the reference's, by the links below)."));
-        b.push(Item::Comb(vec![when("f_past", vec![assert("in_ready == (f_free && !flush)")])]));
-        link.extend([
-            assert("cont == f_cont"),
-            Stmt::Comment("flush is the reference's: only after a span's last segment, only for a tail with a pixel".into()),
-            Stmt::Comment("(on some lane, so on f_lane for some choice), and whenever f_lane's pixel is owed there.".into()),
-            when("flush", vec![assert("!f_cont"), assert(format!("pend_we != {}", lit(p, 0)))]),
-            when("f_pl && !f_cont", vec![assert("flush")]),
-            when("f_cont || flush", vec![assert("pend_addr == f_pa"), assert(format!("pend_we[{lane}] == f_pl"))]),
-            when("f_pl", vec![assert(format!("pend_pix[{at} +: 8] == f_pp"))]),
-            // The reference's own: a pending tail lies below the span's lane offset, in the block after
-            // the last segment's.
-            when("f_pl", vec![assert(format!("{lane} < f_px[{}:0]", l - 1))]),
-            when(
-                "f_cont || flush",
-                vec![assert(format!(
-                    "f_pa == {} * {} + {} + {}",
-                    zext("f_py", yw, aw),
-                    lit(aw, w.blocks_per_row() as u64),
-                    blk_of("f_px"),
-                    lit(aw, 1)
-                ))],
-            ),
-        ]);
+        link.extend(glued_reference(w, lane, at, &mut b));
     } else {
         b.push(wire("f_in", 1, format!("in_mask[{lane}]")));
         b.push(comment("One write per segment: its block, its lanes as they come."));
@@ -213,4 +122,109 @@ pub fn writer_properties(w: &golden::writer::Writer) -> Item {
     b.push(comment("Linking invariants: the writer's registers are the reference's."));
     b.push(Item::Comb(vec![when("f_past", link)]));
     Item::Formal(b)
+}
+
+/// The block number of x, as an address term; on a screen narrower than 2^XW it is narrower
+/// than the port (x < W).
+fn block_of(w: &golden::writer::Writer, x: &str) -> String {
+    let (l, aw) = (w.cfg.log2p(), w.addr_bits());
+    match w.block_bits() {
+        0 => lit(aw, 0),
+        bw => zext(&format!("{x}[{}:{l}]", l + bw - 1), bw, aw),
+    }
+}
+
+/// The span-aligned writer's reference: the rotation (a lemma), the pending tail, the
+/// shader's guarantee about a span's next segment, the write register's clock, and the links
+/// for the tail's own write (returned).
+fn glued_reference(w: &golden::writer::Writer, lane: &str, at: &str, b: &mut Vec<Item>) -> Vec<Stmt> {
+    let cfg = &w.cfg;
+    let (p, l, xw, yw) = (cfg.p, cfg.log2p(), cfg.xbits, w.y_bits());
+    let aw = w.addr_bits();
+    let rotation = format!("rot_pix[{at} +: 8] == f_pix");
+    b.extend([
+        wire("f_r", l, format!("in_x[{}:0]", l - 1)),
+        comment("Input lane j lands on block lane (r + j) mod P: f_lane gets input lane f_lane - r (mod P),"),
+        comment("in the segment's head block when f_lane >= r, else in its tail (the next block)."),
+        wire("f_src", l, "f_lane - f_r"),
+        wire("f_in", 1, "in_mask[f_src]"),
+        wire("f_head", 1, "f_lane >= f_r"),
+        wire("f_pix", 8, "in_pix[{f_src, 3'b000} +: 8]"),
+        comment("The rotation on lane f_lane, a lemma: asserted in a proof of its own, which sees the"),
+        comment("rotation for every input, lane and offset, and assumed here, where the rotation is cut (the"),
+        comment("solver would otherwise redo that proof inside the induction: minutes at P = 128)."),
+        comment(format!("{CUT_TAG}cutpoint w:rot_pix")),
+        Item::IfDef {
+            name: LEMMA_DEFINE.into(),
+            then: vec![Item::Comb(vec![assert(rotation.clone())])],
+            els: vec![Item::Comb(vec![Stmt::Assume(rotation)])],
+        },
+        comment("The pending tail: f_pl, f_lane's pixel f_pp is in it and not yet written; block f_pa; the"),
+        comment("segment that left it (f_px, f_py) and whether its span goes on (f_cont)."),
+        reg("f_cont", 1),
+        reg("f_pl", 1),
+        reg("f_pa", aw),
+        reg("f_pp", 8),
+        reg("f_px", xw),
+        reg("f_py", yw),
+    ]);
+    b.push(comment("What the shader guarantees: a span's next segment is P pixels on, on its scanline."));
+    b.push(Item::Comb(vec![when(
+        "f_past && f_take && f_cont",
+        vec![Stmt::Assume(format!("in_x == f_px + {} && in_y == f_py", lit(xw, p as u64)))],
+    )]));
+    // The tail's own write follows the writer's `flush`, which the links below pin to the
+    // reference's: set exactly when a span's last segment left a pixel in its tail.
+    b.push(Item::Always(vec![Stmt::If(
+        "rst".into(),
+        vec![set("f_wr", "1'b0"), set("f_ml", "1'b0"), set("f_cont", "1'b0"), set("f_pl", "1'b0")],
+        vec![when(
+            "f_free",
+            vec![Stmt::If(
+                "flush".into(),
+                vec![set("f_wr", "1'b1"), set("f_ma", "f_pa"), set("f_ml", "f_pl"), set("f_md", "f_pp"), set("f_pl", "1'b0")],
+                vec![Stmt::If(
+                    "in_valid".into(),
+                    vec![
+                        set("f_wr", "1'b1"),
+                        set("f_ma", "f_addr"),
+                        set("f_ml", "(f_in && f_head) || (f_cont && f_pl)"),
+                        set("f_md", "f_in && f_head ? f_pix : f_pp"),
+                        set("f_pl", "f_in && !f_head"),
+                        set("f_pa", format!("f_addr + {}", lit(aw, 1))),
+                        set("f_pp", "f_pix"),
+                        set("f_px", "in_x"),
+                        set("f_py", "in_y"),
+                        set("f_cont", "!in_last"),
+                    ],
+                    vec![set("f_wr", "1'b0"), set("f_ml", "1'b0")],
+                )],
+            )],
+        )],
+    )]));
+    b.push(comment("The writer takes a segment exactly when its write register is free and no tail owes its"));
+    b.push(comment("own write (flush: the reference's, by the links below)."));
+    b.push(Item::Comb(vec![when("f_past", vec![assert("in_ready == (f_free && !flush)")])]));
+    vec![
+        assert("cont == f_cont"),
+        Stmt::Comment("flush is the reference's: only after a span's last segment, only for a tail with a pixel".into()),
+        Stmt::Comment("(on some lane, so on f_lane for some choice), and whenever f_lane's pixel is owed there.".into()),
+        when("flush", vec![assert("!f_cont"), assert(format!("pend_we != {}", lit(p, 0)))]),
+        when("f_pl && !f_cont", vec![assert("flush")]),
+        when("f_cont || flush", vec![assert("pend_addr == f_pa"), assert(format!("pend_we[{lane}] == f_pl"))]),
+        when("f_pl", vec![assert(format!("pend_pix[{at} +: 8] == f_pp"))]),
+        // The reference's own: a pending tail lies below the span's lane offset, in the block after
+        // the last segment's.
+        when("f_pl", vec![assert(format!("{lane} < f_px[{}:0]", l - 1))]),
+        when(
+            "f_cont || flush",
+            vec![assert(format!(
+                "f_pa == {} * {} + {} + {}",
+                zext("f_py", yw, aw),
+                lit(aw, w.blocks_per_row() as u64),
+                block_of(w, "f_px"),
+                lit(aw, 1)
+            ))],
+        ),
+    ]
 }
