@@ -100,22 +100,22 @@ module fb_writer_p8 (
   // Reset: no write out of reset.
   always @(posedge clk) begin
     if (f_past && $past(rst)) begin
-      assert(!mem_valid);
+      a_reset_0: assert(!mem_valid);
     end
   end
   // Stability: a write offered and not taken stays, unchanged.
   always @(posedge clk) begin
     if (f_past && !$past(rst) && $past(mem_valid && !mem_ready)) begin
-      assert(mem_valid);
-      assert(mem_addr == $past(mem_addr));
-      assert(mem_data == $past(mem_data));
-      assert(mem_we == $past(mem_we));
+      a_stability_0: assert(mem_valid);
+      a_stability_1: assert(mem_addr == $past(mem_addr));
+      a_stability_2: assert(mem_data == $past(mem_data));
+      a_stability_3: assert(mem_we == $past(mem_we));
     end
   end
   // No write without an enable.
   always @(*) begin
     if (f_past && mem_valid) begin
-      assert(mem_we != 8'd0);
+      a_no_write_without_0: assert(mem_we != 8'd0);
     end
   end
   // The reference: each pixel placed by its screen x.
@@ -143,7 +143,7 @@ module fb_writer_p8 (
   // scripts/prove: cutpoint w:rot_pix
 `ifdef FORMAL_LEMMAS
   always @(*) begin
-    assert(rot_pix[{f_lane, 3'b000} +: 8] == f_pix);
+    a_rotation_on_lane_0: assert(rot_pix[{f_lane, 3'b000} +: 8] == f_pix);
   end
 `else
   always @(*) begin
@@ -198,7 +198,7 @@ module fb_writer_p8 (
   // own write (flush: the reference's, by the links below).
   always @(*) begin
     if (f_past) begin
-      assert(in_ready == (f_free && !flush));
+      a_writer_takes_a_0: assert(in_ready == (f_free && !flush));
     end
   end
   // Every write is the reference's: offered when f_lane is enabled in it, only when one was
@@ -207,14 +207,14 @@ module fb_writer_p8 (
   always @(*) begin
     if (f_past) begin
       if (f_ml) begin
-        assert(mem_valid);
+        a_every_write_is_0: assert(mem_valid);
       end
       if (mem_valid) begin
-        assert(f_wr);
-        assert(mem_addr == f_ma);
-        assert(mem_we[f_lane] == f_ml);
+        a_every_write_is_1: assert(f_wr);
+        a_every_write_is_2: assert(mem_addr == f_ma);
+        a_every_write_is_3: assert(mem_we[f_lane] == f_ml);
         if (mem_we[f_lane]) begin
-          assert(mem_data[{f_lane, 3'b000} +: 8] == f_md);
+          a_every_write_is_4: assert(mem_data[{f_lane, 3'b000} +: 8] == f_md);
         end
       end
     end
@@ -233,30 +233,43 @@ module fb_writer_p8 (
   // Linking invariants: the writer's registers are the reference's.
   always @(*) begin
     if (f_past) begin
-      assert(cont == f_cont);
+      a_linking_invariants_0: assert(cont == f_cont);
       // flush is the reference's: only after a span's last segment, only for a tail with a pixel
       // (on some lane, so on f_lane for some choice), and whenever f_lane's pixel is owed there.
       if (flush) begin
-        assert(!f_cont);
-        assert(pend_we != 8'd0);
+        a_linking_invariants_1: assert(!f_cont);
+        a_linking_invariants_2: assert(pend_we != 8'd0);
       end
       if (f_pl && !f_cont) begin
-        assert(flush);
+        a_linking_invariants_3: assert(flush);
       end
       if (f_cont || flush) begin
-        assert(pend_addr == f_pa);
-        assert(pend_we[f_lane] == f_pl);
+        a_linking_invariants_4: assert(pend_addr == f_pa);
+        a_linking_invariants_5: assert(pend_we[f_lane] == f_pl);
       end
       if (f_pl) begin
-        assert(pend_pix[{f_lane, 3'b000} +: 8] == f_pp);
+        a_linking_invariants_6: assert(pend_pix[{f_lane, 3'b000} +: 8] == f_pp);
       end
       if (f_pl) begin
-        assert(f_lane < f_px[2:0]);
+        a_linking_invariants_7: assert(f_lane < f_px[2:0]);
       end
       if (f_cont || flush) begin
-        assert(f_pa == {7'd0, f_py} * 16'd80 + {7'd0, f_px[11:3]} + 16'd1);
+        a_linking_invariants_8: assert(f_pa == {7'd0, f_py} * 16'd80 + {7'd0, f_px[11:3]} + 16'd1);
       end
-      assert(f_owed == (mem_valid && mem_we[f_lane] ? 2'd1 : 2'd0) + (f_pl ? 2'd1 : 2'd0));
+      a_linking_invariants_9: assert(f_owed == (mem_valid && mem_we[f_lane] ? 2'd1 : 2'd0) + (f_pl ? 2'd1 : 2'd0));
+    end
+  end
+  // scripts/prove: cover depth 8
+  // Block written: a write taken.
+  always @(*) begin
+    if (f_past && !rst) begin
+      c_block_written_0: cover(mem_valid && mem_ready);
+    end
+  end
+  // Tail written: its own write, after a span.
+  always @(*) begin
+    if (f_past && !rst) begin
+      c_tail_written_0: cover(flush && mem_valid && mem_ready);
     end
   end
 `endif

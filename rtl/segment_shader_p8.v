@@ -125,17 +125,17 @@ module segment_shader_p8 (
   // Reset: no segment out of reset.
   always @(posedge clk) begin
     if (f_past && $past(rst)) begin
-      assert(!out_valid);
+      a_reset_0: assert(!out_valid);
     end
   end
   // Stability: a segment offered and not taken stays, unchanged.
   always @(posedge clk) begin
     if (f_past && !$past(rst) && $past(out_valid && !out_ready)) begin
-      assert(out_valid);
-      assert(out_x == $past(out_x));
-      assert(out_pix == $past(out_pix));
-      assert(out_mask == $past(out_mask));
-      assert(out_last == $past(out_last));
+      a_stability_0: assert(out_valid);
+      a_stability_1: assert(out_x == $past(out_x));
+      a_stability_2: assert(out_pix == $past(out_pix));
+      a_stability_3: assert(out_mask == $past(out_mask));
+      a_stability_4: assert(out_last == $past(out_last));
     end
   end
   // The shadow: spans accepted whose segments have not all appeared. Span h's next
@@ -175,10 +175,10 @@ module segment_shader_p8 (
   // Each new segment is the one SPEC §3 says comes next; none comes unowed.
   always @(*) begin
     if (f_fresh) begin
-      assert(f_h_v);
-      assert(out_x == f_exp_x);
-      assert(out_last == f_exp_last);
-      assert(out_mask == f_exp_mask);
+      a_each_new_segment_0: assert(f_h_v);
+      a_each_new_segment_1: assert(out_x == f_exp_x);
+      a_each_new_segment_2: assert(out_last == f_exp_last);
+      a_each_new_segment_3: assert(out_mask == f_exp_mask);
     end
   end
   always @(posedge clk) begin
@@ -224,65 +224,78 @@ module segment_shader_p8 (
   // Nothing lost: a span is accepted only when at most one is owed besides it.
   always @(*) begin
     if (f_past && f_push) begin
-      assert(!(f_h_v && f_t_v && !f_pop));
+      a_nothing_lost_0: assert(!(f_h_v && f_t_v && !f_pop));
     end
   end
   // Throughput with out_ready high: no bubble inside a span, nor between spans when the
   // next non-empty span was offered by the time the last segment left the shader.
   always @(posedge clk) begin
     if (f_past && !$past(rst) && $past(out_valid && out_ready && !out_last)) begin
-      assert(out_valid);
+      a_throughput_with_out_0: assert(out_valid);
     end
     if (f_past2 && !$past(rst) && !$past(rst, 2) && $past(out_valid && out_ready && out_last) && $past(in_valid && in_len != 0, 2)) begin
-      assert(out_valid);
+      a_throughput_with_out_1: assert(out_valid);
     end
   end
   // Valid never waits for ready: a segment owed to an empty output is offered the next
   // clock, whatever out_ready was (a sink may wait for valid before raising ready).
   always @(posedge clk) begin
     if (f_past && !$past(rst) && $past(f_h_v && !out_valid)) begin
-      assert(out_valid);
+      a_valid_never_waits_0: assert(out_valid);
     end
   end
   // Linking invariants: the current-span registers hold what the shadow owes next.
   always @(*) begin
     if (f_past) begin
       if (!f_h_v) begin
-        assert(!cur_valid);
-        assert(!f_t_v);
-        assert(!f_fresh);
+        a_linking_invariants_0: assert(!cur_valid);
+        a_linking_invariants_1: assert(!f_t_v);
+        a_linking_invariants_2: assert(!f_fresh);
       end else if (f_fresh && !f_exp_last) begin
-        assert(cur_valid);
-        assert(!f_t_v);
-        assert(cur_x == f_exp_x + 12'd8);
-        assert(cur_rem == f_left - 13'd8);
+        a_linking_invariants_3: assert(cur_valid);
+        a_linking_invariants_4: assert(!f_t_v);
+        a_linking_invariants_5: assert(cur_x == f_exp_x + 12'd8);
+        a_linking_invariants_6: assert(cur_rem == f_left - 13'd8);
       end else if (f_fresh) begin
-        assert(cur_valid == f_t_v);
+        a_linking_invariants_7: assert(cur_valid == f_t_v);
         if (f_t_v) begin
-          assert(cur_x == f_t_b);
-          assert(cur_rem == f_t_tot);
+          a_linking_invariants_8: assert(cur_x == f_t_b);
+          a_linking_invariants_9: assert(cur_rem == f_t_tot);
         end
       end else begin
-        assert(cur_valid);
-        assert(!f_t_v);
-        assert(cur_x == f_exp_x);
-        assert(cur_rem == f_left);
+        a_linking_invariants_10: assert(cur_valid);
+        a_linking_invariants_11: assert(!f_t_v);
+        a_linking_invariants_12: assert(cur_x == f_exp_x);
+        a_linking_invariants_13: assert(cur_rem == f_left);
       end
       if (f_h_v) begin
-        assert(f_h_tot != 13'd0);
-        assert(f_h_off < f_h_tot);
-        assert(f_h_tot <= 13'd8191);
-        assert(f_h_off[2:0] == 3'd0);
-        assert(f_h_lead == 3'd0);
+        a_linking_invariants_14: assert(f_h_tot != 13'd0);
+        a_linking_invariants_15: assert(f_h_off < f_h_tot);
+        a_linking_invariants_16: assert(f_h_tot <= 13'd8191);
+        a_linking_invariants_17: assert(f_h_off[2:0] == 3'd0);
+        a_linking_invariants_18: assert(f_h_lead == 3'd0);
       end
       if (f_t_v) begin
-        assert(f_t_tot != 13'd0);
-        assert(f_t_tot <= 13'd8191);
-        assert(f_t_lead == 3'd0);
+        a_linking_invariants_19: assert(f_t_tot != 13'd0);
+        a_linking_invariants_20: assert(f_t_tot <= 13'd8191);
+        a_linking_invariants_21: assert(f_t_lead == 3'd0);
       end
       if (out_valid && !out_last) begin
-        assert(cur_valid);
+        a_linking_invariants_22: assert(cur_valid);
       end
+    end
+  end
+  // scripts/prove: cover depth 6
+  // Last segment taken: a span ends.
+  always @(*) begin
+    if (f_past && !rst) begin
+      c_last_segment_taken_0: cover(out_valid && out_ready && out_last);
+    end
+  end
+  // Earlier segment taken: a span of two or more.
+  always @(*) begin
+    if (f_past && !rst) begin
+      c_earlier_segment_taken_0: cover(out_valid && out_ready && !out_last);
     end
   end
 `endif

@@ -187,16 +187,16 @@ module specular_unit #(
   // Reset: no pixel out of reset.
   always @(posedge clk) begin
     if (f_past && $past(rst)) begin
-      assert(!out_valid);
+      a_reset_0: assert(!out_valid);
     end
   end
   // Stability: a pixel offered and not taken stays, unchanged.
   always @(posedge clk) begin
     if (f_past && !$past(rst) && $past(out_valid && !out_ready)) begin
-      assert(out_valid);
-      assert(out_spec == $past(out_spec));
-      assert(out_last == $past(out_last));
-      assert(out_err == $past(out_err));
+      a_stability_0: assert(out_valid);
+      a_stability_1: assert(out_spec == $past(out_spec));
+      a_stability_2: assert(out_last == $past(out_last));
+      a_stability_3: assert(out_err == $past(out_err));
     end
   end
   // The reference: the span being issued (f_len pixels, f_k issued) and the pipe.
@@ -248,37 +248,44 @@ module specular_unit #(
   // the output's valid and last are the reference's.
   always @(*) begin
     if (f_past) begin
-      assert(in_ready == (!f_busy || (f_adv && f_last0)));
-      assert(out_valid == f_v4);
+      a_ports_against_the_0: assert(in_ready == (!f_busy || (f_adv && f_last0)));
+      a_ports_against_the_1: assert(out_valid == f_v4);
       if (out_valid) begin
-        assert(out_last == f_l4);
+        a_ports_against_the_2: assert(out_last == f_l4);
       end
     end
   end
   // Linking invariants: the unit's stage registers are the reference's.
   always @(*) begin
     if (f_past) begin
-      assert(busy == f_busy);
+      a_linking_invariants_0: assert(busy == f_busy);
       if (f_busy) begin
-        assert(f_k < f_len);
-        assert(cnt == f_len - f_k);
+        a_linking_invariants_1: assert(f_k < f_len);
+        a_linking_invariants_2: assert(cnt == f_len - f_k);
       end
-      assert(v1 == f_v1);
+      a_linking_invariants_3: assert(v1 == f_v1);
       if (v1) begin
-        assert(last1 == f_l1);
+        a_linking_invariants_4: assert(last1 == f_l1);
       end
-      assert(v2 == f_v2);
+      a_linking_invariants_5: assert(v2 == f_v2);
       if (v2) begin
-        assert(last2 == f_l2);
+        a_linking_invariants_6: assert(last2 == f_l2);
       end
-      assert(v3 == f_v3);
+      a_linking_invariants_7: assert(v3 == f_v3);
       if (v3) begin
-        assert(last3 == f_l3);
+        a_linking_invariants_8: assert(last3 == f_l3);
       end
-      assert(out_valid == f_v4);
+      a_linking_invariants_9: assert(out_valid == f_v4);
       if (out_valid) begin
-        assert(out_last == f_l4);
+        a_linking_invariants_10: assert(out_last == f_l4);
       end
+    end
+  end
+  // scripts/prove: cover depth 8
+  // Last pixel taken: a span ends.
+  always @(*) begin
+    if (f_past && !rst) begin
+      c_last_pixel_taken_0: cover(out_valid && out_ready && out_last);
     end
   end
 `endif

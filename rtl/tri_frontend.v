@@ -837,24 +837,24 @@ module tri_frontend (
   // Reset: no span out of reset.
   always @(posedge clk) begin
     if (f_past && $past(rst)) begin
-      assert(!out_valid);
+      a_reset_0: assert(!out_valid);
     end
   end
   // Stability: a span offered and not taken stays, unchanged.
   always @(posedge clk) begin
     if (f_past && !$past(rst) && $past(out_valid && !out_ready)) begin
-      assert(out_valid);
-      assert(out_y == $past(out_y));
-      assert(out_x == $past(out_x));
-      assert(out_len == $past(out_len));
-      assert(out_i0 == $past(out_i0));
-      assert(out_di == $past(out_di));
+      a_stability_0: assert(out_valid);
+      a_stability_1: assert(out_y == $past(out_y));
+      a_stability_2: assert(out_x == $past(out_x));
+      a_stability_3: assert(out_len == $past(out_len));
+      a_stability_4: assert(out_i0 == $past(out_i0));
+      a_stability_5: assert(out_di == $past(out_di));
     end
   end
   // Reset: no error pulse out of reset either.
   always @(posedge clk) begin
     if (f_past && $past(rst)) begin
-      assert(!err);
+      a_reset_1: assert(!err);
     end
   end
   // The reference. The input stage: the triangle waiting for the set-up, whether its
@@ -1023,20 +1023,20 @@ module tri_frontend (
   // spans, row by row: a triangle's rows top to bottom, then the next triangle's.
   always @(*) begin
     if (f_past) begin
-      assert(in_ready == f_rdy);
-      assert(err == f_errp);
-      assert(out_valid == f_ov);
+      a_front_end_is_0: assert(in_ready == f_rdy);
+      a_front_end_is_1: assert(err == f_errp);
+      a_front_end_is_2: assert(out_valid == f_ov);
       if (f_ov) begin
-        assert(out_y == f_oy);
+        a_front_end_is_3: assert(out_y == f_oy);
       end
       if (out_valid) begin
-        assert(out_len != 13'd0);
-        assert({2'd0, out_x} + {1'd0, out_len} <= 14'd640);
+        a_front_end_is_4: assert(out_len != 13'd0);
+        a_front_end_is_5: assert({2'd0, out_x} + {1'd0, out_len} <= 14'd640);
       end
       // dI once per triangle: a new span that is not its triangle's first carries the dI of
       // the span before it (the same triangle's).
       if (out_valid && f_free && !f_on) begin
-        assert(out_di == f_pdi);
+        a_front_end_is_6: assert(out_di == f_pdi);
       end
     end
   end
@@ -1046,15 +1046,15 @@ module tri_frontend (
   always @(posedge clk) begin
     if (f_past && !$past(rst)) begin
       if ($past(w_valid && adv && !w_end)) begin
-        assert(w_valid);
-        assert(w_row == $past(w_row) + 9'd1);
+        a_rate_0: assert(w_valid);
+        a_rate_1: assert(w_row == $past(w_row) + 9'd1);
       end
       if ($past(w_valid && adv && w_end && st == HOLD)) begin
-        assert(w_valid);
-        assert(w_row == $past(s_first));
+        a_rate_2: assert(w_valid);
+        a_rate_3: assert(w_row == $past(s_first));
       end
       if ($past(calc && (!guard_ok || cull))) begin
-        assert(in_ready);
+        a_rate_4: assert(in_ready);
       end
     end
   end
@@ -1062,77 +1062,90 @@ module tri_frontend (
   // still waiting or in set-up (counts modulo 16).
   always @(*) begin
     if (f_past) begin
-      assert(f_nacc == f_nerr + {3'd0, err} + f_ncull + f_nwalk + {3'd0, f_vf} + {3'd0, f_sb});
+      a_nothing_lost_or_0: assert(f_nacc == f_nerr + {3'd0, err} + f_ncull + f_nwalk + {3'd0, f_vf} + {3'd0, f_sb});
     end
   end
   // Every span the walker produced is offered once: taken at the port, or still in a stage.
   always @(*) begin
     if (f_past) begin
-      assert(f_nrow == f_nout + {3'd0, f_1v} + {3'd0, f_2v} + {3'd0, f_ov});
+      a_every_span_the_0: assert(f_nrow == f_nout + {3'd0, f_1v} + {3'd0, f_2v} + {3'd0, f_ov});
     end
   end
   // Linking invariants: every stage's registers are the reference's; a row's centre
   // (256 r + 128 sub-pixels) lies within its triangle's vertical extent and on the screen.
   always @(*) begin
     if (f_past) begin
-      assert(v_full == f_vf);
+      a_linking_invariants_0: assert(v_full == f_vf);
       if (f_vf) begin
-        assert(guard_ok == f_vg);
-        assert(ymin == f_vymin);
-        assert(ymax == f_vymax);
+        a_linking_invariants_1: assert(guard_ok == f_vg);
+        a_linking_invariants_2: assert(ymin == f_vymin);
+        a_linking_invariants_3: assert(ymax == f_vymax);
       end
-      assert(st == (f_sb ? (f_sh ? HOLD : DIV) : IDLE));
+      a_linking_invariants_4: assert(st == (f_sb ? (f_sh ? HOLD : DIV) : IDLE));
       if (f_sb && !f_sh) begin
-        assert(div_cnt == ({2'd0, f_sn} << 2) + 5'd2);
+        a_linking_invariants_5: assert(div_cnt == ({2'd0, f_sn} << 2) + 5'd2);
       end
       if (f_sn > 3'd5) begin
-        assert(!(f_sb && !f_sh));
+        a_linking_invariants_6: assert(!(f_sb && !f_sh));
       end
       if (f_sb) begin
-        assert($signed({2'b00, s_last, 8'd128}) <= f_symax);
-        assert($signed({2'b00, s_first, 8'd128}) >= f_symin);
-        assert(s_first <= s_last);
-        assert(s_last <= 9'd479);
+        a_linking_invariants_7: assert($signed({2'b00, s_last, 8'd128}) <= f_symax);
+        a_linking_invariants_8: assert($signed({2'b00, s_first, 8'd128}) >= f_symin);
+        a_linking_invariants_9: assert(s_first <= s_last);
+        a_linking_invariants_10: assert(s_last <= 9'd479);
       end
-      assert(w_valid == f_wv);
+      a_linking_invariants_11: assert(w_valid == f_wv);
       if (f_wv) begin
-        assert(w_row == f_wrow);
-        assert(w_last == f_wlast);
-        assert(f_wrow <= f_wlast);
-        assert($signed({2'b00, f_wrow, 8'd128}) >= f_wymin);
-        assert($signed({2'b00, f_wrow, 8'd128}) <= f_wymax);
-        assert($signed({2'b00, f_wlast, 8'd128}) <= f_wymax);
-        assert(f_wlast <= 9'd479);
+        a_linking_invariants_12: assert(w_row == f_wrow);
+        a_linking_invariants_13: assert(w_last == f_wlast);
+        a_linking_invariants_14: assert(f_wrow <= f_wlast);
+        a_linking_invariants_15: assert($signed({2'b00, f_wrow, 8'd128}) >= f_wymin);
+        a_linking_invariants_16: assert($signed({2'b00, f_wrow, 8'd128}) <= f_wymax);
+        a_linking_invariants_17: assert($signed({2'b00, f_wlast, 8'd128}) <= f_wymax);
+        a_linking_invariants_18: assert(f_wlast <= 9'd479);
       end
-      assert(p1_v == f_1v);
+      a_linking_invariants_19: assert(p1_v == f_1v);
       if (f_1v) begin
-        assert(p1_y == f_1y);
+        a_linking_invariants_20: assert(p1_y == f_1y);
       end
-      assert(p2_v == f_2v);
+      a_linking_invariants_21: assert(p2_v == f_2v);
       if (f_2v) begin
-        assert(p2_y == f_2y);
+        a_linking_invariants_22: assert(p2_y == f_2y);
       end
       // A span that is not its triangle's first has the dI of the span ahead of it.
       if (f_ov && !f_free) begin
-        assert(out_di == f_pdi);
+        a_span_that_is_0: assert(out_di == f_pdi);
       end
       if (f_2v && !f_2n) begin
-        assert(p2_di == (f_ov ? out_di : f_pdi));
+        a_span_that_is_1: assert(p2_di == (f_ov ? out_di : f_pdi));
       end
       if (f_1v && !f_1n) begin
-        assert(p1_di == (f_2v ? p2_di : f_ov ? out_di : f_pdi));
+        a_span_that_is_2: assert(p1_di == (f_2v ? p2_di : f_ov ? out_di : f_pdi));
       end
       if (f_wv && !f_wnew) begin
-        assert(w_di == (f_1v ? p1_di : f_2v ? p2_di : f_ov ? out_di : f_pdi));
+        a_span_that_is_3: assert(w_di == (f_1v ? p1_di : f_2v ? p2_di : f_ov ? out_di : f_pdi));
       end
       if (p1_v) begin
-        assert(p1_len != 13'd0);
-        assert({2'd0, p1_x} + {1'd0, p1_len} <= 14'd640);
+        a_span_that_is_4: assert(p1_len != 13'd0);
+        a_span_that_is_5: assert({2'd0, p1_x} + {1'd0, p1_len} <= 14'd640);
       end
       if (p2_v) begin
-        assert(p2_len != 13'd0);
-        assert({2'd0, p2_x} + {1'd0, p2_len} <= 14'd640);
+        a_span_that_is_6: assert(p2_len != 13'd0);
+        a_span_that_is_7: assert({2'd0, p2_x} + {1'd0, p2_len} <= 14'd640);
       end
+    end
+  end
+  // scripts/prove: cover depth 14
+  // Span taken: a triangle walked.
+  always @(*) begin
+    if (f_past && !rst) begin
+      c_span_taken_0: cover(out_valid && out_ready);
+    end
+  end
+  // Guard band drop: a triangle outside it.
+  always @(*) begin
+    if (f_past && !rst) begin
+      c_guard_band_drop_0: cover(err);
     end
   end
 `endif

@@ -26,6 +26,21 @@ pub const CUT_TAG: &str = "scripts/prove: ";
 /// writer's 256-lane rotation: over 30 min at P = 256) is proven once, in ~2 min.
 pub const LEMMA_DEFINE: &str = "FORMAL_LEMMAS";
 
+/// The tag `scripts/prove` reads for how many clocks from reset its cover search may take.
+pub const COVER_DEPTH_TAG: &str = "scripts/prove: cover depth ";
+
+/// Covers: states every proof must show reachable from reset within `depth` clocks (the
+/// block's latency and a margin), each `(heading, condition)` labelled by its heading. A proof
+/// whose assumptions or reset made it vacuous holds every assertion and reaches no cover.
+pub(crate) fn covers(depth: u32, what: &[(&str, &str)]) -> Vec<Item> {
+    let mut v = vec![comment(format!("{COVER_DEPTH_TAG}{depth}"))];
+    for (heading, cond) in what {
+        v.push(comment(*heading));
+        v.push(Item::Comb(vec![when("f_past && !rst", vec![Stmt::Cover(cond.to_string())])]));
+    }
+    v
+}
+
 /// The output stream of the shader and the specular unit (SPEC §3).
 pub(crate) const OUT: (&str, &str) = ("out_valid", "out_ready");
 

@@ -85,6 +85,11 @@ pub enum Stmt {
     Assert(String),
     /// Formal only: an immediate `assume(cond);`, a rule the environment is held to.
     Assume(String),
+    /// Formal only: an immediate `cover(cond);`, a state the proof must show reachable
+    /// (`scripts/prove` runs a cover search), so a proof that holds only vacuously fails.
+    Cover(String),
+    /// Formal only: `label: stmt`, given to every assert and cover when the block renders.
+    Labelled(String, Box<Stmt>),
 }
 
 pub fn set(lhs: impl Into<String>, rhs: impl Into<String>) -> Stmt {
@@ -420,10 +425,91 @@ fn render_items(o: &mut String, items: &[Item], level: usize) {
                 o.push_str("end\n");
             }
             Item::RegInit { name, width, value } => writeln!(o, "reg {}{name} = {value};", range(*width)).unwrap(),
-            Item::Formal(items) => render_ifdef(o, "FORMAL", items, &[], level),
+            Item::Formal(items) => render_ifdef(o, "FORMAL", &labelled(items), &[], level),
             Item::IfDef { name, then, els } => render_ifdef(o, name, then, els, level),
         }
     }
+}
+
+/// A formal block with every assert labelled `a_<section>_<n>` and every cover `c_<section>_<n>`:
+/// the section is the first words of the comment above it, up to its colon ("Reset: ..." gives
+/// `a_reset_0`), numbered in order within the module. A failing proof then names its property
+/// (yosys-smtbmc prints the label), as SymbiYosys's examples do by hand.
+fn labelled(items: &[Item]) -> Vec<Item> {
+    let mut labeller = Labeller::default();
+    labeller.items(items)
+}
+
+#[derive(Default)]
+struct Labeller {
+    section: String,
+    counts: std::collections::HashMap<String, usize>,
+}
+
+impl Labeller {
+    fn items(&mut self, items: &[Item]) -> Vec<Item> {
+        items
+            .iter()
+            .map(|item| match item {
+                Item::Comment(c) => {
+                    self.heading(c);
+                    item.clone()
+                }
+                Item::Always(stmts) => Item::Always(self.stmts(stmts)),
+                Item::Comb(stmts) => Item::Comb(self.stmts(stmts)),
+                Item::IfDef { name, then, els } => Item::IfDef { name: name.clone(), then: self.items(then), els: self.items(els) },
+                other => other.clone(),
+            })
+            .collect()
+    }
+
+    fn stmts(&mut self, stmts: &[Stmt]) -> Vec<Stmt> {
+        stmts
+            .iter()
+            .map(|s| match s {
+                Stmt::Comment(c) => {
+                    self.heading(c);
+                    s.clone()
+                }
+                Stmt::Assert(_) => self.label("a", s),
+                Stmt::Cover(_) => self.label("c", s),
+                Stmt::If(c, then, els) => Stmt::If(c.clone(), self.stmts(then), self.stmts(els)),
+                other => other.clone(),
+            })
+            .collect()
+    }
+
+    /// A comment that starts a sentence names the properties below it; a continuation line, a
+    /// tool's tag or a lint pragma does not.
+    fn heading(&mut self, comment: &str) {
+        let sentence = comment.starts_with(|c: char| c.is_ascii_uppercase());
+        let tag = comment.starts_with("scripts/prove") || comment.starts_with("verilator ");
+        if sentence && !tag && !slug(comment).is_empty() {
+            self.section = slug(comment);
+        }
+    }
+
+    fn label(&mut self, kind: &str, s: &Stmt) -> Stmt {
+        let section = if self.section.is_empty() { "property".to_string() } else { self.section.clone() };
+        let n = self.counts.entry(format!("{kind}_{section}")).or_insert(0);
+        let label = format!("{kind}_{section}_{n}");
+        *n += 1;
+        Stmt::Labelled(label, Box::new(s.clone()))
+    }
+}
+
+/// The first three words of a comment before its colon (or full stop), articles apart, as an
+/// identifier.
+fn slug(comment: &str) -> String {
+    let head = comment.split([':', '.', '(', ',', ';']).next().unwrap_or("");
+    let words: Vec<String> = head
+        .split(|c: char| !c.is_ascii_alphanumeric())
+        .filter(|w| !w.is_empty())
+        .skip_while(|w| ["a", "an", "the"].contains(&w.to_ascii_lowercase().as_str()))
+        .take(3)
+        .map(|w| w.to_ascii_lowercase())
+        .collect();
+    words.join("_")
 }
 
 /// `` `ifdef name `` `then` [`` `else `` `els`] `` `endif ``; preprocessor lines start at column 0,
@@ -450,6 +536,12 @@ fn render_stmts(o: &mut String, stmts: &[Stmt], level: usize) {
             Stmt::Delay(n) => writeln!(o, "#{n};").unwrap(),
             Stmt::Assert(c) => writeln!(o, "assert({c});").unwrap(),
             Stmt::Assume(c) => writeln!(o, "assume({c});").unwrap(),
+            Stmt::Cover(c) => writeln!(o, "cover({c});").unwrap(),
+            Stmt::Labelled(label, stmt) => {
+                let mut inner = String::new();
+                render_stmts(&mut inner, std::slice::from_ref(stmt), level);
+                write!(o, "{label}: {}", inner.trim_start()).unwrap();
+            }
             Stmt::Forever(body) => {
                 o.push_str("forever begin\n");
                 render_stmts(o, body, level + 1);

@@ -6,7 +6,7 @@ use super::setup::{self, Setup};
 use super::span;
 use super::stager::Stager;
 use super::Hw;
-use crate::formal::{assert, past_flags, reset_and_stability, slit, when, CUT_TAG, OUT};
+use crate::formal::{assert, covers, past_flags, reset_and_stability, slit, when, CUT_TAG, OUT};
 use crate::verilog::{comment, lit, reg, set, sext, wire, zext, Item, Stmt};
 
 pub(super) fn emit(hw: &Hw, set_up: Setup, sp: &Stager) -> Item {
@@ -25,6 +25,7 @@ pub(super) fn emit(hw: &Hw, set_up: Setup, sp: &Stager) -> Item {
         bits: hw.div_bits,
         rw: wd.rw,
         div_clocks: hw.div_clocks(),
+        latency: hw.latency(),
         div_regs: divs.iter().flat_map(|d| ["p", "d", "q"].map(|r| format!("{}_{r}", d.name))).collect(),
         calc_stages: (1..=st.stage())
             .map(|j| CalcStage {
@@ -67,6 +68,8 @@ pub struct FrontendShape {
     pub bits: u32,
     pub rw: u32,
     pub div_clocks: u32,
+    /// Clocks from a triangle's transfer to its first span (`Hw::latency`): the cover search's depth.
+    pub latency: u32,
     /// The set-up dividers' registers (partial remainder, divisor, quotient of each): cut.
     pub div_regs: Vec<String>,
     /// CALC's stages after the vertex register (none at level 0), in order.
@@ -149,6 +152,10 @@ pub fn frontend_properties(s: &FrontendShape) -> Item {
     b.push(r.update());
     b.extend(r.at_the_ports());
     b.extend(r.linking());
+    b.extend(covers(
+        s.latency + 3,
+        &[("Span taken: a triangle walked.", "out_valid && out_ready"), ("Guard band drop: a triangle outside it.", "err")],
+    ));
     Item::Formal(b)
 }
 

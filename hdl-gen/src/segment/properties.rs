@@ -10,7 +10,7 @@
 //! co-simulation and to the BFPI proof (`bfpi_reference`): each lane is the accumulator plus a
 //! proven multiple of dI.
 
-use crate::formal::{assert, past_flags, reset_and_stability, spec_mask, when, CUT_TAG, OUT};
+use crate::formal::{assert, covers, past_flags, reset_and_stability, spec_mask, when, CUT_TAG, OUT};
 use crate::verilog::{comment, lit, reg, set, wire, zext, Item, Stmt};
 use golden::{Align, Config};
 
@@ -138,6 +138,14 @@ pub fn segment_properties(cfg: &Config, rw: u32) -> Item {
             when("out_valid && !out_last", vec![assert("cur_valid")]),
         ],
     )]));
+    let lat = golden::segment::latency(cfg, golden::pipeline::Pipeline::default());
+    b.extend(covers(
+        lat + 4,
+        &[
+            ("Last segment taken: a span ends.", "out_valid && out_ready && out_last"),
+            ("Earlier segment taken: a span of two or more.", "out_valid && out_ready && !out_last"),
+        ],
+    ));
     Item::Formal(b)
 }
 
@@ -273,6 +281,13 @@ pub fn segment_pipelined_properties(cfg: &Config, rw: u32, pipe: golden::pipelin
 
     b.push(comment("Linking invariants: every stage's registers are the reference's."));
     b.push(Item::Comb(vec![when("f_past", pipelined_links(cfg, rw, pipe))]));
+    b.extend(covers(
+        lat + 4,
+        &[
+            ("Last segment taken: a span ends.", "out_valid && out_ready && out_last"),
+            ("Earlier segment taken: a span of two or more.", "out_valid && out_ready && !out_last"),
+        ],
+    ));
     Item::Formal(b)
 }
 

@@ -1,6 +1,6 @@
 //! The specular unit's formal properties (scripts/prove): its control against a reference.
 
-use crate::formal::{assert, past_flags, reset_and_stability, when, CUT_TAG, OUT};
+use crate::formal::{assert, covers, past_flags, reset_and_stability, when, CUT_TAG, OUT};
 use crate::verilog::{comment, lit, reg, set, wire, Item, Stmt};
 
 /// Properties of `specular_unit`: its control against a reference model kept at the ports.
@@ -72,5 +72,6 @@ pub fn specular_properties(lw: u32, stages: &[(&str, &str)]) -> Item {
         link.push(when(*v, vec![assert(format!("{l} == f_l{}", k + 1))]));
     }
     b.push(Item::Comb(vec![when("f_past", link)]));
+    b.extend(covers(stages.len() as u32 + 4, &[("Last pixel taken: a span ends.", "out_valid && out_ready && out_last")]));
     Item::Formal(b)
 }

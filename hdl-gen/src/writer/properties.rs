@@ -1,6 +1,6 @@
 //! The block writer's formal properties (scripts/prove): every write against a reference writer.
 
-use crate::formal::{assert, past_flags, reset_and_stability, when, CUT_TAG, LEMMA_DEFINE};
+use crate::formal::{assert, covers, past_flags, reset_and_stability, when, CUT_TAG, LEMMA_DEFINE};
 use crate::verilog::{comment, lit, reg, set, wire, zext, Item, Stmt};
 use golden::Align;
 
@@ -121,6 +121,11 @@ pub fn writer_properties(w: &golden::writer::Writer) -> Item {
     link.push(assert(format!("f_owed == (mem_valid && mem_we[{lane}] ? 2'd1 : 2'd0) + {held}")));
     b.push(comment("Linking invariants: the writer's registers are the reference's."));
     b.push(Item::Comb(vec![when("f_past", link)]));
+    let mut reach = vec![("Block written: a write taken.", "mem_valid && mem_ready")];
+    if glued {
+        reach.push(("Tail written: its own write, after a span.", "flush && mem_valid && mem_ready"));
+    }
+    b.extend(covers(8, &reach));
     Item::Formal(b)
 }
 
