@@ -1,6 +1,7 @@
 //! The repository stands alone: no document links outside it (`../shared/` is not in a user's
-//! clone), and every "SPEC §N" citation, in the documents, the code and the generated Verilog,
-//! names a section that docs/spec.md, the project's specification, has.
+//! clone), every relative link of a document leads to a file or folder of the repository, and
+//! every "SPEC §N" citation, in the documents, the code and the generated Verilog, names a
+//! section that docs/spec.md, the project's specification, has.
 
 use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};
@@ -29,14 +30,47 @@ fn citations(text: &str) -> Vec<(usize, u32)> {
     out
 }
 
-/// The problems of one file: a link to `../shared`, where `is_doc`, and citations of sections
-/// `known` lacks.
+/// The relative link targets of a Markdown line (`[text](target)`; not URLs, not `#anchors`),
+/// without their `#anchor`.
+fn relative_links(line: &str) -> Vec<&str> {
+    line.match_indices("](")
+        .filter_map(|(i, _)| line[i + 2..].split_once(')').map(|(t, _)| t))
+        .filter(|t| !t.is_empty() && !t.starts_with('#') && !t.contains("://") && !t.starts_with("mailto:"))
+        .map(|t| t.split('#').next().unwrap())
+        .collect()
+}
+
+/// Whether `path`, with its `..` resolved by name (no link followed), lies inside the repository.
+fn inside(path: &Path) -> bool {
+    let mut depth = 0i32;
+    for c in path.strip_prefix(repo()).expect("a path under the repository").components() {
+        match c {
+            std::path::Component::ParentDir => depth -= 1,
+            std::path::Component::Normal(_) => depth += 1,
+            _ => {}
+        }
+        if depth < 0 {
+            return false;
+        }
+    }
+    true
+}
+
+/// The problems of one file: where `is_doc` (a Markdown file in folder `dir`), a link to
+/// `../shared` or to a path that does not exist; and citations of sections `known` lacks.
 fn problems(name: &str, text: &str, is_doc: bool, known: &BTreeSet<u32>) -> Vec<String> {
     let mut out = Vec::new();
+    let dir = repo().join(name).parent().unwrap().to_path_buf();
     if is_doc {
         for (k, line) in text.lines().enumerate() {
             if line.contains("../shared") {
                 out.push(format!("{name}:{}: points at ../shared, which a clone does not have: {line}", k + 1));
+            }
+            for target in relative_links(line) {
+                // Inside the repository: a clone has nothing beside it (this machine may).
+                if !inside(&dir.join(target)) || !dir.join(target).exists() {
+                    out.push(format!("{name}:{}: links {target}, which the repository does not have", k + 1));
+                }
             }
         }
     }
@@ -93,11 +127,16 @@ fn a_planted_citation_or_shared_link_is_caught() {
     let known = spec_sections();
     // Built at run time, so that this file itself cites no missing section.
     let missing = 99;
-    let planted = format!("# A page\n\nSee [SPEC](../shared/SPEC.md).\nAs SPEC §3 and § {missing} say.\n");
+    let planted = format!(
+        "# A page\n\nSee [SPEC](../shared/SPEC.md).\nAs SPEC §3 and § {missing} say.\n\
+         [ok](docs/spec.md#2-parameters), [web](https://example.com/x), [gone](docs/gone.md).\n"
+    );
     let found = problems("planted.md", &planted, true, &known);
-    assert_eq!(found.len(), 2, "{found:#?}");
+    assert_eq!(found.len(), 4, "{found:#?}");
     assert!(found[0].starts_with("planted.md:3: points at ../shared"), "{}", found[0]);
-    assert!(found[1].starts_with(&format!("planted.md:4: cites §{missing}")), "{}", found[1]);
+    assert!(found[1].starts_with("planted.md:3: links ../shared/SPEC.md"), "{}", found[1]);
+    assert!(found[2].starts_with("planted.md:5: links docs/gone.md"), "{}", found[2]);
+    assert!(found[3].starts_with(&format!("planted.md:4: cites §{missing}")), "{}", found[3]);
     // The same text in code is not a document: only its citations count.
     assert_eq!(problems("planted.rs", &planted, false, &known).len(), 1);
     assert!(problems("ok.md", "SPEC §1, §2 and §7.\n", true, &known).is_empty());
