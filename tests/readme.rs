@@ -1,8 +1,9 @@
 //! The README's commands, run as a new user runs them: every command line of every `sh` code
 //! block of README.md, found by a parser (so a command added to the README is covered without
-//! touching this file), run from a scratch folder, and required to exit 0. docs/render.md's
-//! commands run the same way, and the images they make must be the committed docs/*.png, byte
-//! for byte.
+//! touching this file), run from a scratch folder, and required to exit 0. The other documents
+//! whose commands take seconds ([`RUN`]: docs/render.md, docs/specular.md, CONTRIBUTING.md,
+//! meshes/README.md) run the same way, and what they write that the repository has (the images
+//! of docs/render.md, the plot of docs/specular.md) must be the committed files, byte for byte.
 //!
 //! How a command runs:
 //! - `cargo run [--release] -p verilator-harness --bin B -- ARGS` runs the binary B this test
@@ -144,6 +145,14 @@ fn stage_path(word: &str, dir: &Path) {
 
 /// Runs one command line in `dir` as described in the module documentation.
 pub fn run_line(cmd: &str, dir: &Path) -> Result<Outcome, String> {
+    let is_env = |w: &str| w.split_once('=').is_some_and(|(k, _)| !k.is_empty() && k.chars().all(|c| c.is_ascii_uppercase() || c == '_'));
+    // Runs of the test suite are recognised before anything else: their filters need quotes.
+    let program: Vec<&str> = cmd.split_whitespace().skip_while(|w| is_env(w)).take(2).collect();
+    match program.as_slice() {
+        ["./scripts/test" | "scripts/test", ..] => return Ok(Outcome::NotRun("the whole test suite, which this test is part of")),
+        ["cargo", "test" | "nextest"] => return Ok(Outcome::NotRun("a run of the test suite, which this test is part of")),
+        _ => {}
+    }
     if let Some(c) = cmd.chars().find(|c| "'\"`|;&<>()*?{}".contains(*c)) {
         return Err(format!("{c:?} needs a shell: this test runs plain words only"));
     }
@@ -152,13 +161,10 @@ pub fn run_line(cmd: &str, dir: &Path) -> Result<Outcome, String> {
     if let Some(w) = words.iter().find(|w| w.contains('$')) {
         return Err(format!("{w}: only $PWD is expanded"));
     }
-    let is_env = |w: &str| w.split_once('=').is_some_and(|(k, _)| !k.is_empty() && k.chars().all(|c| c.is_ascii_uppercase() || c == '_'));
     let n_env = words.iter().take_while(|w| is_env(w)).count();
     let env: BTreeMap<&str, &str> = words[..n_env].iter().map(|w| w.split_once('=').unwrap()).collect();
     let words: Vec<&str> = words[n_env..].iter().map(String::as_str).collect();
     let (bin, first) = match words.as_slice() {
-        ["./scripts/test" | "scripts/test", ..] => return Ok(Outcome::NotRun("the whole test suite, which this test is part of")),
-        ["cargo", "test" | "nextest", ..] => return Ok(Outcome::NotRun("a run of the test suite, which this test is part of")),
         ["cargo", "run", ..] => cargo_run(&words)?,
         _ => return Err("not a command this test knows how to run: teach tests/readme.rs".into()),
     };
@@ -256,33 +262,71 @@ fn a_broken_readme_command_fails_the_check() {
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
-/// docs/render.md's commands make the images it shows: run as written, they write the
-/// committed docs/*.png byte for byte (`render` is deterministic, and the images are current).
+/// The other documents whose commands take seconds: run as the README's are.
+pub const RUN: [&str; 4] = ["CONTRIBUTING.md", "docs/render.md", "docs/specular.md", "meshes/README.md"];
+
+/// The documents whose commands are not run here, and why (a document not named in either list
+/// is reported, not run).
+pub const NOT_RUN: [(&str, &str); 6] = [
+    ("docs/cosim-speed.md", "scripts/bench-cosim: minutes of benchmarking"),
+    ("docs/formal.md", "scripts/prove: the proofs (scripts/test runs the quick set)"),
+    ("docs/fpga.md", "scripts/lint-all and scripts/synth: minutes to hours of synthesis"),
+    ("docs/frontend.md", "sweep over every front-end chain: a minute even in release"),
+    ("docs/regressions.md", "test-suite runs, shards, soaks and a cold clone"),
+    ("docs/waveforms.md", "traced models: a rebuild of the harness with COSIM_TRACE"),
+];
+
+/// Every file under `dir`, relative to it.
+fn files_under(dir: &Path, base: &Path, out: &mut Vec<PathBuf>) {
+    for e in std::fs::read_dir(dir).unwrap() {
+        let p = e.unwrap().path();
+        if p.is_dir() {
+            files_under(&p, base, out);
+        } else {
+            out.push(p.strip_prefix(base).unwrap().to_path_buf());
+        }
+    }
+}
+
+/// The documents of [`RUN`] run as written (docs/render.md's images, docs/specular.md's plot):
+/// each command exits 0, and a file they write that the repository has (docs/sphere.png,
+/// docs/specular-accuracy.svg, ...) has the committed bytes, so the committed file is what its
+/// command makes today (`render` and `report` are deterministic).
 #[test]
-fn render_md_commands_remake_its_images() {
+fn the_documents_commands_run_and_remake_the_committed_files() {
     if verilator_harness::ffi::RTL_DIR.is_some() {
-        eprintln!("readme: render.md's images skipped under COSIM_RTL_DIR: they are the default models'");
+        eprintln!("readme: the documents' commands skipped under COSIM_RTL_DIR: they name the default models");
         return;
     }
-    let doc = std::fs::read_to_string(repo().join("docs/render.md")).unwrap();
-    let dir = scratch("render-md");
-    let failures = run_document("docs/render.md", &doc, &dir);
-    assert!(failures.is_empty(), "docs/render.md commands that fail as written:\n\n{}", failures.join("\n\n"));
-    let mut images: Vec<PathBuf> = std::fs::read_dir(dir.join("docs"))
-        .unwrap()
-        .map(|e| e.unwrap().path())
-        .filter(|p| p.extension().is_some_and(|x| x == "png") && !p.to_string_lossy().ends_with(".golden.png"))
-        .collect();
-    images.sort();
-    assert!(images.len() >= 3, "render.md's commands write its images: {images:?}");
-    for made in images {
-        let name = made.file_name().unwrap();
-        let committed = std::fs::read(repo().join("docs").join(name)).unwrap_or_default();
+    let dir = scratch("documents");
+    let mut failures = Vec::new();
+    for doc in RUN {
+        let text = std::fs::read_to_string(repo().join(doc)).unwrap();
+        assert!(!command_lines(&text).is_empty(), "{doc} has commands");
+        failures.extend(run_document(doc, &text, &dir));
+    }
+    assert!(failures.is_empty(), "document commands that fail as written:\n\n{}", failures.join("\n\n"));
+    let mut written = Vec::new();
+    files_under(&dir, &dir, &mut written);
+    let mut compared = 0;
+    for rel in written {
+        let Ok(committed) = std::fs::read(repo().join(&rel)) else { continue };
+        compared += 1;
         assert!(
-            std::fs::read(&made).unwrap() == committed,
-            "docs/{}: the command in docs/render.md makes other bytes than the committed file; rerun it and commit",
-            name.to_string_lossy()
+            std::fs::read(dir.join(&rel)).unwrap() == committed,
+            "{}: a command of the documents writes other bytes than the committed file; rerun it and commit",
+            rel.display()
         );
+    }
+    assert!(compared >= 5, "the commands remake the committed images and plot ({compared} compared)");
+    let mut md = Vec::new();
+    files_under(&repo().join("docs"), repo(), &mut md);
+    for doc in md.iter().filter(|p| p.extension().is_some_and(|x| x == "md")) {
+        let name = doc.to_string_lossy();
+        let listed = RUN.contains(&name.as_ref()) || NOT_RUN.iter().any(|(d, _)| *d == name);
+        if !listed && !command_lines(&std::fs::read_to_string(repo().join(doc)).unwrap()).is_empty() {
+            eprintln!("readme: {name} has commands and is in neither RUN nor NOT_RUN of tests/readme.rs: not run");
+        }
     }
     std::fs::remove_dir_all(&dir).unwrap();
 }
