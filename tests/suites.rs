@@ -1,7 +1,7 @@
 //! Every co-simulation suite of the harness in one test binary, so the verilated models are
 //! linked once. One module per suite; run one with `cargo test -p verilator-harness --test
-//! suites segment::` (or `bfpi::`, `specular::`, `render::`, `reliability::`, `cli_harness::`,
-//! `frontend::`, `writer::`, `waveforms::`, `axis::`).
+//! suites segment::` (or `bfpi::`, `specular::`, `render::`, `render_cli::`, `reliability::`, `cli_harness::`,
+//! `frontend::`, `writer::`, `waveforms::`, `axis::`, `readme::`).
 
 /// Tests `slice_0` .. `slice_7`, slice `k` calling `$run(k)`: one soaked random test cut into
 /// [`verilator_harness::soak::SLICES`] tests, so nextest's partitions spread it over machines.
@@ -47,8 +47,10 @@ mod axis;
 mod bfpi;
 mod cli_harness;
 mod frontend;
+mod readme;
 mod reliability;
 mod render;
+mod render_cli;
 mod segment;
 mod specular;
 mod waveforms;

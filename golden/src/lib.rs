@@ -1,6 +1,6 @@
 //! The golden model of segshade: the bit-exact definition of every hardware block, the
 //! host-side set-up that feeds them, and f64 references that measure how close the
-//! hardware comes to exact shading. See `../shared/SPEC.md` for the contract.
+//! hardware comes to exact shading. See `docs/spec.md` for the contract.
 
 pub mod bfpi;
 pub mod format;

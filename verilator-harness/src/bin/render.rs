@@ -257,7 +257,15 @@ fn summary(args: &Args, job: &Job, o: &verilator_harness::render::Outcome, tag: 
         (_, _, Some(f)) => format!("mesh {}", f.display()),
         _ => String::new(),
     };
-    println!("render {what}, {}x{}, model {tag} x {} channel(s)", job.screen.width, job.screen.height, job.channels());
+    // The models that ran: with the RTL front-end the segment shader inside the chain is the
+    // chain's, so naming the spans-fed shader model (`tag`) there would name one that never ran.
+    let models = match chain {
+        Chain::Host => tag.to_string(),
+        Chain::HostToMemory(w) => format!("{tag} + {}", w.tag),
+        Chain::Rtl(m) => m.tag.to_string(),
+        Chain::RtlToMemory(m) => m.tag.to_string(),
+    };
+    println!("render {what}, {}x{}, model {models} x {} channel(s)", job.screen.width, job.screen.height, job.channels());
     if job.drawn == job.triangles {
         println!("triangles:  {}", job.triangles);
     } else {
@@ -288,6 +296,10 @@ fn png(buf: &[u8], screen: &Screen, color: png::ColorType) -> Vec<u8> {
     let mut encoder = png::Encoder::new(&mut out, screen.width, screen.height);
     encoder.set_color(color);
     encoder.set_depth(png::BitDepth::Eight);
+    // Stated, not left to the crate's defaults: the committed docs/*.png are compared byte for
+    // byte with what their commands write (tests/readme.rs). No tIME or text chunk is written.
+    encoder.set_compression(png::Compression::Balanced);
+    encoder.set_filter(png::Filter::Adaptive);
     let mut writer = encoder.write_header().expect("in-memory PNG header");
     writer.write_image_data(buf).expect("in-memory PNG encoding");
     writer.finish().expect("in-memory PNG end");
