@@ -12,6 +12,11 @@
 //!
 //! With waveforms on ([`crate::waveform`]), the driver also keeps a tape of its model's inputs,
 //! and the first mismatch of the run names the FST file of its clocks and its clock.
+//!
+//! The clock loop (`drive`) keeps its state in named parts, each with its own tests:
+//! the `pacer` decides each clock's traffic, the `monitor` checks the handshake and notices a
+//! hung model, the `scoreboard` counts what each span still owes, and the `checker`'s
+//! outbox carries the records to the checking thread. A unit plugs in through `unit`'s traits.
 
 mod checker;
 mod monitor;
