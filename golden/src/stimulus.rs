@@ -10,7 +10,8 @@
 use crate::format::{Config, Span};
 use crate::frontend::{FixedTriangle, FrontEnd};
 use crate::setup::{triangle_spans, Screen, Triangle, Vertex};
-use crate::specular::setup::{norm, normalize, setup_span, SpanEnds, Vec3};
+use crate::specular::geometry::{norm, normalize, SpanEnds, Vec3};
+use crate::specular::setup::setup_span;
 use crate::specular::{SpecularSpan, N_MAX};
 use rand::Rng;
 

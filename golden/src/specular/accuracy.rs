@@ -6,8 +6,10 @@
 //! while both references are monotone in |theta|, so the largest error over a run is at one
 //! of its ends: measuring at run ends covers every theta code, not a sample.
 
+use super::contract::{N_MAX, N_MIN, THETA_FRAC};
+use super::plan::SpecularPlan;
 use super::reference::{approx, approx_error, epicentre_code, exact};
-use super::{SpecularPlan, SpecularUnit, N_MAX, N_MIN, THETA_FRAC};
+use super::unit::SpecularUnit;
 use serde::{Deserialize, Serialize};
 
 /// Max relative errors inside n's epicentre.
@@ -84,7 +86,7 @@ pub fn accuracy_table(unit: &SpecularUnit, c: u16) -> Vec<NAccuracy> {
 
 #[cfg(test)]
 mod tests {
-    use super::super::{tolerance, INSIDE_REL};
+    use super::super::contract::{tolerance, INSIDE_REL};
     use super::*;
     use crate::rng::SeedRng;
     use rand::{Rng, SeedableRng};

@@ -11,10 +11,10 @@
 //! upper neighbour; that edge carries the difference.) The cost of a table is the analytic size the plan builder starts
 //! from; the chosen set is then built and verified like any other.
 
-use super::decoder::Decoder;
+use super::contract::{K_MAX, NK_DEPTH, N_MAX};
+use super::decoder::{BrdfK, Decoder};
 use super::plan::{analytic_len, PlanError, SpecularPlan, WORD_BITS_RANGE};
 use super::reference::{approx_error, epicentre_arg};
-use super::{K_MAX, NK_DEPTH, N_MAX};
 use crate::rom::addr_bits;
 
 /// The search considers sets of at most this many tables.
@@ -197,11 +197,23 @@ pub fn auto_plan(max_err: f64) -> Result<SpecularPlan, PlanError> {
     }
     let Some((_, w, ks)) = winner else {
         let (best, best_ks) = best_reachable(MAX_AUTO_TABLES);
-        return Err(PlanError::Unreachable { max_err, best, best_ks });
+        return Err(PlanError::Unreachable { max_tables: MAX_AUTO_TABLES, max_err, best, best_ks });
     };
     let decoder = Decoder::least_error(&ks)?;
     // The search sized with one W; let the builder settle W on the verified sizes.
     SpecularPlan::build(decoder, None).or_else(|_| SpecularPlan::build(Decoder::least_error(&ks)?, Some(w)))
+}
+
+// Here, not beside the other constructors in `plan`, so that `plan` never imports the search
+// built on it.
+impl SpecularPlan {
+    /// `--brdf-k`: a listed k-set ([`SpecularPlan::from_k_set`]) or the search ([`auto_plan`]).
+    pub fn from_brdf_k(b: &BrdfK) -> Result<SpecularPlan, PlanError> {
+        match b {
+            BrdfK::List(ks) => SpecularPlan::from_k_set(ks),
+            BrdfK::Auto { max_err } => auto_plan(*max_err),
+        }
+    }
 }
 
 #[cfg(test)]
@@ -216,7 +228,7 @@ mod tests {
         let (e5, k5) = best_reachable(5);
         assert!(e5 < e4 && k5.len() == 5, "{e5} {k5:?}");
         let err = auto_plan(e5 * 0.99).unwrap_err();
-        assert_eq!(err, PlanError::Unreachable { max_err: e5 * 0.99, best: e5, best_ks: k5 });
+        assert_eq!(err, PlanError::Unreachable { max_tables: MAX_AUTO_TABLES, max_err: e5 * 0.99, best: e5, best_ks: k5 });
         assert!(err.to_string().contains("the best reachable is"), "{err}");
         assert_eq!(auto_plan(0.0), Err(PlanError::AutoTarget(0.0)));
     }

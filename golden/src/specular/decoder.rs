@@ -1,7 +1,7 @@
 //! The decoder n -> table: which `cos^k` curve approximates `cos^n`.
 
+use super::contract::{n_valid, K_MAX, N_MAX, N_MIN};
 use super::reference::approx_error;
-use super::{n_valid, K_MAX, N_MAX, N_MIN};
 use serde::{Deserialize, Serialize};
 use std::fmt;
 

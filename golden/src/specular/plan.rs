@@ -22,12 +22,11 @@
 //! rounding adds at most 0.5/256 and C < 256. A table that fails grows by 0.5% and is
 //! checked again.
 
-use super::auto::MAX_AUTO_TABLES;
-use super::decoder::{BrdfK, Decoder, DecoderError, KRange, KSetError};
+use super::contract::{INSIDE_REL, K_MAX, NK_DEPTH, N_MIN, OUTSIDE_REL, THETA_FRAC};
+use super::decoder::{Decoder, DecoderError, KRange, KSetError};
 use super::reference::{cos_k, epicentre_arg, epicentre_code};
-use super::{INSIDE_REL, K_MAX, NK_DEPTH, N_MIN, OUTSIDE_REL, THETA_FRAC};
 use crate::pipeline::{PipeReg, PipeStage, Pipeline};
-use crate::rom::addr_bits;
+use crate::rom::{addr_bits, Rom};
 use serde::{Deserialize, Serialize};
 use std::ops::RangeInclusive;
 
@@ -181,14 +180,15 @@ pub enum PlanError {
     /// `--brdf-k auto` with a target that is no positive fraction.
     #[error("error target {0} must be positive")]
     AutoTarget(f64),
-    /// `--brdf-k auto`: no set of at most `MAX_AUTO_TABLES` tables is that accurate.
+    /// `--brdf-k auto`: no set of at most `max_tables` tables (the search's limit) is that
+    /// accurate.
     #[error(
-        "no set of at most {MAX_AUTO_TABLES} BRDF tables (k in 1..{K_MAX}) keeps the epicentre error within {:.3}%; \
+        "no set of at most {max_tables} BRDF tables (k in 1..{K_MAX}) keeps the epicentre error within {:.3}%; \
          the best reachable is {:.3}% with k = {best_ks:?}",
         max_err * 100.0,
         best * 100.0
     )]
-    Unreachable { max_err: f64, best: f64, best_ks: Vec<u32> },
+    Unreachable { max_tables: usize, max_err: f64, best: f64, best_ks: Vec<u32> },
 }
 
 impl From<KSetError> for PlanError {
@@ -206,13 +206,6 @@ impl SpecularPlan {
     /// `--brdf-k LIST`: each n on its least-error table.
     pub fn from_k_set(ks: &[u32]) -> Result<SpecularPlan, PlanError> {
         SpecularPlan::build(Decoder::least_error(ks)?, None)
-    }
-
-    pub fn from_brdf_k(b: &BrdfK) -> Result<SpecularPlan, PlanError> {
-        match b {
-            BrdfK::List(ks) => SpecularPlan::from_k_set(ks),
-            BrdfK::Auto { max_err } => super::auto::auto_plan(*max_err),
-        }
     }
 
     /// Sizes, packs and verifies the tables for a decoder. `word_bits = None` lets the
@@ -372,6 +365,24 @@ impl SpecularPlan {
     }
     pub fn brdf_depth(&self) -> u32 {
         self.tables.iter().map(|t| t.len).sum()
+    }
+    /// The BRDF ROM image: the tables packed back to back, table `t` at `base_t..base_t+len_t`,
+    /// each word [`SpecularPlan::brdf_word`], so the sizing checks and this image agree by
+    /// construction. The model looks its answers up in these words and every exporter writes
+    /// them, so the RTL, the model and the files cannot drift apart.
+    pub fn brdf_rom(&self) -> Rom {
+        let mut words = Vec::with_capacity(self.brdf_depth() as usize);
+        for (t, table) in self.tables.iter().enumerate() {
+            debug_assert_eq!(words.len() as u32, table.base);
+            words.extend((0..table.len).map(|i| self.brdf_word(t, i)));
+        }
+        Rom::new("specular_brdf_rom", self.word_bits, words)
+    }
+    /// The n-table ROM image: address `n`, word `{sel, M}` ([`SpecularPlan::nk_word`]); every n
+    /// outside 1..=1000 holds 0, the invalid-n code.
+    pub fn nk_rom(&self) -> Rom {
+        let words = (0..NK_DEPTH as u32).map(|n| self.nk_word(n)).collect();
+        Rom::new("specular_nk_rom", self.nk_width(), words)
     }
     pub fn brdf_bits(&self) -> u64 {
         self.brdf_depth() as u64 * self.word_bits as u64

@@ -7,7 +7,8 @@
 //! * [`approx`]: `C cos^k(sqrt(n/k) delta)`: the table approximation the unit implements.
 //! * the bit-exact unit itself, judged against [`approx`] by SPEC §4.
 
-use super::setup::{dot, slerp, SpanEnds};
+use super::contract::THETA_FRAC;
+use super::geometry::{dot, slerp, SpanEnds};
 use std::f64::consts::{FRAC_PI_2, FRAC_PI_3};
 
 /// SPEC §4 epicentre of the highlight: `delta <= atan(1/sqrt(n-1))`, the inflection point of
@@ -22,7 +23,7 @@ pub fn epicentre(n: u32) -> f64 {
 
 /// The largest `theta` code (Q3.28 magnitude) inside the epicentre of n.
 pub fn epicentre_code(n: u32) -> u32 {
-    (epicentre(n) * (1u64 << super::THETA_FRAC) as f64).floor() as u32
+    (epicentre(n) * (1u64 << THETA_FRAC) as f64).floor() as u32
 }
 
 /// `C cos^n(delta)`, 0 where the cosine is not positive (Blinn–Phong clamps N·H at 0).

@@ -28,58 +28,11 @@
 //!   theta0 = dtheta = 0.
 //! * C beyond UQ8.8 saturates to 65535/256.
 
-use super::{SpecularSpan, C_FRAC, THETA_FRAC};
+use super::contract::{C_FRAC, THETA_FRAC};
+use super::geometry::{add, angle, cross, dot, norm, normalize, perpendicular, rotate, scale, SpanEnds, Vec3};
+use super::unit::{span_overflows, SpecularSpan};
 use serde::{Deserialize, Serialize};
 use std::f64::consts::{FRAC_PI_2, PI};
-
-pub type Vec3 = [f64; 3];
-
-pub fn dot(a: Vec3, b: Vec3) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-pub fn cross(a: Vec3, b: Vec3) -> Vec3 {
-    [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
-}
-pub fn norm(a: Vec3) -> f64 {
-    dot(a, a).sqrt()
-}
-fn scale(a: Vec3, s: f64) -> Vec3 {
-    [a[0] * s, a[1] * s, a[2] * s]
-}
-fn add(a: Vec3, b: Vec3) -> Vec3 {
-    [a[0] + b[0], a[1] + b[1], a[2] + b[2]]
-}
-/// `a / |a|`, `None` for a zero or non-finite vector.
-pub fn normalize(a: Vec3) -> Option<Vec3> {
-    let l = norm(a);
-    (l.is_finite() && l > 1e-150).then(|| scale(a, 1.0 / l))
-}
-/// Angle between unit vectors, accurate near 0 and pi (unlike acos of the dot product).
-pub fn angle(a: Vec3, b: Vec3) -> f64 {
-    norm(cross(a, b)).atan2(dot(a, b))
-}
-/// A fixed unit vector perpendicular to unit `a`: `a` crossed with the coordinate axis it is
-/// least aligned with.
-pub fn perpendicular(a: Vec3) -> Vec3 {
-    let i = (0..3).min_by(|&i, &j| a[i].abs().total_cmp(&a[j].abs())).unwrap_or(0);
-    let mut e = [0.0; 3];
-    e[i] = 1.0;
-    normalize(cross(a, e)).unwrap_or([1.0, 0.0, 0.0])
-}
-/// Rotation of v about unit axis u by phi (Rodrigues).
-pub fn rotate(v: Vec3, u: Vec3, phi: f64) -> Vec3 {
-    let (s, c) = phi.sin_cos();
-    add(add(scale(v, c), scale(cross(u, v), s)), scale(u, dot(u, v) * (1.0 - c)))
-}
-/// Spherical interpolation of unit vectors; for antiparallel ends the half circle through
-/// [`perpendicular`] of `a`.
-pub fn slerp(a: Vec3, b: Vec3, t: f64) -> Vec3 {
-    match normalize(cross(a, b)) {
-        Some(axis) => rotate(a, axis, t * angle(a, b)),
-        None if dot(a, b) > 0.0 => a,
-        None => rotate(a, perpendicular(a), t * PI),
-    }
-}
 
 /// The rotation taking unit n2 to unit n1, applied to v; the second value says whether the
 /// antiparallel fallback was used.
@@ -98,15 +51,6 @@ fn rotate_n2_to_n1(n1: Vec3, n2: Vec3, v: Vec3) -> (Vec3, bool) {
     } else {
         (rotate(v, perpendicular(n1), PI), true)
     }
-}
-
-/// Normals and half-vectors at a span's first (1) and last (2) pixel. Need not be unit.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
-pub struct SpanEnds {
-    pub n1: Vec3,
-    pub h1: Vec3,
-    pub n2: Vec3,
-    pub h2: Vec3,
 }
 
 /// Which fallbacks a set-up took.
@@ -218,7 +162,7 @@ pub fn setup_span(ends: &SpanEnds, il: f64, ks: f64, n: u16, l: u32) -> Specular
     }
     let dtheta = if l == 0 { 0.0 } else { gamma_used / l as f64 };
     let (theta0_q, mut dtheta_q) = (quantize_theta(theta0), quantize_theta(dtheta));
-    if super::span_overflows(theta0_q, dtheta_q, len) {
+    if span_overflows(theta0_q, dtheta_q, len) {
         // Only reachable for spans far longer than any port carries (l beyond ~10^9): l
         // rounding errors of half an LSB each. Truncation keeps the end inside theta0 + gamma.
         dtheta_q = (dtheta * (1u64 << THETA_FRAC) as f64).trunc() as i32;
@@ -243,7 +187,7 @@ pub fn setup_span(ends: &SpanEnds, il: f64, ks: f64, n: u16, l: u32) -> Specular
 #[cfg(test)]
 mod tests {
     use super::super::reference::{approx_error, blinn_phong_slerp, epicentre_code};
-    use super::super::{span_overflows, SpecularUnit, THETA_FRAC};
+    use super::super::unit::SpecularUnit;
     use super::*;
     use crate::rng::SeedRng;
     use rand::{Rng, SeedableRng};

@@ -1,7 +1,7 @@
 //! Meshes and scenes: the built-in sphere and torus, Wavefront OBJ files, and every scene's
 //! camera, light and material. Geometry only: nothing here knows the screen or the hardware.
 
-use golden::specular::setup::{cross, dot, normalize, Vec3};
+use golden::specular::geometry::{cross, dot, normalize, Vec3};
 use std::f64::consts::{PI, TAU};
 
 /// An OBJ text that is no mesh the renderer can frame.

@@ -6,7 +6,8 @@ use super::mesh::{add, lighting, obj_mesh, rotate_xy, scale, scene, sub, Lightin
 use crate::cosim::Stim;
 use golden::frontend::FixedTriangle;
 use golden::setup::{parse_triangles, triangle_spans, ParseError, Screen, ScreenError, SetupError, Triangle, Vertex};
-use golden::specular::setup::{cross, dot, normalize, setup_span, SpanEnds, Vec3};
+use golden::specular::geometry::{cross, dot, normalize, SpanEnds, Vec3};
+use golden::specular::setup::setup_span;
 use golden::specular::SpecularSpan;
 use golden::Config;
 

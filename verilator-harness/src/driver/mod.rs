@@ -12,209 +12,32 @@
 //!
 //! With waveforms on ([`crate::waveform`]), the driver also keeps a tape of its model's inputs,
 //! and the first mismatch of the run names the FST file of its clocks and its clock.
+//!
+//! The clock loop (`drive`) keeps its state in named parts, each with its own tests:
+//! the `pacer` decides each clock's traffic, the `monitor` checks the handshake and notices a
+//! hung model, the `scoreboard` counts what each span still owes, and the `checker`'s
+//! outbox carries the records to the checking thread. A unit plugs in through `unit`'s traits.
+
+mod checker;
+mod monitor;
+mod pacer;
+mod scoreboard;
+mod unit;
+
+pub use pacer::Stress;
+pub use unit::DRAIN_CLOCKS;
+pub(crate) use unit::{Check, Unit};
 
 use crate::ffi::{Control, Handshake, Rtl};
 use crate::report::{Mismatch, Report};
 use crate::tape::{NoTape, Recorder, Tape};
 use crate::traffic::TrafficGen;
 use crate::waveform::{TraceError, Waveform, AFTER, BEFORE};
-use rand::Rng;
-use std::collections::VecDeque;
+use checker::{channels, consume, Link, Outbox};
+use monitor::{Monitor, Stall, STALL_LIMIT};
+use pacer::Pacer;
+use scoreboard::Scoreboard;
 use std::path::PathBuf;
-use std::sync::mpsc::{sync_channel, Receiver, SyncSender};
-
-/// Stress on top of [`crate::traffic::Traffic`], off by default: `rst` at random clocks, long
-/// stretches of `out_ready` low, long `in_valid` gaps between spans. With a reset, the spans
-/// accepted and not yet fully out are *cut* (their remaining output is dropped from the
-/// scoreboard) and a span being offered is offered again afterwards; in a clock with `rst`
-/// high nothing transfers.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct Stress {
-    /// Probability per clock of asserting `rst` (for 1..=3 clocks).
-    pub reset: f64,
-    /// Probability per clock that `out_ready` drops for 1..=`stall_max` clocks.
-    pub stall: f64,
-    pub stall_max: u32,
-    /// Probability after each input transfer of an `in_valid` gap of 1..=`gap_max` clocks.
-    pub gap: f64,
-    pub gap_max: u32,
-}
-
-impl Stress {
-    pub const NONE: Stress = Stress { reset: 0.0, stall: 0.0, stall_max: 0, gap: 0.0, gap_max: 0 };
-    /// Long backpressure bursts and input gaps, no reset.
-    pub const BURSTS: Stress = Stress { reset: 0.0, stall: 0.01, stall_max: 300, gap: 0.05, gap_max: 200 };
-    /// Everything at once: resets about every 500 clocks, bursts and gaps.
-    pub const HARSH: Stress = Stress { reset: 0.002, ..Stress::BURSTS };
-}
-
-/// The per-clock decisions of the driver and the sink under `Traffic` and [`Stress`]: the
-/// generator's two draws of the clock ([`TrafficGen::clock`]), then the stress draws. Without
-/// stress it is exactly the plain traffic of the native and cocotb benches, and with `ON`
-/// false (no stress) the stress draws are compiled out of the clock loop.
-struct Pacer<const ON: bool> {
-    /// The unit's traffic, moved here for the clock loop: behind the driver, whose ports every
-    /// call into the model may touch, it would be stored and reloaded around each call.
-    rng: TrafficGen,
-    stress: Stress,
-    rst_left: u32,
-    stall_left: u32,
-    gap_left: u32,
-}
-
-impl<const ON: bool> Pacer<ON> {
-    fn new(stress: Stress, rng: TrafficGen) -> Self {
-        Pacer { rng, stress, rst_left: 0, stall_left: 0, gap_left: 0 }
-    }
-
-    /// Draws this clock's traffic.
-    #[inline]
-    fn clock(&mut self) {
-        self.rng.clock();
-    }
-
-    /// Whether `rst` is high this clock.
-    #[inline]
-    fn reset(&mut self) -> bool {
-        if !ON {
-            return false;
-        }
-        if self.rst_left == 0 && self.stress.reset > 0.0 && self.rng.gen_bool(self.stress.reset) {
-            self.rst_left = self.rng.gen_range(1..=3);
-        }
-        if self.rst_left > 0 {
-            self.rst_left -= 1;
-            return true;
-        }
-        false
-    }
-
-    /// Whether a pending span starts being offered this clock.
-    #[inline]
-    fn offer(&mut self) -> bool {
-        if ON && self.gap_left > 0 {
-            self.gap_left -= 1;
-            return false;
-        }
-        self.rng.offer()
-    }
-
-    /// `out_ready` this clock.
-    #[inline]
-    fn ready(&mut self) -> bool {
-        if !ON {
-            return self.rng.ready();
-        }
-        if self.stall_left == 0 && self.stress.stall > 0.0 && self.rng.gen_bool(self.stress.stall) {
-            self.stall_left = self.rng.gen_range(1..=self.stress.stall_max.max(1));
-        }
-        if self.stall_left > 0 {
-            self.stall_left -= 1;
-            return false;
-        }
-        self.rng.ready()
-    }
-
-    /// A span was transferred: maybe a gap before the next one is offered.
-    #[inline]
-    fn accepted(&mut self) {
-        if ON && self.stress.gap > 0.0 && self.rng.gen_bool(self.stress.gap) {
-            self.gap_left = self.rng.gen_range(1..=self.stress.gap_max.max(1));
-        }
-    }
-}
-
-/// What the driving thread knows of a unit: how a span goes onto its ports, how many outputs
-/// it owes, and the compact record of an output that the checker reads.
-pub(crate) trait Unit: Sync {
-    type In: Control;
-    type Out: Handshake;
-    type Span: Sync;
-    /// Bytes of one output's record.
-    fn record_bytes(&self) -> usize;
-    fn load(&self, input: &mut Self::In, span: &Self::Span);
-    /// Outputs (segments, pixels) the span yields.
-    fn owed(&self, span: &Self::Span) -> u32;
-    /// Writes the record of `out` into `rec` (`record_bytes` long).
-    fn record(&self, out: &Self::Out, rec: &mut [u8]);
-    /// Whether `out` is the output recorded in `held`, offered in the clock before and not
-    /// taken (don't-care bits ignored).
-    fn same(&self, held: &[u8], out: &Self::Out) -> bool;
-    /// What differs when `out` is not [`Unit::same`] as `held`.
-    fn describe_change(&self, held: &[u8], out: &Self::Out) -> String;
-    /// Quiet clocks after the last expected output before the stream ends. A unit whose inputs
-    /// may owe no output but a late side pulse (a front-end dropping a triangle) waits longer.
-    fn drain_clocks(&self) -> u64 {
-        DRAIN_CLOCKS
-    }
-    /// A one-clock side pulse of the unit (the front-end's `err`), counted in `Report::pulses`.
-    #[inline(always)]
-    fn pulse(&self, _out: &Self::Out) -> bool {
-        false
-    }
-    /// The triangle (or span) to blame and a description, for a mismatch about span `k`.
-    fn blame(&self, k: usize, span: &Self::Span) -> (Option<usize>, String);
-}
-
-/// The checking thread's side: output `j` of span `k`, as [`Unit::record`] wrote it. Outputs
-/// come in transfer order; a span cut by a reset stops early, and the next record is of a
-/// later span.
-pub(crate) trait Check: Send {
-    fn check(&mut self, k: usize, j: u32, rec: &[u8], report: &mut Report);
-}
-
-/// Clocks run after the last expected output, in which the model must stay quiet.
-pub const DRAIN_CLOCKS: u64 = 3;
-
-/// Clocks without any transfer after which the model is declared hung.
-const STALL_LIMIT: u64 = 10_000;
-
-/// Bytes per batch of output records sent to the checker, and batches in flight. The checker
-/// is faster than the model, so it waits for every batch, and waking it costs the driver tens
-/// of microseconds on this kind of (virtual) machine: batches are large (7,000 outputs of a
-/// P = 256 shader to 175,000 specular pixels) and recycled, not allocated anew.
-const BATCH_BYTES: usize = 2 << 20;
-const IN_FLIGHT: usize = 3;
-
-/// A batch of output records: (span, output index) and the records back to back, room for
-/// [`Batch::records`] of them (`at.len()` are filled).
-struct Batch {
-    at: Vec<(u32, u32)>,
-    data: Vec<u8>,
-}
-
-impl Batch {
-    /// Records of `rb` bytes in a batch.
-    fn records(rb: usize) -> usize {
-        (BATCH_BYTES / (rb + std::mem::size_of::<(u32, u32)>())).max(1024)
-    }
-
-    fn new(rb: usize) -> Batch {
-        Batch { at: Vec::with_capacity(Batch::records(rb)), data: vec![0; Batch::records(rb) * rb] }
-    }
-}
-
-/// The driver's ends of the channels to the checking thread.
-struct Link {
-    tx: SyncSender<Batch>,
-    /// Checked batches, empty, to be filled again.
-    back: Receiver<Batch>,
-}
-
-impl Link {
-    /// Hands a full batch to the checker; false when the checker is gone, having panicked (the
-    /// driver then stops and `stream` passes the panic on).
-    #[inline]
-    fn send(&self, batch: Batch) -> bool {
-        self.tx.send(batch).is_ok()
-    }
-
-    /// An empty batch the checker is done with, if there is one.
-    #[inline]
-    fn recycled(&self) -> Option<Batch> {
-        self.back.try_recv().ok()
-    }
-}
 
 /// A unit under test: the model, its traffic and its stress. Written every clock, so aligned
 /// to whole cache lines: nothing the checking thread writes may sit beside it.
@@ -318,9 +141,7 @@ impl<U: Unit> Driver<U> {
     /// the driver's counts, protocol findings and the checker's verdicts all land in `report`.
     /// With waveforms on, the run's first mismatch names its waveform ([`Driver::waveform`]).
     pub fn stream(&mut self, unit: &U, spans: &[U::Span], report: &mut Report, check: impl Check) {
-        let (tx, rx) = sync_channel::<Batch>(IN_FLIGHT);
-        // Checked batches come back empty, to be filled again.
-        let (back_tx, back_rx) = sync_channel::<Batch>(IN_FLIGHT + 2);
+        let (link, rx, back_tx) = channels();
         // Mismatches the driver finds are added to `report` after these.
         let (kept, before) = (report.mismatches.len(), report.mismatch_count);
         let mut tape = self.tape.take();
@@ -331,7 +152,6 @@ impl<U: Unit> Driver<U> {
             // The checker's state (its checker, its report) lives on its own thread: written
             // for every output, it must share no cache line with the driver's.
             let checker = s.spawn(move || consume(rx, back_tx, unit.record_bytes(), check));
-            let link = Link { tx, back: back_rx };
             let rng = self.rng.clone();
             // The clock loop for each case, so none pays for what it does not do.
             match (self.stress == Stress::NONE, tape.as_deref_mut()) {
@@ -435,27 +255,15 @@ impl<U: Unit> Driver<U> {
         link: &Link,
         rec: &mut impl Recorder<U::In>,
     ) {
-        let (rb, full) = (unit.record_bytes(), Batch::records(unit.record_bytes()));
-        let new_batch = || link.recycled().unwrap_or_else(|| Batch::new(rb));
-        let mut batch = new_batch();
-        // The model's clock is `first_clock` plus the clocks this loop has counted in
-        // `report.cycles` since it began: `clock!()` is the clock being stepped.
-        let (mut first_clock, first_cycle) = (self.clock, report.cycles);
-        macro_rules! clock {
-            () => {
-                first_clock + (report.cycles - first_cycle)
-            };
-        }
-        // Every accepted span with outputs still owed, oldest first, as (span, next output,
-        // owed): the oldest in `front` (in registers: every output transfer updates it), the
-        // rest queued behind it.
-        let mut front: Option<(usize, u32, u32)> = None;
-        let mut behind: VecDeque<(usize, u32, u32)> = VecDeque::new();
-        let mut held = vec![0; rb];
-        let (mut next, mut offering, mut idle, mut drain) = (0, false, 0u64, 0);
-        let (mut in_reset, mut holding) = (false, false);
+        let mut outbox = Outbox::new(link, unit.record_bytes());
+        let (mut owed, mut monitor, mut stall) = (Scoreboard::default(), Monitor::new(unit.record_bytes()), Stall::default());
+        // The next span to offer, whether it is on the ports, and the quiet clocks run after the
+        // last output.
+        let (mut next, mut offering, mut drain) = (0, false, 0);
+        // The clock about to be stepped (reset clocks included).
+        let mut clock = self.clock;
         loop {
-            if next == spans.len() && front.is_none() {
+            if next == spans.len() && owed.is_empty() {
                 // Everything came out; a few more clocks must bring nothing.
                 if drain == unit.drain_clocks() {
                     break;
@@ -466,21 +274,18 @@ impl<U: Unit> Driver<U> {
             if pacer.reset() {
                 // Nothing transfers in a reset clock: the spans in flight are cut, the one
                 // being offered stays offered.
-                if !in_reset {
+                if monitor.reset() {
                     report.resets += 1;
-                    report.cut_spans += front.is_some() as u64 + behind.len() as u64;
-                    front = None;
-                    behind.clear();
-                    rec.reset(clock!());
+                    report.cut_spans += owed.cut();
+                    rec.reset(clock);
                 }
-                in_reset = true;
-                holding = false;
                 let ready = pacer.ready();
                 self.input.set_control(true, offering, ready);
                 self.rtl.step_into(&self.input, &mut self.output);
-                rec.clock(clock!(), &self.input);
+                rec.clock(clock, &self.input);
                 report.cycles += 1;
-                idle = 0;
+                clock += 1;
+                stall.reset();
                 continue;
             }
             if !offering && next < spans.len() {
@@ -493,108 +298,65 @@ impl<U: Unit> Driver<U> {
             let ready = pacer.ready();
             self.input.set_control(false, offering, ready);
             self.rtl.step_into(&self.input, &mut self.output);
-            rec.clock(clock!(), &self.input);
+            rec.clock(clock, &self.input);
             // The ports now hold this span's data: until the next span, the shim need not
             // write them again.
             self.input.keep_data(true);
             report.cycles += 1;
-            let out = &self.output;
+            let (now, out) = (clock, &self.output);
+            clock += 1;
             report.pulses += unit.pulse(out) as u64;
-            if std::mem::take(&mut in_reset) && out.out_valid() {
-                rec.found(clock!() - 1);
-                report.mismatch(Mismatch {
-                    triangle: None,
-                    context: format!("clock {}", clock!() - 1),
-                    what: "out_valid high in the first clock after a reset".into(),
-                });
-            }
+            monitor.watch(unit, out, ready, |what| flag(rec, report, now, what));
             let mut progress = false;
-            if out.out_valid() {
-                if std::mem::take(&mut holding) && !unit.same(&held, out) {
-                    let what = unit.describe_change(&held, out);
-                    rec.found(clock!() - 1);
-                    report.mismatch(Mismatch { triangle: None, context: format!("clock {}", clock!() - 1), what });
-                }
-                if ready {
-                    match &mut front {
-                        Some((k, j, owed)) => {
-                            progress = true;
-                            let n = batch.at.len();
-                            unit.record(out, &mut batch.data[n * rb..(n + 1) * rb]);
-                            batch.at.push((*k as u32, *j));
-                            rec.transfer(clock!() - 1);
-                            *j += 1;
-                            if *j == *owed {
-                                front = behind.pop_front();
-                            }
-                            if batch.at.len() == full && !link.send(std::mem::replace(&mut batch, new_batch())) {
-                                return;
-                            }
-                        }
-                        // Output nobody asked for is no progress: a model that streams garbage
-                        // while refusing input is declared hung, not followed forever.
-                        None => {
-                            rec.found(clock!() - 1);
-                            report.mismatch(Mismatch {
-                                triangle: None,
-                                context: format!("clock {}", clock!() - 1),
-                                what: "output with no span outstanding".into(),
-                            })
+            if out.out_valid() && ready {
+                match owed.transfer() {
+                    Some((k, j)) => {
+                        progress = true;
+                        rec.transfer(now);
+                        if !outbox.push(k, j, |r| unit.record(out, r)) {
+                            return;
                         }
                     }
-                } else {
-                    holding = true;
-                    unit.record(out, &mut held);
+                    // Output nobody asked for is no progress: a model that streams garbage
+                    // while refusing input is declared hung, not followed forever.
+                    None => flag(rec, report, now, "output with no span outstanding".into()),
                 }
-            } else if std::mem::take(&mut holding) {
-                rec.found(clock!() - 1);
-                report.mismatch(Mismatch {
-                    triangle: None,
-                    context: format!("clock {}", clock!() - 1),
-                    what: "out_valid dropped before the output offered was taken".into(),
-                });
             }
             if offering && out.in_ready() {
                 progress = true;
-                let owed = unit.owed(&spans[next]);
-                if owed > 0 {
-                    if front.is_none() {
-                        front = Some((next, 0, owed));
-                    } else {
-                        behind.push_back((next, 0, owed));
-                    }
-                }
+                owed.accept(next, unit.owed(&spans[next]));
                 report.spans += 1;
                 next += 1;
                 offering = false;
                 pacer.accepted();
             }
-            idle = if progress { 0 } else { idle + 1 };
-            if idle > STALL_LIMIT {
-                let (triangle, context) = match front {
-                    Some((k, _, _)) => unit.blame(k, &spans[k]),
+            if stall.hung(progress) {
+                let (triangle, context) = match owed.oldest() {
+                    Some(k) => unit.blame(k, &spans[k]),
                     None => (None, "idle".into()),
                 };
-                let left: u64 = front.iter().chain(&behind).map(|&(_, j, owed)| (owed - j) as u64).sum();
-                rec.found(clock!() - 1);
-                report.mismatch(Mismatch {
-                    triangle,
-                    context,
-                    what: format!("no transfer for {STALL_LIMIT} clocks (clock {}); {left} outputs still expected", clock!() - 1),
-                });
-                self.clock = clock!();
+                let what = format!("no transfer for {STALL_LIMIT} clocks (clock {now}); {} outputs still expected", owed.left());
+                rec.found(now);
+                report.mismatch(Mismatch { triangle, context, what });
+                self.clock = clock;
                 self.reset_with(rec);
-                first_clock += 2;
+                clock = self.clock;
                 break;
             }
         }
-        self.clock = clock!();
+        self.clock = clock;
         // The next stream goes on with the traffic where this one left it.
         self.rng = pacer.rng;
-        if !batch.at.is_empty() {
-            link.send(batch);
-        }
+        outbox.flush();
     }
+}
+
+/// A breach of the protocol the driver found in clock `clock`: told to the tape (a waveform may
+/// be needed) and reported.
+#[cold]
+fn flag<I>(rec: &mut impl Recorder<I>, report: &mut Report, clock: u64, what: String) {
+    rec.found(clock);
+    report.mismatch(Mismatch { triangle: None, context: format!("clock {clock}"), what });
 }
 
 /// Adds `note` to a mismatch's message, in brackets.
@@ -602,27 +364,6 @@ fn annotate(m: Option<&mut Mismatch>, note: &str) {
     if let Some(m) = m {
         m.what = format!("{} [{note}]", m.what);
     }
-}
-
-/// The checking thread: every record of every batch, in order; each batch then goes back.
-/// Returns the report and the index (in transfer order) of the first output that failed.
-fn consume(rx: Receiver<Batch>, back: SyncSender<Batch>, rb: usize, mut check: impl Check) -> (Report, Option<usize>) {
-    let mut report = Report::default();
-    let (mut n, mut first_bad) = (0, None);
-    for mut batch in rx {
-        for (&(k, j), rec) in batch.at.iter().zip(batch.data.chunks_exact(rb)) {
-            let before = report.mismatch_count;
-            check.check(k as usize, j, rec, &mut report);
-            if report.mismatch_count != before && first_bad.is_none() {
-                first_bad = Some(n);
-            }
-            n += 1;
-        }
-        batch.at.clear();
-        // The driver may have finished, or hold enough spares already: then it is dropped.
-        let _ = back.try_send(batch);
-    }
-    (report, first_bad)
 }
 
 #[cfg(test)]
@@ -749,50 +490,5 @@ mod tests {
             "{:?}",
             many.mismatches
         );
-    }
-
-    /// The checking thread hands back the index, in transfer order, of the first output that
-    /// failed, over batches; the driver names the waveform after it.
-    #[test]
-    fn the_checker_names_its_first_failing_output() {
-        struct FailFrom(usize, usize);
-        impl Check for FailFrom {
-            fn check(&mut self, _k: usize, _j: u32, _rec: &[u8], report: &mut Report) {
-                if self.1 >= self.0 {
-                    report.mismatch(Mismatch { triangle: None, context: String::new(), what: "planted".into() });
-                }
-                self.1 += 1;
-            }
-        }
-        let (tx, rx) = sync_channel(IN_FLIGHT);
-        let (back, _back_rx) = sync_channel(IN_FLIGHT + 2);
-        let rb = 4;
-        let per = Batch::records(rb);
-        let sender = std::thread::spawn(move || {
-            for b in 0..3 {
-                let mut batch = Batch::new(rb);
-                for r in 0..per {
-                    batch.at.push((b, r as u32));
-                }
-                tx.send(batch).unwrap();
-            }
-        });
-        let (report, first_bad) = consume(rx, back, rb, FailFrom(per + 5, 0));
-        sender.join().unwrap();
-        assert_eq!(first_bad, Some(per + 5));
-        assert_eq!(report.mismatch_count, (3 * per - per - 5) as u64);
-    }
-
-    /// Without stress the pacer is the plain traffic, draw for draw (the benches' stream).
-    #[test]
-    fn an_unstressed_pacer_is_the_plain_traffic() {
-        let (mut plain, mut pacer) =
-            (TrafficGen::new(Traffic::RANDOM, 9), Pacer::<false>::new(Stress::NONE, TrafficGen::new(Traffic::RANDOM, 9)));
-        for _ in 0..10_000 {
-            plain.clock();
-            pacer.clock();
-            assert!(!pacer.reset());
-            assert_eq!((pacer.offer(), pacer.ready()), (plain.offer(), plain.ready()));
-        }
     }
 }
