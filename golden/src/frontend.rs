@@ -53,9 +53,7 @@
 //! UQ8.F intensities the hardware receives; real-valued vertex intensities add at most
 //! `2^-(F+1)` more when they are rounded onto the port.
 
-mod incremental;
-
-pub use incremental::{Cost, Step, Steps};
+pub mod incremental;
 
 use crate::format::{Config, Span};
 use crate::setup::{is_top_left, snap, Screen, Snapped, Triangle, SUBPIXEL};

@@ -3,10 +3,16 @@
 //! staged) and renamed over its destination only when all of them were written. The one
 //! implementation behind `generate`, `rom`, `report --svg`, `render` and `sweep --out`.
 
-use crate::GeneratedFile;
 use std::fs;
 use std::io::Write;
 use std::path::{Path, PathBuf};
+
+/// One output file, name relative to the output folder.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct GeneratedFile {
+    pub name: String,
+    pub contents: String,
+}
 
 /// Prefix of the staged files (tests check that none is left behind).
 pub const TEMP_PREFIX: &str = ".tmp-segshade-";

@@ -208,3 +208,75 @@ fn docs_axis_tables_are_the_layout() {
     assert_ne!(broken, doc, "the control edits a row the tables have");
     assert_ne!(axis_tables(&broken), Some(want.as_str()));
 }
+
+// Tests of the whole generator, kept out of its modules so that no module imports the crate root
+// (scripts/import-cycles).
+use hdl_gen::manifest::{Manifest, Role, MANIFEST_FILE};
+
+/// The reader is the writer's schema: every configuration's manifest reads back into
+/// [`Manifest`] and prints again byte for byte, so no field is dropped or misread.
+#[test]
+fn manifests_read_back_exactly() {
+    let configs = [
+        Options::default(),
+        Options { cfg: Config { p: 64, align: Align::Screen, ..Config::default() }, prefix: "x_".into(), ..Default::default() },
+        Options { cfg: Config::new(2, 20, 16, Align::Span).unwrap(), bfpi_arch: BfpiArch::Tree, ..Default::default() },
+        Options { prefix: "a_".into(), bus: Bus::Axis, ..Default::default() },
+    ];
+    for opts in configs {
+        let files = generate(&opts);
+        let text = &files.iter().find(|f| f.name == MANIFEST_FILE).unwrap().contents;
+        let m = Manifest::parse(text).unwrap();
+        assert_eq!(&(serde_json::to_string_pretty(&m).unwrap() + "\n"), text);
+        assert_eq!(m.parameters.align, opts.cfg.align);
+        assert!(m.by_role(Role::SegmentShader).is_some());
+        assert_eq!(m.axis.len(), if opts.bus == Bus::Axis { 4 } else { 0 });
+        for w in &m.axis {
+            w.check().unwrap();
+            assert_eq!(m.module(&w.module).unwrap().role, Role::Axis);
+            assert_eq!(m.module(&w.module).unwrap().latency, m.module(&w.wraps).unwrap().latency);
+        }
+    }
+}
+
+#[test]
+fn a_missing_module_is_named_with_the_ones_listed() {
+    let files = generate(&Options::default());
+    let m = Manifest::parse(&files.iter().find(|f| f.name == MANIFEST_FILE).unwrap().contents).unwrap();
+    let e = m.module("nope").unwrap_err().to_string();
+    assert!(e.contains("'nope'") && e.contains("segment_shader_p8"), "{e}");
+    assert!(Manifest::parse("{}").is_err());
+}
+
+/// The extreme P (a byte and 256 bytes of pixels; P = 4 has a one-word lane bus) in both
+/// alignments (the default P = 8 is in the manifest tests): each wrapper's packings keep the
+/// rule, every data input is in `s_axis_tdata` once, and the shader's TKEEP has a bit per
+/// TDATA byte.
+#[test]
+fn every_configuration_packs_by_the_rule() {
+    for p in [1, 4, 256] {
+        for align in Align::ALL {
+            let cfg = Config { p, align, ..golden::Config::default() };
+            let opts = Options { cfg, bus: Bus::Axis, ..Default::default() };
+            let names = hdl_gen::Names::new("", &cfg);
+            let files = generate(&opts);
+            let m = Manifest::parse(&files.iter().find(|f| f.name == "manifest.json").unwrap().contents).unwrap();
+            assert_eq!(m.axis.len(), 4, "p = {p}");
+            for w in &m.axis {
+                w.check().unwrap();
+                let core = m.module(&w.wraps).unwrap();
+                let inputs: Vec<&str> = core
+                    .ports
+                    .iter()
+                    .filter(|x| x.direction == hdl_gen::verilog::Dir::Input && !hdl_gen::axis::CONTROL.contains(&x.name.as_str()))
+                    .map(|x| x.name.as_str())
+                    .collect();
+                let packed: Vec<&str> = w.s_axis.tdata.fields.iter().map(|f| f.port.as_str()).collect();
+                assert_eq!(packed, inputs, "{}", w.module);
+                if w.wraps == names.segment {
+                    assert_eq!((w.m_axis.tdata.bits, w.m_axis.tkeep.as_deref()), (8 * p, Some("out_mask")));
+                }
+            }
+        }
+    }
+}

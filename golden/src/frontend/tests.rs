@@ -1,5 +1,6 @@
 //! The front-end against the host set-up, the exact plane and itself (orders, windings, screens).
 
+use super::incremental::{Cost, Steps};
 use super::*;
 use crate::setup::Vertex;
 use crate::Align;

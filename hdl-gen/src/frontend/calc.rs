@@ -2,8 +2,8 @@
 //! ([`golden::pipeline::SETUP_STAGES`]): one clock at level 0, a register boundary after each
 //! stage above it.
 
+use super::hw::{slit, Hw};
 use super::stager::Stager;
-use super::{slit, Hw};
 use crate::verilog::{comment, lit, sext, zext, Item};
 use golden::frontend::Widths;
 

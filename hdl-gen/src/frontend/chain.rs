@@ -1,6 +1,6 @@
 //! `tri_shader_p<P>`: the front-end chained with the segment shader.
 
-use super::{ports, Hw};
+use super::hw::{ports, Hw};
 use crate::verilog::{assign, comment, reg, set, swire, wire, Item, Module, Port, Stmt};
 use crate::Names;
 

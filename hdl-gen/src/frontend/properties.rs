@@ -2,10 +2,10 @@
 //! its state, handed to the property writer. The scanline comparison option's divider adds a
 //! stall of its own and is left to co-simulation.
 
+use super::hw::Hw;
 use super::setup::{self, Setup};
 use super::span;
 use super::stager::Stager;
-use super::Hw;
 use crate::formal::{assert, covers, past_flags, reset_and_stability, slit, when, CUT_TAG, OUT};
 use crate::verilog::{comment, lit, reg, set, sext, wire, zext, Item, Stmt};
 

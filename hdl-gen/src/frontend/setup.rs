@@ -3,8 +3,8 @@
 
 use super::calc::calc;
 use super::divider::{div_chain, div_iter, div_load, div_regs, Div};
+use super::hw::Hw;
 use super::stager::Stager;
-use super::Hw;
 use crate::verilog::{assign, comment, lit, net, reg, set, sreg, wire, zext, Item, Stmt};
 use golden::frontend::Widths;
 

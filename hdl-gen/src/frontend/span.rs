@@ -4,9 +4,9 @@
 //! them all. Then the output register (and, per scanline, the span's dI divider).
 
 use super::divider::{div_chain, div_iter, div_load};
+use super::hw::Hw;
 use super::stager::Stager;
 use super::walker::scanline_divider;
-use super::Hw;
 use crate::verilog::{comment, lit, reg, set, wire, zext, Item, Stmt};
 use golden::frontend::{DiMode, Widths};
 

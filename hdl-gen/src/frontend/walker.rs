@@ -2,7 +2,7 @@
 //! side by side; it loads the next triangle in the clock its current one finishes.
 
 use super::divider::{div_regs, Div};
-use super::{slit, Hw};
+use super::hw::{slit, Hw};
 use crate::verilog::{assign, comment, lit, reg, set, sext, sreg, swire, wire, zext, Item, Stmt};
 use golden::frontend::{DiMode, Widths};
 

@@ -1,0 +1,105 @@
+//! What a generated front-end is (golden's configuration and the hardware's choices: divider
+//! rate, pipeline level) and its ports: the types every part of the generator shares.
+
+use crate::verilog::Port;
+use golden::frontend::{DiMode, FrontEnd, Widths};
+
+/// Quotient bits the set-up's dividers take per clock (`--fe-div-bits`): area against rate.
+pub const DIV_BITS: [u32; 3] = [1, 2, 4];
+pub const DEFAULT_DIV_BITS: u32 = 4;
+
+/// A front-end as generated: golden's configuration and the hardware's own choices.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Hw {
+    pub fe: FrontEnd,
+    /// Quotient bits per clock of every set-up divider (one of [`DIV_BITS`]).
+    pub div_bits: u32,
+    /// The chain's register stages (`--pipeline`): the shader's, and the set-up's CALC stages.
+    pub pipeline: golden::pipeline::Pipeline,
+}
+
+impl Hw {
+    /// Clocks the dividers run: the reciprocal's RW quotient bits, `div_bits` a clock.
+    pub fn div_clocks(&self) -> u32 {
+        self.fe.widths().rw.div_ceil(self.div_bits)
+    }
+
+    /// Clocks the per-scanline divider runs for a span of two pixels or more (`DiMode::Scanline`,
+    /// the comparison option; 0 with the per-triangle `dI`): IW quotient bits, `div_bits` a clock.
+    pub fn span_div_clocks(&self) -> u32 {
+        match self.fe.di {
+            DiMode::Triangle => 0,
+            DiMode::Scanline => self.fe.cfg.iw().div_ceil(self.div_bits),
+        }
+    }
+
+    /// Clocks CALC takes: 1, or its stages at `--pipeline 1` and above.
+    pub fn calc_clocks(&self) -> u32 {
+        self.pipeline.calc_clocks()
+    }
+
+    /// Register stages between the walker and the output register: 2, or 6 at `--pipeline 1`
+    /// and above ([`golden::pipeline::i0_registers`]).
+    pub fn i0_stages(&self) -> u32 {
+        golden::pipeline::i0_registers(self.pipeline).iter().filter(|&&r| r).count() as u32
+    }
+
+    /// Clocks from a triangle's transfer to the first span's `out_valid` when the walker is
+    /// idle: CALC, the dividers, the hand-off, the walker's clock, the span path's stages (and,
+    /// per scanline, the span's division when it has two pixels or more).
+    pub fn latency(&self) -> u32 {
+        self.calc_clocks() + self.div_clocks() + 2 + self.i0_stages() + self.span_div_clocks()
+    }
+
+    /// Clocks from a triangle's transfer to the first segment out of `tri_shader_p<P>` when idle:
+    /// the front-end's latency, then the shader's at the chain's pipeline level.
+    pub fn shader_latency(&self) -> u32 {
+        self.latency() + golden::segment::latency(&self.fe.cfg, self.pipeline)
+    }
+
+    /// Set-up clocks per triangle that is walked (the rate limit for tiny triangles: the
+    /// dividers, then the hand-off clock, which is also the next triangle's last CALC clock),
+    /// and per triangle dropped in set-up (its last CALC clock). CALC's earlier stages overlap
+    /// the triangle ahead's division, so neither depends on the pipeline level.
+    pub fn setup_clocks(&self) -> (u32, u32) {
+        (self.div_clocks() + 1, 1)
+    }
+}
+
+pub(super) fn slit(w: u32, v: i64) -> String {
+    if v < 0 {
+        format!("-{w}'sd{}", -v)
+    } else {
+        format!("{w}'sd{v}")
+    }
+}
+
+pub fn ports(fe: &FrontEnd, wd: &Widths) -> Vec<Port> {
+    let cfg = &fe.cfg;
+    let mut v = vec![
+        Port::input("clk", 1, "", "rising edge"),
+        Port::input("rst", 1, "", "synchronous, active high; drops the triangles in progress"),
+        Port::input("in_valid", 1, "", "triangle valid"),
+        Port::output("in_ready", 1, "", "triangle accepted when in_valid && in_ready"),
+    ];
+    for k in 0..3 {
+        v.push(Port::input(&format!("in_x{k}"), wd.cx, &format!("signed Q{}.8", cfg.xbits + 2), &format!("vertex {k} x, pixels")).signed());
+        v.push(Port::input(&format!("in_y{k}"), wd.cy, &format!("signed Q{}.8", wd.yw + 2), &format!("vertex {k} y, pixels")).signed());
+        v.push(Port::input(&format!("in_i{k}"), cfg.iw(), &format!("UQ8.{}", cfg.frac), &format!("vertex {k} intensity")));
+    }
+    v.push(Port::output("err", 1, "", "one-clock pulse: a triangle with a vertex outside the guard band was dropped").reg());
+    v
+}
+
+pub fn span_ports(fe: &FrontEnd, wd: &Widths) -> Vec<Port> {
+    let cfg = &fe.cfg;
+    vec![
+        Port::output("out_valid", 1, "", "span valid").reg(),
+        Port::input("out_ready", 1, "", "span taken when out_valid && out_ready"),
+        Port::output("out_y", wd.yw, "unsigned integer", "scanline").reg(),
+        Port::output("out_x", cfg.xbits, "unsigned integer", "x0, first covered pixel").reg(),
+        Port::output("out_len", cfg.xbits + 1, "unsigned integer", "m >= 1, covered pixels").reg(),
+        Port::output("out_i0", cfg.iw(), &format!("UQ8.{}", cfg.frac), "intensity at the first pixel's centre").reg(),
+        Port::output("out_di", cfg.dw(), &format!("signed Q8.{}", cfg.frac), "dI/dx, once per triangle").signed().reg(),
+    ]
+}
