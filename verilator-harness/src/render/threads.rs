@@ -18,6 +18,9 @@ use golden::Span;
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::time::Duration;
 
+/// The models' seed: a render is the same picture every run.
+const SEED: u64 = 1;
+
 /// What a render produced.
 #[derive(Debug)]
 pub struct Outcome {
@@ -108,99 +111,19 @@ pub fn run_with(
     let screen = job.screen;
     let (width, npix) = (screen.width, (screen.width * screen.height) as usize);
     let channels = job.channels();
-    let p = seg.cfg.p;
     let with_spec = !job.specular.is_empty() && spec.is_some();
     let total = (job.shaded_pixels() * (channels as u64 + with_spec as u64)).max(1);
     let done = AtomicU64::new(0);
     let owner = &job.owner;
-    const SEED: u64 = 1;
 
     let (diffuse, coverage, segment, writer, spec_out) = std::thread::scope(|s| {
         let seg_threads: Vec<_> = job
             .stims
             .iter()
             .enumerate()
-            .map(|(c, stims)| {
+            .map(|(c, _)| {
                 let done = &done;
-                s.spawn(move || {
-                    let mut img = vec![0u8; npix];
-                    let mut cov = if c == 0 { vec![0u16; npix] } else { Vec::new() };
-                    let mut paint = |triangle: usize, y: u32, out: &SegView| {
-                        let mut n = 0;
-                        for i in (0..p).filter(|&i| out.lane_enabled(i)) {
-                            let x = out.out_x + i;
-                            if x >= width {
-                                continue;
-                            }
-                            let idx = (y * width + x) as usize;
-                            n += 1;
-                            if c == 0 {
-                                cov[idx] = cov[idx].saturating_add(1);
-                            }
-                            if owner[idx] == triangle as u32 {
-                                img[idx] = out.pix[i as usize];
-                            }
-                        }
-                        done.fetch_add(n, Ordering::Relaxed);
-                    };
-                    // Through memory the paint only counts: the image is read out of memory.
-                    let to_memory = matches!(chain, Chain::HostToMemory(_) | Chain::RtlToMemory(_));
-                    let mut lanes: Vec<SegStim> = Vec::new();
-                    let report = match (chain, exps) {
-                        (Chain::Rtl(info), Some(exps)) => stream_chain(info, SEED + c as u64, Traffic::FULL, &exps[c], paint),
-                        (Chain::RtlToMemory(info), Some(exps)) => {
-                            let run = stream_fb(info, SEED + c as u64, Traffic::FULL, &exps[c], Some(owner.clone()));
-                            done.fetch_add(run.report.pixels, Ordering::Relaxed);
-                            img = memory_image(&run.frame);
-                            if c == 0 {
-                                cov = run.mem.screen_writes().into_iter().map(u16::from).collect();
-                            }
-                            run.report
-                        }
-                        _ => {
-                            let mut sim = SegmentCosim::new(seg, SEED + c as u64, Traffic::FULL);
-                            let mut report = Report { triangles: job.drawn, ..Report::default() };
-                            // (span number, segment index) of the last segment; a span's
-                            // segments come one after another, so a new `&Stim` is a new span.
-                            let mut at: Option<(usize, usize, u32)> = None;
-                            sim.stream(stims, &mut report, |stim, out| {
-                                if to_memory {
-                                    // The RTL's segments, as they came out, go on to the writer.
-                                    let addr = stim as *const Stim as usize;
-                                    let (span_index, s) = match at {
-                                        Some((prev, k, s)) if prev == addr => (k, s + 1),
-                                        Some((_, k, _)) => (k + 1, 0),
-                                        None => (0, 0),
-                                    };
-                                    at = Some((addr, span_index, s));
-                                    let mut l = out.pix[..p as usize].to_vec();
-                                    l.extend_from_slice(&out.mask[..p.div_ceil(8) as usize]);
-                                    let lanes_of = Some(l.into_boxed_slice());
-                                    lanes.push(SegStim {
-                                        span_index,
-                                        triangle: Some(stim.triangle),
-                                        y: stim.y,
-                                        span: stim.span,
-                                        s,
-                                        lanes: lanes_of,
-                                    });
-                                }
-                                paint(stim.triangle, stim.y, out)
-                            });
-                            report
-                        }
-                    };
-                    let writer = match chain {
-                        Chain::HostToMemory(info) => {
-                            let w = Writer::new(info.cfg, screen).expect("the job's screen fits the writer");
-                            let run = run_segments(info, SEED + c as u64, Traffic::FULL, Stress::NONE, &lanes, w, Some(owner.clone()));
-                            img = memory_image(&run.mem.memory.frame());
-                            Some(run.report)
-                        }
-                        _ => None,
-                    };
-                    (img, cov, report, writer)
-                })
+                s.spawn(move || channel(job, seg, chain, exps, c, done))
             })
             .collect();
         let spec_thread = spec.filter(|_| with_spec).map(|info| {
@@ -243,9 +166,117 @@ pub fn run_with(
         (diffuse, coverage, reports, writers, spec_out)
     });
 
-    // Golden: the same spans, the same ownership, golden's pixels (the host's spans, or with
-    // the RTL front-end golden's front-end spans; then the host's image is kept beside).
-    let frac = seg.cfg.frac;
+    let GoldenImages { host_diffuse, gold_diffuse, gold_spec } = golden_images(job, seg.cfg.frac, exps, with_spec);
+    let (spec_img, spec_report) = match spec_out {
+        Some((img, r)) => (Some(img), Some(r)),
+        None => (None, None),
+    };
+    Outcome {
+        rtl: compose(&diffuse, spec_img.as_deref(), owner),
+        golden: compose(&gold_diffuse, gold_spec.as_deref(), owner),
+        host: exps.is_some().then(|| compose(&host_diffuse, gold_spec.as_deref(), owner)),
+        coverage,
+        segment,
+        specular: spec_report,
+        writer,
+    }
+}
+
+/// One channel's co-simulation thread: its image (the RTL's pixels on the pixels each triangle
+/// owns), the first channel's coverage, its report and, through memory, its writer's report.
+fn channel(
+    job: &Job,
+    seg: &'static ModelInfo<SegIn, SegOut>,
+    chain: Chain,
+    exps: &Option<Vec<Expected>>,
+    c: usize,
+    done: &AtomicU64,
+) -> (Vec<u8>, Vec<u16>, Report, Option<Report>) {
+    let screen = job.screen;
+    let (width, npix) = (screen.width, (screen.width * screen.height) as usize);
+    let p = seg.cfg.p;
+    let owner = &job.owner;
+    let stims = &job.stims[c];
+    let mut img = vec![0u8; npix];
+    let mut cov = if c == 0 { vec![0u16; npix] } else { Vec::new() };
+    let mut paint = |triangle: usize, y: u32, out: &SegView| {
+        let mut n = 0;
+        for i in (0..p).filter(|&i| out.lane_enabled(i)) {
+            let x = out.out_x + i;
+            if x >= width {
+                continue;
+            }
+            let idx = (y * width + x) as usize;
+            n += 1;
+            if c == 0 {
+                cov[idx] = cov[idx].saturating_add(1);
+            }
+            if owner[idx] == triangle as u32 {
+                img[idx] = out.pix[i as usize];
+            }
+        }
+        done.fetch_add(n, Ordering::Relaxed);
+    };
+    // Through memory the paint only counts: the image is read out of memory.
+    let to_memory = matches!(chain, Chain::HostToMemory(_) | Chain::RtlToMemory(_));
+    let mut lanes: Vec<SegStim> = Vec::new();
+    let report = match (chain, exps) {
+        (Chain::Rtl(info), Some(exps)) => stream_chain(info, SEED + c as u64, Traffic::FULL, &exps[c], paint),
+        (Chain::RtlToMemory(info), Some(exps)) => {
+            let run = stream_fb(info, SEED + c as u64, Traffic::FULL, &exps[c], Some(owner.clone()));
+            done.fetch_add(run.report.pixels, Ordering::Relaxed);
+            img = memory_image(&run.frame);
+            if c == 0 {
+                cov = run.mem.screen_writes().into_iter().map(u16::from).collect();
+            }
+            run.report
+        }
+        _ => {
+            let mut sim = SegmentCosim::new(seg, SEED + c as u64, Traffic::FULL);
+            let mut report = Report { triangles: job.drawn, ..Report::default() };
+            // (span number, segment index) of the last segment; a span's
+            // segments come one after another, so a new `&Stim` is a new span.
+            let mut at: Option<(usize, usize, u32)> = None;
+            sim.stream(stims, &mut report, |stim, out| {
+                if to_memory {
+                    // The RTL's segments, as they came out, go on to the writer.
+                    let addr = stim as *const Stim as usize;
+                    let (span_index, s) = match at {
+                        Some((prev, k, s)) if prev == addr => (k, s + 1),
+                        Some((_, k, _)) => (k + 1, 0),
+                        None => (0, 0),
+                    };
+                    at = Some((addr, span_index, s));
+                    let mut l = out.pix[..p as usize].to_vec();
+                    l.extend_from_slice(&out.mask[..p.div_ceil(8) as usize]);
+                    let lanes_of = Some(l.into_boxed_slice());
+                    lanes.push(SegStim { span_index, triangle: Some(stim.triangle), y: stim.y, span: stim.span, s, lanes: lanes_of });
+                }
+                paint(stim.triangle, stim.y, out)
+            });
+            report
+        }
+    };
+    let writer = match chain {
+        Chain::HostToMemory(info) => {
+            let w = Writer::new(info.cfg, screen).expect("the job's screen fits the writer");
+            let run = run_segments(info, SEED + c as u64, Traffic::FULL, Stress::NONE, &lanes, w, Some(owner.clone()));
+            img = memory_image(&run.mem.memory.frame());
+            Some(run.report)
+        }
+        _ => None,
+    };
+    (img, cov, report, writer)
+}
+
+/// Golden's images from the same spans and the same ownership: the host's spans, and with the
+/// RTL front-end golden's front-end spans (the host's image then kept beside); the specular
+/// channel from golden's unit.
+fn golden_images(job: &Job, frac: u32, exps: &Option<Vec<Expected>>, with_spec: bool) -> GoldenImages {
+    let screen = job.screen;
+    let (width, npix) = (screen.width, (screen.width * screen.height) as usize);
+    let channels = job.channels();
+    let owner = &job.owner;
     let paint_golden = |spans: &mut dyn Iterator<Item = (usize, u32, Span)>, img: &mut [u8]| {
         for (triangle, y, span) in spans {
             for j in 0..span.len {
@@ -287,17 +318,13 @@ pub fn run_with(
         }
         out
     });
-    let (spec_img, spec_report) = match spec_out {
-        Some((img, r)) => (Some(img), Some(r)),
-        None => (None, None),
-    };
-    Outcome {
-        rtl: compose(&diffuse, spec_img.as_deref(), owner),
-        golden: compose(&gold_diffuse, gold_spec.as_deref(), owner),
-        host: exps.is_some().then(|| compose(&host_diffuse, gold_spec.as_deref(), owner)),
-        coverage,
-        segment,
-        specular: spec_report,
-        writer,
-    }
+    GoldenImages { host_diffuse, gold_diffuse, gold_spec }
+}
+
+/// Golden's images: per channel from the host's spans and from the ones the render drew, and
+/// the specular channel.
+struct GoldenImages {
+    host_diffuse: Vec<Vec<u8>>,
+    gold_diffuse: Vec<Vec<u8>>,
+    gold_spec: Option<Vec<u16>>,
 }
