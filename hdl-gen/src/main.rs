@@ -223,10 +223,27 @@ fn main() -> ExitCode {
     }
 }
 
+/// Largest manifest.json read: the largest `generate` writes (p = 256, every option) is about
+/// 110 kB; a file past this limit is no manifest of ours, and is not read whole.
+const MAX_MANIFEST_BYTES: u64 = 16 << 20;
+
+/// A manifest.json's text, read no further than [`MAX_MANIFEST_BYTES`].
+fn read_manifest(path: &std::path::Path) -> anyhow::Result<String> {
+    use std::io::Read;
+    let mut text = String::new();
+    std::fs::File::open(path)
+        .and_then(|f| f.take(MAX_MANIFEST_BYTES + 1).read_to_string(&mut text))
+        .with_context(|| format!("cannot read {}", path.display()))?;
+    if text.len() as u64 > MAX_MANIFEST_BYTES {
+        bail!("{}: larger than {} MiB, not a manifest generate wrote", path.display(), MAX_MANIFEST_BYTES >> 20);
+    }
+    Ok(text)
+}
+
 /// The files an earlier `generate` wrote into `dir`, by its manifest.json: the modules' files,
 /// the ROM images, the manifest and the core. None without a manifest that reads as one.
 fn owned_files(dir: &std::path::Path) -> Vec<String> {
-    let Ok(text) = std::fs::read_to_string(dir.join(hdl_gen::manifest::MANIFEST_FILE)) else { return Vec::new() };
+    let Ok(text) = read_manifest(&dir.join(hdl_gen::manifest::MANIFEST_FILE)) else { return Vec::new() };
     let Ok(m) = hdl_gen::manifest::Manifest::parse(&text) else { return Vec::new() };
     let mut names: Vec<String> = m.modules.iter().map(|e| e.file.clone()).collect();
     names.extend([&m.specular.brdf_rom.file, &m.specular.nk_rom.file].map(String::clone));
@@ -266,7 +283,7 @@ fn run(command: Command) -> anyhow::Result<()> {
         }
         Command::SynthWrapper { rtl, module, out, outputs } => {
             let path = rtl.join(hdl_gen::manifest::MANIFEST_FILE);
-            let text = std::fs::read_to_string(&path).with_context(|| format!("cannot read {}", path.display()))?;
+            let text = read_manifest(&path)?;
             let ports = hdl_gen::wrapper::ports_from_manifest(&text, &module)?;
             output::check_not_input(&out, &[&path])?;
             output::write_one(&out, hdl_gen::wrapper::module(&module, &ports, outputs)?.render().as_bytes())?;

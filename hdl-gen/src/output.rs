@@ -253,9 +253,10 @@ pub fn write_owned(dir: &Path, files: &[GeneratedFile], owned: &[String]) -> Res
         for entry in entries {
             let entry = entry.map_err(|error| OutputError::Write { path: dir.to_path_buf(), error })?;
             let name = entry.file_name().to_string_lossy().into_owned();
-            let regular = entry.file_type().is_ok_and(|t| t.is_file());
+            let kind = entry.file_type().ok();
+            let regular = kind.is_some_and(|t| t.is_file());
             if !regular || !owned.contains(&name) {
-                foreign.push(if regular { name } else { format!("{name}/") });
+                foreign.push(if kind.is_some_and(|t| t.is_dir()) { format!("{name}/") } else { name });
             } else if !files.iter().any(|f| f.name == name) {
                 stale.push(name);
             }

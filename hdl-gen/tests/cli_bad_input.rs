@@ -244,6 +244,11 @@ fn synth_wrapper_refuses_insane_manifests_and_its_own_input() {
         std::fs::write(rtl.join("manifest.json"), manifest_with(ports)).unwrap();
         assert_rejected(&["synth-wrapper", "--rtl", rtl.to_str().unwrap(), "--module", "m", "--out", w], needle, &dir);
     }
+    // A manifest.json that never ends is not read whole.
+    let endless = dir.join("endless");
+    std::fs::create_dir_all(&endless).unwrap();
+    std::os::unix::fs::symlink("/dev/zero", endless.join("manifest.json")).unwrap();
+    assert_rejected(&["synth-wrapper", "--rtl", endless.to_str().unwrap(), "--module", "m", "--out", w], "larger than 16 MiB", &dir);
     // The limit itself is accepted (a negative control of the refusals above).
     let rtl = dir.join("ok");
     std::fs::create_dir_all(&rtl).unwrap();
