@@ -90,6 +90,7 @@ fn prove_refuses_bad_arguments() {
     let yosys = Command::new("yosys-smtbmc").arg("-h").output().is_ok();
     if venv.exists() && yosys {
         assert_refused("prove", &["--rtl", s, "--only", "NOMATCH"], &["--only 'NOMATCH' matches no proof"], &dir);
+        assert_refused("prove", &["--self-test", "--only", "NOMATCH"], &["--only 'NOMATCH' matches no planted fault"], &dir);
     } else {
         eprintln!("cli_scripts: skipped: prove --only NOMATCH needs yosys and target/formal-venv (scripts/test installs them)");
     }
@@ -122,5 +123,34 @@ fn synth_and_check_rtl_dir_show_the_generators_message() {
     ];
     for (args, needles) in cases {
         assert_refused("check-rtl-dir", args, needles, &dir);
+    }
+}
+
+/// The other scripts that take arguments: values checked before anything is installed, built or
+/// run, and the generator's message shown where it decides.
+#[test]
+fn other_scripts_refuse_bad_arguments() {
+    let dir = scratch_dir("others");
+    let file = dir.join("a-file");
+    std::fs::write(&file, "keep").unwrap();
+    let f = file.to_str().unwrap();
+    let cases: &[(&str, &[&str], &[&str])] = &[
+        ("bench-cosim", &["--runs", "abc"], &["--runs takes a positive number, not 'abc'"]),
+        ("bench-cosim", &["--runs"], &["--runs needs a value"]),
+        ("bench-cosim", &["--seg-spans", "0"], &["--seg-spans takes a positive number"]),
+        ("bench-cosim", &["--seg-spans", "5", "--cocotb-seg-spans", "10"], &["exceeds --seg-spans 5"]),
+        ("bench-cosim", &["--out", f], &["is not a folder"]),
+        ("bench-cosim", &["--bogus"], &["unknown argument '--bogus'"]),
+        ("mutate", &["--only", "("], &["--only '('", "not a valid regular expression"]),
+        ("mutate", &["--only", "NOMATCH"], &["--only 'NOMATCH' matches no mutant"]),
+        ("mutate", &["--seed"], &["--seed needs a value"]),
+        ("icarus-tests", &["--vectors"], &["--vectors needs a value"]),
+        ("check-fusesoc", &["--p 3"], &["configuration '--p 3'", "power of two"]),
+    ];
+    for (name, args, needles) in cases {
+        assert_refused(name, args, needles, &dir);
+    }
+    if Command::new("iverilog").arg("-V").output().is_ok() {
+        assert_refused("icarus-tests", &["--vectors", "0"], &["--vectors"], &dir);
     }
 }
