@@ -37,7 +37,8 @@ struct Args {
     #[arg(long, value_enum)]
     scene: Option<SceneKind>,
     /// A triangle file (SPEC §5: `x0 y0 i0 x1 y1 i1 x2 y2 i2` per line, `#` comments): 8-bit
-    /// grayscale, background 0, later triangles over earlier ones, diffuse only.
+    /// grayscale, background 0, later triangles over earlier ones, diffuse only. Input files
+    /// (this and --obj) hold at most 64 MiB, in lines of at most 4096 bytes.
     #[arg(long, value_name = "FILE")]
     triangles: Option<PathBuf>,
     /// A Wavefront OBJ mesh (polygons triangulated; normals from the file, else smoothed from
