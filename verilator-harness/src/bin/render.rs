@@ -85,8 +85,8 @@ struct Args {
 const MAX_SIDE: i64 = golden::setup::COORD_LIMIT as i64;
 
 /// Largest input file (--triangles, --obj): read no further than this. A SPEC §5 line takes
-/// about 60 bytes, so this is a million triangles, hours through the RTL; the teapot's OBJ is
-/// a few hundred kilobytes.
+/// about 60 bytes, so this is about a million triangles, each of them simulated clock by clock;
+/// a file larger than that is a mistake more often than a render.
 const MAX_INPUT_BYTES: u64 = 64 << 20;
 /// Longest line of an input file: a triangle takes nine numbers, an OBJ face a vertex list.
 const MAX_LINE_BYTES: usize = 4096;
