@@ -3,7 +3,7 @@
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
-use verilator_harness::ffi::{default_model_args, require, SEGMENT_MODELS};
+use verilator_harness::ffi::{default_model_args, require, require_segment_model, SEGMENT_MODELS};
 
 fn run(bin: &str, args: &[&str]) -> Output {
     Command::new(bin).args(args).output().unwrap_or_else(|e| panic!("running {bin}: {e}"))
@@ -29,12 +29,29 @@ fn with_model<'a>(model: &'a [String], args: &[&'a str]) -> Vec<&'a str> {
 const COSIM: &str = env!("CARGO_BIN_EXE_cosim");
 const RENDER: &str = env!("CARGO_BIN_EXE_render");
 const SWEEP: &str = env!("CARGO_BIN_EXE_sweep");
+const BENCH: &str = env!("CARGO_BIN_EXE_bench");
 
 fn scratch(name: &str) -> PathBuf {
     let dir = std::env::temp_dir().join(format!("cli-harness-{}-{name}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
     std::fs::create_dir_all(&dir).unwrap();
     dir
+}
+
+/// Every entry of `dir` with its kind, size and (for files under 1 MiB) bytes: equal snapshots
+/// mean nothing was written, removed, replaced or changed.
+fn snapshot(dir: &Path) -> Vec<(String, String, u64, Vec<u8>)> {
+    let mut v: Vec<_> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| {
+            let e = e.unwrap();
+            let meta = std::fs::symlink_metadata(e.path()).unwrap();
+            let bytes = if meta.is_file() && meta.len() < 1 << 20 { std::fs::read(e.path()).unwrap() } else { Vec::new() };
+            (e.file_name().to_string_lossy().into_owned(), format!("{:?}", meta.file_type()), meta.len(), bytes)
+        })
+        .collect();
+    v.sort();
+    v
 }
 
 fn listing(dir: &Path) -> Vec<String> {
@@ -65,6 +82,11 @@ fn cosim_rejects_every_bad_flag() {
         (&["--width", "wide"], "--width"),
         (&["--height", "0"], "--height"),
         (&["--height", "-480"], "--height"),
+        // Random vertices lie anywhere on the screen, and the set-up stops at COORD_LIMIT: a
+        // taller screen was reported as an RTL MISMATCH.
+        (&["--height", "65536"], "--height"),
+        (&["--height", "32769"], "--height"),
+        (&["--width", "40000"], "--width"),
         (&["--width", "5000"], "--width"),
         (&["--traffic", "bursty"], "--traffic"),
         (&["--traffic"], "--traffic"),
@@ -115,6 +137,19 @@ fn render_rejects_every_bad_flag_and_input_file() {
     let binary = bad_file("binary.txt", &[0xff, 0xfe, 0x00, 0x41]);
     let no_faces = bad_file("points.obj", b"v 0 0 0\nv 1 0 0\n");
     let flat = bad_file("point.obj", b"v 1 1 1\nv 1 1 1\nv 1 1 1\nf 1 2 3\n");
+    let short_face = bad_file("line.obj", b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nf 1 2\n");
+    let mut long = b"0 0 0 10 0 128 0 10 255\n#".to_vec();
+    long.extend(std::iter::repeat_n(b'x', 5000));
+    let long = bad_file("long.txt", &long);
+    // 1 GB, sparse: the reader must stop at its limit, not read (or allocate) all of it.
+    let huge = dir.join("huge.txt");
+    std::fs::File::create(&huge).unwrap().set_len(1 << 30).unwrap();
+    let huge = huge.to_str().unwrap().to_string();
+    // The input by another name: a link to it.
+    let alias = dir.join("alias.png");
+    std::os::unix::fs::symlink(&good, &alias).unwrap();
+    let golden_named = bad_file("in.golden.png", b"0 0 0 10 0 128 0 10 255\n");
+    let golden_out = golden_named.replace(".golden.png", ".png");
     let missing = dir.join("missing.txt");
     let (g, d) = (good.to_str().unwrap(), dir.to_str().unwrap());
     let out = dir.join("out.png");
@@ -151,12 +186,24 @@ fn render_rejects_every_bad_flag_and_input_file() {
         (vec!["--obj", &no_faces, "--triangles", g, "--out", o], "--obj".into()),
         (vec!["--triangles", g, "--out", o, "--writer", "disk"], "--writer".into()),
         (vec!["--triangles", g, "--out", o, "--writer", "rtl", "--width", "320"], "--writer rtl".into()),
+        // The output is the input: by its name, through a link, or as the golden image's name.
+        (vec!["--triangles", g, "--out", g], "is the input file".into()),
+        (vec!["--triangles", g, "--out", alias.to_str().unwrap()], "is the input file".into()),
+        (vec!["--triangles", &golden_named, "--out", &golden_out], "is the input file".into()),
+        (vec!["--obj", &short_face, "--out", &short_face], "is the input file".into()),
+        // Images taller than the set-up's coordinates reach: refused at once, for every input.
+        (vec!["--scene", "sphere", "--out", o, "--height", "65536"], "--height".into()),
+        (vec!["--obj", &no_faces, "--out", o, "--height", "65536"], "--height".into()),
+        (vec!["--triangles", g, "--out", o, "--width", "32769"], "--width".into()),
+        (vec!["--obj", &short_face, "--out", o], "line 5: a face needs at least 3 vertices, this one has 2".into()),
+        (vec!["--triangles", &long, "--out", o], "line 2 is longer than 4096 bytes".into()),
+        (vec!["--triangles", &huge, "--out", o], "larger than 64 MiB".into()),
     ];
     let Some(model) = default_model_args("cli_harness: render's bad flags and files") else { return };
-    let before = listing(&dir);
+    let before = snapshot(&dir);
     for (args, needle) in &cases {
         assert_rejected(RENDER, &with_model(&model, args), needle);
-        assert_eq!(listing(&dir), before, "{args:?} wrote or removed files");
+        assert!(snapshot(&dir) == before, "{args:?} wrote, removed or changed files");
     }
 }
 
@@ -173,11 +220,18 @@ fn sweep_rejects_every_bad_flag() {
         (vec!["--width", "4097"], "--width"),
         (vec!["--height", "63"], "--height"),
         (vec!["--height", "tall"], "--height"),
+        (vec!["--height", "40000"], "--height"),
+        (vec!["--height", "65536"], "--height"),
         (vec!["--out"], "--out"),
         (vec!["--bogus"], "--bogus"),
+        // A bad --out is refused before the sweep, not after its minutes.
+        (vec!["--out", dir.to_str().unwrap()], "is a folder"),
+        (vec!["--triangles", "1000000", "--out", missing.to_str().unwrap()], "no/such"),
     ];
     for (args, needle) in &cases {
+        let t = std::time::Instant::now();
         assert_rejected(SWEEP, args, needle);
+        assert!(t.elapsed().as_secs() < 10, "{args:?}: refused only after {:?}", t.elapsed());
     }
     // An unwritable --out is found after the sweep, which runs on level-0 shaders only: a
     // COSIM_RTL_DIR folder generated with --pipeline has none (sweep then says so instead).
@@ -186,4 +240,90 @@ fn sweep_rejects_every_bad_flag() {
         assert_rejected(SWEEP, &["--triangles", "1", "--out", missing.to_str().unwrap()], "no/such");
     }
     assert!(listing(&dir).is_empty());
+}
+
+/// Bytes free in `dir`'s file system (for the one case that depends on it).
+fn free_bytes(dir: &Path) -> u64 {
+    use std::os::unix::ffi::OsStrExt;
+    let c = std::ffi::CString::new(dir.as_os_str().as_bytes()).unwrap();
+    let mut st: libc::statvfs = unsafe { std::mem::zeroed() };
+    // SAFETY: a NUL-terminated path and a statvfs we own.
+    assert_eq!(unsafe { libc::statvfs(c.as_ptr(), &mut st) }, 0);
+    st.f_bavail as u64 * st.f_frsize as u64
+}
+
+/// `bench`: stimulus files that are missing, empty, not files, garbage, truncated or with a
+/// header that lies; `gen` into a folder that is not there or with a count beyond the header's
+/// u32 or the disk. Each is one message and exit status 2, nothing written, no panic, and no
+/// allocation sized by a garbage count (the 32 GB). A good file still runs (the control).
+#[test]
+fn bench_rejects_bad_files_and_flags() {
+    let dir = scratch("bench");
+    let file = |name: &str, body: &[u8]| {
+        let p = dir.join(name);
+        std::fs::write(&p, body).unwrap();
+        p.to_str().unwrap().to_string()
+    };
+    let empty = file("empty.stim", b"");
+    let garbage = file("garbage.stim", &[0x5a; 200]);
+    let mut lying = b"SSBSTIM1".to_vec();
+    lying.extend([0u8; 56]);
+    lying[28..32].copy_from_slice(&u32::MAX.to_le_bytes());
+    let lying = file("lying.stim", &lying);
+    let missing = dir.join("missing.stim");
+    let m = missing.to_str().unwrap();
+    let no_folder = dir.join("no/such/prefix");
+    let d = dir.to_str().unwrap();
+    let folder_prefix = format!("{d}/");
+    let prefix = dir.join("ok");
+    let p = prefix.to_str().unwrap();
+    let cases: Vec<(Vec<&str>, String)> = vec![
+        (vec!["harness", m], m.to_string()),
+        (vec!["harness", &empty], "shorter than the 64-byte header".into()),
+        (vec!["harness", &garbage], "not a bench stimulus file".into()),
+        (vec!["harness", &lying], "the header promises 4294967295 spans".into()),
+        (vec!["harness", d], "not a file".into()),
+        (vec!["harness"], "STIM".into()),
+        (vec!["harness", &empty, "--limit", "-1"], "--limit".into()),
+        (vec!["gen", "--design", "segment", "--spans", "0", "--out", p], "--spans".into()),
+        (vec!["gen", "--design", "segment", "--spans", "4294967296", "--out", p], "--spans".into()),
+        (vec!["gen", "--design", "segment", "--spans", "many", "--out", p], "--spans".into()),
+        (vec!["gen", "--design", "segment", "--spans", "10"], "--out".into()),
+        (vec!["gen", "--design", "cube", "--spans", "10", "--out", p], "--design".into()),
+        (vec!["gen", "--design", "segment", "--spans", "10", "--out", no_folder.to_str().unwrap()], "no/such".into()),
+        (vec!["gen", "--design", "specular", "--spans", "10", "--out", &folder_prefix], "a path prefix, not a folder".into()),
+        (vec!["gen", "--design", "segment", "--spans", "10", "--traffic", "bursty", "--out", p], "--traffic".into()),
+        (vec!["frobnicate"], "frobnicate".into()),
+    ];
+    let before = snapshot(&dir);
+    for (args, needle) in &cases {
+        assert_rejected(BENCH, args, needle);
+        assert!(snapshot(&dir) == before, "{args:?} wrote, removed or changed files");
+    }
+    // The most the header holds, on a disk without the room: refused at once.
+    if free_bytes(&dir) < 200_000_000_000 {
+        let t = std::time::Instant::now();
+        assert_rejected(BENCH, &["gen", "--design", "specular", "--spans", "4294967295", "--out", p], "GB free");
+        assert!(t.elapsed().as_secs() < 10, "refused only after {:?}", t.elapsed());
+    }
+    assert!(snapshot(&dir) == before);
+
+    // The control: a small file is written and streamed; then the same file cut short is refused.
+    if require_segment_model(8, golden::Align::Span, "cli_harness: bench on a good file").is_none() {
+        return;
+    }
+    let out = run(BENCH, &["gen", "--design", "segment", "--spans", "20", "--out", p]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let stim = format!("{p}.stim");
+    let out = run(BENCH, &["harness", &stim]);
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success() && text.contains("RESULT impl=harness") && text.contains("spans=20"), "{text}");
+    let bytes = std::fs::read(&stim).unwrap();
+    let cut = file("cut.stim", &bytes[..bytes.len() - 5]);
+    assert_rejected(BENCH, &["harness", &cut], "the header promises 20 spans");
+    // A span no port can carry in an otherwise good file.
+    let mut bad = bytes.clone();
+    bad[64 + 4..64 + 8].copy_from_slice(&u32::MAX.to_le_bytes());
+    let bad = file("badspan.stim", &bad);
+    assert_rejected(BENCH, &["harness", &bad], "span 0: span length 4294967295 exceeds");
 }

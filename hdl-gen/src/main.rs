@@ -21,6 +21,12 @@ struct Cli {
 #[derive(Subcommand)]
 enum Command {
     /// Write every module of one configuration, manifest.json and a FuseSoC core into a folder.
+    ///
+    /// The folder is generate's own: it must be new, empty, or hold only the files an earlier
+    /// generate wrote there (the ones its manifest.json lists, and manifest.json and the core).
+    /// Those are replaced, and the ones the new configuration does not have are removed, so the
+    /// folder always holds one configuration. A folder holding anything else is refused and left
+    /// as it is.
     Generate {
         #[command(flatten)]
         config: ConfigArgs,
@@ -59,7 +65,7 @@ enum Command {
         /// and the specular unit, with Vivado interface attributes (docs/axis.md).
         #[arg(long, value_enum, default_value_t = Bus::Native)]
         bus: Bus,
-        /// Output folder (created if missing).
+        /// Output folder (created if missing; see above for one that exists).
         #[arg(long)]
         out: PathBuf,
     },
@@ -217,6 +223,35 @@ fn main() -> ExitCode {
     }
 }
 
+/// Largest manifest.json read. The largest `generate` writes is 107,751 bytes (`generate --p 256
+/// --bus axis --pipeline 3 --frac 20 --xbits 16 --brdf-k auto --max-rel-error 1%`); a file past
+/// this limit is no manifest of ours, and is not read whole.
+const MAX_MANIFEST_BYTES: u64 = 16 << 20;
+
+/// A manifest.json's text, read no further than [`MAX_MANIFEST_BYTES`].
+fn read_manifest(path: &std::path::Path) -> anyhow::Result<String> {
+    use std::io::Read;
+    let mut text = String::new();
+    std::fs::File::open(path)
+        .and_then(|f| f.take(MAX_MANIFEST_BYTES + 1).read_to_string(&mut text))
+        .with_context(|| format!("cannot read {}", path.display()))?;
+    if text.len() as u64 > MAX_MANIFEST_BYTES {
+        bail!("{}: larger than {} MiB, not a manifest generate wrote", path.display(), MAX_MANIFEST_BYTES >> 20);
+    }
+    Ok(text)
+}
+
+/// The files an earlier `generate` wrote into `dir`, by its manifest.json: the modules' files,
+/// the ROM images, the manifest and the core. None without a manifest that reads as one.
+fn owned_files(dir: &std::path::Path) -> Vec<String> {
+    let Ok(text) = read_manifest(&dir.join(hdl_gen::manifest::MANIFEST_FILE)) else { return Vec::new() };
+    let Ok(m) = hdl_gen::manifest::Manifest::parse(&text) else { return Vec::new() };
+    let mut names: Vec<String> = m.modules.iter().map(|e| e.file.clone()).collect();
+    names.extend([&m.specular.brdf_rom.file, &m.specular.nk_rom.file].map(String::clone));
+    names.extend([hdl_gen::manifest::MANIFEST_FILE, hdl_gen::manifest::CORE_FILE].map(String::from));
+    names
+}
+
 fn run(command: Command) -> anyhow::Result<()> {
     match command {
         Command::Generate { config, bfpi_arch, brdf, width, height, fe_div_bits, fe_di, pipeline, bus, out } => {
@@ -229,7 +264,7 @@ fn run(command: Command) -> anyhow::Result<()> {
             }
             let opts = Options { bfpi_arch, screen: Some(screen), fe_div_bits, fe_di, pipeline, bus, ..opts };
             opts.frontend().context("--width/--height")?;
-            output::write_all(&out, &generate(&opts))?;
+            output::write_owned(&out, &generate(&opts), &owned_files(&out))?;
             eprintln!("wrote {}", out.display());
         }
         Command::Rom { table, format, brdf, out } => {
@@ -249,8 +284,9 @@ fn run(command: Command) -> anyhow::Result<()> {
         }
         Command::SynthWrapper { rtl, module, out, outputs } => {
             let path = rtl.join(hdl_gen::manifest::MANIFEST_FILE);
-            let text = std::fs::read_to_string(&path).with_context(|| format!("cannot read {}", path.display()))?;
+            let text = read_manifest(&path)?;
             let ports = hdl_gen::wrapper::ports_from_manifest(&text, &module)?;
+            output::check_not_input(&out, &[&path])?;
             output::write_one(&out, hdl_gen::wrapper::module(&module, &ports, outputs)?.render().as_bytes())?;
             eprintln!("wrote {}", out.display());
         }

@@ -51,17 +51,64 @@ pub enum WrapperError {
     NoClock(String),
     #[error("module '{0}' needs at least one input besides clk and one output")]
     NoData(String),
+    /// A module or port name that is no plain Verilog identifier (it would be pasted into
+    /// the harness's text).
+    #[error("'{0}' is not a Verilog identifier")]
+    Name(String),
+    #[error("module '{block}' lists port '{port}' twice")]
+    DuplicatePort { block: String, port: String },
+    /// A port, or all inputs or outputs together (the harness's shift chain and output
+    /// register are one vector each), outside 1..=[`MAX_VECTOR_BITS`].
+    #[error("module '{block}': {what} is {width} bits, outside 1..={MAX_VECTOR_BITS} (the vector length every Verilog tool must support)")]
+    Width { block: String, what: String, width: u64 },
+}
+
+/// IEEE 1364-2005 §4.3.1: a tool may limit a vector's length, but to no fewer than 2^16 bits.
+/// The widest port `generate` writes (the p = 256 shader's 2,048 pixel bits) is far below; a
+/// manifest asking for more is not one `generate` wrote.
+pub const MAX_VECTOR_BITS: u64 = 1 << 16;
+
+/// Every name an identifier, no port twice, every width and the inputs' and outputs' totals
+/// within [`MAX_VECTOR_BITS`]: checked before anything is built from a manifest's values.
+fn check_ports(block: &str, ports: &[BlockPort]) -> Result<(), WrapperError> {
+    let ident = |s: &str| !s.is_empty() && crate::check_prefix(s).is_ok();
+    if !ident(block) {
+        return Err(WrapperError::Name(block.into()));
+    }
+    let width_err = |what: String, width: u64| WrapperError::Width { block: block.into(), what, width };
+    for (k, p) in ports.iter().enumerate() {
+        if !ident(&p.name) {
+            return Err(WrapperError::Name(p.name.clone()));
+        }
+        if ports[..k].iter().any(|q| q.name == p.name) {
+            return Err(WrapperError::DuplicatePort { block: block.into(), port: p.name.clone() });
+        }
+        if p.width == 0 || p.width as u64 > MAX_VECTOR_BITS {
+            return Err(width_err(format!("port '{}'", p.name), p.width as u64));
+        }
+    }
+    for (dir, what) in [(Dir::Input, "the inputs together"), (Dir::Output, "the outputs together")] {
+        let total: u64 = ports.iter().filter(|p| p.dir == dir && p.name != "clk").map(|p| p.width as u64).sum();
+        if total > MAX_VECTOR_BITS {
+            return Err(width_err(what.into(), total));
+        }
+    }
+    Ok(())
 }
 
 /// The ports of `module` in a `manifest.json` text.
-pub fn ports_from_manifest(manifest: &str, module: &str) -> Result<Vec<BlockPort>, ManifestError> {
+/// The ports of `module` in a `manifest.json` text, checked as [`module`] checks them.
+pub fn ports_from_manifest(manifest: &str, module: &str) -> Result<Vec<BlockPort>, WrapperError> {
     let m = Manifest::parse(manifest)?;
     let entry = m.module(module)?;
-    Ok(entry.ports.iter().map(|p| BlockPort { name: p.name.clone(), dir: p.direction, width: p.width }).collect())
+    let ports: Vec<BlockPort> = entry.ports.iter().map(|p| BlockPort { name: p.name.clone(), dir: p.direction, width: p.width }).collect();
+    check_ports(module, &ports)?;
+    Ok(ports)
 }
 
 /// The harness module `<block>_synth` around `block`, which must have an input `clk`.
 pub fn module(block: &str, ports: &[BlockPort], outputs: Outputs) -> Result<Module, WrapperError> {
+    check_ports(block, ports)?;
     if !ports.iter().any(|p| p.name == "clk" && p.dir == Dir::Input && p.width == 1) {
         return Err(WrapperError::NoClock(block.into()));
     }
@@ -198,5 +245,28 @@ mod tests {
         assert!(matches!(&e, WrapperError::NoClock(b) if b == "blk"), "{e}");
         let e = module("blk", &[port("clk", Dir::Input, 1), port("y", Dir::Output, 2)], Outputs::Folded).unwrap_err();
         assert!(matches!(&e, WrapperError::NoData(b) if b == "blk"), "{e}");
+    }
+
+    /// Values no generated manifest holds are refused before any text is built.
+    #[test]
+    fn refuses_names_and_widths_out_of_bounds() {
+        let ok = [port("clk", Dir::Input, 1), port("a", Dir::Input, 5), port("y", Dir::Output, 9)];
+        assert!(module("blk", &ok, Outputs::Registered).is_ok());
+        let with = |extra: BlockPort| [ok[0].clone(), ok[1].clone(), ok[2].clone(), extra];
+        let max = MAX_VECTOR_BITS as u32;
+        for (ports, want) in [
+            (with(port("z", Dir::Output, 99_999_999)), "port 'z' is 99999999 bits"),
+            (with(port("z", Dir::Output, 0)), "port 'z' is 0 bits"),
+            (with(port("z", Dir::Output, max)), "the outputs together is 65545 bits"),
+            (with(port("b", Dir::Input, max)), "the inputs together is 65541 bits"),
+            (with(port("a", Dir::Output, 1)), "port 'a' twice"),
+            (with(port("y; end", Dir::Output, 1)), "'y; end' is not a Verilog identifier"),
+        ] {
+            let e = module("blk", &ports, Outputs::Registered).unwrap_err().to_string();
+            assert!(e.contains(want), "{e}");
+        }
+        assert!(module("blk", &with(port("z", Dir::Output, max - 9)), Outputs::Folded).is_ok());
+        let e = module("1blk", &ok, Outputs::Registered).unwrap_err().to_string();
+        assert!(e.contains("'1blk' is not"), "{e}");
     }
 }

@@ -31,9 +31,10 @@ use golden::segment::segments;
 use golden::setup::{triangle_spans, Screen};
 use golden::specular::SpecularSpan;
 use golden::{Align, Span};
+use hdl_gen::output::{commit, stage, Staged};
 use rand::SeedableRng;
 use std::fs::File;
-use std::io::{BufReader, BufWriter, Read, Write};
+use std::io::{BufReader, Read};
 use std::path::PathBuf;
 use std::process::ExitCode;
 use std::time::Instant;
@@ -69,21 +70,25 @@ struct Args {
 #[derive(Subcommand)]
 enum Cmd {
     /// Write PREFIX.stim and PREFIX.expect.
+    // A negative number is a value its flag's range then refuses by name, not an unknown flag.
+    #[command(allow_negative_numbers = true)]
     Gen {
         #[arg(long, value_enum)]
         design: Design,
         /// Segment width (segment shader, span alignment).
         #[arg(long, default_value_t = 8)]
         p: u32,
-        /// Spans to write.
-        #[arg(long)]
-        spans: usize,
+        /// Spans to write (1..=4294967295: the header holds the count as a u32). Written as they
+        /// are made, so memory does not grow with the count; refused at once when the folder
+        /// has not the room the two files take at the least.
+        #[arg(long, value_parser = clap::value_parser!(u64).range(1..=u32::MAX as u64))]
+        spans: u64,
         #[arg(long, default_value_t = 1)]
         seed: u64,
         #[arg(long, value_enum, default_value = "random")]
         traffic: TrafficArg,
-        /// Output path prefix.
-        #[arg(long)]
+        /// Output path prefix: PREFIX.stim and PREFIX.expect are written (all or none).
+        #[arg(long, value_name = "PREFIX")]
         out: PathBuf,
     },
     /// The RTL folder and build time of the models the benchmark uses.
@@ -92,6 +97,7 @@ enum Cmd {
         p: u32,
     },
     /// Stream a stimulus file through the harness with the golden comparison on; time the loop.
+    #[command(allow_negative_numbers = true)]
     Harness {
         stim: PathBuf,
         /// Only the first N spans (0: all).
@@ -100,21 +106,30 @@ enum Cmd {
     },
 }
 
+/// A bad argument or input file: one `error:` line, exit status 2.
+type Bad = String;
+
 fn main() -> ExitCode {
-    match Args::parse().cmd {
+    let run = match Args::parse().cmd {
         Cmd::Gen { design, p, spans, seed, traffic, out } => {
             let traffic = match traffic {
                 TrafficArg::Random => Traffic::RANDOM,
                 TrafficArg::Full => Traffic::FULL,
             };
+            // clap bounds the count to the header's u32.
+            let count = spans as u32;
             match design {
-                Design::Segment => gen_segment(p, spans, seed, traffic, &out),
-                Design::Specular => gen_specular(spans, seed, traffic, &out),
+                Design::Segment => gen_segment(p, count, seed, traffic, &out),
+                Design::Specular => gen_specular(count, seed, traffic, &out),
             }
         }
         Cmd::Harness { stim, limit } => harness(&stim, limit),
-        Cmd::Info { p } => info(p),
-    }
+        Cmd::Info { p } => Ok(info(p)),
+    };
+    run.unwrap_or_else(|e| {
+        eprintln!("error: {e}");
+        ExitCode::from(2)
+    })
 }
 
 /// `MODEL tag=... top=... rtl=DIR verilate=S compile=S total=S` per model, then the runtime's
@@ -166,26 +181,42 @@ impl Header {
         h
     }
 
-    fn parse(h: &[u8]) -> Header {
-        assert_eq!(&h[..8], STIM_MAGIC, "not a bench stimulus file");
-        let w = |k: usize| u32::from_le_bytes(h[8 + 4 * k..12 + 4 * k].try_into().unwrap());
-        Header {
+    /// The header of a stimulus file of `len` bytes, every field checked against what `gen`
+    /// writes, so a truncated, foreign or garbage file is refused before anything is read.
+    fn parse(h: &[u8; HEADER], len: u64) -> Result<Header, String> {
+        if &h[..8] != STIM_MAGIC {
+            return Err("not a bench stimulus file (no SSBSTIM1 header)".into());
+        }
+        let w = |k: usize| u32::from_le_bytes(h[8 + 4 * k..12 + 4 * k].try_into().expect("4 bytes"));
+        let header = Header {
             design: w(0),
             p: w(1),
             state: w(2),
             valid_thr: w(3),
             ready_thr: w(4),
             spans: w(5),
-            outputs: u64::from_le_bytes(h[32..40].try_into().unwrap()),
-            seed: u64::from_le_bytes(h[40..48].try_into().unwrap()),
-            rec: u32::from_le_bytes(h[48..52].try_into().unwrap()),
-            dw: u32::from_le_bytes(h[52..56].try_into().unwrap()),
+            outputs: u64::from_le_bytes(h[32..40].try_into().expect("8 bytes")),
+            seed: u64::from_le_bytes(h[40..48].try_into().expect("8 bytes")),
+            rec: u32::from_le_bytes(h[48..52].try_into().expect("4 bytes")),
+            dw: u32::from_le_bytes(h[52..56].try_into().expect("4 bytes")),
+        };
+        let want = HEADER as u64 + 32 * header.spans as u64;
+        if len != want {
+            return Err(format!("the header promises {} spans ({want} bytes), the file has {len} bytes", header.spans));
         }
+        let rec = match header.design {
+            0 => seg_record_bytes(header.p.min(256)),
+            1 => 4,
+            d => return Err(format!("unknown design {d} (0 segment, 1 specular)")),
+        };
+        if header.rec != rec || !(1..=32).contains(&header.dw) || header.valid_thr > 256 || header.ready_thr > 256 {
+            return Err("header fields out of range (record bytes, in_di width or traffic thresholds)".into());
+        }
+        if header.state != state_of(header.seed) {
+            return Err("traffic state is not state_of(seed)".into());
+        }
+        Ok(header)
     }
-}
-
-fn create(path: PathBuf) -> BufWriter<File> {
-    BufWriter::with_capacity(1 << 20, File::create(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display())))
 }
 
 fn with_ext(prefix: &std::path::Path, ext: &str) -> PathBuf {
@@ -194,13 +225,47 @@ fn with_ext(prefix: &std::path::Path, ext: &str) -> PathBuf {
     PathBuf::from(s)
 }
 
-/// PREFIX.stim and PREFIX.expect, each begun with its header.
-fn create_pair(out: &std::path::Path, header: &Header) -> (BufWriter<File>, BufWriter<File>) {
-    let mut sf = create(with_ext(out, ".stim"));
-    let mut ef = create(with_ext(out, ".expect"));
-    sf.write_all(&header.bytes()).unwrap();
-    ef.write_all(&expect_header(header.design, header.rec, header.outputs)).unwrap();
-    (sf, ef)
+/// Refuses an --out prefix whose files cannot be written, or whose folder has less room than
+/// `least` bytes, the least the two files take: checked before a span is made (with a lower
+/// bound) and again with the exact size.
+fn check_out(out: &std::path::Path, spans: u32, least: u64) -> Result<(), Bad> {
+    if out.file_name().is_none() || out.as_os_str().to_string_lossy().ends_with('/') {
+        return Err(format!("--out {}: a path prefix, not a folder", out.display()));
+    }
+    for path in [with_ext(out, ".stim"), with_ext(out, ".expect")] {
+        hdl_gen::output::check_writable(&path).map_err(|e| format!("--out: {e}"))?;
+    }
+    let dir = out.parent().filter(|d| !d.as_os_str().is_empty()).unwrap_or(std::path::Path::new("."));
+    match free_bytes(dir) {
+        Some(free) if free < least => Err(format!(
+            "--spans {spans}: the two files take at least {:.1} GB, {} has {:.1} GB free",
+            least as f64 / 1e9,
+            dir.display(),
+            free as f64 / 1e9
+        )),
+        _ => Ok(()),
+    }
+}
+
+/// PREFIX.stim and PREFIX.expect, staged (nothing visible until [`commit`]), each begun with its
+/// header.
+fn create_pair(out: &std::path::Path, header: &Header, least: u64) -> Result<(Staged, Staged), Bad> {
+    check_out(out, header.spans, least)?;
+    let mut sf = stage(&with_ext(out, ".stim")).map_err(|e| format!("--out: {e}"))?;
+    let mut ef = stage(&with_ext(out, ".expect")).map_err(|e| format!("--out: {e}"))?;
+    sf.put(&header.bytes()).map_err(|e| e.to_string())?;
+    ef.put(&expect_header(header.design, header.rec, header.outputs)).map_err(|e| e.to_string())?;
+    Ok((sf, ef))
+}
+
+/// Bytes free to an unprivileged user in `dir`'s file system, if the system says.
+fn free_bytes(dir: &std::path::Path) -> Option<u64> {
+    use std::os::unix::ffi::OsStrExt;
+    let c = std::ffi::CString::new(dir.as_os_str().as_bytes()).ok()?;
+    let mut st: libc::statvfs = unsafe { std::mem::zeroed() };
+    // SAFETY: a NUL-terminated path and a statvfs we own, filled by the call.
+    let rc = unsafe { libc::statvfs(c.as_ptr(), &mut st) };
+    (rc == 0).then(|| st.f_bavail as u64 * st.f_frsize as u64)
 }
 
 fn stim_record(ports: [u32; 5], outputs: u32, triangle: u32, y: u32) -> [u8; 32] {
@@ -224,43 +289,58 @@ fn seg_record_bytes(p: u32) -> u32 {
     (4 + p.div_ceil(8) + p).next_multiple_of(4)
 }
 
-fn gen_segment(p: u32, count: usize, seed: u64, traffic: Traffic, out: &std::path::Path) -> ExitCode {
-    let Some(info) = segment_model(p, Align::Span) else {
-        eprintln!("error: no segment shader model for p = {p}");
-        return ExitCode::from(2);
-    };
-    let cfg = info.cfg;
+/// The first `count` spans of golden set-up of random triangles from `seed`, each to `f`: made
+/// as they are used, so a pass over them holds no list (gen makes them twice: counting, writing).
+fn segment_spans(cfg: &golden::Config, count: u32, seed: u64, mut f: impl FnMut(Stim) -> Result<(), Bad>) -> Result<(), Bad> {
     let screen = Screen::default();
     let mut rng = SeedRng::seed_from_u64(seed);
-    let mut stims: Vec<Stim> = Vec::with_capacity(count);
-    let mut triangle = 0;
-    while stims.len() < count {
+    let (mut made, mut triangle) = (0u32, 0usize);
+    while made < count {
         let t = random_triangle(&mut rng, &screen);
-        let _ = triangle_spans(&cfg, &screen, &t, |y, span| stims.push(Stim { triangle, y, span }));
+        let mut spans = Vec::new();
+        let _ = triangle_spans(cfg, &screen, &t, |y, span| spans.push(Stim { triangle, y, span }));
+        for s in spans.into_iter().take((count - made) as usize) {
+            f(s)?;
+            made += 1;
+        }
         triangle += 1;
     }
-    stims.truncate(count);
+    Ok(())
+}
+
+fn gen_segment(p: u32, count: u32, seed: u64, traffic: Traffic, out: &std::path::Path) -> Result<ExitCode, Bad> {
+    let Some(info) = segment_model(p, Align::Span) else {
+        return Err(format!("no segment shader model for p = {p}"));
+    };
+    let cfg = info.cfg;
     let rec = seg_record_bytes(p);
-    let outputs: u64 = stims.iter().map(|s| cfg.segment_count(s.span.x0, s.span.len) as u64).sum();
+    // Every span yields at least one record.
+    check_out(out, count, (HEADER + 24) as u64 + (32 + rec as u64) * count as u64)?;
+    let mut outputs = 0u64;
+    segment_spans(&cfg, count, seed, |s| {
+        outputs += cfg.segment_count(s.span.x0, s.span.len) as u64;
+        Ok(())
+    })?;
     let header = Header {
         design: 0,
         p,
         state: state_of(seed),
         valid_thr: traffic.valid_thr(),
         ready_thr: traffic.ready_thr(),
-        spans: count as u32,
+        spans: count,
         outputs,
         seed,
         rec,
         dw: cfg.dw(),
     };
-    let (mut sf, mut ef) = create_pair(out, &header);
+    let least = (HEADER + 24) as u64 + 32 * count as u64 + rec as u64 * outputs;
+    let (mut sf, mut ef) = create_pair(out, &header, least)?;
     let mut r = vec![0u8; rec as usize];
     let mut pixels = 0u64;
-    for s in &stims {
+    segment_spans(&cfg, count, seed, |s| {
         let Span { x0, len, i0, di } = s.span;
         let n = cfg.segment_count(x0, len);
-        sf.write_all(&stim_record([x0, len, i0, to_port(di as i64, cfg.dw()), 0], n, s.triangle as u32, s.y)).unwrap();
+        sf.put(&stim_record([x0, len, i0, to_port(di as i64, cfg.dw()), 0], n, s.triangle as u32, s.y)).map_err(|e| e.to_string())?;
         for seg in segments(&cfg, &s.span) {
             r.fill(0);
             r[..4].copy_from_slice(&(seg.x | (seg.last as u32) << 31).to_le_bytes());
@@ -273,66 +353,80 @@ fn gen_segment(p: u32, count: usize, seed: u64, traffic: Traffic, out: &std::pat
                     pixels += 1;
                 }
             }
-            ef.write_all(&r).unwrap();
+            ef.put(&r).map_err(|e| e.to_string())?;
         }
-    }
-    sf.flush().unwrap();
-    ef.flush().unwrap();
+        Ok(())
+    })?;
+    commit(vec![sf, ef]).map_err(|e| e.to_string())?;
     println!("wrote {} spans, {outputs} segments, {pixels} pixels ({})", count, info.tag);
-    ExitCode::SUCCESS
+    Ok(ExitCode::SUCCESS)
 }
 
-fn gen_specular(count: usize, seed: u64, traffic: Traffic, out: &std::path::Path) -> ExitCode {
+fn gen_specular(count: u32, seed: u64, traffic: Traffic, out: &std::path::Path) -> Result<ExitCode, Bad> {
     let Some(info) = SPECULAR_MODELS.first() else {
-        eprintln!("error: this build has no specular unit");
-        return ExitCode::from(2);
+        return Err("this build has no specular unit".into());
     };
     let unit = specular_unit();
-    let mut rng = SeedRng::seed_from_u64(seed);
-    let spans: Vec<SpecularSpan> = (0..count).map(|_| random_span(&mut rng, info.cfg.max_len())).collect();
-    let outputs: u64 = spans.iter().map(|s| s.len as u64).sum();
+    check_out(out, count, (HEADER + 24) as u64 + (32 + 4) * count as u64)?;
+    let spans = || {
+        let mut rng = SeedRng::seed_from_u64(seed);
+        (0..count).map(move |_| random_span(&mut rng, info.cfg.max_len()))
+    };
+    let outputs: u64 = spans().map(|s| s.len as u64).sum();
     let header = Header {
         design: 1,
         p: 1,
         state: state_of(seed),
         valid_thr: traffic.valid_thr(),
         ready_thr: traffic.ready_thr(),
-        spans: count as u32,
+        spans: count,
         outputs,
         seed,
         rec: 4,
         dw: 32,
     };
-    let (mut sf, mut ef) = create_pair(out, &header);
-    for (k, s) in spans.iter().enumerate() {
+    let least = (HEADER + 24) as u64 + 32 * count as u64 + 4 * outputs;
+    let (mut sf, mut ef) = create_pair(out, &header, least)?;
+    for (k, s) in spans().enumerate() {
         let ports = [s.c as u32, s.n as u32, to_port(s.theta0 as i64, 32), to_port(s.dtheta as i64, 32), s.len];
-        sf.write_all(&stim_record(ports, s.len, k as u32, 0)).unwrap();
-        for px in unit.span(s) {
+        sf.put(&stim_record(ports, s.len, k as u32, 0)).map_err(|e| e.to_string())?;
+        for px in unit.span(&s) {
             let mut r = [0u8; 4];
             r[..2].copy_from_slice(&px.spec.to_le_bytes());
             r[2] = px.err as u8;
             r[3] = px.last as u8;
-            ef.write_all(&r).unwrap();
+            ef.put(&r).map_err(|e| e.to_string())?;
         }
     }
-    sf.flush().unwrap();
-    ef.flush().unwrap();
+    commit(vec![sf, ef]).map_err(|e| e.to_string())?;
     println!("wrote {count} spans, {outputs} pixels ({})", info.tag);
-    ExitCode::SUCCESS
+    Ok(ExitCode::SUCCESS)
 }
 
-fn read_stim(path: &std::path::Path) -> (Header, Vec<[u32; 8]>) {
-    let mut f = BufReader::new(File::open(path).unwrap_or_else(|e| panic!("{}: {e}", path.display())));
-    let mut h = [0u8; HEADER];
-    f.read_exact(&mut h).unwrap();
-    let header = Header::parse(&h);
-    let mut recs = Vec::with_capacity(header.spans as usize);
-    let mut r = [0u8; 32];
-    for _ in 0..header.spans {
-        f.read_exact(&mut r).unwrap();
-        recs.push(std::array::from_fn(|k| u32::from_le_bytes(r[4 * k..4 * k + 4].try_into().unwrap())));
+/// The header and the records (at most `limit`, 0: all) of a stimulus file; the file's size
+/// must be what its header says, so nothing is allocated on a garbage count.
+fn read_stim(path: &std::path::Path, limit: usize) -> Result<(Header, Vec<[u32; 8]>), Bad> {
+    let name = path.display();
+    let file = File::open(path).map_err(|e| format!("{name}: {e}"))?;
+    let meta = file.metadata().map_err(|e| format!("{name}: {e}"))?;
+    if !meta.is_file() {
+        return Err(format!("{name}: not a file"));
     }
-    (header, recs)
+    let mut f = BufReader::new(file);
+    let mut h = [0u8; HEADER];
+    f.read_exact(&mut h).map_err(|_| format!("{name}: shorter than the {HEADER}-byte header of a bench stimulus file"))?;
+    let header = Header::parse(&h, meta.len()).map_err(|e| format!("{name}: {e}"))?;
+    let n = match limit {
+        0 => header.spans as usize,
+        l => l.min(header.spans as usize),
+    };
+    let mut recs = Vec::with_capacity(n);
+    let mut r = [0u8; 32];
+    for _ in 0..n {
+        f.read_exact(&mut r).map_err(|e| format!("{name}: {e}"))?;
+        recs.push(std::array::from_fn(|k| u32::from_le_bytes(r[4 * k..4 * k + 4].try_into().expect("4 bytes"))));
+    }
+    Ok((header, recs))
 }
 
 /// The sign-extension of a `width`-bit port value.
@@ -357,34 +451,41 @@ fn timed(f: impl FnOnce()) -> (f64, f64) {
     (start.elapsed().as_secs_f64(), process_cpu() - cpu)
 }
 
-fn harness(path: &std::path::Path, limit: usize) -> ExitCode {
-    let (h, mut recs) = read_stim(path);
-    if limit > 0 {
-        recs.truncate(limit);
-    }
-    assert_eq!(h.state, state_of(h.seed), "stimulus file: traffic state is not state_of(seed)");
+fn harness(path: &std::path::Path, limit: usize) -> Result<ExitCode, Bad> {
+    let (h, recs) = read_stim(path, limit)?;
     let traffic = Traffic { valid: h.valid_thr as f64 / 256.0, ready: h.ready_thr as f64 / 256.0 };
     let mut report = Report::default();
+    let rejected = |e: &dyn std::fmt::Display| format!("{}: {e}", path.display());
     let (tag, (secs, cpu)) = match h.design {
         0 => {
-            let info = segment_model(h.p, Align::Span).unwrap_or_else(|| panic!("no segment model for p = {}", h.p));
+            let info =
+                segment_model(h.p, Align::Span).ok_or_else(|| format!("{}: no segment shader model for p = {}", path.display(), h.p))?;
+            if h.dw != info.cfg.dw() {
+                return Err(format!("{}: in_di is {} bits in the file, {} in {}", path.display(), h.dw, info.cfg.dw(), info.tag));
+            }
             let stims: Vec<Stim> = recs
                 .iter()
                 .map(|r| Stim { triangle: r[6] as usize, y: r[7], span: Span { x0: r[0], len: r[1], i0: r[2], di: from_port(r[3], h.dw) } })
                 .collect();
+            // Spans the ports cannot carry are refused before the timed loop.
+            if let Some((index, e)) = stims.iter().enumerate().find_map(|(k, s)| s.span.check(&info.cfg).err().map(|e| (k, e))) {
+                return Err(rejected(&format!("span {index}: {e}")));
+            }
             let mut sim = SegmentCosim::new(info, h.seed, traffic);
             (info.tag, timed(|| sim.stream(&stims, &mut report, |_, _| {})))
         }
-        1 => {
-            let info = SPECULAR_MODELS.first().expect("no specular unit in this build");
+        _ => {
+            let info = SPECULAR_MODELS.first().ok_or("no specular unit in this build")?;
             let spans: Vec<SpecularSpan> = recs
                 .iter()
                 .map(|r| SpecularSpan { c: r[0] as u16, n: r[1] as u16, theta0: r[2] as i32, dtheta: r[3] as i32, len: r[4] })
                 .collect();
             let mut sim = SpecularCosim::new(info, specular_unit(), h.seed, traffic);
-            (info.tag, timed(|| sim.stream(&spans, &mut report)))
+            let mut result = Ok(());
+            let t = timed(|| result = sim.try_stream(&spans, &mut report));
+            result.map_err(|e| rejected(&e))?;
+            (info.tag, t)
         }
-        d => panic!("unknown design {d}"),
     };
     for m in &report.mismatches {
         eprintln!("MISMATCH {m}");
@@ -393,9 +494,5 @@ fn harness(path: &std::path::Path, limit: usize) -> ExitCode {
         "RESULT impl=harness model={tag} spans={} clocks={} pixels={} secs={secs:.6} cpu={cpu:.6} mismatches={}",
         report.spans, report.cycles, report.pixels, report.mismatch_count
     );
-    if report.ok() {
-        ExitCode::SUCCESS
-    } else {
-        ExitCode::from(1)
-    }
+    Ok(if report.ok() { ExitCode::SUCCESS } else { ExitCode::from(1) })
 }

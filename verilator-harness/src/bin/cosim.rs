@@ -17,6 +17,11 @@ use verilator_harness::specular::{random_span, SpecularCosim};
 use verilator_harness::stimulus::random_triangle;
 use verilator_harness::waveform;
 
+/// Widest and tallest screen: `golden::stimulus::random_triangle` puts vertices anywhere on it,
+/// and the set-up refuses a coordinate beyond `COORD_LIMIT` (a larger screen made bad triangles,
+/// reported as mismatches).
+const MAX_SIDE: i64 = golden::setup::COORD_LIMIT as i64;
+
 /// `--traffic`: the valid/ready pattern at both ends.
 #[derive(Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
 enum TrafficArg {
@@ -54,9 +59,12 @@ struct Args {
     /// Seed of the triangles and of the traffic (default: fresh, printed).
     #[arg(long)]
     seed: Option<u64>,
-    #[arg(long, default_value_t = 640, value_parser = clap::value_parser!(u32).range(1..=65536))]
+    /// Screen width (1..=32768; see --height).
+    #[arg(long, default_value_t = 640, value_parser = clap::value_parser!(u32).range(1..=MAX_SIDE))]
     width: u32,
-    #[arg(long, default_value_t = 480, value_parser = clap::value_parser!(u32).range(1..=65536))]
+    /// Screen height (1..=32768: the random triangles' vertices lie anywhere on the screen, and
+    /// the set-up takes coordinates up to golden::setup::COORD_LIMIT).
+    #[arg(long, default_value_t = 480, value_parser = clap::value_parser!(u32).range(1..=MAX_SIDE))]
     height: u32,
     /// `random`: random input gaps and output backpressure; `full`: both ends always ready
     /// (the shader's own throughput).

@@ -37,7 +37,8 @@ struct Args {
     #[arg(long, value_enum)]
     scene: Option<SceneKind>,
     /// A triangle file (SPEC §5: `x0 y0 i0 x1 y1 i1 x2 y2 i2` per line, `#` comments): 8-bit
-    /// grayscale, background 0, later triangles over earlier ones, diffuse only.
+    /// grayscale, background 0, later triangles over earlier ones, diffuse only. Input files
+    /// (this and --obj) hold at most 64 MiB, in lines of at most 4096 bytes.
     #[arg(long, value_name = "FILE")]
     triangles: Option<PathBuf>,
     /// A Wavefront OBJ mesh (polygons triangulated; normals from the file, else smoothed from
@@ -50,9 +51,12 @@ struct Args {
     /// Segmentation of the shader model.
     #[arg(long, value_enum, default_value_t = Align::Span)]
     align: Align,
-    #[arg(long, default_value_t = 640, value_parser = clap::value_parser!(u32).range(1..=65536))]
+    /// Image width (1..=32768; see --height).
+    #[arg(long, default_value_t = 640, value_parser = clap::value_parser!(u32).range(1..=MAX_SIDE))]
     width: u32,
-    #[arg(long, default_value_t = 480, value_parser = clap::value_parser!(u32).range(1..=65536))]
+    /// Image height (1..=32768: a scene or mesh is framed to the image, and a triangle file's
+    /// vertices stop at golden::setup::COORD_LIMIT, so no triangle reaches past it).
+    #[arg(long, default_value_t = 480, value_parser = clap::value_parser!(u32).range(1..=MAX_SIDE))]
     height: u32,
     /// Blinn–Phong exponent n of the scene's highlight.
     #[arg(long, default_value_t = 40, value_parser = clap::value_parser!(u16).range(1..=1000), conflicts_with = "triangles")]
@@ -73,6 +77,55 @@ struct Args {
     /// COSIM_TRACE is set at build time).
     #[arg(long, value_name = "DIR")]
     trace: Option<PathBuf>,
+}
+
+/// Widest and tallest image: a scene or mesh is framed to the image, so its vertices reach its
+/// far edges, and the set-up refuses a coordinate beyond `COORD_LIMIT` (a taller image made a late
+/// error, or gigabytes of buffers first).
+const MAX_SIDE: i64 = golden::setup::COORD_LIMIT as i64;
+
+/// Largest input file (--triangles, --obj): read no further than this. A SPEC §5 line takes
+/// about 60 bytes, so this is about a million triangles, each of them simulated clock by clock;
+/// a file larger than that is a mistake more often than a render.
+const MAX_INPUT_BYTES: u64 = 64 << 20;
+/// Longest line of an input file: a triangle takes nine numbers, an OBJ face a vertex list.
+const MAX_LINE_BYTES: usize = 4096;
+
+/// The text of an input file, refused when it is no file, larger than [`MAX_INPUT_BYTES`], not
+/// UTF-8, or has a line longer than [`MAX_LINE_BYTES`]. Reads at most one byte past the limit.
+fn read_input(file: &Path) -> Result<String, String> {
+    use std::io::Read;
+    let name = file.display();
+    if file.is_dir() {
+        return Err(format!("{name}: is a folder"));
+    }
+    let mut bytes = Vec::new();
+    std::fs::File::open(file).and_then(|f| f.take(MAX_INPUT_BYTES + 1).read_to_end(&mut bytes)).map_err(|e| format!("{name}: {e}"))?;
+    if bytes.len() as u64 > MAX_INPUT_BYTES {
+        return Err(format!("{name}: larger than {} MiB, the most an input file may hold", MAX_INPUT_BYTES >> 20));
+    }
+    let text = String::from_utf8(bytes).map_err(|_| format!("{name}: not UTF-8 text"))?;
+    if let Some(n) = text.lines().position(|l| l.len() > MAX_LINE_BYTES) {
+        return Err(format!("{name}: line {} is longer than {MAX_LINE_BYTES} bytes", n + 1));
+    }
+    Ok(text)
+}
+
+/// What can be checked before any model is chosen: every output writable and none of them the
+/// input file, so a bad --out costs no rendering and never destroys what it was made from.
+fn check_args(args: &Args) -> Result<(), String> {
+    let input = args.triangles.as_deref().or(args.obj.as_deref());
+    let mut outs = vec![args.out.clone(), sibling(&args.out, ".golden.png")];
+    if args.diff {
+        outs.push(sibling(&args.out, ".diff.png"));
+    }
+    for out in &outs {
+        hdl_gen::output::check_writable(out).map_err(|e| format!("--out: {e}"))?;
+        if let Some(input) = input {
+            hdl_gen::output::check_not_input(out, &[input]).map_err(|e| format!("--out: {e}"))?;
+        }
+    }
+    Ok(())
 }
 
 fn fail(msg: impl std::fmt::Display) -> ExitCode {
@@ -122,6 +175,9 @@ fn model_for<I, O>(
 
 fn main() -> ExitCode {
     let args = Args::parse();
+    if let Err(e) = check_args(&args) {
+        return fail(e);
+    }
     let start = Instant::now();
     let align = args.align;
     let Some(info) = segment_model(args.p, align) else {
@@ -144,33 +200,19 @@ fn main() -> ExitCode {
         Ok(c) => c,
         Err(e) => return fail(e),
     };
-    let dir = match args.out.parent() {
-        Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
-        _ => PathBuf::from("."),
-    };
-    if !dir.is_dir() {
-        return fail(format!("--out {}: folder {} does not exist", args.out.display(), dir.display()));
-    }
-    if args.out.is_dir() {
-        return fail(format!("--out {}: is a folder", args.out.display()));
-    }
     let golden_path = sibling(&args.out, ".golden.png");
     let diff_path = sibling(&args.out, ".diff.png");
 
-    let read = |file: &Path| match std::fs::read(file) {
-        Ok(bytes) => String::from_utf8(bytes).map_err(|_| format!("{}: not UTF-8 text", file.display())),
-        Err(e) => Err(format!("{}: {e}", file.display())),
-    };
     if (args.scene.is_some() || args.obj.is_some()) && SPECULAR_MODELS.is_empty() {
         return fail("--scene/--obj: this build has no specular unit");
     }
     let job = match (&args.scene, &args.triangles, &args.obj) {
         (Some(kind), _, _) => scene_job(*kind, args.shininess, &info.cfg, &screen).map_err(|e| format!("--scene {}: {e}", kind.name())),
         (None, Some(file), _) => {
-            read(file).and_then(|t| triangles_job(&t, &info.cfg, &screen).map_err(|e| format!("{}: {e}", file.display())))
+            read_input(file).and_then(|t| triangles_job(&t, &info.cfg, &screen).map_err(|e| format!("{}: {e}", file.display())))
         }
         (None, None, Some(file)) => {
-            read(file).and_then(|t| obj_job(&t, args.shininess, &info.cfg, &screen).map_err(|e| format!("{}: {e}", file.display())))
+            read_input(file).and_then(|t| obj_job(&t, args.shininess, &info.cfg, &screen).map_err(|e| format!("{}: {e}", file.display())))
         }
         (None, None, None) => unreachable!("clap requires one"),
     };

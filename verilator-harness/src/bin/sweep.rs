@@ -34,7 +34,9 @@ struct Args {
     seed: u64,
     #[arg(long, default_value_t = 640, value_parser = clap::value_parser!(u32).range(64..=4096))]
     width: u32,
-    #[arg(long, default_value_t = 480, value_parser = clap::value_parser!(u32).range(64..=65536))]
+    /// Screen height (64..=32768: the workload's vertices lie anywhere on the screen, and the
+    /// set-up takes coordinates up to golden::setup::COORD_LIMIT).
+    #[arg(long, default_value_t = 480, value_parser = clap::value_parser!(u32).range(64..=golden::setup::COORD_LIMIT as i64))]
     height: u32,
     /// Write the table here (atomically) instead of to standard output.
     #[arg(long, value_name = "FILE.md")]
@@ -96,6 +98,11 @@ impl Cell {
 
 fn main() -> ExitCode {
     let args = Args::parse();
+    // A bad --out is refused now, not after the sweep's minutes.
+    if let Some(Err(e)) = args.out.as_deref().map(hdl_gen::output::check_writable) {
+        eprintln!("error: --out: {e}");
+        return ExitCode::from(2);
+    }
     let start = Instant::now();
     let screen = Screen { width: args.width, height: args.height };
     // SPEC's seed structure: the schemes are compared as the seeds describe them (`--pipeline`

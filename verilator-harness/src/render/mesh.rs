@@ -15,6 +15,17 @@ pub enum MeshError {
     NotFinite,
     #[error("the OBJ mesh has no extent")]
     NoExtent,
+    /// A face of fewer than three vertices (the OBJ reader would drop it without a word).
+    #[error("line {line}: a face needs at least 3 vertices, this one has {vertices}")]
+    ShortFace { line: usize, vertices: usize },
+}
+
+/// The first `f` statement of fewer than three vertices.
+fn short_face(text: &str) -> Option<MeshError> {
+    text.lines().enumerate().find_map(|(n, line)| {
+        let words: Vec<&str> = line.split('#').next().unwrap_or("").split_whitespace().collect();
+        (words.first() == Some(&"f") && words.len() < 4).then(|| MeshError::ShortFace { line: n + 1, vertices: words.len() - 1 })
+    })
 }
 
 /// A triangle mesh. Faces are wound counter-clockwise seen from outside; `normals` are the
@@ -153,6 +164,9 @@ pub(super) fn lighting(colour: [f64; 3], shininess: u16) -> Lighting {
 /// one, else smooth normals from the faces (area-weighted), the faces' winding taken as given
 /// (counter-clockwise seen from outside, OBJ's convention). Materials are ignored.
 pub fn obj_mesh(text: &str) -> Result<Mesh, MeshError> {
+    if let Some(e) = short_face(text) {
+        return Err(e);
+    }
     let opts = tobj::LoadOptions { triangulate: true, single_index: true, ..Default::default() };
     let (models, _) = tobj::load_obj_buf(&mut text.as_bytes(), &opts, |_| Err(tobj::LoadError::OpenFileFailed)).map_err(MeshError::Obj)?;
     let mut mesh = Mesh::default();
@@ -239,6 +253,10 @@ mod tests {
         assert!(matches!(obj_mesh("v 0 0 0\n"), Err(MeshError::NoFaces)));
         assert!(matches!(obj_mesh("v 0 0 0\nv 0 0 0\nv 0 0 0\nf 1 2 3\n"), Err(MeshError::NoExtent)));
         assert!(matches!(obj_mesh("f 1 2 3\n"), Err(MeshError::Obj(_))));
+        // A face of two vertices (or one, or none) is refused by line, also after a good one.
+        let short = "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n# c\nf 1 2\n";
+        assert!(matches!(obj_mesh(short), Err(MeshError::ShortFace { line: 6, vertices: 2 })), "{:?}", obj_mesh(short).err());
+        assert!(matches!(obj_mesh("v 0 0 0\nf 1\n"), Err(MeshError::ShortFace { line: 2, vertices: 1 })));
     }
 
     #[test]
