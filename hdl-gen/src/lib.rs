@@ -9,13 +9,11 @@ pub mod manifest;
 mod names;
 mod options;
 pub mod output;
-pub mod report;
 pub mod rom;
 pub mod segment;
 pub mod specular;
-pub mod testbench;
+pub mod tools;
 pub mod verilog;
-pub mod wrapper;
 pub mod writer;
 
 pub use axis::Bus;

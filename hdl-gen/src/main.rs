@@ -98,7 +98,7 @@ enum Command {
         /// Register the block's outputs before the XOR tree, or fold them directly (a flip-flop
         /// fewer per output bit, for a design that only fits without them; never a better Fmax).
         #[arg(long, value_enum, default_value_t)]
-        outputs: hdl_gen::wrapper::Outputs,
+        outputs: hdl_gen::tools::wrapper::Outputs,
     },
     /// Write a self-checking Verilog-2005 testbench of the segment shader and of the specular
     /// unit, with vectors from the golden model, beside the generated RTL (runs in Icarus).
@@ -108,7 +108,7 @@ enum Command {
         #[command(flatten)]
         brdf: BrdfArgs,
         /// Spans per block (1..1000000).
-        #[arg(long, default_value_t = 1000, value_parser = clap::value_parser!(u32).range(1..=hdl_gen::testbench::MAX_VECTORS as i64))]
+        #[arg(long, default_value_t = 1000, value_parser = clap::value_parser!(u32).range(1..=hdl_gen::tools::testbench::MAX_VECTORS as i64))]
         vectors: u32,
         /// Seed of the vectors and of the bench's traffic pattern.
         #[arg(long, default_value_t = 1)]
@@ -285,19 +285,19 @@ fn run(command: Command) -> anyhow::Result<()> {
         Command::SynthWrapper { rtl, module, out, outputs } => {
             let path = rtl.join(hdl_gen::manifest::MANIFEST_FILE);
             let text = read_manifest(&path)?;
-            let ports = hdl_gen::wrapper::ports_from_manifest(&text, &module)?;
+            let ports = hdl_gen::tools::wrapper::ports_from_manifest(&text, &module)?;
             output::check_not_input(&out, &[&path])?;
-            output::write_one(&out, hdl_gen::wrapper::module(&module, &ports, outputs)?.render().as_bytes())?;
+            output::write_one(&out, hdl_gen::tools::wrapper::module(&module, &ports, outputs)?.render().as_bytes())?;
             eprintln!("wrote {}", out.display());
         }
         Command::Testbench { config, brdf, vectors, seed, out } => {
             let opts = config.options(&brdf)?;
-            output::write_all(&out, &hdl_gen::testbench::testbench(&opts, vectors, seed)?)?;
+            output::write_all(&out, &hdl_gen::tools::testbench::testbench(&opts, vectors, seed)?)?;
             eprintln!("wrote {}", out.display());
         }
         Command::Report { report: Report::Accuracy { brdf, svg } } => {
             let unit = Options { brdf: brdf.plan()?, ..Options::default() }.specular_unit();
-            let report = hdl_gen::report::AccuracyReport::measure(&unit);
+            let report = hdl_gen::tools::report::AccuracyReport::measure(&unit);
             // The file first: a failed write then leaves no table behind either.
             if let Some(path) = &svg {
                 output::write_one(path, report.svg().as_bytes())?;
