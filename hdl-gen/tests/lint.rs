@@ -9,7 +9,8 @@
 use golden::frontend::DiMode;
 use golden::pipeline::Pipeline;
 use golden::{Align, Config};
-use hdl_gen::{generate, output, wrapper, BfpiArch, Bus, Options};
+use hdl_gen::tools::wrapper;
+use hdl_gen::{generate, output, BfpiArch, Bus, Options};
 use std::path::Path;
 use std::process::Command;
 
