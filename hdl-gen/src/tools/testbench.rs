@@ -258,6 +258,35 @@ struct BenchSpec<'a> {
 }
 
 fn bench_module(b: &BenchSpec) -> Module {
+    let mut body = declarations(b);
+    let run = clock(b);
+    body.push(Item::Always(vec![
+        blocking("cycle", "cycle + 1"),
+        if_("cycle <= 4", vec![Stmt::Comment("Three clocks of reset.".into()), set("rst", "cycle < 4")], run),
+    ]));
+
+    let mut header = b.header.clone();
+    header.extend([
+        String::new(),
+        "Run it from this folder (the ROM images and vector files are read from the current directory):".into(),
+        format!("  iverilog -g2005 -s {0} -o {0}.vvp *.v && vvp -n {0}.vvp", b.name),
+        "It prints every mismatch, then `N passed, M failed` (spans); on failure it ends with $fatal, so the".into(),
+        "simulator exits non-zero. Other vector files: override the IN_FILE and EXP_FILE parameters.".into(),
+    ]);
+    Module {
+        name: b.name.to_string(),
+        header,
+        params: vec![
+            Param { name: "IN_FILE".into(), value: format!("\"{}_in.hex\"", b.name), doc: "input spans".into() },
+            Param { name: "EXP_FILE".into(), value: format!("\"{}_exp.hex\"", b.name), doc: "expected outputs".into() },
+        ],
+        ports: vec![],
+        body,
+    }
+}
+
+/// The bench's nets, the DUT, the vector memories, its state and the clock and reset.
+fn declarations(b: &BenchSpec) -> Vec<Item> {
     let mut body = vec![
         Item::Localparam { name: "N_SPANS".into(), width: 32, value: b.n_in.to_string() },
         Item::Localparam { name: "N_OUT".into(), width: 32, value: b.n_exp.to_string() },
@@ -300,19 +329,27 @@ fn bench_module(b: &BenchSpec) -> Module {
     init.push(blocking("extra", "1'b0"));
     body.push(Item::Initial(init));
     body.push(Item::Blank);
+    body
+}
 
-    let finish = |passed_msg: bool| -> Vec<Stmt> {
-        let mut v = vec![
-            if_("failed > N_SPANS", vec![blocking("failed", "N_SPANS")], vec![]),
-            call("$display(\"%0d passed, %0d failed\", N_SPANS - failed, failed)".to_string()),
-        ];
-        if passed_msg {
-            v.push(if_("failed != 0", vec![call(format!("$fatal(1, \"{}: FAILED\")", b.name))], vec![call("$finish")]));
-        } else {
-            v.push(call(format!("$fatal(1, \"{}: FAILED\")", b.name)));
-        }
-        v
-    };
+/// The end of a run: the tally line, then `$finish` if nothing failed (`passed_msg`), else
+/// `$fatal`, so the simulator's exit status tells.
+fn finish(b: &BenchSpec, passed_msg: bool) -> Vec<Stmt> {
+    let mut v = vec![
+        if_("failed > N_SPANS", vec![blocking("failed", "N_SPANS")], vec![]),
+        call("$display(\"%0d passed, %0d failed\", N_SPANS - failed, failed)".to_string()),
+    ];
+    if passed_msg {
+        v.push(if_("failed != 0", vec![call(format!("$fatal(1, \"{}: FAILED\")", b.name))], vec![call("$finish")]));
+    } else {
+        v.push(call(format!("$fatal(1, \"{}: FAILED\")", b.name)));
+    }
+    v
+}
+
+/// One clock of the bench: the traffic pattern, the output check, the input side, the sink's
+/// stalls, and the end (done, or a hang).
+fn clock(b: &BenchSpec) -> Vec<Stmt> {
     let fields = format!("{{{}}}", b.in_fields.join(", "));
     let mut run = vec![
         Stmt::Comment("Full rate one stretch of 1024 clocks in eight: spans back to back, the sink always ready.".into()),
@@ -320,7 +357,7 @@ fn bench_module(b: &BenchSpec) -> Module {
         blocking("progress", "1'b0"),
         if_(
             "out_valid !== 1'b0 && out_valid !== 1'b1",
-            [vec![call("$display(\"FAIL: out_valid is %b after reset\", out_valid)"), blocking("failed", "N_SPANS")], finish(false)].concat(),
+            [vec![call("$display(\"FAIL: out_valid is %b after reset\", out_valid)"), blocking("failed", "N_SPANS")], finish(b, false)].concat(),
             vec![],
         ),
         scomment("Output side: the transfer at this edge must be the next expected word."),
@@ -358,7 +395,7 @@ fn bench_module(b: &BenchSpec) -> Module {
         scomment("Input side: the span taken at this edge; offer the next one or hold the current."),
         if_(
             "in_valid !== 1'b0 && in_ready !== 1'b0 && in_ready !== 1'b1",
-            [vec![call("$display(\"FAIL: in_ready is %b\", in_ready)"), blocking("failed", "N_SPANS")], finish(false)].concat(),
+            [vec![call("$display(\"FAIL: in_ready is %b\", in_ready)"), blocking("failed", "N_SPANS")], finish(b, false)].concat(),
             vec![],
         ),
         if_("in_valid && in_ready", vec![blocking("progress", "1'b1"), blocking("n_in", "n_in + 1")], vec![]),
@@ -378,7 +415,7 @@ fn bench_module(b: &BenchSpec) -> Module {
         blocking("idle", "progress ? 32'd0 : idle + 1"),
         if_(
             "n_in == N_SPANS && n_out == N_OUT",
-            vec![blocking("drain", "drain + 1"), if_(format!("drain == {DRAIN}"), finish(true), vec![])],
+            vec![blocking("drain", "drain + 1"), if_(format!("drain == {DRAIN}"), finish(b, true), vec![])],
             vec![if_(
                 "idle == STALL_LIMIT",
                 [
@@ -391,7 +428,7 @@ fn bench_module(b: &BenchSpec) -> Module {
                         ),
                         blocking("failed", "failed + N_SPANS - first_open - (last_failed == first_open ? 32'd1 : 32'd0)"),
                     ],
-                    finish(false),
+                    finish(b, false),
                 ]
                 .concat(),
                 vec![],
@@ -402,29 +439,7 @@ fn bench_module(b: &BenchSpec) -> Module {
     run.insert(1, blocking("rnd", "rnd ^ (rnd << 13)"));
     run.insert(2, blocking("rnd", "rnd ^ (rnd >> 17)"));
     run.insert(3, blocking("rnd", "rnd ^ (rnd << 5)"));
-    body.push(Item::Always(vec![
-        blocking("cycle", "cycle + 1"),
-        if_("cycle <= 4", vec![Stmt::Comment("Three clocks of reset.".into()), set("rst", "cycle < 4")], run),
-    ]));
-
-    let mut header = b.header.clone();
-    header.extend([
-        String::new(),
-        "Run it from this folder (the ROM images and vector files are read from the current directory):".into(),
-        format!("  iverilog -g2005 -s {0} -o {0}.vvp *.v && vvp -n {0}.vvp", b.name),
-        "It prints every mismatch, then `N passed, M failed` (spans); on failure it ends with $fatal, so the".into(),
-        "simulator exits non-zero. Other vector files: override the IN_FILE and EXP_FILE parameters.".into(),
-    ]);
-    Module {
-        name: b.name.to_string(),
-        header,
-        params: vec![
-            Param { name: "IN_FILE".into(), value: format!("\"{}_in.hex\"", b.name), doc: "input spans".into() },
-            Param { name: "EXP_FILE".into(), value: format!("\"{}_exp.hex\"", b.name), doc: "expected outputs".into() },
-        ],
-        ports: vec![],
-        body,
-    }
+    run
 }
 
 fn segment_bench(opts: &Options, name: &str, spans: &[Span], seed: u32) -> Vec<GeneratedFile> {
