@@ -117,6 +117,16 @@ enum Command {
         #[arg(long)]
         out: PathBuf,
     },
+    /// Print the name of the module a generated folder holds in a role (scripts read the
+    /// manifest through this, not through a JSON parser of their own); exit 2 when it has none.
+    Manifest {
+        /// A folder written by `generate`.
+        #[arg(long)]
+        rtl: PathBuf,
+        /// The module's role in the chain (manifest.json's `role`).
+        #[arg(long, value_enum)]
+        role: hdl_gen::manifest::Role,
+    },
     /// Measure the generated hardware against its references.
     Report {
         #[command(subcommand)]
@@ -289,6 +299,17 @@ fn run(command: Command) -> anyhow::Result<()> {
             output::check_not_input(&out, &[&path])?;
             output::write_one(&out, hdl_gen::tools::wrapper::module(&module, &ports, outputs)?.render().as_bytes())?;
             eprintln!("wrote {}", out.display());
+        }
+        Command::Manifest { rtl, role } => {
+            let path = rtl.join(hdl_gen::manifest::MANIFEST_FILE);
+            let manifest = hdl_gen::manifest::Manifest::parse(&read_manifest(&path)?).with_context(|| path.display().to_string())?;
+            match manifest.by_role(role) {
+                Some(m) => println!("{}", m.name),
+                None => {
+                    let name = clap::ValueEnum::to_possible_value(&role).map(|v| v.get_name().to_string()).unwrap_or_default();
+                    bail!("{} lists no module in the role {name}", path.display())
+                }
+            }
         }
         Command::Testbench { config, brdf, vectors, seed, out } => {
             let opts = config.options(&brdf)?;

@@ -39,7 +39,7 @@ pub struct Manifest {
 }
 
 /// What a module is in the chain; readers find modules by role, not by name (names take a prefix).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, clap::ValueEnum)]
 #[serde(rename_all = "snake_case")]
 pub enum Role {
     Bfpi,

@@ -78,3 +78,22 @@ fn unwritable_output_folder_exits_2_and_leaves_nothing() {
     assert_eq!(listing(&base).len(), 1, "only the original file remains");
     assert_eq!(std::fs::read(&file).unwrap(), b"not a folder");
 }
+
+/// `hdl-gen manifest` names the module of each role, prefix and all, as the scripts read it.
+#[test]
+fn manifest_names_the_module_of_a_role() {
+    let dir = scratch("manifest-role");
+    let d = dir.to_str().unwrap();
+    assert!(hdl_gen(&["generate", "--out", d, "--p", "16", "--prefix", "my_"]).status.success());
+    for (role, name) in [
+        ("segment-shader", "my_segment_shader_p16"),
+        ("frontend", "my_tri_frontend"),
+        ("writer", "my_fb_writer_p16"),
+        ("triangle-writer", "my_tri_fb_p16"),
+        ("specular-unit", "my_specular_unit"),
+    ] {
+        let out = hdl_gen(&["manifest", "--rtl", d, "--role", role]);
+        assert!(out.status.success(), "{role}: {}", String::from_utf8_lossy(&out.stderr));
+        assert_eq!(String::from_utf8_lossy(&out.stdout), format!("{name}\n"), "{role}");
+    }
+}

@@ -143,6 +143,13 @@ fn synth_wrapper_bad_flags_and_input() {
             vec!["synth-wrapper", "--rtl", r, "--module", "segment_shader_p8", "--out", unwritable.to_str().unwrap()],
             unwritable.display().to_string(),
         ),
+        // `manifest`, the scripts' reader of the same file.
+        (vec!["manifest", "--role", "writer"], "--rtl".into()),
+        (vec!["manifest", "--rtl", r], "--role".into()),
+        (vec!["manifest", "--rtl", r, "--role", "no-such-role"], "no-such-role".into()),
+        (vec!["manifest", "--rtl", empty.to_str().unwrap(), "--role", "writer"], empty.join("manifest.json").display().to_string()),
+        (vec!["manifest", "--rtl", bad.to_str().unwrap(), "--role", "writer"], "manifest.json".into()),
+        (vec!["manifest", "--rtl", r, "--role", "axis"], "no module in the role axis".into()),
     ];
     let before = files_under(&dir);
     for (args, needle) in &cases {
