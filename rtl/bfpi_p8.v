@@ -13,7 +13,7 @@
 
 module bfpi_p8 (
   input  wire signed [20:0] di, // signed Q8.12; increment
-  output wire [191:0] inc       // 8 lanes of signed Q11.12; lane i = (i+1)*di
+  output reg  [191:0] inc       // 8 lanes of signed Q11.12; lane i = (i+1)*di
 );
   // Every node is a multiple of di, wide enough for P*di.
   wire signed [23:0] m1 = {{3{di[20]}}, di};
@@ -21,14 +21,10 @@ module bfpi_p8 (
   wire signed [23:0] m5 = (m1 << 2) + m1;
   wire signed [23:0] m7 = (m1 << 3) - m1;
 
-  assign inc[0 +: 24] = m1;
-  assign inc[24 +: 24] = m1 << 1;
-  assign inc[48 +: 24] = m3;
-  assign inc[72 +: 24] = m1 << 2;
-  assign inc[96 +: 24] = m5;
-  assign inc[120 +: 24] = m3 << 1;
-  assign inc[144 +: 24] = m7;
-  assign inc[168 +: 24] = m1 << 3;
+  // Lane i at inc[i*MW +: MW], all lanes in one process: the bus then changes once per change of di.
+  always @(*) begin
+    inc = {m1 << 3, m7, m3 << 1, m5, m1 << 2, m3, m1 << 1, m1};
+  end
 
 endmodule
 

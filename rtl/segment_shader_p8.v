@@ -53,8 +53,8 @@ module segment_shader_p8 (
   wire signed [32:0] step = {{9{inc_p[23]}}, inc_p};
 
   // Lanes: add, round (the half is in the accumulator), clamp to 0..255, mask.
-  wire [63:0] pix;
-  wire [7:0] mask;
+  reg [63:0] pix;
+  reg [7:0] mask;
   genvar i;
   generate
     for (i = 0; i < 8; i = i + 1) begin : lane
@@ -70,10 +70,17 @@ module segment_shader_p8 (
       end
       wire signed [20:0] q = v[32:12];
       // verilator lint_on UNUSEDSIGNAL
-      assign pix[i*8 +: 8] = q[20] ? 8'd0 : (|q[19:8]) ? 8'd255 : q[7:0];
-      assign mask[i] = LANE < cur_rem;
+      wire [7:0] pixel = q[20] ? 8'd0 : (|q[19:8]) ? 8'd255 : q[7:0];
+      wire in_span = LANE < cur_rem;
     end
   endgenerate
+  // Lane i's pixel and in_span, on the buses pix and mask; one process per bus, so each changes once a clock.
+  always @(*) begin
+    pix = {lane[7].pixel, lane[6].pixel, lane[5].pixel, lane[4].pixel, lane[3].pixel, lane[2].pixel, lane[1].pixel, lane[0].pixel};
+  end
+  always @(*) begin
+    mask = {lane[7].in_span, lane[6].in_span, lane[5].in_span, lane[4].in_span, lane[3].in_span, lane[2].in_span, lane[1].in_span, lane[0].in_span};
+  end
 
   // A span of length 0 is consumed and yields nothing.
   always @(posedge clk) begin

@@ -7,7 +7,7 @@
 
 pub mod properties;
 
-use crate::verilog::{assign, comment, sext, swire, Item, Module, Port};
+use crate::verilog::{comment, gather, sext, swire, Item, Module, Port};
 use crate::Names;
 use golden::bfpi::BfpiPlan;
 use golden::Config;
@@ -73,20 +73,33 @@ pub fn module(cfg: &Config, names: &Names) -> Module {
         body.push(swire(&node(a.value), mw, a.describe(node)));
     }
     body.push(Item::Blank);
-    for c in 1..=p {
-        let (odd, s) = BfpiPlan::multiple(c);
-        let rhs = if s == 0 { node(odd) } else { format!("{} << {s}", node(odd)) };
-        body.push(assign(format!("inc[{} +: {mw}]", (c - 1) * mw), rhs));
-    }
+    body.push(gather_comment());
+    body.push(gather("inc", lanes(p, node)));
     Module { name: names.bfpi.clone(), header, params: vec![], ports: ports(cfg), body }
+}
+
+/// The lanes `c * di`, c = 1..=P, from golden's graph whose node for an odd multiple `v` is
+/// `node(v)`: an even multiple is wiring, `odd << s`.
+pub fn lanes(p: u32, node: impl Fn(u32) -> String) -> Vec<String> {
+    (1..=p)
+        .map(|c| match BfpiPlan::multiple(c) {
+            (odd, 0) => node(odd),
+            (odd, s) => format!("{} << {s}", node(odd)),
+        })
+        .collect()
 }
 
 fn ports(cfg: &Config) -> Vec<Port> {
     let (p, dw, mw) = (cfg.p, cfg.dw(), cfg.mw());
     vec![
         Port::input("di", dw, &format!("signed Q8.{}", cfg.frac), "increment").signed(),
-        Port::output("inc", p * mw, &format!("{p} lanes of signed Q{}.{}", 8 + cfg.log2p(), cfg.frac), "lane i = (i+1)*di"),
+        Port::output("inc", p * mw, &format!("{p} lanes of signed Q{}.{}", 8 + cfg.log2p(), cfg.frac), "lane i = (i+1)*di").reg(),
     ]
+}
+
+/// Why the lanes are gathered by one process ([`gather`]), in the Verilog.
+fn gather_comment() -> Item {
+    comment("Lane i at inc[i*MW +: MW], all lanes in one process: the bus then changes once per change of di.")
 }
 
 /// The comparison form `--bfpi-arch naive`: the same ports and function, every lane a product
@@ -105,8 +118,7 @@ pub fn naive_module(cfg: &Config, names: &Names) -> Module {
     let mut body = vec![comment("Every lane is di times a constant, wide enough for P*di.")];
     body.push(swire("m1", mw, sext("di", dw, mw)));
     body.push(Item::Blank);
-    for c in 1..=p {
-        body.push(assign(format!("inc[{} +: {mw}]", (c - 1) * mw), format!("m1 * {mw}'sd{c}")));
-    }
+    body.push(gather_comment());
+    body.push(gather("inc", (1..=p).map(|c| format!("m1 * {mw}'sd{c}")).collect()));
     Module { name: names.bfpi.clone(), header, params: vec![], ports: ports(cfg), body }
 }

@@ -14,7 +14,7 @@
 use crate::bfpi::BfpiArch;
 mod properties;
 
-use crate::verilog::{assign, bit, bus, comment, lit, net, reg, set, sext, sreg, swire, wire, zext, Item, Module, Port, Stmt};
+use crate::verilog::{assign, bit, comment, gather, lit, net, reg, set, sext, sreg, swire, wire, zext, Item, Module, Port, Stmt};
 use crate::Names;
 use golden::pipeline::Pipeline;
 use golden::segment::{latency, rem_bits};
@@ -198,10 +198,8 @@ pub fn module_with(cfg: &Config, names: &Names, arch: BfpiArch, pipe: Pipeline) 
             let term = if k == 0 { "cur_di_ext".to_string() } else { format!("(cur_di_ext << {k})") };
             body.push(swire(&format!("tv{i}"), aw, format!("tv{j} + {term}")));
         }
-        body.push(bus("tree", p * aw));
-        for i in 0..p {
-            body.push(assign(format!("tree[{} +: {aw}]", i * aw), format!("tv{i}")));
-        }
+        body.push(reg("tree", p * aw));
+        body.push(gather("tree", (0..p).map(|i| format!("tv{i}")).collect()));
         let step = if log2p == 0 { "cur_di_ext".to_string() } else { format!("cur_di_ext << {log2p}") };
         body.push(swire("step", aw, step));
     } else {
@@ -217,12 +215,8 @@ pub fn module_with(cfg: &Config, names: &Names, arch: BfpiArch, pipe: Pipeline) 
             for a in plan.adders.iter().filter(|a| a.depth > 1) {
                 body.push(swire(&node(a.value), mw, a.describe(node)));
             }
-            body.push(net("sp_inc", p * mw));
-            for c in 1..=p {
-                let (odd, s) = golden::bfpi::BfpiPlan::multiple(c);
-                let rhs = if s == 0 { node(odd) } else { format!("{} << {s}", node(odd)) };
-                body.push(assign(format!("sp_inc[{} +: {mw}]", (c - 1) * mw), rhs));
-            }
+            body.push(reg("sp_inc", p * mw));
+            body.push(gather("sp_inc", crate::bfpi::lanes(p, node)));
             body.push(net("inc", p * mw));
             body.push(assign("inc", "cur_inc"));
         } else if pipe.span_stage() {
@@ -252,18 +246,20 @@ pub fn module_with(cfg: &Config, names: &Names, arch: BfpiArch, pipe: Pipeline) 
     body.push(Item::Blank);
 
     let sum = pipe.sum_stage();
+    // Each lane's results are nets of its own (`lane[i].pixel`, ...), gathered into the buses
+    // below by one process each (`verilog::gather`), so that a clock costs Icarus O(P).
     if split {
         body.push(comment("Lanes: add in two parts, the fraction's carry and the high part (the half is in the"));
         body.push(comment("accumulator); join, clamp and mask a stage later."));
-        body.push(net("hcs", p * (qw + 1)));
+        body.push(reg("hcs", p * (qw + 1)));
     } else if sum {
         body.push(comment("Lanes: add (the half is in the accumulator) and mask; round and clamp a stage later."));
-        body.push(net("qs", p * qw));
+        body.push(reg("qs", p * qw));
     } else {
         body.push(comment("Lanes: add, round (the half is in the accumulator), clamp to 0..255, mask."));
     }
-    body.push(net("pix", 8 * p));
-    body.push(bus("mask", p));
+    body.push(reg("pix", 8 * p));
+    body.push(reg("mask", p));
     if screen {
         body.push(wire("lead_mask", p, format!("{{{p}{{1'b1}}}} << cur_lead")));
     }
@@ -289,8 +285,7 @@ pub fn module_with(cfg: &Config, names: &Names, arch: BfpiArch, pipe: Pipeline) 
                     ],
                 ),
             },
-            comment("Lane i's high part and carry: {hi, c}."),
-            assign(format!("hcs[i*{h} +: {h}]", h = qw + 1), "{hi, c}"),
+            comment("Lane i's high part and carry, {hi, c}, go to hcs[i*(QW+1) +: QW+1]."),
             // clamp(h + c) without the qw-bit carry chain of the sum: h <= h + c <= h + 1, so the
             // clamp is decided by h alone (h < 0 gives 0, h >= 255 gives 255, whatever c is),
             // and in between the pixel is the 8-bit increment h[7:0] + c.
@@ -299,7 +294,7 @@ pub fn module_with(cfg: &Config, names: &Names, arch: BfpiArch, pipe: Pipeline) 
             wire("low", 8, format!("h[7:0] + {}", zext("hc", 1, 8))),
             wire("neg", 1, format!("h[{}]", qw - 1)),
             wire("over", 1, format!("!h[{}] && ((|h[{}:8]) || (&h[7:0]))", qw - 1, qw - 2)),
-            assign("pix[i*8 +: 8]", "neg ? 8'd0 : over ? 8'd255 : low"),
+            wire("pixel", 8, "neg ? 8'd0 : over ? 8'd255 : low"),
         ]);
     } else {
         lane.extend([
@@ -322,19 +317,33 @@ pub fn module_with(cfg: &Config, names: &Names, arch: BfpiArch, pipe: Pipeline) 
             comment("verilator lint_on UNUSEDSIGNAL"),
         ]);
         if sum {
-            lane.push(assign(format!("qs[i*{qw} +: {qw}]"), "q"));
+            lane.push(comment("q goes to qs[i*QW +: QW]; the sum stage gives it back as r."));
             lane.push(swire("r", qw, format!("s1_q[i*{qw} +: {qw}]")));
-            lane.push(assign("pix[i*8 +: 8]", clamp("r")));
+            lane.push(wire("pixel", 8, clamp("r")));
         } else {
-            lane.push(assign("pix[i*8 +: 8]", clamp("q")));
+            lane.push(wire("pixel", 8, clamp("q")));
         }
     }
     if screen {
-        lane.push(assign("mask[i]", "(LANE < cur_rem) && lead_mask[i]"));
+        lane.push(wire("in_span", 1, "(LANE < cur_rem) && lead_mask[i]"));
     } else {
-        lane.push(assign("mask[i]", "LANE < cur_rem"));
+        lane.push(wire("in_span", 1, "LANE < cur_rem"));
     }
     body.push(Item::ForGenerate { var: "i".into(), count: p, label: "lane".into(), body: lane });
+    let lanes = |of: &dyn Fn(u32) -> String| (0..p).map(of).collect::<Vec<_>>();
+    let (stage_bus, stage_lane) = if split { ("hcs", "{hi, c}") } else { ("qs", "q") };
+    body.push(comment(if sum {
+        format!("Lane i's {stage_lane}, pixel and in_span, on the buses {stage_bus}, pix and mask; one process per bus, so each changes once a clock.")
+    } else {
+        "Lane i's pixel and in_span, on the buses pix and mask; one process per bus, so each changes once a clock.".into()
+    }));
+    if split {
+        body.push(gather("hcs", lanes(&|k| format!("{{lane[{k}].hi, lane[{k}].c}}"))));
+    } else if sum {
+        body.push(gather("qs", lanes(&|k| format!("lane[{k}].q"))));
+    }
+    body.push(gather("pix", lanes(&|k| format!("lane[{k}].pixel"))));
+    body.push(gather("mask", lanes(&|k| format!("lane[{k}].in_span"))));
     body.push(Item::Blank);
 
     let x_step = lit(xw, (p as u64) % (1u64 << xw));

@@ -160,6 +160,12 @@ pub enum Item {
     Initial(Vec<Stmt>),
     /// `always @(*) begin ... end`: combinational checks of the formal properties.
     Comb(Vec<Stmt>),
+    /// `always @(*) name = {...};`: a bus of lanes (`lanes[0]` least significant) assembled by
+    /// one process. See [`gather`].
+    Gather {
+        name: String,
+        lanes: Vec<String>,
+    },
     /// Formal only: `reg [w-1:0] name = value;`, a register whose first value the solver
     /// knows (the `f_past` flags; the product RTL has no initial values).
     RegInit {
@@ -206,6 +212,24 @@ pub fn assign(lhs: impl Into<String>, rhs: impl Into<String>) -> Item {
 pub fn comment(text: impl Into<String>) -> Item {
     Item::Comment(text.into())
 }
+
+/// The bus `name` (a `reg`) assembled from `lanes`, least significant first, by one
+/// `always @(*)` concatenation, where `assign name[k*w +: w] = ...` would drive it lane by lane.
+///
+/// A bus driven lane by lane changes once per lane, and Icarus Verilog hands the whole bus to
+/// every reader at each change: P lanes changing in one clock cost P times the bus (O(P^2) bit
+/// copies, O(P^3) when P readers each take a lane). One process runs once per clock however
+/// many of its inputs change, so the bus changes once. Icarus builds a concatenation left to
+/// right, copying what it has built at each step; rows of eight lanes, nested, divide that
+/// copying by about eight (a few per cent of a P = 256 clock). Synthesis and Verilator see the
+/// same wires either way.
+pub fn gather(name: &str, lanes: Vec<String>) -> Item {
+    assert!(!lanes.is_empty(), "gather {name} from no lanes");
+    Item::Gather { name: name.into(), lanes }
+}
+
+/// Lanes per row of an [`Item::Gather`] concatenation.
+const GATHER_ROW: usize = 8;
 
 #[derive(Clone, Debug)]
 pub struct Param {
@@ -424,6 +448,27 @@ fn render_items(o: &mut String, items: &[Item], level: usize) {
                 indent(o, level);
                 o.push_str("end\n");
             }
+            Item::Gather { name, lanes } => {
+                o.push_str("always @(*) begin\n");
+                indent(o, level + 1);
+                // Most significant first, as a concatenation reads.
+                let rows: Vec<String> =
+                    lanes.chunks(GATHER_ROW).rev().map(|row| row.iter().rev().cloned().collect::<Vec<_>>().join(", ")).collect();
+                if let [row] = rows.as_slice() {
+                    writeln!(o, "{name} = {{{row}}};").unwrap();
+                } else {
+                    writeln!(o, "{name} = {{").unwrap();
+                    for (k, row) in rows.iter().enumerate() {
+                        indent(o, level + 2);
+                        let comma = if k + 1 < rows.len() { "," } else { "" };
+                        writeln!(o, "{{{row}}}{comma}").unwrap();
+                    }
+                    indent(o, level + 1);
+                    o.push_str("};\n");
+                }
+                indent(o, level);
+                o.push_str("end\n");
+            }
             Item::RegInit { name, width, value } => writeln!(o, "reg {}{name} = {value};", range(*width)).unwrap(),
             Item::Formal(items) => render_ifdef(o, "FORMAL", &labelled(items), &[], level),
             Item::IfDef { name, then, els } => render_ifdef(o, name, then, els, level),
@@ -608,6 +653,23 @@ mod tests {
         let text = m.render();
         assert!(text.contains("(\n  (* A = \"x\" *)\n  (* B = \"y\" *)\n  input  wire clk,"), "{text}");
         assert!(text.contains("clk, // \n  output wire y "), "{text}");
+    }
+
+    #[test]
+    fn gathers_rows_of_eight_most_significant_first() {
+        let render = |n: usize| {
+            let m = Module {
+                name: "t".into(),
+                header: vec![],
+                params: vec![],
+                ports: vec![],
+                body: vec![gather("b", (0..n).map(|k| format!("l{k}")).collect())],
+            };
+            m.render()
+        };
+        assert!(render(3).contains("  always @(*) begin\n    b = {l2, l1, l0};\n  end\n"), "{}", render(3));
+        let two = render(10);
+        assert!(two.contains("    b = {\n      {l9, l8},\n      {l7, l6, l5, l4, l3, l2, l1, l0}\n    };\n  end\n"), "{two}");
     }
 
     #[test]
