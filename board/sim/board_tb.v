@@ -1,0 +1,69 @@
+// board_tb — the simulation bench of segshade_ulx3s (Verilator --binary --timing). It waits for
+// led[0] (drawing done), then records the GPDI pins as a DVI receiver would: it samples every
+// half shift clock, aligns words on the clock channel (its rise starts a symbol: 0000011111 sent
+// LSB first), and writes each word of channels 0, 1, 2 as a line "c0 c1 c2" (hex) to the file
+// +out=FILE, FRAMES frames' worth and a margin, so one whole frame from its first active pixel
+// is inside whatever the phase. Exits with "board_tb: timeout" if drawing never ends.
+
+`timescale 1ns / 1ps
+`default_nettype none
+
+module board_tb;
+
+localparam integer WORDS = 2 * 800 * 525 + 1600;
+localparam integer TIMEOUT_MS = 50;
+
+reg clk_25mhz = 1'b0;
+always #20 clk_25mhz = ~clk_25mhz;
+
+/* verilator lint_off UNUSEDSIGNAL */
+wire [7:0] led;
+/* verilator lint_on UNUSEDSIGNAL */
+wire [3:0] gpdi_dp;
+segshade_ulx3s dut (.clk_25mhz(clk_25mhz), .btn(7'd0), .led(led), .gpdi_dp(gpdi_dp));
+
+reg [8*1024-1:0] out_name;
+integer fd;
+integer words = 0;
+reg [9:0] w0 = 10'd0, w1 = 10'd0, w2 = 10'd0;
+reg prev_clk_lane = 1'b0;
+reg armed = 1'b0;
+
+initial begin
+    if (!$value$plusargs("out=%s", out_name)) begin
+        $display("board_tb: no +out=FILE");
+        $finish;
+    end
+    fd = $fopen(out_name, "w");
+    // In 1 ms steps: one delay of 50 ms in picoseconds overflows Verilator's 32-bit delays.
+    repeat (TIMEOUT_MS) #1000000;
+    $display("board_tb: timeout: led[0] (drawing done) never rose");
+    $finish;
+end
+
+always @(posedge led[0]) begin
+    if (!armed) $display("board_tb: drawing done at %0t ps", $time);
+    armed = 1'b1;
+end
+
+// Half a shift period is 4 ns: sample 1 ns after each edge, away from the pins' changes.
+always @(dut.u_cells.clk_shift) begin
+    #1;
+    if (armed && gpdi_dp[3] && !prev_clk_lane) begin
+        $fwrite(fd, "%03x %03x %03x\n", w0, w1, w2);
+        words = words + 1;
+        if (words == WORDS) begin
+            $fclose(fd);
+            $display("board_tb: %0d words at %0t ps", words, $time);
+            $finish;
+        end
+    end
+    prev_clk_lane = gpdi_dp[3];
+    w0 = {gpdi_dp[0], w0[9:1]};
+    w1 = {gpdi_dp[1], w1[9:1]};
+    w2 = {gpdi_dp[2], w2[9:1]};
+end
+
+endmodule
+
+`default_nettype wire
