@@ -18,7 +18,7 @@ module EHXPLLL #(
     parameter FEEDBK_PATH = "CLKOP", parameter CLKFB_DIV = 1
 ) (
     input wire RST, input wire STDBY, input wire CLKI, output wire CLKOP, output wire CLKOS, output wire CLKOS2,
-    input wire CLKFB, output wire CLKINTFB, input wire PHASESEL0, input wire PHASESEL1, input wire PHASEDIR,
+    input wire CLKFB, input wire PHASESEL0, input wire PHASESEL1, input wire PHASEDIR,
     input wire PHASESTEP, input wire PHASELOADREG, input wire PLLWAKESYNC, input wire ENCLKOP, output wire LOCK
 );
 endmodule

@@ -49,8 +49,8 @@ fn quick_picture_equals_golden_and_faults_are_caught() {
     }
     // The same flip on all three channels stays grey but breaks the 2 x 2 doubling.
     let mut bad = one.clone();
-    for c in 0..3 {
-        bad[(y + 1) * frame::H_TOTAL + x + 1][c] ^= 1 << 3;
+    for symbol in bad[(y + 1) * frame::H_TOTAL + x + 1].iter_mut() {
+        *symbol ^= 1 << 3;
     }
     assert!(matches!(frame::decode_frame(&bad), Err(FrameError::NotDoubled { .. })));
     // A horizontal sync one clock late.
