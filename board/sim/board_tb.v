@@ -1,16 +1,17 @@
 // board_tb — the simulation bench of segshade_ulx3s (Verilator --binary --timing). It waits for
 // led[0] (drawing done), then records the GPDI pins as a DVI receiver would: it samples every
 // half shift clock, aligns words on the clock channel (its rise starts a symbol: 0000011111 sent
-// LSB first), and writes each word of channels 0, 1, 2 as a line "c0 c1 c2" (hex) to the file
-// +out=FILE, FRAMES frames' worth and a margin, so one whole frame from its first active pixel
-// is inside whatever the phase. Exits with "board_tb: timeout" if drawing never ends.
+// LSB first), and from the next vertical sync (a control symbol with c1 = 0 on channel 0) writes
+// each word of channels 0, 1, 2 as a line "c0 c1 c2" (hex) to the file +out=FILE: the rest of
+// the blanking and one whole frame, with a line's margin. Exits with "board_tb: timeout" if
+// drawing never ends.
 
 `timescale 1ns / 1ps
 `default_nettype none
 
 module board_tb;
 
-localparam integer WORDS = 2 * 800 * 525 + 1600;
+localparam integer WORDS = 800 * (525 - 490) + 800 * 525 + 800;
 localparam integer TIMEOUT_MS = 50;
 
 reg clk_25mhz = 1'b0;
@@ -28,6 +29,7 @@ integer words = 0;
 reg [9:0] w0 = 10'd0, w1 = 10'd0, w2 = 10'd0;
 reg prev_clk_lane = 1'b0;
 reg armed = 1'b0;
+reg recording = 1'b0;
 
 initial begin
     if (!$value$plusargs("out=%s", out_name)) begin
@@ -49,7 +51,8 @@ end
 // Half a shift period is 4 ns: sample 1 ns after each edge, away from the pins' changes.
 always @(dut.u_cells.clk_shift) begin
     #1;
-    if (armed && gpdi_dp[3] && !prev_clk_lane) begin
+    if (armed && gpdi_dp[3] && !prev_clk_lane && (w0 == 10'b1101010100 || w0 == 10'b0010101011)) recording = 1'b1;
+    if (recording && gpdi_dp[3] && !prev_clk_lane) begin
         $fwrite(fd, "%03x %03x %03x\n", w0, w1, w2);
         words = words + 1;
         if (words == WORDS) begin
