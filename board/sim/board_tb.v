@@ -4,7 +4,8 @@
 // LSB first), and from the next vertical sync (a control symbol with c1 = 0 on channel 0) writes
 // each word of channels 0, 1, 2 as a line "c0 c1 c2" (hex) to the file +out=FILE: the rest of
 // the blanking and one whole frame, with a line's margin. Exits with "board_tb: timeout" if
-// drawing never ends.
+// drawing never ends. With +redraw it first presses F1 (btn[1]) once drawing is done and records
+// after the drawing that press starts.
 
 `timescale 1ns / 1ps
 `default_nettype none
@@ -21,7 +22,8 @@ always #20 clk_25mhz = ~clk_25mhz;
 wire [7:0] led;
 /* verilator lint_on UNUSEDSIGNAL */
 wire [3:0] gpdi_dp;
-segshade_ulx3s dut (.clk_25mhz(clk_25mhz), .btn(7'd0), .led(led), .gpdi_dp(gpdi_dp));
+reg [6:0] btn = 7'd0;
+segshade_ulx3s dut (.clk_25mhz(clk_25mhz), .btn(btn), .led(led), .gpdi_dp(gpdi_dp));
 
 reg [8*1024-1:0] out_name;
 integer fd;
@@ -30,6 +32,7 @@ reg [9:0] w0 = 10'd0, w1 = 10'd0, w2 = 10'd0;
 reg prev_clk_lane = 1'b0;
 reg armed = 1'b0;
 reg recording = 1'b0;
+integer drawn = 0;
 
 initial begin
     if (!$value$plusargs("out=%s", out_name)) begin
@@ -44,8 +47,17 @@ initial begin
 end
 
 always @(posedge led[0]) begin
-    if (!armed) $display("board_tb: drawing done at %0t ps", $time);
-    armed = 1'b1;
+    drawn = drawn + 1;
+    $display("board_tb: drawing done at %0t ps", $time);
+    if (drawn == 1 && $test$plusargs("redraw")) begin
+        // F1 for 2 us; led[0] must fall and rise again, or the bench times out.
+        $display("board_tb: pressing F1");
+        btn[1] = 1'b1;
+        #2000;
+        btn[1] = 1'b0;
+    end else begin
+        armed = 1'b1;
+    end
 end
 
 // Half a shift period is 4 ns: sample 1 ns after each edge, away from the pins' changes.

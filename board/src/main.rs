@@ -32,6 +32,9 @@ struct Args {
     /// Write the RTL only; no simulation.
     #[arg(long)]
     rtl_only: bool,
+    /// Press F1 (btn[1]) in simulation once drawing is done, and record after the redraw.
+    #[arg(long)]
+    redraw: bool,
     /// Seed of the registers' random power-up values in simulation.
     #[arg(long, default_value_t = 1)]
     seed: u64,
@@ -95,7 +98,7 @@ fn run(
     let exe = sim::build(&rtl, &work)?;
     println!("verilated   {:.1} s", t.elapsed().as_secs_f64());
     let t = std::time::Instant::now();
-    let (rec, log) = sim::simulate(&exe, &rtl, &work, args.seed)?;
+    let (rec, log) = sim::simulate(&exe, &rtl, &work, args.seed, args.redraw)?;
     print!("{log}");
     println!("simulated   {:.1} s", t.elapsed().as_secs_f64());
     let text = std::fs::read_to_string(&rec).with_context(|| format!("reading {}", rec.display()))?;

@@ -61,8 +61,9 @@ pub fn build(rtl: &Path, work: &Path) -> Result<PathBuf, SimError> {
 }
 
 /// Runs the bench in `rtl` (where `$readmemh` finds the ROM image), registers powering up
-/// random from `seed`; returns the recording's path and the bench's output.
-pub fn simulate(exe: &Path, rtl: &Path, work: &Path, seed: u64) -> Result<(PathBuf, String), SimError> {
+/// random from `seed`; with `redraw`, F1 is pressed once the first drawing is done and the
+/// recording follows the second. Returns the recording's path and the bench's output.
+pub fn simulate(exe: &Path, rtl: &Path, work: &Path, seed: u64, redraw: bool) -> Result<(PathBuf, String), SimError> {
     let rec = work.join("recording.txt");
     let _ = std::fs::remove_file(&rec);
     let exe = std::path::absolute(exe).map_err(|error| SimError::Io { what: format!("{}", exe.display()), error })?;
@@ -71,6 +72,9 @@ pub fn simulate(exe: &Path, rtl: &Path, work: &Path, seed: u64) -> Result<(PathB
         .arg(format!("+out={}", std::path::absolute(&rec).unwrap_or(rec.clone()).display()))
         .arg("+verilator+rand+reset+2")
         .arg(format!("+verilator+seed+{}", seed.max(1)));
+    if redraw {
+        cmd.arg("+redraw");
+    }
     let log = run(&mut cmd, "the simulation")?;
     if !log.contains(" words at ") {
         return Err(SimError::NoRecording(log));
