@@ -3,13 +3,13 @@
 //
 // EHXPLLL: 25 MHz in, VCO 625 MHz (CLKFB from CLKOP: 25 * 5 = 125, CLKOP_DIV 5), CLKOP 125 MHz
 // (TMDS shift, DDR: 10 bits a pixel), CLKOS 25 MHz (pixels; 640x480 nominally wants 25.175),
-// CLKOS2 625 / DRAW_DIV (the drawing clock; 24: 26.04 MHz). ODDRX1F: D0 is sent in the half
+// CLKOS2 625 / DRAW_DIV (the drawing clock; 16: 39.06 MHz). ODDRX1F: D0 is sent in the half
 // after the rising edge, D1 after the falling edge.
 
 `default_nettype none
 
 module board_cells #(
-    parameter DRAW_DIV = 24
+    parameter DRAW_DIV = 16
 ) (
     input wire clk_in,
     output wire clk_pix,

@@ -6,7 +6,7 @@
 `default_nettype none
 
 module board_cells #(
-    parameter DRAW_DIV = 24
+    parameter DRAW_DIV = 16
 ) (
     /* verilator lint_off UNUSEDSIGNAL */
     input wire clk_in,   // the model runs its own clocks

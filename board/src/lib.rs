@@ -20,6 +20,12 @@ use hdl_gen::GeneratedFile;
 /// The frame buffer's screen: 640 x 480 with every pixel doubled.
 pub const SCREEN: Screen = Screen { width: frame::WIDTH as u32, height: frame::HEIGHT as u32 };
 
+/// The chain's register stages (`generate --pipeline 1`) and the front-end's quotient bits a
+/// clock (`--fe-div-bits 2`): the fastest front-end measured on the ECP5-85F (47.5 MHz alone,
+/// docs/fpga.md), where level 0 is 17 MHz. Both leave every value as golden computes it.
+pub const PIPELINE: u32 = 1;
+pub const FE_DIV_BITS: u32 = 2;
+
 /// The hand-written RTL, written beside the generated files.
 pub const HAND_WRITTEN: [(&str, &str); 4] = [
     ("board_fb.v", include_str!("../rtl/board_fb.v")),
@@ -62,7 +68,13 @@ pub fn fixed(cfg: &Config, tris: &[Triangle]) -> Vec<FixedTriangle> {
 
 /// Every file of the board's RTL folder: the chain's modules, the board's, the ROM image.
 pub fn rtl_files(cfg: &Config, tris: &[FixedTriangle]) -> Result<Vec<GeneratedFile>, RtlError> {
-    let opts = hdl_gen::Options { cfg: *cfg, screen: Some(SCREEN), ..Default::default() };
+    let opts = hdl_gen::Options {
+        cfg: *cfg,
+        screen: Some(SCREEN),
+        pipeline: golden::pipeline::Pipeline::at(PIPELINE),
+        fe_div_bits: Some(FE_DIV_BITS),
+        ..Default::default()
+    };
     let names = hdl_gen::Names::new("", cfg);
     let hw = opts.frontend()?;
     let w = opts.writer()?;
