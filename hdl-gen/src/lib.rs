@@ -3,6 +3,7 @@
 
 pub mod axis;
 pub mod bfpi;
+pub mod board;
 pub mod formal;
 pub mod frontend;
 pub mod manifest;

@@ -1,0 +1,164 @@
+//! The board top, simulated: the quick picture (`tests/quick.txt`) through the Verilator
+//! model of segshade_ulx3s, one frame recorded at the pins after drawing ends, decoded, equal to
+//! golden's picture; and the negative controls: a symbol's bit flipped, a sync misplaced, a
+//! frame-buffer write dropped in the RTL (the last one builds a second model: `--ignored`).
+
+use segshade_board::frame::{self, Clock, FrameError};
+use segshade_board::{config, differences, expected, fixed, rtl_files, sim};
+use std::path::Path;
+
+const QUICK: &str = include_str!("quick.txt");
+
+/// Generates the board's RTL for `tris` into `dir/rtl` (after `mutate` edits its files), builds
+/// it, and returns the simulation's executable, golden's picture and the configuration.
+fn build(dir: &Path, text: &str, mutate: impl Fn(&mut Vec<hdl_gen::GeneratedFile>)) -> (std::path::PathBuf, Vec<u8>) {
+    let cfg = config(8).unwrap();
+    let tris = fixed(&cfg, &golden::setup::parse_triangles(text).unwrap());
+    let mut files = rtl_files(&cfg, &tris).unwrap();
+    mutate(&mut files);
+    let rtl = dir.join("rtl");
+    hdl_gen::output::write_all(&rtl, &files).unwrap();
+    (sim::build(&rtl, &dir.join("sim")).unwrap(), expected(&cfg, &tris).unwrap())
+}
+
+/// Simulates the build in `dir`; returns one recorded frame and the bench's output.
+fn simulate(dir: &Path, exe: &Path, redraw: bool) -> (Vec<Clock>, String) {
+    let (rec, log) = sim::simulate(exe, &dir.join("rtl"), &dir.join("sim"), 7, redraw).unwrap();
+    eprint!("{log}");
+    let clocks = frame::parse_recording(&std::fs::read_to_string(rec).unwrap()).unwrap();
+    let start = frame::frame_start(&clocks).unwrap();
+    (clocks[start..start + frame::CLOCKS].to_vec(), log)
+}
+
+#[test]
+fn quick_picture_equals_golden_and_faults_are_caught() {
+    let dir = tempfile::tempdir().unwrap();
+    let (exe, want) = build(dir.path(), QUICK, |_| {});
+    // Registers and RAM power up random: the clear is what makes the background golden's 0.
+    let (one, _) = simulate(dir.path(), &exe, false);
+    let got = frame::decode_frame(&one).expect("valid DVI");
+    let drawn = want.iter().filter(|&&v| v != 0).count();
+    assert!(drawn > 10_000, "the quick picture draws something ({drawn} pixels)");
+    assert_eq!(differences(&want, &got), (0, None), "the board's frame equals golden's picture");
+    assert_eq!(frame::tmds_bin(&one).len(), frame::CLOCKS * 6);
+
+    // A bit of one video symbol flipped: the pixel decodes to another value (so it is no longer
+    // grey, or no longer doubled, or differs from golden), whichever bit it is.
+    let (x, y) = (2 * 80, 2 * 60);
+    for bit in 0..10 {
+        let mut bad = one.clone();
+        bad[y * frame::H_TOTAL + x][1] ^= 1 << bit;
+        match frame::decode_frame(&bad) {
+            Err(FrameError::NotGrey { .. } | FrameError::Period { .. }) => {}
+            other => panic!("bit {bit} flipped at ({x}, {y}): {other:?}"),
+        }
+    }
+    // The same flip on all three channels stays grey but breaks the 2 x 2 doubling.
+    let mut bad = one.clone();
+    for symbol in bad[(y + 1) * frame::H_TOTAL + x + 1].iter_mut() {
+        *symbol ^= 1 << 3;
+    }
+    assert!(matches!(frame::decode_frame(&bad), Err(FrameError::NotDoubled { .. })));
+    // A horizontal sync one clock late.
+    let mut bad = one.clone();
+    bad[10 * frame::H_TOTAL + frame::H_SYNC.end] = bad[10 * frame::H_TOTAL + frame::H_SYNC.start];
+    assert!(matches!(frame::decode_frame(&bad), Err(FrameError::Sync { .. })));
+
+    // F1 once the picture is done: done falls (or the bench would time out), the buffer is
+    // cleared and drawn again, and the frame after it is golden's too.
+    let (again, log) = simulate(dir.path(), &exe, true);
+    assert_eq!(log.matches("drawing done").count(), 2, "{log}");
+    assert_eq!(differences(&want, &frame::decode_frame(&again).expect("valid DVI")), (0, None), "the redrawn frame");
+}
+
+/// The RTL negative control: `board_draw` drops every block write to one address the quick
+/// picture writes; the simulated frame must differ from golden's there.
+#[test]
+#[ignore = "builds a second Verilator model (~30 s); run with --ignored"]
+fn dropped_frame_buffer_write_is_caught() {
+    let cfg = config(8).unwrap();
+    let want = expected(&cfg, &fixed(&cfg, &golden::setup::parse_triangles(QUICK).unwrap())).unwrap();
+    let first = want.iter().position(|&v| v != 0).unwrap() as u32;
+    let w = golden::writer::Writer::new(cfg, segshade_board::SCREEN).unwrap();
+    let addr = w.addr(first % w.screen.width, first / w.screen.width);
+    let dir = tempfile::tempdir().unwrap();
+    let (exe, _) = build(dir.path(), QUICK, |files| {
+        let f = files.iter_mut().find(|f| f.name == "board_draw.v").unwrap();
+        let from = "(drawing && mem_valid) ? mem_we";
+        assert!(f.contents.contains(from), "the mutation's site");
+        f.contents = f.contents.replace(from, &format!("(drawing && mem_valid && mem_addr != {addr}) ? mem_we"));
+    });
+    let (one, _) = simulate(dir.path(), &exe, false);
+    let got = frame::decode_frame(&one).expect("still valid DVI");
+    let (n, at) = differences(&want, &got);
+    assert!(n > 0, "a dropped write at block {addr} went unnoticed");
+    eprintln!("dropped writes to block {addr}: {n} pixels differ, first {at:?}");
+}
+
+#[test]
+fn a_file_too_large_for_the_rom_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let file = dir.path().join("many.txt");
+    let line = "1 1 10  5 1 20  1 5 30\n";
+    std::fs::write(&file, line.repeat(hdl_gen::board::MAX_TRIANGLES + 1)).unwrap();
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_board"))
+        .args(["ulx3s-85f", "--triangles"])
+        .arg(&file)
+        .arg("--out")
+        .arg(dir.path().join("out"))
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(err.contains("2049 triangles") && err.contains("at most 2048"), "{err}");
+    assert!(!dir.path().join("out").exists(), "nothing written");
+    // At the limit it is taken.
+    std::fs::write(&file, line.repeat(hdl_gen::board::MAX_TRIANGLES)).unwrap();
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_board"))
+        .args(["ulx3s-85f", "--rtl-only", "--triangles"])
+        .arg(&file)
+        .arg("--out")
+        .arg(dir.path().join("out"))
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+}
+
+/// Lints the RTL folder `rtl` as docs/board.md says: Verilator `-Wall` and Icarus `-g2005`, with
+/// the ECP5 cells' port-only stubs; returns the first tool's complaint, if any.
+fn lint(rtl: &Path) -> Result<(), String> {
+    let stub = Path::new(env!("CARGO_MANIFEST_DIR")).join("lint/ecp5_cells_stub.v");
+    let mut sources: Vec<std::path::PathBuf> =
+        std::fs::read_dir(rtl).unwrap().map(|e| e.unwrap().path()).filter(|p| p.extension().is_some_and(|e| e == "v")).collect();
+    sources.sort();
+    sources.push(stub);
+    let vvp = rtl.join("top.vvp");
+    let runs: [(&str, Vec<std::ffi::OsString>); 2] = [
+        ("verilator", ["--lint-only", "-Wall", "--top-module", "segshade_ulx3s"].iter().map(Into::into).collect()),
+        ("iverilog", vec!["-g2005".into(), "-s".into(), "segshade_ulx3s".into(), "-o".into(), vvp.into_os_string()]),
+    ];
+    for (tool, args) in runs {
+        let out = std::process::Command::new(tool).args(args).args(&sources).output().unwrap();
+        let text = format!("{}{}", String::from_utf8_lossy(&out.stdout), String::from_utf8_lossy(&out.stderr));
+        if !out.status.success() || !text.trim().is_empty() {
+            return Err(format!("{tool}: {text}"));
+        }
+    }
+    Ok(())
+}
+
+#[test]
+fn board_rtl_is_lint_clean_verilog_2005() {
+    let cfg = config(8).unwrap();
+    let tris = fixed(&cfg, &golden::setup::parse_triangles(QUICK).unwrap());
+    let mut files = rtl_files(&cfg, &tris).unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    hdl_gen::output::write_all(&dir.path().join("ok"), &files).unwrap();
+    lint(&dir.path().join("ok")).unwrap();
+    // Negative control: an unused register planted in the video side must be reported.
+    let f = files.iter_mut().find(|f| f.name == "board_video.v").unwrap();
+    f.contents = f.contents.replace("reg [9:0] hx;", "reg [9:0] hx;\nreg planted;");
+    hdl_gen::output::write_all(&dir.path().join("bad"), &files).unwrap();
+    let err = lint(&dir.path().join("bad")).unwrap_err();
+    assert!(err.contains("planted"), "{err}");
+}
