@@ -150,7 +150,6 @@ fn render_rejects_every_bad_flag_and_input_file() {
         (vec!["--obj", &flat, "--out", o], "no extent".into()),
         (vec!["--obj", &no_faces, "--triangles", g, "--out", o], "--obj".into()),
         (vec!["--triangles", g, "--out", o, "--writer", "disk"], "--writer".into()),
-        (vec!["--triangles", g, "--out", o, "--writer", "rtl", "--width", "320"], "--writer rtl".into()),
     ];
     let Some(model) = default_model_args("cli_harness: render's bad flags and files") else { return };
     let before = listing(&dir);

@@ -47,6 +47,7 @@ mod axis;
 mod bfpi;
 mod cli_harness;
 mod frontend;
+mod ondemand;
 mod reliability;
 mod render;
 mod segment;

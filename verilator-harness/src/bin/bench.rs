@@ -39,6 +39,7 @@ use std::process::ExitCode;
 use std::time::Instant;
 use verilator_harness::cosim::{Report, SegmentCosim, Stim};
 use verilator_harness::ffi::{segment_model, specular_unit, to_port, SPECULAR_MODELS};
+use verilator_harness::ondemand;
 use verilator_harness::specular::{random_span, SpecularCosim};
 use verilator_harness::stimulus::random_triangle;
 use verilator_harness::traffic::{state_of, Traffic};
@@ -225,9 +226,9 @@ fn seg_record_bytes(p: u32) -> u32 {
 }
 
 fn gen_segment(p: u32, count: usize, seed: u64, traffic: Traffic, out: &std::path::Path) -> ExitCode {
-    let Some(info) = segment_model(p, Align::Span) else {
-        eprintln!("error: no segment shader model for p = {p}");
-        return ExitCode::from(2);
+    let info = match ondemand::options(p, Align::Span, None).and_then(|o| ondemand::segment(&o)) {
+        Ok(info) => info,
+        Err(e) => return ondemand::exit(&format!("--p {p}"), &e),
     };
     let cfg = info.cfg;
     let screen = Screen::default();
@@ -367,7 +368,9 @@ fn harness(path: &std::path::Path, limit: usize) -> ExitCode {
     let mut report = Report::default();
     let (tag, (secs, cpu)) = match h.design {
         0 => {
-            let info = segment_model(h.p, Align::Span).unwrap_or_else(|| panic!("no segment model for p = {}", h.p));
+            let info = ondemand::options(h.p, Align::Span, None)
+                .and_then(|o| ondemand::segment(&o))
+                .unwrap_or_else(|e| panic!("the segment shader for p = {}: {e}", h.p));
             let stims: Vec<Stim> = recs
                 .iter()
                 .map(|r| Stim { triangle: r[6] as usize, y: r[7], span: Span { x0: r[0], len: r[1], i0: r[2], di: from_port(r[3], h.dw) } })
