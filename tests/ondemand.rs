@@ -116,3 +116,30 @@ fn a_configuration_generate_refuses_is_a_usage_error() {
         assert!(e.to_string().contains(needle), "{e}");
     }
 }
+
+/// COSIM_RTL_DIR's rule for a relative path: from the process's folder when it exists there, else
+/// from the workspace's root (cargo runs build scripts and tests in the package's folder, so
+/// `COSIM_RTL_DIR=rtl` typed at the root means `<root>/rtl`); an absolute path is itself.
+#[test]
+fn a_relative_cosim_rtl_dir_is_found_from_the_workspace_root() {
+    use std::path::Path;
+    use verilator_harness::models::catalogue::resolve_rtl_dir;
+    let package = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let root = package.parent().expect("the workspace");
+    let rtl = resolve_rtl_dir(Path::new("rtl"), package, package);
+    assert_eq!(rtl, root.join("rtl"));
+    assert!(rtl.join(hdl_gen::manifest::MANIFEST_FILE).is_file(), "{}: the repository's rtl/", rtl.display());
+    // A folder that exists from the process's own folder is that one; an absolute path is kept.
+    assert_eq!(resolve_rtl_dir(Path::new("csrc"), package, package), package.join("csrc"));
+    assert_eq!(resolve_rtl_dir(&root.join("rtl"), package, package), root.join("rtl"));
+    // From the root, the same relative path is the same folder.
+    assert_eq!(resolve_rtl_dir(Path::new("rtl"), root, package), root.join("rtl"));
+    // The folder's models, described from it, are the catalogue's circuits: checking an
+    // unmodified generate folder builds nothing.
+    let manifest = verilator_harness::models::catalogue::read_manifest(&rtl);
+    let models = verilator_harness::models::catalogue::models_from_dir(&rtl, &manifest).unwrap_or_else(|e| panic!("{e}"));
+    let seg = models.iter().find(|m| m.kind == Kind::Segment && m.axis.is_none()).expect("rtl/ has a segment shader");
+    if on_demand("ondemand: rtl/ against the catalogue") {
+        assert!(SEGMENT_MODELS.iter().any(|c| c.identity() == seg.identity()), "rtl/'s {} is not the catalogue's", seg.tag);
+    }
+}

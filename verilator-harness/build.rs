@@ -52,7 +52,11 @@ fn main() {
     let root = out.ancestors().nth(3).map_or_else(|| out.join("cache"), |p| p.join("segshade-models"));
     println!("cargo:rustc-env=SEGSHADE_MODEL_CACHE={}", root.display());
     println!("cargo:rustc-env=SEGSHADE_TARGET={}", std::env::var("TARGET").unwrap());
-    let rtl_dir = std::env::var_os("COSIM_RTL_DIR").map(|d| rtl_dir(Path::new(&d)));
+    let package = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let rtl_dir = std::env::var_os("COSIM_RTL_DIR").map(|d| {
+        let dir = catalogue::resolve_rtl_dir(Path::new(&d), package, package);
+        dir.canonicalize().unwrap_or_else(|e| panic!("COSIM_RTL_DIR={}: {e}", dir.display()))
+    });
     let manifest = rtl_dir.as_deref().map(|dir| {
         println!("cargo:rerun-if-changed={}", dir.display());
         (dir, catalogue::read_manifest(dir))
@@ -103,19 +107,6 @@ fn main() {
     // of models is this build's, written where tests/segment.rs includes it.
     let seg: Vec<&str> = models.iter().filter(|m| m.kind == Kind::Segment && m.axis.is_none()).map(|m| m.tag.as_str()).collect();
     fs::write(out.join("segment_slices.rs"), format!("random_triangle_slices!({});\n", seg.join(", "))).unwrap();
-}
-
-/// COSIM_RTL_DIR as a folder to read. A relative path is taken from the folder cargo was started
-/// in, which a build script is not told: cargo runs it in the package's folder
-/// (`verilator-harness/`), so a path that does not exist there is taken from the workspace's root
-/// (`COSIM_RTL_DIR=rtl cargo test -p verilator-harness`, typed at the root, reads `<root>/rtl`).
-fn rtl_dir(dir: &Path) -> PathBuf {
-    let package = Path::new(env!("CARGO_MANIFEST_DIR"));
-    let dir = match dir.is_relative() && !package.join(dir).exists() {
-        true => package.parent().expect("the package sits in the workspace").join(dir),
-        false => package.join(dir),
-    };
-    dir.canonicalize().unwrap_or_else(|e| panic!("COSIM_RTL_DIR={}: {e}", dir.display()))
 }
 
 /// The runtime files the lists ask for, each once, in the order first asked.

@@ -47,6 +47,19 @@ impl SpecTables {
     }
 }
 
+/// COSIM_RTL_DIR as a folder to read, `cwd` being the folder of the process that reads it. A
+/// relative path is taken from the folder the user typed the command in, which neither a build
+/// script nor a test is told: cargo runs both in the package's folder (`verilator-harness/`). So a
+/// relative path that does not exist from `cwd` is taken from the workspace's root, the package's
+/// parent (`COSIM_RTL_DIR=rtl cargo test -p verilator-harness`, typed at the root, reads
+/// `<root>/rtl`). An absolute path is itself.
+pub fn resolve_rtl_dir(dir: &Path, cwd: &Path, package: &Path) -> std::path::PathBuf {
+    match dir.is_relative() && !cwd.join(dir).exists() {
+        true => package.parent().unwrap_or(package).join(dir),
+        false => cwd.join(dir),
+    }
+}
+
 /// `DIR/manifest.json`, read as the generator's own schema (`hdl_gen::manifest::Manifest`), or
 /// the build stops saying why.
 pub fn read_manifest(dir: &Path) -> Manifest {
