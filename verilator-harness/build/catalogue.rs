@@ -120,252 +120,104 @@ fn geometry_diff(stated: &SpecularGeometry, built: &SpecularGeometry) -> String 
         .join("; ")
 }
 
+/// The catalogue: every model build.rs compiles in, each the model of one kind that `generate`
+/// makes for one configuration (described as any other configuration is, [`model_of`]), under
+/// its own tag. Its order is the lists' order in `ffi`.
 pub fn generated_models() -> Vec<Model> {
-    let mut models = Vec::new();
-    let spec_names = hdl_gen::specular::SpecNames::new("");
+    let mut described: std::collections::HashMap<String, Vec<Model>> = std::collections::HashMap::new();
+    entries()
+        .into_iter()
+        .map(|(tag, kind, opts)| {
+            // One generation per configuration: many entries share one.
+            let models = described
+                .entry(format!("{opts:?}"))
+                .or_insert_with(|| models_of_options(&opts, "").unwrap_or_else(|e| panic!("{tag}: {e}")));
+            let axis = opts.bus == hdl_gen::Bus::Axis;
+            let m = pick(models, kind, axis).unwrap_or_else(|e| panic!("{tag}: {e}"));
+            Model { tag, ..m }
+        })
+        .collect()
+}
+
+/// The catalogue's entries: (tag, kind, configuration).
+fn entries() -> Vec<(String, Kind, hdl_gen::Options)> {
+    use hdl_gen::Options;
+    let all_chains = std::env::var_os("SEGSHADE_ALL_CHAINS").is_some();
+    let mut e: Vec<(String, Kind, Options)> = Vec::new();
     // The specular unit as SPEC's seed builds it, then split for clock rate (`--pipeline 1`;
     // level 2 adds nothing to the unit).
-    for pipeline in [Pipeline::NONE, Pipeline::at(1)] {
-        let opts = hdl_gen::Options { pipeline, ..Default::default() };
-        let tag = if pipeline == Pipeline::NONE { "spec".to_string() } else { format!("spec_pl{pipeline}") };
-        models.push(Model {
-            tag,
-            kind: Kind::Specular,
-            cfg: Config::default(),
-            di: DiMode::Triangle,
-            screen: Screen::default(),
-            top: spec_names.unit.clone(),
-            latency: opts.specular_unit().plan().latency(),
-            pipeline,
-            axis: None,
-            sources: hdl_gen::generate(&opts)
-                .into_iter()
-                .filter(|f| f.name.ends_with(".hex") || f.name.starts_with("specular_"))
-                .map(|f| (f.name, f.contents))
-                .collect(),
-        });
-    }
+    e.push(("spec".into(), Kind::Specular, Options::default()));
+    e.push(("spec_pl1".into(), Kind::Specular, Options { pipeline: Pipeline::at(1), ..Default::default() }));
     for p in BUILT_P {
         for align in Align::ALL {
-            let cfg = Config { p, align, ..Config::default() };
-            let files = hdl_gen::generate(&hdl_gen::Options { cfg, ..Default::default() });
-            let sources: Vec<(String, String)> =
-                files.into_iter().filter(|f| f.name.ends_with(".v")).map(|f| (f.name, f.contents)).collect();
-            let names = hdl_gen::Names::new("", &cfg);
+            let o = Options { cfg: Config { p, align, ..Config::default() }, ..Default::default() };
+            let with = |f: &dyn Fn(&mut Options)| {
+                let mut o = o.clone();
+                f(&mut o);
+                o
+            };
             if align == Align::Span {
-                let bfpi = sources.iter().filter(|(n, _)| *n == format!("{}.v", names.bfpi)).cloned().collect();
-                models.push(Model {
-                    tag: format!("bfpi_p{p}"),
-                    kind: Kind::Bfpi,
-                    cfg,
-                    di: DiMode::Triangle,
-                    screen: Screen::default(),
-                    top: names.bfpi.clone(),
-                    latency: 0,
-                    pipeline: Pipeline::NONE,
-                    axis: None,
-                    sources: bfpi,
-                });
+                e.push((format!("bfpi_p{p}"), Kind::Bfpi, o.clone()));
             }
-            let latency = golden::segment::latency(&cfg, Pipeline::NONE);
             // The chain at every P and alignment only on request (`sweep`'s front-end table):
             // each is a few seconds of compiling that the test suite does not need.
-            if BUILT_TRI.contains(&(p, align)) || std::env::var_os("SEGSHADE_ALL_CHAINS").is_some() {
-                let opts = hdl_gen::Options { cfg, screen: Some(Screen::default()), ..Default::default() };
-                let hw = opts.frontend().expect("640x480 front-end");
-                let fe = hw.fe;
-                let (fe_lat, top_lat) = (hw.latency(), hw.latency() + latency);
+            if BUILT_TRI.contains(&(p, align)) || all_chains {
                 if p == 8 && align == Align::Span {
-                    let src = sources.iter().filter(|(n, _)| *n == format!("{}.v", names.frontend)).cloned().collect();
-                    models.push(Model {
-                        tag: "fe".into(),
-                        kind: Kind::Frontend,
-                        cfg,
-                        di: DiMode::Triangle,
-                        screen: fe.screen,
-                        top: names.frontend.clone(),
-                        latency: fe_lat,
-                        pipeline: Pipeline::NONE,
-                        axis: None,
-                        sources: src,
-                    });
+                    e.push(("fe".into(), Kind::Frontend, o.clone()));
                     // The classical per-scanline dI (`--fe-di scanline`), the comparison option.
-                    let scan = hdl_gen::frontend::Hw { fe: fe.with_di(DiMode::Scanline), ..hw };
-                    let m = hdl_gen::frontend::module(&scan, &names);
-                    models.push(Model {
-                        tag: "fe_scan".into(),
-                        kind: Kind::Frontend,
-                        cfg,
-                        di: DiMode::Scanline,
-                        screen: fe.screen,
-                        top: m.name.clone(),
-                        latency: scan.latency(),
-                        pipeline: Pipeline::NONE,
-                        axis: None,
-                        sources: vec![(format!("{}.v", m.name), m.render())],
-                    });
+                    e.push(("fe_scan".into(), Kind::Frontend, with(&|o| o.fe_di = DiMode::Scanline)));
                     // The set-up and the span path in stages (`--pipeline 1` and above: one
                     // front-end for them all); with the per-scanline dI too on request (a
                     // comparison option's, as `sweep`'s chains; `scripts/check-rtl-dir` also
                     // checks one such folder through COSIM_RTL_DIR).
-                    let staged_di: &[(&str, DiMode)] = if std::env::var_os("SEGSHADE_ALL_CHAINS").is_some() {
-                        &[("fe_pl1", DiMode::Triangle), ("fe_scan_pl1", DiMode::Scanline)]
-                    } else {
-                        &[("fe_pl1", DiMode::Triangle)]
-                    };
-                    for &(tag, di) in staged_di {
-                        let staged = hdl_gen::frontend::Hw { fe: fe.with_di(di), pipeline: Pipeline::at(1), ..hw };
-                        let m = hdl_gen::frontend::module(&staged, &names);
-                        models.push(Model {
-                            tag: tag.into(),
-                            kind: Kind::Frontend,
-                            cfg,
-                            di,
-                            screen: fe.screen,
-                            top: m.name.clone(),
-                            latency: staged.latency(),
-                            pipeline: staged.pipeline,
-                            axis: None,
-                            sources: vec![(format!("{}.v", m.name), m.render())],
-                        });
+                    e.push(("fe_pl1".into(), Kind::Frontend, with(&|o| o.pipeline = Pipeline::at(1))));
+                    if all_chains {
+                        let staged = with(&|o| (o.pipeline, o.fe_di) = (Pipeline::at(1), DiMode::Scanline));
+                        e.push(("fe_scan_pl1".into(), Kind::Frontend, staged));
                     }
                     // The other divider rates (`--fe-div-bits`), so co-simulation covers every option.
-                    for div_bits in hdl_gen::frontend::DIV_BITS.into_iter().filter(|&b| b != hw.div_bits) {
-                        let hw = hdl_gen::frontend::Hw { div_bits, ..hw };
-                        let m = hdl_gen::frontend::module(&hw, &names);
-                        let src = vec![(format!("{}.v", m.name), m.render())];
-                        models.push(Model {
-                            tag: format!("fe_div{div_bits}"),
-                            kind: Kind::Frontend,
-                            cfg,
-                            di: DiMode::Triangle,
-                            screen: fe.screen,
-                            top: m.name,
-                            latency: hw.latency(),
-                            pipeline: Pipeline::NONE,
-                            axis: None,
-                            sources: src,
-                        });
+                    for b in hdl_gen::frontend::DIV_BITS.into_iter().filter(|&b| b != hdl_gen::frontend::DEFAULT_DIV_BITS) {
+                        e.push((format!("fe_div{b}"), Kind::Frontend, with(&|o| o.fe_div_bits = Some(b))));
                     }
                 }
-                let chain = [&names.bfpi, &names.segment, &names.frontend, &names.top].map(|n| format!("{n}.v"));
-                let src: Vec<(String, String)> = sources.iter().filter(|(n, _)| chain.contains(n)).cloned().collect();
-                if BUILT_TRI.contains(&(p, align)) && std::env::var_os("SEGSHADE_ALL_CHAINS").is_some() {
+                if BUILT_TRI.contains(&(p, align)) && all_chains {
                     // The chain with the per-scanline dI, for `sweep`'s comparison.
-                    let scan = hdl_gen::frontend::Hw { fe: fe.with_di(DiMode::Scanline), ..hw };
-                    let m = hdl_gen::frontend::module(&scan, &names);
-                    let mut src = src.clone();
-                    src.retain(|(n, _)| *n != format!("{}.v", names.frontend));
-                    src.push((format!("{}.v", m.name), m.render()));
-                    models.push(Model {
-                        tag: format!("tris_p{p}_{align}_scan"),
-                        kind: Kind::TriShader,
-                        cfg,
-                        di: DiMode::Scanline,
-                        screen: fe.screen,
-                        top: names.top.clone(),
-                        latency: scan.latency() + latency,
-                        pipeline: Pipeline::NONE,
-                        axis: None,
-                        sources: src,
-                    });
+                    e.push((format!("tris_p{p}_{align}_scan"), Kind::TriShader, with(&|o| o.fe_di = DiMode::Scanline)));
                 }
-                models.push(Model {
-                    tag: format!("tris_p{p}_{align}"),
-                    kind: Kind::TriShader,
-                    cfg,
-                    di: DiMode::Triangle,
-                    screen: fe.screen,
-                    top: names.top.clone(),
-                    latency: top_lat,
-                    pipeline: Pipeline::NONE,
-                    axis: None,
-                    sources: src,
-                });
+                e.push((format!("tris_p{p}_{align}"), Kind::TriShader, o.clone()));
             }
-            let all_chains = std::env::var_os("SEGSHADE_ALL_CHAINS").is_some();
             if BUILT_WR.contains(&(p, align)) || all_chains {
-                let src = sources.iter().filter(|(n, _)| *n == format!("{}.v", names.writer)).cloned().collect();
-                let (tag, top) = (format!("wr_p{p}_{align}"), names.writer.clone());
-                let latency = golden::writer::LATENCY;
-                models.push(Model {
-                    tag,
-                    kind: Kind::Writer,
-                    cfg,
-                    di: DiMode::Triangle,
-                    screen: Screen::default(),
-                    top,
-                    latency,
-                    pipeline: Pipeline::NONE,
-                    axis: None,
-                    sources: src,
-                });
+                e.push((format!("wr_p{p}_{align}"), Kind::Writer, o.clone()));
             }
             if BUILT_FB.contains(&(p, align)) || all_chains {
-                let opts = hdl_gen::Options { cfg, screen: Some(Screen::default()), ..Default::default() };
-                let chain =
-                    [&names.bfpi, &names.segment, &names.frontend, &names.top, &names.writer, &names.fb_top].map(|n| format!("{n}.v"));
-                let src = sources.iter().filter(|(n, _)| chain.contains(n)).cloned().collect();
-                let latency = opts.frontend().expect("640x480 front-end").latency() + latency + golden::writer::LATENCY;
-                let (tag, top) = (format!("trw_p{p}_{align}"), names.fb_top.clone());
-                models.push(Model {
-                    tag,
-                    kind: Kind::TriWriter,
-                    cfg,
-                    di: DiMode::Triangle,
-                    screen: Screen::default(),
-                    top,
-                    latency,
-                    pipeline: Pipeline::NONE,
-                    axis: None,
-                    sources: src,
-                });
+                e.push((format!("trw_p{p}_{align}"), Kind::TriWriter, o.clone()));
             }
-            let sources: Vec<(String, String)> =
-                sources.into_iter().filter(|(n, _)| *n == format!("{}.v", names.segment) || *n == format!("{}.v", names.bfpi)).collect();
             for level in BUILT_PIPE.iter().filter(|(bp, _, a)| *bp == p && a.is_none_or(|a| a == align)).map(|&(_, l, _)| l) {
                 let pipeline = Pipeline::new(level).expect("a built level exists");
-                let m = hdl_gen::segment::module_with(&cfg, &names, hdl_gen::BfpiArch::ShiftAdd, pipeline);
-                let mut src: Vec<(String, String)> =
-                    sources.iter().filter(|(n, _)| *n != format!("{}.v", names.segment)).cloned().collect();
-                src.push((format!("{}.v", m.name), m.render()));
-                models.push(Model {
-                    tag: format!("seg_p{p}_{align}_pl{level}"),
-                    kind: Kind::Segment,
-                    cfg,
-                    di: DiMode::Triangle,
-                    screen: Screen::default(),
-                    top: names.segment.clone(),
-                    latency: golden::segment::latency(&cfg, pipeline),
-                    pipeline,
-                    axis: None,
-                    sources: src,
-                });
+                e.push((format!("seg_p{p}_{align}_pl{level}"), Kind::Segment, with(&|o| o.pipeline = pipeline)));
             }
-            models.push(Model {
-                tag: format!("seg_p{p}_{align}"),
-                kind: Kind::Segment,
-                cfg,
-                di: DiMode::Triangle,
-                screen: Screen::default(),
-                top: names.segment,
-                latency,
-                pipeline: Pipeline::NONE,
-                axis: None,
-                sources,
-            });
+            e.push((format!("seg_p{p}_{align}"), Kind::Segment, o));
         }
     }
     // The AXI4-Stream wrappers (`--bus axis`) of the default shader and specular unit, driven
     // through their cores' structs: two models, so the default suite stays quick; COSIM_RTL_DIR
     // builds every wrapper its folder has.
-    let files = hdl_gen::generate(&hdl_gen::Options { bus: hdl_gen::Bus::Axis, ..Default::default() });
-    let text = |name: &str| files.iter().find(|f| f.name == name).map(|f| f.contents.clone()).expect("a generated file");
-    let manifest = Manifest::parse(&text(MANIFEST_FILE)).expect("the generated manifest reads back");
-    let names = hdl_gen::Names::new("", &Config::default());
-    let wanted = |w: &hdl_gen::axis::Wrapper| w.wraps == names.segment || w.wraps == spec_names.unit;
-    models.extend(axis_models(&models, &manifest, wanted, |file| Ok((file.to_string(), text(file)))).expect("the default wrappers"));
-    models
+    let axis = Options { bus: hdl_gen::Bus::Axis, ..Default::default() };
+    e.push(("seg_p8_span_axis".into(), Kind::Segment, axis.clone()));
+    e.push(("spec_axis".into(), Kind::Specular, axis));
+    e
+}
+
+/// The model of `kind` among `models` (its AXI4-Stream wrapper when `axis`).
+pub fn pick(models: &[Model], kind: Kind, axis: bool) -> Result<Model, String> {
+    let found = models.iter().find(|m| m.kind == kind && m.axis.is_some() == axis).cloned();
+    found.ok_or_else(|| format!("this configuration has no {kind:?} model{}", if axis { " with --bus axis" } else { "" }))
+}
+
+/// The model of `kind` that `generate` makes for `opts` (its AXI4-Stream wrapper with `--bus
+/// axis`), described from the files generated in memory, its tag ending in `suffix`.
+pub fn model_of(opts: &hdl_gen::Options, kind: Kind, suffix: &str) -> Result<Model, String> {
+    pick(&models_of_options(opts, suffix)?, kind, opts.bus == hdl_gen::Bus::Axis)
 }
 
 /// The models of one `generate` configuration, described by its manifest `m` (as `hdl-gen

@@ -294,11 +294,7 @@ pub fn describe(opts: &hdl_gen::Options, kind: Kind) -> Result<Model, ModelError
         opts.frontend().map_err(|e| ModelError::Config(format!("--width/--height: {e}")))?;
         opts.writer().map_err(|e| ModelError::Config(format!("--width/--height: {e}")))?;
     }
-    let axis = opts.bus == hdl_gen::Bus::Axis;
-    let models = catalogue::models_of_options(opts, &tag_suffix(opts)).map_err(ModelError::Config)?;
-    models.into_iter().find(|m| m.kind == kind && m.axis.is_some() == axis).ok_or_else(|| {
-        ModelError::Config(format!("this configuration has no {kind:?} model{}", if axis { " with --bus axis" } else { "" }))
-    })
+    catalogue::model_of(opts, kind, &tag_suffix(opts)).map_err(ModelError::Config)
 }
 
 /// The model of `kind` for `opts`: the compiled catalogue's when it has this very circuit, else
