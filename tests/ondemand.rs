@@ -111,7 +111,9 @@ fn the_catalogue_answers_what_it_has() {
 #[test]
 fn a_configuration_generate_refuses_is_a_usage_error() {
     for (p, screen, needle) in [(3, None, "power of two"), (8, Some(Screen { width: 9000, height: 480 }), "--width/--height")] {
-        let e = ondemand::options(p, Align::Span, screen).and_then(|o| ondemand::tri_shader(&o)).map(|m| m.tag).expect_err("refused");
+        // `describe`, not `tri_shader`: a COSIM_RTL_DIR build hands out its folder's chain by P and
+        // alignment, and the binaries check its screen themselves.
+        let e = ondemand::options(p, Align::Span, screen).and_then(|o| ondemand::describe(&o, Kind::TriShader)).expect_err("refused");
         assert_eq!(ondemand::exit_status(&e), 2, "{e}");
         assert!(e.to_string().contains(needle), "{e}");
     }

@@ -134,7 +134,7 @@ pub fn generated_models() -> Vec<Model> {
                 .or_insert_with(|| models_of_options(&opts, "").unwrap_or_else(|e| panic!("{tag}: {e}")));
             let axis = opts.bus == hdl_gen::Bus::Axis;
             let m = pick(models, kind, axis).unwrap_or_else(|e| panic!("{tag}: {e}"));
-            Model { tag, ..m }
+            Model { tag, options: Some(options_key(&opts)), ..m }
         })
         .collect()
 }
@@ -208,6 +208,15 @@ fn entries() -> Vec<(String, Kind, hdl_gen::Options)> {
     e
 }
 
+/// `opts` in one text, the same for options that generate the same files: the screen and the
+/// dividers' rate spelled out when left to their defaults.
+pub fn options_key(opts: &hdl_gen::Options) -> String {
+    let mut o = opts.clone();
+    o.screen = Some(o.screen.unwrap_or_else(|| hdl_gen::Options::default_screen(&o.cfg)));
+    o.fe_div_bits = Some(o.fe_div_bits.unwrap_or(hdl_gen::frontend::DEFAULT_DIV_BITS));
+    format!("{o:?}")
+}
+
 /// The model of `kind` among `models` (its AXI4-Stream wrapper when `axis`).
 pub fn pick(models: &[Model], kind: Kind, axis: bool) -> Result<Model, String> {
     let found = models.iter().find(|m| m.kind == kind && m.axis.is_some() == axis).cloned();
@@ -246,6 +255,7 @@ pub fn models_of_manifest(m: &Manifest, read: &dyn Fn(&str) -> Result<String, St
         pipeline,
         axis: None,
         sources,
+        options: None,
     };
     let (none, screen0, di0) = (Pipeline::NONE, Screen::default(), DiMode::Triangle);
     let sources = files_of(&[Role::Bfpi, Role::SegmentShader])?;

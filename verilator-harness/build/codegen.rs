@@ -109,8 +109,8 @@ pub fn models_rs(models: &[Model], twins: &[Model], trace_all: bool, rtl_dir: Op
             list,
             "    ModelInfo {{ tag: \"{t}\", top: \"{}\", latency: {}, pipeline: golden::pipeline::Pipeline::at({}), cfg: Config {{ p: {}, frac: {}, xbits: {}, align: Align::{align} }}, \
              screen: golden::setup::Screen {{ width: {}, height: {} }}, di: golden::frontend::DiMode::{:?}, \
-             new: {t}_new, free: {t}_free, step: {t}_step, traced: {traced}, identity: {:#x} }},",
-            m.top, m.latency, m.pipeline, c.p, c.frac, c.xbits, m.screen.width, m.screen.height, m.di, m.identity()
+             new: {t}_new, free: {t}_free, step: {t}_step, traced: {traced}, identity: {:#x}, options: {:?} }},",
+            m.top, m.latency, m.pipeline, c.p, c.frac, c.xbits, m.screen.width, m.screen.height, m.di, m.identity(), m.options
         )
         .unwrap();
     }

@@ -59,6 +59,10 @@ pub struct Model {
     /// `--bus axis`: the model is the AXI4-Stream wrapper `top` of the SPEC module of its kind,
     /// driven through the kind's per-clock structs, packed as this layout says.
     pub axis: Option<hdl_gen::axis::Wrapper>,
+    /// The catalogue's models: the configuration they were generated from
+    /// (`catalogue::options_key`), so that a model asked for with the same options is found
+    /// without generating it again.
+    pub options: Option<String>,
 }
 
 /// The suffix of a traced twin's tag (and symbols) after its model's.

@@ -280,6 +280,9 @@ pub struct ModelInfo<I: 'static, O: 'static> {
     /// The circuit's identity (`Model::identity`): a model asked for at run time is this one
     /// when its identity is.
     identity: u64,
+    /// The catalogue's models: the configuration they were generated from
+    /// (`catalogue::options_key`).
+    options: Option<&'static str>,
 }
 
 /// A model's traced twin (`verilator --trace-fst`, `csrc/trace.h`): the same RTL and the same
@@ -356,7 +359,12 @@ impl<I, O> ModelInfo<I, O> {
         step: StepFn<I, O>,
         identity: u64,
     ) -> Self {
-        ModelInfo { tag, top, latency, pipeline, cfg, screen, di, new, free, step, traced: None, identity }
+        ModelInfo { tag, top, latency, pipeline, cfg, screen, di, new, free, step, traced: None, identity, options: None }
+    }
+
+    /// A catalogue model's configuration (`catalogue::options_key`); `None` for the others.
+    pub fn options(&self) -> Option<&'static str> {
+        self.options
     }
 
     /// What circuit this is (`Model::identity` of its description).

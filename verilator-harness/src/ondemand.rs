@@ -315,6 +315,13 @@ fn model<I: 'static, O: 'static>(
             ))
         });
     }
+    // The catalogue's model of these very options, found without generating them (the binaries
+    // ask once per run, and generating every block of a configuration takes a noticeable part of
+    // a second).
+    let key = catalogue::options_key(opts);
+    if let Some(m) = compiled.iter().find(|m| m.options() == Some(key.as_str())) {
+        return Ok(m);
+    }
     find_or_load(compiled, &describe(opts, kind)?)
 }
 
