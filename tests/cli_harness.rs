@@ -185,7 +185,6 @@ fn render_rejects_every_bad_flag_and_input_file() {
         (vec!["--obj", &flat, "--out", o], "no extent".into()),
         (vec!["--obj", &no_faces, "--triangles", g, "--out", o], "--obj".into()),
         (vec!["--triangles", g, "--out", o, "--writer", "disk"], "--writer".into()),
-        (vec!["--triangles", g, "--out", o, "--writer", "rtl", "--width", "320"], "--writer rtl".into()),
         // The output is the input: by its name, through a link, or as the golden image's name.
         (vec!["--triangles", g, "--out", g], "is the input file".into()),
         (vec!["--triangles", g, "--out", alias.to_str().unwrap()], "is the input file".into()),

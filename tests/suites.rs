@@ -48,6 +48,7 @@ mod bfpi;
 mod cli_harness;
 mod frontend;
 mod readme;
+mod ondemand;
 mod reliability;
 mod render;
 mod render_cli;

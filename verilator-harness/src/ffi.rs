@@ -277,6 +277,12 @@ pub struct ModelInfo<I: 'static, O: 'static> {
     step: unsafe extern "C" fn(*mut c_void, *const I, *mut O),
     /// Its traced twin, when this build has one (see [`crate::waveform`]).
     pub traced: Option<TracedModel<I, O>>,
+    /// The circuit's identity (`Model::identity`): a model asked for at run time is this one
+    /// when its identity is.
+    identity: u64,
+    /// The catalogue's models: the configuration they were generated from
+    /// (`catalogue::options_key`).
+    options: Option<&'static str>,
 }
 
 /// A model's traced twin (`verilator --trace-fst`, `csrc/trace.h`): the same RTL and the same
@@ -334,6 +340,38 @@ pub fn specular_unit() -> SpecularUnit {
 pub type StepFn<I, O> = unsafe extern "C" fn(*mut c_void, *const I, *mut O);
 
 impl<I, O> ModelInfo<I, O> {
+    /// A model loaded at run time ([`crate::ondemand`]), from its shim's symbols.
+    ///
+    /// # Safety
+    /// `new`, `free` and `step` are the shim's `<tag>_new`, `_free` and `_step` of a model driven
+    /// through `I` and `O`.
+    #[allow(clippy::too_many_arguments)]
+    pub(crate) unsafe fn from_symbols(
+        tag: &'static str,
+        top: &'static str,
+        latency: u32,
+        pipeline: golden::pipeline::Pipeline,
+        cfg: Config,
+        screen: golden::setup::Screen,
+        di: golden::frontend::DiMode,
+        new: unsafe extern "C" fn(u64) -> *mut c_void,
+        free: unsafe extern "C" fn(*mut c_void),
+        step: StepFn<I, O>,
+        identity: u64,
+    ) -> Self {
+        ModelInfo { tag, top, latency, pipeline, cfg, screen, di, new, free, step, traced: None, identity, options: None }
+    }
+
+    /// A catalogue model's configuration (`catalogue::options_key`); `None` for the others.
+    pub fn options(&self) -> Option<&'static str> {
+        self.options
+    }
+
+    /// What circuit this is (`Model::identity` of its description).
+    pub fn identity(&self) -> u64 {
+        self.identity
+    }
+
     /// The model's own clock, for a fault-injecting wrapper ([`ModelInfo::with_step`]).
     pub fn step_fn(&self) -> StepFn<I, O> {
         self.step

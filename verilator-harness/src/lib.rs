@@ -1,6 +1,8 @@
 //! Co-simulation of segshade's generated RTL against the golden model, through Verilator.
 //!
-//! `build.rs` verilates and links the models; [`ffi`] wraps them; [`stimulus`] makes random
+//! `build.rs` verilates and links the catalogue of models the suites use, and [`ondemand`] builds
+//! any other configuration when it is first asked for, both through one description of a model
+//! ([`models`]); [`ffi`] wraps them; [`stimulus`] makes random
 //! and directed triangles; [`driver`] is the clock loop every unit shares (random valid gaps
 //! and backpressure, the protocol monitor, the scoreboard on a second thread); [`cosim`]
 //! checks every segment of a segment shader and the final frames; [`specular`] does the same
@@ -13,6 +15,11 @@ pub mod cosim;
 pub mod driver;
 pub mod ffi;
 pub mod frontend;
+// build.rs's module tree, which describes, verilates and compiles a model; the library builds
+// the models asked for at run time with it (`ondemand`).
+#[path = "../build/mod.rs"]
+pub mod models;
+pub mod ondemand;
 pub mod render;
 pub mod report;
 pub mod soak;

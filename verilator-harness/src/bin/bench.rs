@@ -40,6 +40,7 @@ use std::process::ExitCode;
 use std::time::Instant;
 use verilator_harness::cosim::{Report, SegmentCosim, Stim};
 use verilator_harness::ffi::{segment_model, specular_unit, to_port, SPECULAR_MODELS};
+use verilator_harness::ondemand;
 use verilator_harness::specular::{random_span, SpecularCosim};
 use verilator_harness::stimulus::random_triangle;
 use verilator_harness::traffic::{state_of, Traffic};
@@ -309,9 +310,7 @@ fn segment_spans(cfg: &golden::Config, count: u32, seed: u64, mut f: impl FnMut(
 }
 
 fn gen_segment(p: u32, count: u32, seed: u64, traffic: Traffic, out: &std::path::Path) -> Result<ExitCode, Bad> {
-    let Some(info) = segment_model(p, Align::Span) else {
-        return Err(format!("no segment shader model for p = {p}"));
-    };
+    let info = ondemand::options(p, Align::Span, None).and_then(|o| ondemand::segment(&o)).map_err(|e| format!("--p {p}: {e}"))?;
     let cfg = info.cfg;
     let rec = seg_record_bytes(p);
     // Every span yields at least one record.
@@ -458,8 +457,9 @@ fn harness(path: &std::path::Path, limit: usize) -> Result<ExitCode, Bad> {
     let rejected = |e: &dyn std::fmt::Display| format!("{}: {e}", path.display());
     let (tag, (secs, cpu)) = match h.design {
         0 => {
-            let info =
-                segment_model(h.p, Align::Span).ok_or_else(|| format!("{}: no segment shader model for p = {}", path.display(), h.p))?;
+            let info = ondemand::options(h.p, Align::Span, None)
+                .and_then(|o| ondemand::segment(&o))
+                .map_err(|e| format!("{}: the segment shader for p = {}: {e}", path.display(), h.p))?;
             if h.dw != info.cfg.dw() {
                 return Err(format!("{}: in_di is {} bits in the file, {} in {}", path.display(), h.dw, info.cfg.dw(), info.tag));
             }

@@ -11,8 +11,9 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 use std::time::Instant;
 use verilator_harness::cosim::{Report, SegmentCosim, Traffic};
-use verilator_harness::ffi::{segment_model, specular_unit, ModelInfo, SEGMENT_MODELS, SPECULAR_MODELS, TRISHADER_MODELS};
+use verilator_harness::ffi::{specular_unit, ModelInfo, SPECULAR_MODELS};
 use verilator_harness::frontend::{random_triangles, run_chain_at};
+use verilator_harness::ondemand;
 use verilator_harness::specular::{random_span, SpecularCosim};
 use verilator_harness::stimulus::random_triangle;
 use verilator_harness::waveform;
@@ -124,10 +125,10 @@ fn main() -> ExitCode {
         return rtl_frontend(&args);
     }
     let align = args.align;
-    let Some(info) = segment_model(args.p, align) else {
-        let built: Vec<&str> = SEGMENT_MODELS.iter().map(|m| m.tag).collect();
-        eprintln!("error: --p {} --align {align}: no such model in this build (built: {})", args.p, built.join(", "));
-        return ExitCode::from(2);
+    // The compiled catalogue's model, or one built (once, then cached) for this configuration.
+    let info = match ondemand::options(args.p, align, None).and_then(|o| ondemand::segment(&o)) {
+        Ok(info) => info,
+        Err(e) => return ondemand::exit(&format!("--p {} --align {align}", args.p), &e),
     };
     let screen = Screen { width: args.width, height: args.height };
     if let Err(e) = screen.check_for(&info.cfg) {
@@ -183,10 +184,11 @@ fn finish(seed: u64, report: &Report, triangles: &str, spans: Option<u64>, speed
 /// Random triangles of every kind into `tri_shader_p<P>`; every segment, `y` and frame checked.
 fn rtl_frontend(args: &Args) -> ExitCode {
     let align = args.align;
-    let Some(info) = TRISHADER_MODELS.iter().find(|m| m.cfg.p == args.p && m.cfg.align == align) else {
-        let built: Vec<&str> = TRISHADER_MODELS.iter().map(|m| m.tag).collect();
-        eprintln!("error: --frontend rtl --p {} --align {align}: no such model in this build (built: {})", args.p, built.join(", "));
-        return ExitCode::from(2);
+    // The chain on the screen asked for: the catalogue's, or built for it.
+    let screen = Screen { width: args.width, height: args.height };
+    let info = match ondemand::options(args.p, align, Some(screen)).and_then(|o| ondemand::tri_shader(&o)) {
+        Ok(info) => info,
+        Err(e) => return ondemand::exit(&format!("--frontend rtl --p {} --align {align}", args.p), &e),
     };
     if (args.width, args.height) != (info.screen.width, info.screen.height) {
         eprintln!("error: --width/--height: the front-end model draws on {}x{}", info.screen.width, info.screen.height);

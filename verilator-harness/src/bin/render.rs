@@ -12,9 +12,9 @@ use golden::Align;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::time::Instant;
-use verilator_harness::ffi::{
-    segment_model, ModelInfo, SEGMENT_MODELS, SPECULAR_MODELS, TRISHADER_MODELS, TRIWRITER_MODELS, WRITER_MODELS,
-};
+use verilator_harness::ffi::{ModelInfo, SPECULAR_MODELS};
+use verilator_harness::models::ModelError;
+use verilator_harness::ondemand;
 use verilator_harness::render::{busy_cycles, difference_image, obj_job, run_with, scene_job, triangles_job, Chain, Job, SceneKind};
 use verilator_harness::waveform::trace_everything;
 
@@ -152,24 +152,20 @@ enum Writer {
     Rtl,
 }
 
-/// The model of `models` for `p`, `align` and `screen`, or the one-line reason there is none.
+/// The model `found` for `screen` (the catalogue's or one built for this configuration, see
+/// `ondemand`), or the one-line reason there is none and the exit status.
 fn model_for<I, O>(
-    models: &'static [ModelInfo<I, O>],
-    p: u32,
-    align: Align,
+    found: Result<&'static ModelInfo<I, O>, ModelError>,
     screen: Screen,
     what: &str,
-) -> Result<&'static ModelInfo<I, O>, String> {
-    match models.iter().find(|m| m.cfg.p == p && m.cfg.align == align) {
-        Some(m) if m.screen == screen => Ok(m),
-        Some(m) => Err(format!(
-            "{what}: the model {} draws on {}x{}, not {}x{}",
-            m.tag, m.screen.width, m.screen.height, screen.width, screen.height
+) -> Result<&'static ModelInfo<I, O>, (String, u8)> {
+    match found {
+        Ok(m) if m.screen == screen => Ok(m),
+        Ok(m) => Err((
+            format!("{what}: the model {} draws on {}x{}, not {}x{}", m.tag, m.screen.width, m.screen.height, screen.width, screen.height),
+            2,
         )),
-        None => {
-            let built: Vec<&str> = models.iter().map(|m| m.tag).collect();
-            Err(format!("{what} --p {p} --align {align}: no such model in this build (built: {})", built.join(", ")))
-        }
+        Err(e) => Err((format!("{what}: {e}"), ondemand::exit_status(&e))),
     }
 }
 
@@ -180,25 +176,34 @@ fn main() -> ExitCode {
     }
     let start = Instant::now();
     let align = args.align;
-    let Some(info) = segment_model(args.p, align) else {
-        let built: Vec<&str> = SEGMENT_MODELS.iter().map(|m| m.tag).collect();
-        return fail(format!("--p {} --align {align}: no such model in this build (built: {})", args.p, built.join(", ")));
+    let info = match ondemand::options(args.p, align, None).and_then(|o| ondemand::segment(&o)) {
+        Ok(info) => info,
+        Err(e) => return ondemand::exit(&format!("--p {} --align {align}", args.p), &e),
     };
     let screen = Screen { width: args.width, height: args.height };
     if let Err(e) = screen.check_for(&info.cfg) {
         return fail(format!("--width/--height: {e}"));
     }
+    // The RTL blocks on this screen: the catalogue's, or built for it.
+    let on_screen = || ondemand::options(args.p, align, Some(screen));
     let chain = match (args.frontend, args.writer) {
         (Frontend::Host, Writer::Host) => Ok(Chain::Host),
-        (Frontend::Host, Writer::Rtl) => model_for(WRITER_MODELS, args.p, align, screen, "--writer rtl").map(Chain::HostToMemory),
-        (Frontend::Rtl, Writer::Host) => model_for(TRISHADER_MODELS, args.p, align, screen, "--frontend rtl").map(Chain::Rtl),
+        (Frontend::Host, Writer::Rtl) => {
+            model_for(on_screen().and_then(|o| ondemand::writer(&o)), screen, "--writer rtl").map(Chain::HostToMemory)
+        }
+        (Frontend::Rtl, Writer::Host) => {
+            model_for(on_screen().and_then(|o| ondemand::tri_shader(&o)), screen, "--frontend rtl").map(Chain::Rtl)
+        }
         (Frontend::Rtl, Writer::Rtl) => {
-            model_for(TRIWRITER_MODELS, args.p, align, screen, "--frontend rtl --writer rtl").map(Chain::RtlToMemory)
+            model_for(on_screen().and_then(|o| ondemand::tri_writer(&o)), screen, "--frontend rtl --writer rtl").map(Chain::RtlToMemory)
         }
     };
     let chain = match chain {
         Ok(c) => c,
-        Err(e) => return fail(e),
+        Err((e, status)) => {
+            eprintln!("error: {e}");
+            return ExitCode::from(status);
+        }
     };
     let golden_path = sibling(&args.out, ".golden.png");
     let diff_path = sibling(&args.out, ".diff.png");

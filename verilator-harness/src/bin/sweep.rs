@@ -18,8 +18,10 @@ use std::process::ExitCode;
 use std::time::Instant;
 use verilator_harness::cosim::Stress;
 use verilator_harness::cosim::{Report, SegmentCosim, Stim, Traffic};
-use verilator_harness::ffi::{SEGMENT_MODELS, TRISHADER_MODELS, WRITER_MODELS};
+use verilator_harness::ffi::{ModelInfo, TriIn, TriSegOut, WrIn, WrOut, RTL_DIR, SEGMENT_MODELS, TRISHADER_MODELS, WRITER_MODELS};
 use verilator_harness::frontend::{drain_clocks, run_chain};
+use verilator_harness::models::{catalogue, ModelError};
+use verilator_harness::ondemand;
 use verilator_harness::render::{busy_cycles, scene_job, SceneKind};
 use verilator_harness::writer::run_writer;
 
@@ -41,6 +43,28 @@ struct Args {
     /// Write the table here (atomically) instead of to standard output.
     #[arg(long, value_name = "FILE.md")]
     out: Option<PathBuf>,
+}
+
+/// The chains and writers (p > 1) to sweep on `screen`: the compiled catalogue's on its own
+/// screen; on another, the same configurations built for it (once, then cached:
+/// `verilator_harness::ondemand`). None on a screen the front-end cannot draw on.
+#[allow(clippy::type_complexity)]
+fn on_screen(screen: Screen) -> Result<(Vec<&'static ModelInfo<TriIn, TriSegOut>>, Vec<&'static ModelInfo<WrIn, WrOut>>), ModelError> {
+    let chains: Vec<_> = TRISHADER_MODELS.iter().filter(|m| m.screen == screen).collect();
+    let writers: Vec<_> = WRITER_MODELS.iter().filter(|m| m.screen == screen && m.cfg.p > 1).collect();
+    if !chains.is_empty() || RTL_DIR.is_some() {
+        return Ok((chains, writers));
+    }
+    let built = || -> Result<_, ModelError> {
+        let chains = catalogue::BUILT_TRI.iter().map(|&(p, a)| ondemand::tri_shader(&ondemand::options(p, a, Some(screen))?));
+        let writers =
+            catalogue::BUILT_WR.iter().filter(|(p, _)| *p > 1).map(|&(p, a)| ondemand::writer(&ondemand::options(p, a, Some(screen))?));
+        Ok((chains.collect::<Result<Vec<_>, _>>()?, writers.collect::<Result<Vec<_>, _>>()?))
+    };
+    match built() {
+        Err(ModelError::Config(_)) => Ok((Vec::new(), Vec::new())),
+        other => other,
+    }
 }
 
 /// The size classes: target area in pixels.
@@ -118,9 +142,12 @@ fn main() -> ExitCode {
     let mut rng = SeedRng::seed_from_u64(args.seed);
     let workloads: Vec<Vec<Triangle>> =
         CLASSES.iter().map(|&a| (0..args.triangles).map(|_| sized_triangle(&mut rng, &screen, a)).collect()).collect();
+    let (mut chain_models, mut wr_models) = match on_screen(screen) {
+        Ok(models) => models,
+        Err(e) => return ondemand::exit("--width/--height", &e),
+    };
     // One bar over every RTL run; indicatif hides it when stderr is not a terminal.
-    let chain_runs = TRISHADER_MODELS.iter().filter(|m| m.screen == screen).count();
-    let writer_runs = WRITER_MODELS.iter().filter(|m| m.screen == screen && m.cfg.p > 1).count();
+    let (chain_runs, writer_runs) = (chain_models.len(), wr_models.len());
     let bar = indicatif::ProgressBar::new(((models.len() + chain_runs) * workloads.len() + writer_runs * (workloads.len() + 2)) as u64)
         .with_style(indicatif::ProgressStyle::with_template("sweep [{bar:30}] {pos}/{len} {msg}").expect("a valid template"));
     let mut failures = Vec::new();
@@ -175,7 +202,6 @@ fn main() -> ExitCode {
     }
     // Triangles into the RTL front-end and shader (tri_shader_p<P>), the same workload.
     let mut chains: Vec<(String, Vec<String>)> = Vec::new();
-    let mut chain_models: Vec<_> = TRISHADER_MODELS.iter().filter(|m| m.screen == screen).collect();
     chain_models.sort_by_key(|m| (m.cfg.p, m.cfg.align == Align::Screen, m.di == golden::frontend::DiMode::Scanline));
     // Clocks of each per-triangle chain per class: the per-scanline rows are set against them.
     let mut tri_clocks: Vec<((u32, Align), Vec<u64>)> = Vec::new();
@@ -216,7 +242,6 @@ fn main() -> ExitCode {
     }
     // SPEC §7: the segment writer on the same spans (and on the two scenes' spans), at full rate.
     let mut writer_rows: Vec<(String, &str, Vec<String>)> = Vec::new();
-    let mut wr_models: Vec<_> = WRITER_MODELS.iter().filter(|m| m.screen == screen && m.cfg.p > 1).collect();
     wr_models.sort_by_key(|m| (m.cfg.p, m.cfg.align == Align::Screen));
     let mut span_sets: Vec<Vec<(u32, golden::Span)>> = Vec::new();
     if !wr_models.is_empty() {

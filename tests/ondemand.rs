@@ -1,0 +1,147 @@
+//! Models built when first asked for (`verilator_harness::ondemand`): a configuration outside the
+//! compiled catalogue is generated, verilated, compiled into a shared object, loaded, and runs
+//! bit-exact against golden (and a planted fault in it is caught); asking again loads it from the
+//! cache without building; a configuration the catalogue has is taken from it, built nothing.
+
+use golden::setup::Screen;
+use golden::{Align, Config};
+use std::sync::OnceLock;
+use verilator_harness::cosim::{assert_clean, Report, SegmentCosim, Traffic};
+use verilator_harness::ffi::{ModelInfo, SegIn, SegOut, StepFn, RTL_DIR, SEGMENT_MODELS};
+use verilator_harness::models::Kind;
+use verilator_harness::ondemand::{self, Outcome};
+use verilator_harness::stimulus::random_triangle;
+
+/// p = 2 with 10 fraction bits: small (a few seconds to build, once; cached after) and in no
+/// catalogue.
+fn options() -> hdl_gen::Options {
+    hdl_gen::Options { cfg: Config::new(2, 10, 12, Align::Span).expect("a valid configuration"), ..Default::default() }
+}
+
+/// Whether this build asks models of `ondemand` (under a build-time COSIM_RTL_DIR it hands out the
+/// folder's models only); says so on stderr when it does not.
+fn on_demand(what: &str) -> bool {
+    if let Some(dir) = RTL_DIR {
+        use std::io::Write;
+        let _ = writeln!(std::io::stderr().lock(), "{what}: skipped: COSIM_RTL_DIR={dir} provides the models");
+        return false;
+    }
+    true
+}
+
+/// `report` after `triangles` random triangles through `info`, under random gaps and backpressure.
+fn run(info: &'static ModelInfo<SegIn, SegOut>, seed: u64, triangles: usize) -> Report {
+    let screen = Screen::default();
+    let mut rng = <golden::rng::SeedRng as rand::SeedableRng>::seed_from_u64(seed);
+    let mut sim = SegmentCosim::new(info, seed, Traffic::RANDOM);
+    let mut report = Report::default();
+    let batch: Vec<_> = (0..triangles).map(|_| random_triangle(&mut rng, &screen)).collect();
+    sim.run_triangles(&screen, &batch, 0, &mut report);
+    report
+}
+
+static REAL_STEP: OnceLock<StepFn<SegIn, SegOut>> = OnceLock::new();
+
+/// The built model's step, then lane 0's pixel with its lowest bit flipped.
+unsafe extern "C" fn flipped_step(h: *mut std::ffi::c_void, i: *const SegIn, o: *mut SegOut) {
+    (REAL_STEP.get().expect("set before use"))(h, i, o);
+    (*o).pix[0] ^= 1;
+}
+
+#[test]
+fn a_configuration_outside_the_catalogue_is_built_and_runs_bit_exact() {
+    if !on_demand("ondemand: a configuration outside the catalogue") {
+        return;
+    }
+    let m = ondemand::describe(&options(), Kind::Segment).expect("the model of p = 2, frac 10");
+    assert!(SEGMENT_MODELS.iter().all(|c| c.identity() != m.identity()), "{}: the catalogue has it, pick another", m.tag);
+    let info = ondemand::segment(&options()).unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!((info.tag, info.top, info.cfg), ("seg_p2_span_f10", "segment_shader_p2", options().cfg));
+    let seed = verilator_harness::seed("ondemand::a_configuration_outside_the_catalogue");
+    let report = run(info, seed, 200);
+    assert_clean(info.tag, seed, &report);
+    assert!(report.pixels > 1000, "{} pixels compared", report.pixels);
+    // Negative control: the same model with one bit of one lane flipped fails.
+    REAL_STEP.set(info.step_fn()).expect("one mutant");
+    // SAFETY: flipped_step calls the model's own step with the same arguments, then edits its output.
+    let mutant: &'static ModelInfo<SegIn, SegOut> = Box::leak(Box::new(unsafe { info.with_step(flipped_step) }));
+    assert!(run(mutant, seed, 20).mismatch_count > 0, "a flipped pixel bit went unnoticed");
+}
+
+#[test]
+fn a_second_ask_loads_from_the_cache() {
+    if !on_demand("ondemand: the cache") {
+        return;
+    }
+    let m = ondemand::describe(&options(), Kind::Segment).expect("the model of p = 2, frac 10");
+    // The first ask (here or in another test's process) builds it at most once.
+    let (so, _) = ondemand::shared_object(&m).unwrap_or_else(|e| panic!("{e}"));
+    let built = std::fs::metadata(&so).and_then(|f| f.modified()).expect("the shared object");
+    let (again, outcome) = ondemand::shared_object(&m).unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!((&again, outcome), (&so, Outcome::Cached), "the second ask rebuilt it");
+    assert_eq!(std::fs::metadata(&so).and_then(|f| f.modified()).expect("the shared object"), built, "rewritten");
+    // Loaded once per process: the same ModelInfo.
+    let a = ondemand::segment(&options()).unwrap_or_else(|e| panic!("{e}"));
+    let b = ondemand::segment(&options()).unwrap_or_else(|e| panic!("{e}"));
+    assert!(std::ptr::eq(a, b));
+    // Another configuration is another cache entry (and would be built on its own).
+    let other = hdl_gen::Options { cfg: Config::new(2, 11, 12, Align::Span).expect("valid"), ..Default::default() };
+    let other = ondemand::describe(&other, Kind::Segment).expect("the model of p = 2, frac 11");
+    assert_ne!(ondemand::cache_entry(&other).expect("verilator"), ondemand::cache_entry(&m).expect("verilator"));
+}
+
+#[test]
+fn the_catalogue_answers_what_it_has() {
+    if !on_demand("ondemand: the catalogue first") {
+        return;
+    }
+    for (p, align) in [(8, Align::Span), (1, Align::Screen), (64, Align::Span)] {
+        let opts = ondemand::options(p, align, None).expect("a valid configuration");
+        let found = ondemand::segment(&opts).unwrap_or_else(|e| panic!("{e}"));
+        let compiled = SEGMENT_MODELS.iter().find(|m| m.tag == format!("seg_p{p}_{align}")).expect("in the catalogue");
+        assert!(std::ptr::eq(found, compiled), "seg_p{p}_{align}: {} was loaded, not the catalogue's", found.tag);
+    }
+    // The pipelined ones too, and the front-end's chain on its default screen.
+    let opts = hdl_gen::Options { pipeline: golden::pipeline::Pipeline::at(1), ..Default::default() };
+    assert_eq!(ondemand::segment(&opts).map(|m| m.tag).unwrap_or_else(|e| panic!("{e}")), "seg_p8_span_pl1");
+    let opts = ondemand::options(8, Align::Span, Some(Screen::default())).expect("valid");
+    assert_eq!(ondemand::tri_shader(&opts).map(|m| m.tag).unwrap_or_else(|e| panic!("{e}")), "tris_p8_span");
+}
+
+#[test]
+fn a_configuration_generate_refuses_is_a_usage_error() {
+    for (p, screen, needle) in [(3, None, "power of two"), (8, Some(Screen { width: 9000, height: 480 }), "--width/--height")] {
+        // `describe`, not `tri_shader`: a COSIM_RTL_DIR build hands out its folder's chain by P and
+        // alignment, and the binaries check its screen themselves.
+        let e = ondemand::options(p, Align::Span, screen).and_then(|o| ondemand::describe(&o, Kind::TriShader)).expect_err("refused");
+        assert_eq!(ondemand::exit_status(&e), 2, "{e}");
+        assert!(e.to_string().contains(needle), "{e}");
+    }
+}
+
+/// COSIM_RTL_DIR's rule for a relative path: from the process's folder when it exists there, else
+/// from the workspace's root (cargo runs build scripts and tests in the package's folder, so
+/// `COSIM_RTL_DIR=rtl` typed at the root means `<root>/rtl`); an absolute path is itself.
+#[test]
+fn a_relative_cosim_rtl_dir_is_found_from_the_workspace_root() {
+    use std::path::Path;
+    use verilator_harness::models::catalogue::resolve_rtl_dir;
+    let package = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let root = package.parent().expect("the workspace");
+    let rtl = resolve_rtl_dir(Path::new("rtl"), package, package);
+    assert_eq!(rtl, root.join("rtl"));
+    assert!(rtl.join(hdl_gen::manifest::MANIFEST_FILE).is_file(), "{}: the repository's rtl/", rtl.display());
+    // A folder that exists from the process's own folder is that one; an absolute path is kept.
+    assert_eq!(resolve_rtl_dir(Path::new("csrc"), package, package), package.join("csrc"));
+    assert_eq!(resolve_rtl_dir(&root.join("rtl"), package, package), root.join("rtl"));
+    // From the root, the same relative path is the same folder.
+    assert_eq!(resolve_rtl_dir(Path::new("rtl"), root, package), root.join("rtl"));
+    // The folder's models, described from it, are the catalogue's circuits: checking an
+    // unmodified generate folder builds nothing.
+    let manifest = verilator_harness::models::catalogue::read_manifest(&rtl);
+    let models = verilator_harness::models::catalogue::models_from_dir(&rtl, &manifest).unwrap_or_else(|e| panic!("{e}"));
+    let seg = models.iter().find(|m| m.kind == Kind::Segment && m.axis.is_none()).expect("rtl/ has a segment shader");
+    if on_demand("ondemand: rtl/ against the catalogue") {
+        assert!(SEGMENT_MODELS.iter().any(|c| c.identity() == seg.identity()), "rtl/'s {} is not the catalogue's", seg.tag);
+    }
+}
