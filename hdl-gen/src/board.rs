@@ -208,6 +208,24 @@ pub fn draw_module(fe: &FrontEnd, w: &Writer, names: &Names, triangles: usize) -
         Item::Blank,
         comment("The chain is held in reset until the clear is over; the ROM word's fields, x0 in the high bits."),
     ];
+    body.push(Item::Instance { module: names.fb_top.clone(), name: "u_chain".into(), params: vec![], conns: chain_conns(fe, bits) });
+    body.push(Item::Blank);
+    body.push(comment("The frame buffer's write port: the clear's zeros, then the chain's block writes."));
+    body.push(assign("fb_we", format!("clearing ? {{{p}{{1'b1}}}} : ((drawing && mem_valid) ? mem_we : {})", lit(p, 0))));
+    body.push(assign("fb_addr", "clearing ? caddr : mem_addr"));
+    body.push(assign("fb_data", format!("clearing ? {} : mem_data", lit(8 * p, 0))));
+    Module {
+        name: DRAW.into(),
+        header,
+        params: vec![Param { name: "INIT_FILE".into(), value: format!("\"{ROM_HEX}\""), doc: "$readmemh image of the triangles".into() }],
+        ports,
+        body,
+    }
+}
+
+/// `tri_fb_p<P>`'s connections: held in reset until the clear is over, its triangle from the
+/// ROM word's fields (x0 in the high bits), its block writes to the frame buffer's port.
+fn chain_conns(fe: &FrontEnd, bits: u32) -> Vec<(String, String)> {
     let mut conns: Vec<(String, String)> = vec![
         ("clk".into(), "clk".into()),
         ("rst".into(), "!drawing".into()),
@@ -230,19 +248,7 @@ pub fn draw_module(fe: &FrontEnd, w: &Writer, names: &Names, triangles: usize) -
     ] {
         conns.push((port.into(), sig.into()));
     }
-    body.push(Item::Instance { module: names.fb_top.clone(), name: "u_chain".into(), params: vec![], conns });
-    body.push(Item::Blank);
-    body.push(comment("The frame buffer's write port: the clear's zeros, then the chain's block writes."));
-    body.push(assign("fb_we", format!("clearing ? {{{p}{{1'b1}}}} : ((drawing && mem_valid) ? mem_we : {})", lit(p, 0))));
-    body.push(assign("fb_addr", "clearing ? caddr : mem_addr"));
-    body.push(assign("fb_data", format!("clearing ? {} : mem_data", lit(8 * p, 0))));
-    Module {
-        name: DRAW.into(),
-        header,
-        params: vec![Param { name: "INIT_FILE".into(), value: format!("\"{ROM_HEX}\""), doc: "$readmemh image of the triangles".into() }],
-        ports,
-        body,
-    }
+    conns
 }
 
 /// `segshade_ulx3s`: the board's pins (the names of the ULX3S LPF) and the four blocks.
