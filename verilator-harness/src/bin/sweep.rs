@@ -142,7 +142,7 @@ fn main() -> ExitCode {
     let mut rng = SeedRng::seed_from_u64(args.seed);
     let workloads: Vec<Vec<Triangle>> =
         CLASSES.iter().map(|&a| (0..args.triangles).map(|_| sized_triangle(&mut rng, &screen, a)).collect()).collect();
-    let (mut chain_models, mut wr_models) = match on_screen(screen) {
+    let (mut chain_models, wr_models) = match on_screen(screen) {
         Ok(models) => models,
         Err(e) => return ondemand::exit("--width/--height", &e),
     };
@@ -241,12 +241,147 @@ fn main() -> ExitCode {
         chains.push((format!("front-end + shader p = {p}, {align}{di}"), cells));
     }
     // SPEC §7: the segment writer on the same spans (and on the two scenes' spans), at full rate.
+    let writer_rows = writer_rows(&args, screen, &workloads, wr_models, &bar, &mut failures);
+    bar.finish_and_clear();
+
+    let md = markdown(&args, screen, failures.is_empty(), &Tables { stats, rows, rtl, chains, writer_rows });
+    match &args.out {
+        Some(path) => {
+            if let Err(e) = hdl_gen::output::write_one(path, md.as_bytes()) {
+                eprintln!("error: --out {}: {e}", path.display());
+                return ExitCode::from(2);
+            }
+        }
+        None => print!("{md}"),
+    }
+    eprintln!("sweep: {} models x {} classes in {:.1} s", models.len(), workloads.len(), start.elapsed().as_secs_f64());
+    for f in &failures {
+        eprintln!("FAIL {f}");
+    }
+    if failures.is_empty() {
+        ExitCode::SUCCESS
+    } else {
+        ExitCode::from(1)
+    }
+}
+
+/// What the sweep measured, as the report's tables take it.
+struct Tables<'a> {
+    /// Per size class: the workload's pixels, spans and triangles.
+    stats: Vec<golden::schemes::Count>,
+    /// Per scheme or model: its name, where its clocks come from, a cell per class.
+    rows: Vec<(String, &'a str, Vec<Cell>)>,
+    /// Per segment shader model: p, alignment, pixels per clock per class.
+    rtl: Vec<(u32, Align, Vec<f64>)>,
+    chains: Vec<(String, Vec<String>)>,
+    writer_rows: Vec<(String, &'a str, Vec<String>)>,
+}
+
+/// The sweep's Markdown report: the workload, the schemes' pixels per clock with the best p
+/// in bold, the front-end chains and the writer.
+fn markdown(args: &Args, screen: Screen, passed: bool, t: &Tables) -> String {
+    let Tables { stats, rows, rtl, chains, writer_rows } = t;
+    // Best p per class and alignment: the smallest p within 10% of the widest model's rate.
+    let best = |align: Align, k: usize| -> Option<u32> {
+        let of = rtl.iter().filter(|r| r.1 == align);
+        let top = of.clone().map(|r| r.2[k]).fold(0.0, f64::max);
+        of.filter(|r| r.2[k] >= 0.9 * top).map(|r| r.0).min()
+    };
+    let mut md = String::new();
+    let cmd = format!(
+        "cargo run --release -p verilator-harness --bin sweep -- --triangles {} --seed {}{}",
+        args.triangles,
+        args.seed,
+        if (args.width, args.height) == (640, 480) { String::new() } else { format!(" --width {} --height {}", args.width, args.height) }
+    );
+    let _ = writeln!(md, "Regenerate with `{cmd}`.\n");
+    let _ = writeln!(
+        md,
+        "Workload: {} random triangles per size class on a {}x{} screen (seed {}); random shapes, area \
+         within ±20% of the class, entirely on screen. Every segment shader is co-simulated at full rate \
+         (both ends always ready) with every segment checked against golden; its clocks run from the \
+         first span offered to the last segment out{}. The other schemes are cycle models \
+         (`golden::schemes`, same assumptions: no per-span overhead, the same {}-clock fill).\n",
+        args.triangles,
+        screen.width,
+        screen.height,
+        args.seed,
+        if passed {
+            format!(" and equal Σ segments + {} (pipeline fill) in every cell", fill())
+        } else {
+            " (THIS RUN FAILED ITS CHECKS: see the FAIL lines)".to_string()
+        },
+        fill()
+    );
+    let _ = writeln!(md, "| | ~10 px | ~100 px | ~1000 px |\n|---|---:|---:|---:|");
+    let row = |f: &dyn Fn(&golden::schemes::Count) -> String| stats.iter().map(f).collect::<Vec<_>>().join(" | ");
+    let _ = writeln!(md, "| pixels per triangle (mean) | {} |", row(&|c| format!("{:.1}", c.pixels as f64 / c.triangles as f64)));
+    let _ = writeln!(md, "| span length (mean pixels) | {} |", row(&|c| format!("{:.2}", c.pixels as f64 / c.spans as f64)));
+    let _ = writeln!(md, "| spans per triangle (mean) | {} |\n", row(&|c| format!("{:.2}", c.spans as f64 / c.triangles as f64)));
+    let _ = writeln!(md, "Pixels per clock (in brackets: of the pixels the scheme could make per clock). **Bold**: the best p of each class and alignment.\n");
+    let _ = writeln!(md, "| scheme | clocks | ~10 px | ~100 px | ~1000 px |\n|---|---|---:|---:|---:|");
+    for (name, source, cells) in rows {
+        let bold = |k: usize| rtl.iter().any(|r| *name == format!("segment shader p = {}, {}", r.0, r.1) && best(r.1, k) == Some(r.0));
+        let c: Vec<String> = cells.iter().enumerate().map(|(k, c)| c.show(bold(k))).collect();
+        let _ = writeln!(md, "| {name} | {source} | {} |", c.join(" | "));
+    }
+    let _ = writeln!(
+        md,
+        "\nBest p: the smallest p within 10% of the pixels per clock of the widest model (p = {}), per alignment:\n",
+        rtl.iter().map(|r| r.0).max().unwrap_or(0)
+    );
+    for (k, class) in ["~10 px", "~100 px", "~1000 px"].iter().enumerate() {
+        let show = |a| best(a, k).map_or("-".to_string(), |p| p.to_string());
+        let _ = writeln!(md, "- {class}: p = {} span-aligned, p = {} screen-aligned", show(Align::Span), show(Align::Screen));
+    }
+
+    if !chains.is_empty() {
+        let _ = writeln!(
+            md,
+            "\nTriangles into the generated front-end and shader (`tri_shader_p<P>`, SPEC §6), the same triangles, \
+             both ends always ready, every segment and the frame checked. Each cell: pixels per clock (in brackets: \
+             of the spans-fed shader's above), then triangles per 1000 clocks; for the classical per-scanline dI \
+             (`--fe-di scanline`, built with `SEGSHADE_ALL_CHAINS=1`), its clocks over the per-triangle chain's.\n"
+        );
+        let _ = writeln!(md, "| chain | ~10 px | ~100 px | ~1000 px |\n|---|---:|---:|---:|");
+        for (name, cells) in chains {
+            let _ = writeln!(md, "| {name} | {} |", cells.join(" | "));
+        }
+    }
+
+    if !writer_rows.is_empty() {
+        let _ = writeln!(
+            md,
+            "\nThe segment writer (`fb_writer_p<P>`, SPEC §7) on the same triangles' spans and on the two scenes' \
+             (640x480, every span the host's set-up makes, one channel), fed golden's segments at full rate, the \
+             memory always ready, every write checked. RTL cells: block writes per span, then the writer's clocks \
+             for the whole workload (in brackets: the segments the shader makes for it, its clocks). Model rows: \
+             block writes per span the seed's alternatives would make.\n"
+        );
+        let _ = writeln!(md, "| writer | clocks | ~10 px | ~100 px | ~1000 px | sphere | torus |\n|---|---|---:|---:|---:|---:|---:|");
+        for (name, source, cells) in writer_rows {
+            let _ = writeln!(md, "| {name} | {source} | {} |", cells.join(" | "));
+        }
+    }
+    md
+}
+
+/// The segment writer's rows: each model's block writes per span and clocks on the workloads'
+/// spans and the two scenes', and the seed's alternatives counted on golden's segments.
+fn writer_rows(
+    args: &Args,
+    screen: Screen,
+    workloads: &[Vec<Triangle>],
+    mut wr_models: Vec<&'static ModelInfo<WrIn, WrOut>>,
+    bar: &indicatif::ProgressBar,
+    failures: &mut Vec<String>,
+) -> Vec<(String, &'static str, Vec<String>)> {
     let mut writer_rows: Vec<(String, &str, Vec<String>)> = Vec::new();
     wr_models.sort_by_key(|m| (m.cfg.p, m.cfg.align == Align::Screen));
     let mut span_sets: Vec<Vec<(u32, golden::Span)>> = Vec::new();
     if !wr_models.is_empty() {
         let cfg = wr_models[0].cfg;
-        for tris in &workloads {
+        for tris in workloads {
             let mut spans = Vec::new();
             for tri in tris {
                 golden::setup::triangle_spans(&cfg, &screen, tri, |y, span| spans.push((y, span))).expect("the workload fits");
@@ -300,107 +435,5 @@ fn main() -> ExitCode {
         };
         writer_rows.push((name, "RTL", cells));
     }
-    bar.finish_and_clear();
-
-    // Best p per class and alignment: the smallest p within 10% of the widest model's rate.
-    let best = |align: Align, k: usize| -> Option<u32> {
-        let of = rtl.iter().filter(|r| r.1 == align);
-        let top = of.clone().map(|r| r.2[k]).fold(0.0, f64::max);
-        of.filter(|r| r.2[k] >= 0.9 * top).map(|r| r.0).min()
-    };
-    let mut md = String::new();
-    let cmd = format!(
-        "cargo run --release -p verilator-harness --bin sweep -- --triangles {} --seed {}{}",
-        args.triangles,
-        args.seed,
-        if (args.width, args.height) == (640, 480) { String::new() } else { format!(" --width {} --height {}", args.width, args.height) }
-    );
-    let _ = writeln!(md, "Regenerate with `{cmd}`.\n");
-    let _ = writeln!(
-        md,
-        "Workload: {} random triangles per size class on a {}x{} screen (seed {}); random shapes, area \
-         within ±20% of the class, entirely on screen. Every segment shader is co-simulated at full rate \
-         (both ends always ready) with every segment checked against golden; its clocks run from the \
-         first span offered to the last segment out{}. The other schemes are cycle models \
-         (`golden::schemes`, same assumptions: no per-span overhead, the same {}-clock fill).\n",
-        args.triangles,
-        screen.width,
-        screen.height,
-        args.seed,
-        if failures.is_empty() {
-            format!(" and equal Σ segments + {} (pipeline fill) in every cell", fill())
-        } else {
-            " (THIS RUN FAILED ITS CHECKS: see the FAIL lines)".to_string()
-        },
-        fill()
-    );
-    let _ = writeln!(md, "| | ~10 px | ~100 px | ~1000 px |\n|---|---:|---:|---:|");
-    let row = |f: &dyn Fn(&golden::schemes::Count) -> String| stats.iter().map(f).collect::<Vec<_>>().join(" | ");
-    let _ = writeln!(md, "| pixels per triangle (mean) | {} |", row(&|c| format!("{:.1}", c.pixels as f64 / c.triangles as f64)));
-    let _ = writeln!(md, "| span length (mean pixels) | {} |", row(&|c| format!("{:.2}", c.pixels as f64 / c.spans as f64)));
-    let _ = writeln!(md, "| spans per triangle (mean) | {} |\n", row(&|c| format!("{:.2}", c.spans as f64 / c.triangles as f64)));
-    let _ = writeln!(md, "Pixels per clock (in brackets: of the pixels the scheme could make per clock). **Bold**: the best p of each class and alignment.\n");
-    let _ = writeln!(md, "| scheme | clocks | ~10 px | ~100 px | ~1000 px |\n|---|---|---:|---:|---:|");
-    for (name, source, cells) in &rows {
-        let bold = |k: usize| rtl.iter().any(|r| *name == format!("segment shader p = {}, {}", r.0, r.1) && best(r.1, k) == Some(r.0));
-        let c: Vec<String> = cells.iter().enumerate().map(|(k, c)| c.show(bold(k))).collect();
-        let _ = writeln!(md, "| {name} | {source} | {} |", c.join(" | "));
-    }
-    let _ = writeln!(
-        md,
-        "\nBest p: the smallest p within 10% of the pixels per clock of the widest model (p = {}), per alignment:\n",
-        rtl.iter().map(|r| r.0).max().unwrap_or(0)
-    );
-    for (k, class) in ["~10 px", "~100 px", "~1000 px"].iter().enumerate() {
-        let show = |a| best(a, k).map_or("-".to_string(), |p| p.to_string());
-        let _ = writeln!(md, "- {class}: p = {} span-aligned, p = {} screen-aligned", show(Align::Span), show(Align::Screen));
-    }
-
-    if !chains.is_empty() {
-        let _ = writeln!(
-            md,
-            "\nTriangles into the generated front-end and shader (`tri_shader_p<P>`, SPEC §6), the same triangles, \
-             both ends always ready, every segment and the frame checked. Each cell: pixels per clock (in brackets: \
-             of the spans-fed shader's above), then triangles per 1000 clocks; for the classical per-scanline dI \
-             (`--fe-di scanline`, built with `SEGSHADE_ALL_CHAINS=1`), its clocks over the per-triangle chain's.\n"
-        );
-        let _ = writeln!(md, "| chain | ~10 px | ~100 px | ~1000 px |\n|---|---:|---:|---:|");
-        for (name, cells) in &chains {
-            let _ = writeln!(md, "| {name} | {} |", cells.join(" | "));
-        }
-    }
-
-    if !writer_rows.is_empty() {
-        let _ = writeln!(
-            md,
-            "\nThe segment writer (`fb_writer_p<P>`, SPEC §7) on the same triangles' spans and on the two scenes' \
-             (640x480, every span the host's set-up makes, one channel), fed golden's segments at full rate, the \
-             memory always ready, every write checked. RTL cells: block writes per span, then the writer's clocks \
-             for the whole workload (in brackets: the segments the shader makes for it, its clocks). Model rows: \
-             block writes per span the seed's alternatives would make.\n"
-        );
-        let _ = writeln!(md, "| writer | clocks | ~10 px | ~100 px | ~1000 px | sphere | torus |\n|---|---|---:|---:|---:|---:|---:|");
-        for (name, source, cells) in &writer_rows {
-            let _ = writeln!(md, "| {name} | {source} | {} |", cells.join(" | "));
-        }
-    }
-
-    match &args.out {
-        Some(path) => {
-            if let Err(e) = hdl_gen::output::write_one(path, md.as_bytes()) {
-                eprintln!("error: --out {}: {e}", path.display());
-                return ExitCode::from(2);
-            }
-        }
-        None => print!("{md}"),
-    }
-    eprintln!("sweep: {} models x {} classes in {:.1} s", models.len(), workloads.len(), start.elapsed().as_secs_f64());
-    for f in &failures {
-        eprintln!("FAIL {f}");
-    }
-    if failures.is_empty() {
-        ExitCode::SUCCESS
-    } else {
-        ExitCode::from(1)
-    }
+    writer_rows
 }
