@@ -104,7 +104,7 @@ fn main() {
     fs::write(out.join("models.rs"), codegen::models_rs(&models, &twins, trace_all, rtl_dir.as_deref(), &tables)).unwrap();
     // The segment suite's random test is one test per (model, soak slice), so that nextest can
     // deal a configuration's soak out to several machines (`verilator_harness::soak`): its list
-    // of models is this build's, written where tests/segment.rs includes it.
+    // of models is this build's, written where verilator-harness/tests/segment.rs includes it.
     let seg: Vec<&str> = models.iter().filter(|m| m.kind == Kind::Segment && m.axis.is_none()).map(|m| m.tag.as_str()).collect();
     fs::write(out.join("segment_slices.rs"), format!("random_triangle_slices!({});\n", seg.join(", "))).unwrap();
 }

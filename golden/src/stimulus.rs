@@ -359,7 +359,7 @@ mod tests {
         }
     }
 
-    /// The premise of the front-end suite's "every outcome is reached" check (tests/frontend.rs):
+    /// The premise of the front-end suite's "every outcome is reached" check (verilator-harness/tests/frontend.rs):
     /// each outcome has a probability of at least 1/20 per random port triangle, here on 20,000
     /// triangles from a fixed seed.
     #[test]

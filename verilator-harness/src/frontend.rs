@@ -8,10 +8,10 @@
 //! driver's input item; it owes its spans (or segments), and its guard-band `err` pulse is
 //! counted against golden's.
 
-use crate::cosim::{agrees, check_lanes, describe, golden_row, SegView, Stim};
 use crate::driver::{Check, Driver, Stress, Unit, DRAIN_CLOCKS};
 use crate::ffi::{to_port, FeOut, ModelInfo, Rtl, TriIn, TriSegOut};
 use crate::report::{Mismatch, Report};
+use crate::segment::{agrees, check_lanes, describe, golden_row, SegView, Stim};
 use crate::traffic::{Traffic, TrafficGen};
 use golden::frontend::{FixedTriangle, FrontEnd, Outcome};
 use golden::raster::{compare, reference_triangle, Frame, RefFrame};

@@ -4,14 +4,13 @@
 //! any other configuration when it is first asked for, both through one description of a model
 //! ([`models`]); [`ffi`] wraps them; [`stimulus`] makes random
 //! and directed triangles; [`driver`] is the clock loop every unit shares (random valid gaps
-//! and backpressure, the protocol monitor, the scoreboard on a second thread); [`cosim`]
+//! and backpressure, the protocol monitor, the scoreboard on a second thread); [`segment`]
 //! checks every segment of a segment shader and the final frames; [`specular`] does the same
 //! for the specular unit, pixel by pixel; [`render`] draws whole scenes through them;
 //! [`traffic`] makes the driver's and the sink's per-clock decisions (shared, bit for bit,
 //! with the native and cocotb benches of `scripts/bench-cosim`); [`waveform`] writes FST files of
 //! failures (COSIM_TRACE) and of whole runs (`--trace`).
 
-pub mod cosim;
 pub mod driver;
 pub mod ffi;
 pub mod frontend;
@@ -22,6 +21,7 @@ pub mod models;
 pub mod ondemand;
 pub mod render;
 pub mod report;
+pub mod segment;
 pub mod soak;
 pub mod specular;
 pub mod stimulus;

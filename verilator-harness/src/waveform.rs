@@ -181,7 +181,7 @@ pub struct FstSummary {
 /// Checks that `path` is a whole FST file: its header block, then blocks (a type byte and a
 /// big-endian length) that end exactly at the end of the file, with a hierarchy, a geometry and
 /// value changes among them, as GTKWave's `fstapi.c` writes them. No decompression: `fst2vcd`
-/// (Debian's gtkwave) reads the values (`tests/waveforms.rs`, `scripts/check-rtl-dir --trace`).
+/// (Debian's gtkwave) reads the values (`verilator-harness/tests/waveforms.rs`, `scripts/check-rtl-dir --trace`).
 pub fn check_fst(path: &Path) -> Result<FstSummary, FstError> {
     let fail = |problem: FstProblem| FstError { path: path.to_path_buf(), problem };
     let bytes = std::fs::read(path).map_err(|e| fail(FstProblem::Read(e.to_string())))?;

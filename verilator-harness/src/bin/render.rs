@@ -344,7 +344,7 @@ fn png(buf: &[u8], screen: &Screen, color: png::ColorType) -> Vec<u8> {
     encoder.set_color(color);
     encoder.set_depth(png::BitDepth::Eight);
     // Stated, not left to the crate's defaults: the committed docs/*.png are compared byte for
-    // byte with what their commands write (tests/readme.rs). No tIME or text chunk is written.
+    // byte with what their commands write (verilator-harness/tests/readme.rs). No tIME or text chunk is written.
     encoder.set_compression(png::Compression::Balanced);
     encoder.set_filter(png::Filter::Adaptive);
     let mut writer = encoder.write_header().expect("in-memory PNG header");

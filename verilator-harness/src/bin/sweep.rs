@@ -16,13 +16,13 @@ use std::fmt::Write as _;
 use std::path::PathBuf;
 use std::process::ExitCode;
 use std::time::Instant;
-use verilator_harness::cosim::Stress;
-use verilator_harness::cosim::{Report, SegmentCosim, Stim, Traffic};
 use verilator_harness::ffi::{ModelInfo, TriIn, TriSegOut, WrIn, WrOut, RTL_DIR, SEGMENT_MODELS, TRISHADER_MODELS, WRITER_MODELS};
 use verilator_harness::frontend::{drain_clocks, run_chain};
 use verilator_harness::models::{catalogue, ModelError};
 use verilator_harness::ondemand;
 use verilator_harness::render::{busy_cycles, scene_job, SceneKind};
+use verilator_harness::segment::Stress;
+use verilator_harness::segment::{Report, SegmentCosim, Stim, Traffic};
 use verilator_harness::writer::run_writer;
 
 #[derive(Parser)]

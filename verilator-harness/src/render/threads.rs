@@ -4,11 +4,11 @@
 
 use super::image::{compose, memory_image};
 use super::visibility::Job;
-use crate::cosim::{SegView, SegmentCosim, Stim};
 use crate::driver::{Stress, DRAIN_CLOCKS};
 use crate::ffi::{specular_unit, ModelInfo, SegIn, SegOut, SpecIn, SpecOut, TriIn, TriSegOut, WrIn, WrOut};
 use crate::frontend::{stream_chain, Expected};
 use crate::report::Report;
+use crate::segment::{SegView, SegmentCosim, Stim};
 use crate::specular::SpecularCosim;
 use crate::traffic::Traffic;
 use crate::writer::{run_segments, stream_fb, SegStim};

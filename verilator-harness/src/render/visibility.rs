@@ -3,7 +3,7 @@
 //! and a depth pre-pass for meshes, file order for triangle files (see [`super`]).
 
 use super::mesh::{add, lighting, obj_mesh, rotate_xy, scale, scene, sub, Lighting, Mesh, MeshError, SceneKind};
-use crate::cosim::Stim;
+use crate::segment::Stim;
 use golden::frontend::FixedTriangle;
 use golden::setup::{parse_triangles, triangle_spans, ParseError, Screen, ScreenError, SetupError, Triangle, Vertex};
 use golden::specular::geometry::{cross, dot, normalize, SpanEnds, Vec3};

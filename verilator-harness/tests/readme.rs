@@ -166,7 +166,7 @@ pub fn run_line(cmd: &str, dir: &Path) -> Result<Outcome, String> {
     let words: Vec<&str> = words[n_env..].iter().map(String::as_str).collect();
     let (bin, first) = match words.as_slice() {
         ["cargo", "run", ..] => cargo_run(&words)?,
-        _ => return Err("not a command this test knows how to run: teach tests/readme.rs".into()),
+        _ => return Err("not a command this test knows how to run: teach verilator-harness/tests/readme.rs".into()),
     };
     let mut args: Vec<String> = words[first..].iter().map(|w| w.to_string()).collect();
     let mut note = String::new();
@@ -325,7 +325,7 @@ fn the_documents_commands_run_and_remake_the_committed_files() {
         let name = doc.to_string_lossy();
         let listed = RUN.contains(&name.as_ref()) || NOT_RUN.iter().any(|(d, _)| *d == name);
         if !listed && !command_lines(&std::fs::read_to_string(repo().join(doc)).unwrap()).is_empty() {
-            eprintln!("readme: {name} has commands and is in neither RUN nor NOT_RUN of tests/readme.rs: not run");
+            eprintln!("readme: {name} has commands and is in neither RUN nor NOT_RUN of verilator-harness/tests/readme.rs: not run");
         }
     }
     std::fs::remove_dir_all(&dir).unwrap();

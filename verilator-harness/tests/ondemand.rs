@@ -6,10 +6,10 @@
 use golden::setup::Screen;
 use golden::{Align, Config};
 use std::sync::OnceLock;
-use verilator_harness::cosim::{assert_clean, Report, SegmentCosim, Traffic};
 use verilator_harness::ffi::{ModelInfo, SegIn, SegOut, StepFn, RTL_DIR, SEGMENT_MODELS};
 use verilator_harness::models::Kind;
 use verilator_harness::ondemand::{self, Outcome};
+use verilator_harness::segment::{assert_clean, Report, SegmentCosim, Traffic};
 use verilator_harness::stimulus::random_triangle;
 
 /// p = 2 with 10 fraction bits: small (a few seconds to build, once; cached after) and in no

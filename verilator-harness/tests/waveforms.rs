@@ -17,8 +17,8 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::sync::atomic::{AtomicU32, Ordering};
 use std::sync::OnceLock;
-use verilator_harness::cosim::{Report, SegmentCosim, Stim, Stress, Traffic};
 use verilator_harness::ffi::{require, require_segment_model, ModelInfo, SegIn, SegOut, SEGMENT_MODELS};
+use verilator_harness::segment::{Report, SegmentCosim, Stim, Stress, Traffic};
 use verilator_harness::stimulus::random_triangle;
 use verilator_harness::waveform::{check_fst, AFTER, BEFORE, TIME_PER_CLOCK};
 

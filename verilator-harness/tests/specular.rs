@@ -7,8 +7,8 @@ use golden::rng::SeedRng;
 use golden::specular::reference::epicentre;
 use golden::specular::{n_valid, theta_at, SpecularSpan, THETA_FRAC};
 use rand::{Rng, SeedableRng};
-use verilator_harness::cosim::{assert_clean, Report, Traffic, DRAIN_CLOCKS};
 use verilator_harness::ffi::{require_models, require_specular_model, specular_unit, ModelInfo, SpecIn, SpecOut, SPECULAR_MODELS};
+use verilator_harness::segment::{assert_clean, Report, Traffic, DRAIN_CLOCKS};
 use verilator_harness::soak;
 use verilator_harness::specular::{random_span, SpecularCosim};
 

@@ -4,9 +4,9 @@
 use golden::frontend::{FixedTriangle, FrontEnd, Outcome};
 use golden::rng::SeedRng;
 use rand::SeedableRng;
-use verilator_harness::cosim::{assert_clean, Stress, Traffic};
 use verilator_harness::ffi::{require, require_models, FRONTEND_MODELS, TRISHADER_MODELS};
 use verilator_harness::frontend::{mesh, random_triangles, run_chain, run_frontend, Expected};
+use verilator_harness::segment::{assert_clean, Stress, Traffic};
 
 fn frontend(m: &verilator_harness::ffi::ModelInfo<impl Sized, impl Sized>) -> FrontEnd {
     m.frontend()

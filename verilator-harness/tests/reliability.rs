@@ -17,10 +17,10 @@ use golden::setup::{triangle_spans, Screen, Triangle, Vertex, COORD_LIMIT};
 use golden::specular::{SpecularSpan, N_BITS};
 use golden::{Config, Span, SpanError};
 use rand::{Rng, SeedableRng};
-use verilator_harness::cosim::{assert_clean, Report, SegmentCosim, SpanRejected, Stim, Stress, Traffic};
 use verilator_harness::ffi::{
     require_models, require_specular_model, specular_unit, to_port, ModelInfo, Rtl, SegIn, SegOut, SpecIn, SpecOut, RTL_DIR, SEGMENT_MODELS,
 };
+use verilator_harness::segment::{assert_clean, Report, SegmentCosim, SpanRejected, Stim, Stress, Traffic};
 use verilator_harness::specular::{random_span, SpecSpanRejected, SpecularCosim};
 use verilator_harness::stimulus::{directed, random_triangle};
 

@@ -9,12 +9,12 @@ use golden::rng::SeedRng;
 use golden::setup::Screen;
 use golden::specular::SpecularSpan;
 use rand::SeedableRng;
-use verilator_harness::cosim::{assert_clean, Report, SegmentCosim, Stim, Stress, Traffic, DRAIN_CLOCKS};
 use verilator_harness::ffi::{
     require_models, specular_unit, ModelInfo, SegIn, SegOut, AXIS_FRONTEND_MODELS, AXIS_SEGMENT_MISPACKED, AXIS_SEGMENT_MODELS,
     AXIS_SPECULAR_MODELS, AXIS_TRISHADER_MODELS,
 };
 use verilator_harness::frontend::{random_triangles, run_chain, run_frontend};
+use verilator_harness::segment::{assert_clean, Report, SegmentCosim, Stim, Stress, Traffic, DRAIN_CLOCKS};
 use verilator_harness::specular::{random_span, SpecularCosim};
 use verilator_harness::stimulus::random_triangle;
 

@@ -7,8 +7,8 @@ use golden::rng::SeedRng;
 use golden::setup::Screen;
 use golden::Span;
 use rand::{Rng, SeedableRng};
-use verilator_harness::cosim::{assert_clean, Report, SegmentCosim, Stim, Traffic, DRAIN_CLOCKS};
 use verilator_harness::ffi::{require, SEGMENT_MODELS};
+use verilator_harness::segment::{assert_clean, Report, SegmentCosim, Stim, Traffic, DRAIN_CLOCKS};
 use verilator_harness::soak;
 use verilator_harness::stimulus::{directed, random_triangle};
 

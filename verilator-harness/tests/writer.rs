@@ -9,9 +9,9 @@ use golden::setup::Screen;
 use golden::writer::Writer;
 use golden::Span;
 use rand::{Rng, SeedableRng};
-use verilator_harness::cosim::{assert_clean, Stress, Traffic};
 use verilator_harness::ffi::{require_models, Rtl, WrIn, WrOut, TRIWRITER_MODELS, WRITER_MODELS};
 use verilator_harness::frontend::{mesh, random_triangles};
+use verilator_harness::segment::{assert_clean, Stress, Traffic};
 use verilator_harness::writer::{run_fb, run_writer, run_writer_against};
 
 /// Spans of every shape the glue has a corner for: one pixel, shorter than a block, starting or
