@@ -48,11 +48,18 @@ unsafe extern "C" fn flipped_step(h: *mut std::ffi::c_void, i: *const SegIn, o: 
     (*o).pix[0] ^= 1;
 }
 
+/// One test for the build and the cache, so that a cold run compiles the model once: two test
+/// processes asking at once would each compile it (safely, but twice the CPU).
 #[test]
-fn a_configuration_outside_the_catalogue_is_built_and_runs_bit_exact() {
+fn a_configuration_outside_the_catalogue_is_built_runs_bit_exact_and_is_cached() {
     if !on_demand("ondemand: a configuration outside the catalogue") {
         return;
     }
+    built_and_bit_exact();
+    second_ask_loads_from_the_cache();
+}
+
+fn built_and_bit_exact() {
     let m = ondemand::describe(&options(), Kind::Segment).expect("the model of p = 2, frac 10");
     assert!(SEGMENT_MODELS.iter().all(|c| c.identity() != m.identity()), "{}: the catalogue has it, pick another", m.tag);
     let info = ondemand::segment(&options()).unwrap_or_else(|e| panic!("{e}"));
@@ -68,13 +75,9 @@ fn a_configuration_outside_the_catalogue_is_built_and_runs_bit_exact() {
     assert!(run(mutant, seed, 20).mismatch_count > 0, "a flipped pixel bit went unnoticed");
 }
 
-#[test]
-fn a_second_ask_loads_from_the_cache() {
-    if !on_demand("ondemand: the cache") {
-        return;
-    }
+fn second_ask_loads_from_the_cache() {
     let m = ondemand::describe(&options(), Kind::Segment).expect("the model of p = 2, frac 10");
-    // The first ask (here or in another test's process) builds it at most once.
+    // The first ask (above) built it.
     let (so, _) = ondemand::shared_object(&m).unwrap_or_else(|e| panic!("{e}"));
     let built = std::fs::metadata(&so).and_then(|f| f.modified()).expect("the shared object");
     let (again, outcome) = ondemand::shared_object(&m).unwrap_or_else(|e| panic!("{e}"));
