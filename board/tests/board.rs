@@ -5,25 +5,42 @@
 
 use segshade_board::frame::{self, Clock, FrameError};
 use segshade_board::{config, differences, expected, fixed, rtl_files, sim};
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 const QUICK: &str = include_str!("quick.txt");
 
-/// Generates the board's RTL for `tris` into `dir/rtl` (after `mutate` edits its files), builds
-/// it, and returns the simulation's executable, golden's picture and the configuration.
-fn build(dir: &Path, text: &str, mutate: impl Fn(&mut Vec<hdl_gen::GeneratedFile>)) -> (std::path::PathBuf, Vec<u8>) {
+/// Generates the board's RTL for `text` (after `mutate` edits its files) and builds it, in a
+/// folder under the target directory named by the hash of everything the build reads (the RTL,
+/// the bench's files, Verilator's version), so a warm run reuses the model; returns that folder,
+/// the simulation's executable and golden's picture.
+fn build(text: &str, mutate: impl Fn(&mut Vec<hdl_gen::GeneratedFile>)) -> (PathBuf, PathBuf, Vec<u8>) {
+    use std::hash::{Hash, Hasher};
     let cfg = config(8).unwrap();
     let tris = fixed(&cfg, &golden::setup::parse_triangles(text).unwrap());
     let mut files = rtl_files(&cfg, &tris).unwrap();
     mutate(&mut files);
-    let rtl = dir.join("rtl");
-    hdl_gen::output::write_all(&rtl, &files).unwrap();
-    (sim::build(&rtl, &dir.join("sim")).unwrap(), expected(&cfg, &tris).unwrap())
+    let verilator = std::process::Command::new("verilator").arg("--version").output().expect("verilator").stdout;
+    let mut h = std::collections::hash_map::DefaultHasher::new();
+    (files.iter().map(|f| (&f.name, &f.contents)).collect::<Vec<_>>(), segshade_board::SIM_FILES, verilator).hash(&mut h);
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("board-sim-{:016x}", h.finish()));
+    let exe = dir.join("sim/obj/board_sim");
+    if !exe.exists() {
+        // Built aside and renamed into place: a run stopped half-way leaves nothing to reuse.
+        let staging = tempfile::tempdir_in(env!("CARGO_TARGET_TMPDIR")).unwrap();
+        hdl_gen::output::write_all(&staging.path().join("rtl"), &files).unwrap();
+        sim::build(&staging.path().join("rtl"), &staging.path().join("sim")).unwrap();
+        let _ = std::fs::remove_dir_all(&dir);
+        std::fs::rename(staging.keep(), &dir).unwrap();
+    }
+    (dir, exe, expected(&cfg, &tris).unwrap())
 }
 
-/// Simulates the build in `dir`; returns one recorded frame and the bench's output.
+/// Simulates the build in `dir` (its RTL folder holds the ROM image); returns one recorded frame
+/// and the bench's output.
 fn simulate(dir: &Path, exe: &Path, redraw: bool) -> (Vec<Clock>, String) {
-    let (rec, log) = sim::simulate(exe, &dir.join("rtl"), &dir.join("sim"), 7, redraw).unwrap();
+    // The recording in a folder of its own: the build's folder may serve two tests at once.
+    let work = tempfile::tempdir().unwrap();
+    let (rec, log) = sim::simulate(exe, &dir.join("rtl"), work.path(), 7, redraw).unwrap();
     eprint!("{log}");
     let clocks = frame::parse_recording(&std::fs::read_to_string(rec).unwrap()).unwrap();
     let start = frame::frame_start(&clocks).unwrap();
@@ -32,10 +49,9 @@ fn simulate(dir: &Path, exe: &Path, redraw: bool) -> (Vec<Clock>, String) {
 
 #[test]
 fn quick_picture_equals_golden_and_faults_are_caught() {
-    let dir = tempfile::tempdir().unwrap();
-    let (exe, want) = build(dir.path(), QUICK, |_| {});
+    let (dir, exe, want) = build(QUICK, |_| {});
     // Registers and RAM power up random: the clear is what makes the background golden's 0.
-    let (one, _) = simulate(dir.path(), &exe, false);
+    let (one, _) = simulate(&dir, &exe, false);
     let got = frame::decode_frame(&one).expect("valid DVI");
     let drawn = want.iter().filter(|&&v| v != 0).count();
     assert!(drawn > 10_000, "the quick picture draws something ({drawn} pixels)");
@@ -72,9 +88,8 @@ fn quick_picture_equals_golden_and_faults_are_caught() {
 #[test]
 #[ignore = "builds its own Verilator model (~20 s); run with --ignored or scripts/board --redraw"]
 fn f1_redraws_the_same_picture() {
-    let dir = tempfile::tempdir().unwrap();
-    let (exe, want) = build(dir.path(), QUICK, |_| {});
-    let (again, log) = simulate(dir.path(), &exe, true);
+    let (dir, exe, want) = build(QUICK, |_| {});
+    let (again, log) = simulate(&dir, &exe, true);
     assert_eq!(log.matches("drawing done").count(), 2, "{log}");
     assert_eq!(differences(&want, &frame::decode_frame(&again).expect("valid DVI")), (0, None), "the redrawn frame");
 }
@@ -89,14 +104,13 @@ fn dropped_frame_buffer_write_is_caught() {
     let first = want.iter().position(|&v| v != 0).unwrap() as u32;
     let w = golden::writer::Writer::new(cfg, segshade_board::SCREEN).unwrap();
     let addr = w.addr(first % w.screen.width, first / w.screen.width);
-    let dir = tempfile::tempdir().unwrap();
-    let (exe, _) = build(dir.path(), QUICK, |files| {
+    let (dir, exe, _) = build(QUICK, |files| {
         let f = files.iter_mut().find(|f| f.name == "board_draw.v").unwrap();
         let from = "(drawing && mem_valid) ? mem_we";
         assert!(f.contents.contains(from), "the mutation's site");
         f.contents = f.contents.replace(from, &format!("(drawing && mem_valid && mem_addr != {addr}) ? mem_we"));
     });
-    let (one, _) = simulate(dir.path(), &exe, false);
+    let (one, _) = simulate(&dir, &exe, false);
     let got = frame::decode_frame(&one).expect("still valid DVI");
     let (n, at) = differences(&want, &got);
     assert!(n > 0, "a dropped write at block {addr} went unnoticed");
