@@ -170,7 +170,7 @@ struct Reference<'a> {
     nw: u32,
 }
 
-/// The reference's CALC stage j: valid, guard-band check, vertical extent (0: the vertex register).
+/// The reference's CALC stage j's valid bit (0: the vertex register).
 fn f_v(j: usize) -> String {
     if j == 0 {
         "f_vf".to_string()
@@ -178,25 +178,13 @@ fn f_v(j: usize) -> String {
         format!("f_c{j}v")
     }
 }
-fn f_g(j: usize) -> String {
+/// What the reference holds of a triangle in CALC stage j (`g`: the guard-band check, `ymin`,
+/// `ymax`: its vertical extent); stage 0 is the vertex register.
+fn f_held(j: usize, what: &str) -> String {
     if j == 0 {
-        "f_vg".to_string()
+        format!("f_v{what}")
     } else {
-        format!("f_c{j}g")
-    }
-}
-fn f_ymin(j: usize) -> String {
-    if j == 0 {
-        "f_vymin".to_string()
-    } else {
-        format!("f_c{j}ymin")
-    }
-}
-fn f_ymax(j: usize) -> String {
-    if j == 0 {
-        "f_vymax".to_string()
-    } else {
-        format!("f_c{j}ymax")
+        format!("f_c{j}{what}")
     }
 }
 /// Stage j's triangle moves on; the last stage's move is the set-up's load.
@@ -275,9 +263,9 @@ impl Reference<'_> {
             if j == 1 {
                 b.push(comment("CALC's stages: each triangle's guard-band check and vertical extent, as the vertex register's."));
             }
-            b.extend([reg(&f_v(j), 1), reg(&f_g(j), 1)]);
-            b.push(Item::Reg { name: f_ymin(j), width: cy, signed: true });
-            b.push(Item::Reg { name: f_ymax(j), width: cy, signed: true });
+            b.extend([reg(&f_v(j), 1), reg(&f_held(j, "g"), 1)]);
+            b.push(Item::Reg { name: f_held(j, "ymin"), width: cy, signed: true });
+            b.push(Item::Reg { name: f_held(j, "ymax"), width: cy, signed: true });
         }
         b.push(comment("The set-up: busy (dividing, f_sn + 1 clocks left, or holding its result: f_sh), its extent."));
         b.extend([reg("f_sb", 1), reg("f_sh", 1), reg("f_sn", nw)]);
@@ -333,13 +321,13 @@ impl Reference<'_> {
             set("f_sb", "1'b1"),
             set("f_sh", "1'b0"),
             set("f_sn", lit(nw, (div_clocks - 1) as u64)),
-            set("f_symin", f_ymin(last)),
-            set("f_symax", f_ymax(last)),
+            set("f_symin", f_held(last, "ymin")),
+            set("f_symax", f_held(last, "ymax")),
         ];
         let setup = Stmt::If(
             "f_calc".into(),
             vec![Stmt::If(
-                format!("!{}", f_g(last)),
+                format!("!{}", f_held(last, "g")),
                 vec![set("f_errp", "1'b1"), set("f_sb", "1'b0")],
                 vec![Stmt::If("f_cull".into(), vec![set("f_sb", "1'b0"), inc1("f_ncull")], calc_go)],
             )],
@@ -392,7 +380,12 @@ impl Reference<'_> {
             .map(|j| {
                 Stmt::If(
                     f_mv(j - 1),
-                    vec![set(f_v(j), "1'b1"), set(f_g(j), f_g(j - 1)), set(f_ymin(j), f_ymin(j - 1)), set(f_ymax(j), f_ymax(j - 1))],
+                    vec![
+                        set(f_v(j), "1'b1"),
+                        set(f_held(j, "g"), f_held(j - 1, "g")),
+                        set(f_held(j, "ymin"), f_held(j - 1, "ymin")),
+                        set(f_held(j, "ymax"), f_held(j - 1, "ymax")),
+                    ],
                     vec![when(f_mv(j), vec![set(f_v(j), "1'b0")])],
                 )
             })
@@ -521,20 +514,20 @@ impl Reference<'_> {
         ];
         let ryc = |r: &str| format!("$signed({{{r}, 8'd128}})");
         for (j, c) in calc_stages.iter().enumerate().map(|(i, c)| (i + 1, c)) {
-            let mut held = vec![assert(format!("{} == {}", c.guard, f_g(j)))];
+            let mut held = vec![assert(format!("{} == {}", c.guard, f_held(j, "g")))];
             if let Some(r) = &c.ymin {
-                held.push(assert(format!("{r} == {}", f_ymin(j))));
+                held.push(assert(format!("{r} == {}", f_held(j, "ymin"))));
             }
             if let Some(r) = &c.ymax {
-                held.push(assert(format!("{r} == {}", f_ymax(j))));
+                held.push(assert(format!("{r} == {}", f_held(j, "ymax"))));
             }
             if let Some(r) = &c.first_s {
                 held.push(assert(format!("!{r}[{}]", cy - 8)));
-                held.push(assert(format!("{} >= {}", ryc(r), f_ymin(j))));
+                held.push(assert(format!("{} >= {}", ryc(r), f_held(j, "ymin"))));
             }
             for r in c.last_s.iter().chain(&c.last_alt) {
                 held.push(assert(format!("{r} <= {}", slit(cy - 7, height as i64 - 1))));
-                held.push(assert(format!("{} <= {}", ryc(r), f_ymax(j))));
+                held.push(assert(format!("{} <= {}", ryc(r), f_held(j, "ymax"))));
             }
             if let (Some(k), Some(a), Some(z)) = (&c.cull, &c.first_s, &c.last_s) {
                 held.push(when(format!("!{k}"), vec![assert(format!("{a} <= {z}"))]));
