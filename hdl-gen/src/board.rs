@@ -4,10 +4,28 @@
 //! (`board/rtl/*.v`). What depends on P, the screen or the front-end's port widths is generated
 //! here; what does not (video timing, TMDS, the serializer, the RAM lanes) is plain Verilog.
 
+pub mod uart;
+
 use crate::verilog::{assign, comment, lit, net, reg, set, wire, Item, Module, Param, Port, Stmt};
 use crate::Names;
 use golden::frontend::{FixedTriangle, FrontEnd};
 use golden::writer::Writer;
+
+/// The drawing clock: board_cells' PLL, 625 MHz / 16 (its `DRAW_DIV`).
+pub const DRAW_HZ: f64 = 625e6 / 16.0;
+
+/// Where the board's triangles come from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Source {
+    /// Baked into a ROM at generate time, drawn at power-up and on F1.
+    Rom,
+    /// Streamed over the FT231X's serial line at `div` drawing clocks a bit ([`uart`]).
+    Uart { div: u32 },
+}
+
+/// Entries of the UART source's triangle queue: 2^10 words of the ROM's width (10 DP16KD at
+/// the defaults), so a burst of 1024 triangles is taken whatever their size.
+pub const QUEUE_BITS: u32 = 10;
 
 /// Triangles the ROM holds at most: 2048 words of 3 x (x, y, I) bits (183 at the defaults, 21 of
 /// the LFE5U-85F's 208 DP16KD blocks), beside the 320x240 frame buffer's 40.
@@ -115,31 +133,20 @@ pub fn draw_module(fe: &FrontEnd, w: &Writer, names: &Names, triangles: usize) -
         "the triangles go in, in ROM order; `done` rises once the last is in and the chain has written".into(),
         format!("nothing for 2^{QUIET_BITS} clocks."),
     ];
-    let ports = vec![
-        Port::input("clk", 1, "", "drawing clock, rising edge"),
-        Port::input("locked", 1, "", "the PLL's lock: low holds everything in reset"),
-        Port::input("redraw", 1, "", "button, asynchronous, active high: clear and draw again"),
-        Port::output("fb_we", p, "bit per lane", "frame buffer write enable of lane i").vector(),
-        Port::output("fb_addr", aw, "unsigned integer", &format!("block y * {} + x div {p}", w.blocks_per_row())),
-        Port::output("fb_data", 8 * p, &format!("{p} lanes of UQ8.0"), "lane i = pixel x mod P = i"),
+    let mut ports = common_ports(w, "clear and draw again");
+    ports.extend([
         Port::output("done", 1, "", "the picture is complete").reg(),
         Port::output("err_seen", 1, "", "a triangle was dropped (outside the guard band) since the last start").reg(),
-    ];
+    ]);
     let mut body = vec![
         Item::Localparam { name: "NTRI".into(), width: kw, value: lit(kw, triangles as u64) },
         Item::Localparam { name: "LAST_BLOCK".into(), width: aw, value: lit(aw, w.blocks() as u64 - 1) },
         Item::Memory { name: "rom".into(), width: bits, depth: depth as u32 },
         Item::ReadMemH { file: "INIT_FILE".into(), mem: "rom".into() },
         Item::Blank,
-        comment("Reset: 16 clocks after lock, and the button's rising edge (two flops against metastability)."),
-        reg("por", 5),
-        reg("btn_s", 3),
-        wire("start", 1, "!por[4] || (btn_s[1] && !btn_s[2])"),
-        Item::Always(vec![
-            Stmt::If("!locked".into(), vec![set("por", "5'd0")], vec![Stmt::If("!por[4]".into(), vec![set("por", "por + 5'd1")], vec![])]),
-            set("btn_s", "{btn_s[1:0], redraw}"),
-        ]),
-        Item::Blank,
+    ];
+    body.extend(reset_items());
+    body.extend([
         reg("clearing", 1),
         reg("drawing", 1),
         reg("caddr", aw),
@@ -147,12 +154,9 @@ pub fn draw_module(fe: &FrontEnd, w: &Writer, names: &Names, triangles: usize) -
         reg("ld", 1),
         reg("quiet", QUIET_BITS),
         reg("rom_q", bits),
-        net("in_ready", 1),
-        net("tri_err", 1),
-        net("mem_valid", 1),
-        net("mem_addr", aw),
-        net("mem_data", 8 * p),
-        Item::Bus { name: "mem_we".into(), width: p },
+    ]);
+    body.extend(chain_nets(p, aw));
+    body.extend([
         wire("in_valid", 1, "drawing && ld && (k != NTRI)"),
         wire("accept", 1, "in_valid && in_ready"),
         // k rests at NTRI after the last triangle; its low bits then name a padding word.
@@ -172,14 +176,7 @@ pub fn draw_module(fe: &FrontEnd, w: &Writer, names: &Names, triangles: usize) -
                     set("err_seen", "1'b0"),
                 ],
                 vec![
-                    Stmt::If(
-                        "clearing".into(),
-                        vec![
-                            set("caddr", format!("caddr + {}", lit(aw, 1))),
-                            Stmt::If("caddr == LAST_BLOCK".into(), vec![set("clearing", "1'b0"), set("drawing", "1'b1")], vec![]),
-                        ],
-                        vec![],
-                    ),
+                    clear_step(aw),
                     Stmt::If(
                         "drawing".into(),
                         vec![
@@ -207,13 +204,8 @@ pub fn draw_module(fe: &FrontEnd, w: &Writer, names: &Names, triangles: usize) -
         ]),
         Item::Blank,
         comment("The chain is held in reset until the clear is over; the ROM word's fields, x0 in the high bits."),
-    ];
-    body.push(Item::Instance { module: names.fb_top.clone(), name: "u_chain".into(), params: vec![], conns: chain_conns(fe, bits) });
-    body.push(Item::Blank);
-    body.push(comment("The frame buffer's write port: the clear's zeros, then the chain's block writes."));
-    body.push(assign("fb_we", format!("clearing ? {{{p}{{1'b1}}}} : ((drawing && mem_valid) ? mem_we : {})", lit(p, 0))));
-    body.push(assign("fb_addr", "clearing ? caddr : mem_addr"));
-    body.push(assign("fb_data", format!("clearing ? {} : mem_data", lit(8 * p, 0))));
+    ]);
+    body.extend(chain_and_port(fe, names, "rom_q", bits));
     Module {
         name: DRAW.into(),
         header,
@@ -223,9 +215,76 @@ pub fn draw_module(fe: &FrontEnd, w: &Writer, names: &Names, triangles: usize) -
     }
 }
 
+/// Power-up and F1: `start` is high for 16 clocks after the PLL locks and for one clock on the
+/// button's rising edge (two flops against metastability).
+fn reset_items() -> Vec<Item> {
+    vec![
+        comment("Reset: 16 clocks after lock, and the button's rising edge (two flops against metastability)."),
+        reg("por", 5),
+        reg("btn_s", 3),
+        wire("start", 1, "!por[4] || (btn_s[1] && !btn_s[2])"),
+        Item::Always(vec![
+            Stmt::If("!locked".into(), vec![set("por", "5'd0")], vec![Stmt::If("!por[4]".into(), vec![set("por", "por + 5'd1")], vec![])]),
+            set("btn_s", "{btn_s[1:0], redraw}"),
+        ]),
+        Item::Blank,
+    ]
+}
+
+/// Both sources' clock, reset, button and frame-buffer write port; `button` says what F1 does.
+fn common_ports(w: &Writer, button: &str) -> Vec<Port> {
+    let (p, aw) = (w.cfg.p, w.addr_bits());
+    vec![
+        Port::input("clk", 1, "", "drawing clock, rising edge"),
+        Port::input("locked", 1, "", "the PLL's lock: low holds everything in reset"),
+        Port::input("redraw", 1, "", &format!("button, asynchronous, active high: {button}")),
+        Port::output("fb_we", p, "bit per lane", "frame buffer write enable of lane i").vector(),
+        Port::output("fb_addr", aw, "unsigned integer", &format!("block y * {} + x div {p}", w.blocks_per_row())),
+        Port::output("fb_data", 8 * p, &format!("{p} lanes of UQ8.0"), "lane i = pixel x mod P = i"),
+    ]
+}
+
+/// The chain's outputs.
+fn chain_nets(p: u32, aw: u32) -> Vec<Item> {
+    vec![
+        net("in_ready", 1),
+        net("tri_err", 1),
+        net("mem_valid", 1),
+        net("mem_addr", aw),
+        net("mem_data", 8 * p),
+        Item::Bus { name: "mem_we".into(), width: p },
+    ]
+}
+
+/// One block of the clear a clock; drawing starts after the last.
+fn clear_step(aw: u32) -> Stmt {
+    Stmt::If(
+        "clearing".into(),
+        vec![
+            set("caddr", format!("caddr + {}", lit(aw, 1))),
+            Stmt::If("caddr == LAST_BLOCK".into(), vec![set("clearing", "1'b0"), set("drawing", "1'b1")], vec![]),
+        ],
+        vec![],
+    )
+}
+
+/// The chain fed from `word`, and the frame buffer's write port: the clear's zeros, then the
+/// chain's block writes.
+fn chain_and_port(fe: &FrontEnd, names: &Names, word: &str, bits: u32) -> Vec<Item> {
+    let p = fe.cfg.p;
+    vec![
+        Item::Instance { module: names.fb_top.clone(), name: "u_chain".into(), params: vec![], conns: chain_conns(fe, word, bits) },
+        Item::Blank,
+        comment("The frame buffer's write port: the clear's zeros, then the chain's block writes."),
+        assign("fb_we", format!("clearing ? {{{p}{{1'b1}}}} : ((drawing && mem_valid) ? mem_we : {})", lit(p, 0))),
+        assign("fb_addr", "clearing ? caddr : mem_addr"),
+        assign("fb_data", format!("clearing ? {} : mem_data", lit(8 * p, 0))),
+    ]
+}
+
 /// `tri_fb_p<P>`'s connections: held in reset until the clear is over, its triangle from the
-/// ROM word's fields (x0 in the high bits), its block writes to the frame buffer's port.
-fn chain_conns(fe: &FrontEnd, bits: u32) -> Vec<(String, String)> {
+/// word's fields (x0 in the high bits), its block writes to the frame buffer's port.
+fn chain_conns(fe: &FrontEnd, word: &str, bits: u32) -> Vec<(String, String)> {
     let mut conns: Vec<(String, String)> = vec![
         ("clk".into(), "clk".into()),
         ("rst".into(), "!drawing".into()),
@@ -235,7 +294,7 @@ fn chain_conns(fe: &FrontEnd, bits: u32) -> Vec<(String, String)> {
     let mut hi = bits;
     for (v, (field, width)) in word_fields(fe).iter().enumerate() {
         let name = format!("in_{}{}", ["x", "y", "i"][*field], v / 3);
-        conns.push((name, format!("rom_q[{}:{}]", hi - 1, hi - width)));
+        conns.push((name, format!("{word}[{}:{}]", hi - 1, hi - width)));
         hi -= width;
     }
     for (port, sig) in [
@@ -252,11 +311,17 @@ fn chain_conns(fe: &FrontEnd, bits: u32) -> Vec<(String, String)> {
 }
 
 /// `segshade_ulx3s`: the board's pins (the names of the ULX3S LPF) and the four blocks.
-pub fn top_module(w: &Writer) -> Module {
+pub fn top_module(w: &Writer, source: Source) -> Module {
     let p = w.cfg.p;
     let aw = w.addr_bits();
     let header = vec![
-        format!("{TOP} — segshade on the Radiona ULX3S: triangles from ROM, drawn into a frame buffer, shown as DVI on GPDI."),
+        format!(
+            "{TOP} — segshade on the Radiona ULX3S: triangles from {}, drawn into a frame buffer, shown as DVI on GPDI.",
+            match source {
+                Source::Rom => "ROM",
+                Source::Uart { .. } => "the USB serial port",
+            }
+        ),
         "Generated by segshade hdl-gen (board); do not edit.".into(),
         String::new(),
         format!(
@@ -267,15 +332,49 @@ pub fn top_module(w: &Writer) -> Module {
         ),
         "Clocks (board_cells): 25 MHz pixel, 125 MHz shift (DDR: 10 bits per pixel clock), the drawing clock.".into(),
         "The frame buffer crosses the clocks: a true dual-port RAM, written on the drawing clock, read on the pixel clock.".into(),
-        "LEDs: 0 drawing done, 1 PLL locked, 2 a triangle was dropped. btn[1] (F1): clear and draw again.".into(),
+        match source {
+            Source::Rom => "LEDs: 0 drawing done, 1 PLL locked, 2 a triangle was dropped. btn[1] (F1): clear and draw again.",
+            Source::Uart { .. } => {
+                "LEDs: 0 all received drawn, 1 PLL locked, 2 a triangle dropped, 3 a framing error, 4 a bad packet, 7:5 packets taken. btn[1] (F1): reset."
+            }
+        }
+        .into(),
     ];
     let ports = vec![
         Port::input("clk_25mhz", 1, "", "the board's 25 MHz oscillator"),
         Port::input("btn", 7, "", "buttons; btn[1] redraws"),
         Port::output("led", 8, "", "status"),
         Port::output("gpdi_dp", 4, "", "TMDS: blue (syncs), green, red, clock; the LPF makes them differential"),
+        Port::input("ftdi_txd", 1, "", "the FT231X's TXD: the host's serial line into the board"),
+        Port::output("ftdi_rxd", 1, "", "the FT231X's RXD: the board's serial line to the host"),
     ];
-    let body = vec![
+    let mut draw_conns: Vec<(String, String)> = [
+        ("clk", "clk_draw"),
+        ("locked", "locked"),
+        ("redraw", "btn[1]"),
+        ("fb_we", "fb_we"),
+        ("fb_addr", "fb_waddr"),
+        ("fb_data", "fb_wdata"),
+        ("done", "done"),
+        ("err_seen", "err_seen"),
+    ]
+    .map(|(a, b)| (a.to_string(), b.to_string()))
+    .into();
+    let (unused, led, flags) = match source {
+        Source::Rom => ("&{1'b1, btn[0], btn[6:2], ftdi_txd}", "{5'd0, err_seen, locked, done}", vec![]),
+        Source::Uart { .. } => {
+            draw_conns.extend(
+                [("rx", "ftdi_txd"), ("tx", "ftdi_rxd"), ("ferr_seen", "ferr_seen"), ("bad_seen", "bad_seen"), ("pk", "pk")]
+                    .map(|(a, b)| (a.to_string(), b.to_string())),
+            );
+            (
+                "&{1'b1, btn[0], btn[6:2]}",
+                "{pk, bad_seen, ferr_seen, err_seen, locked, done}",
+                vec![net("ferr_seen", 1), net("bad_seen", 1), net("pk", 3)],
+            )
+        }
+    };
+    let mut body = vec![
         net("clk_pix", 1),
         net("clk_shift", 1),
         net("clk_draw", 1),
@@ -289,7 +388,13 @@ pub fn top_module(w: &Writer) -> Module {
         net("fb_rdata", 8 * p),
         net("done", 1),
         net("err_seen", 1),
-        wire("unused_btn", 1, "&{1'b1, btn[0], btn[6:2]}"),
+        wire("unused_in", 1, unused),
+    ];
+    body.extend(flags);
+    if source == Source::Rom {
+        body.push(assign("ftdi_rxd", "1'b1"));
+    }
+    body.extend([
         Item::Instance {
             module: "board_cells".into(),
             name: "u_cells".into(),
@@ -307,23 +412,7 @@ pub fn top_module(w: &Writer) -> Module {
             .map(|(a, b)| (a.to_string(), b.to_string()))
             .into(),
         },
-        Item::Instance {
-            module: DRAW.into(),
-            name: "u_draw".into(),
-            params: vec![],
-            conns: [
-                ("clk", "clk_draw"),
-                ("locked", "locked"),
-                ("redraw", "btn[1]"),
-                ("fb_we", "fb_we"),
-                ("fb_addr", "fb_waddr"),
-                ("fb_data", "fb_wdata"),
-                ("done", "done"),
-                ("err_seen", "err_seen"),
-            ]
-            .map(|(a, b)| (a.to_string(), b.to_string()))
-            .into(),
-        },
+        Item::Instance { module: DRAW.into(), name: "u_draw".into(), params: vec![], conns: draw_conns },
         Item::Instance {
             module: "board_fb".into(),
             name: "u_fb".into(),
@@ -356,7 +445,266 @@ pub fn top_module(w: &Writer) -> Module {
             .map(|(a, b)| (a.to_string(), b.to_string()))
             .into(),
         },
-        assign("led", "{5'd0, err_seen, locked, done}"),
-    ];
+        assign("led", led),
+    ]);
     Module { name: TOP.into(), header, params: vec![], ports, body }
+}
+
+/// A saturating count of `cond`.
+fn count(name: &str, cond: &str) -> Stmt {
+    Stmt::If(format!("{cond} && ({name} != 16'hffff)"), vec![set(name, format!("{name} + 16'd1"))], vec![])
+}
+
+/// Byte `o` of the UART window (`o = 0` the oldest of its [`uart::LEN`]).
+fn win_byte(o: usize) -> String {
+    let lo = 8 * (uart::LEN - 1 - o);
+    format!("win[{}:{lo}]", lo + 7)
+}
+
+/// The status counters, in the status record's order.
+const COUNTERS: [&str; 5] = ["n_ok", "n_bad", "n_ferr", "n_drop", "n_guard"];
+
+/// `board_draw` for the UART source: the serial line's bytes into a window of the last
+/// [`uart::LEN`], checked after each byte; a packet's triangle or clear goes into a queue that
+/// feeds `tri_fb_p<P>` (a clear waits until what came before it is drawn); a status request
+/// answers on `tx`. Faults are counted, never waited on.
+pub fn draw_module_uart(fe: &FrontEnd, w: &Writer, names: &Names, div: u32) -> Module {
+    let p = fe.cfg.p;
+    let aw = w.addr_bits();
+    let bits = word_bits(fe);
+    let qb = QUEUE_BITS;
+    let full = (1u64 << QUIET_BITS) - 1;
+    let header = vec![
+        format!("{DRAW} — the ULX3S board's drawing clock, UART source: triangles from the serial line, drawn as they come."),
+        "Generated by segshade hdl-gen (board); do not edit.".into(),
+        String::new(),
+        format!(
+            "{} on a {}x{} screen, {} blocks of {p} pixels; 8N1 at {div} clocks a bit.",
+            names.fb_top,
+            w.screen.width,
+            w.screen.height,
+            w.blocks()
+        ),
+        format!(
+            "Packets (docs/spec.md): {:02X} {:02X}, a command, 27 bytes, CRC-16/IBM-3740 high byte first; {} bytes in all.",
+            uart::SYNC[0],
+            uart::SYNC[1],
+            uart::LEN
+        ),
+        format!(
+            "After every byte the last {} are checked: the sync, the command, the CRC; a packet's bytes are not looked at again.",
+            uart::LEN
+        ),
+        format!("Triangles and clears wait in a queue of {} (a full queue drops, counted); a clear waits until the chain has", 1u64 << qb),
+        format!("written nothing for 2^{QUIET_BITS} clocks. `done`: the queue empty and the chain quiet that long."),
+        "After `locked` rises or the button is pressed: the frame buffer is cleared, the queue emptied, the counts zeroed.".into(),
+    ];
+    let mut ports = common_ports(w, "reset, clear, take packets again");
+    ports.extend([
+        Port::input("rx", 1, "", "serial line from the host (FT231X TXD), idle high"),
+        Port::output("tx", 1, "", "serial line to the host (FT231X RXD): status records"),
+        Port::output("done", 1, "", "every triangle received is drawn").reg(),
+        Port::output("err_seen", 1, "", "a triangle was dropped (guard band, port range, queue full) since the last start").reg(),
+        Port::output("ferr_seen", 1, "", "a framing error since the last start").reg(),
+        Port::output("bad_seen", 1, "", "a window with the sync failed its check since the last start").reg(),
+        Port::output("pk", 3, "", "packets taken, low bits"),
+    ]);
+    let (hi, lo, zero) = uart::check_equations();
+    let wb = 8 * uart::LEN as u32;
+    let cb = wb - 16;
+    let mut body = vec![Item::Localparam { name: "LAST_BLOCK".into(), width: aw, value: lit(aw, w.blocks() as u64 - 1) }, Item::Blank];
+    body.extend(reset_items());
+    body.extend([
+        comment("The serial line's bytes, and the window of the last packet-length of them."),
+        net("rx_valid", 1),
+        net("rx_byte", 8),
+        net("rx_ferr", 1),
+        Item::Instance {
+            module: uart::RX.into(),
+            name: "u_rx".into(),
+            params: vec![],
+            conns: [("clk", "clk"), ("rst", "start"), ("rx", "rx"), ("valid", "rx_valid"), ("data", "rx_byte"), ("ferr", "rx_ferr")]
+                .map(|(a, b)| (a.to_string(), b.to_string()))
+                .into(),
+        },
+        reg("win", wb),
+        reg("fill", 6),
+        reg("chk", 1),
+        comment(format!("The CRC of window bytes 2..{}, each bit a parity of the window (zero for a packet).", uart::LEN)),
+        net("syn", 16),
+    ]);
+    for j in 0..16 {
+        let mask = format!("{cb}'h{:0w1$x}{:032x}", hi[j], lo[j], w1 = (cb as usize - 128) / 4);
+        body.push(assign(format!("syn[{j}]"), format!("^(win[{}:0] & {mask}) ^ 1'b{}", cb - 1, zero >> j & 1)));
+    }
+    let cmd = win_byte(2);
+    body.extend([
+        wire(
+            "sync_ok",
+            1,
+            format!("fill[5] && ({} == 8'h{:02x}) && ({} == 8'h{:02x})", win_byte(0), uart::SYNC[0], win_byte(1), uart::SYNC[1]),
+        ),
+        wire("is_tri", 1, format!("{cmd} == 8'h{:02x}", uart::TRIANGLE)),
+        wire("is_clear", 1, format!("{cmd} == 8'h{:02x}", uart::CLEAR)),
+        wire("is_status", 1, format!("{cmd} == 8'h{:02x}", uart::STATUS)),
+        wire("good", 1, "sync_ok && (syn == 16'd0) && (is_tri || is_clear || is_status)"),
+        wire("take", 1, "chk && good"),
+    ]);
+    // The payload's fields, each 24 bits little-endian, then cut to the front-end's ports.
+    let widths = word_fields(fe);
+    let mut fits = Vec::new();
+    let mut word = Vec::new();
+    for (v, (f, width)) in widths.iter().enumerate() {
+        let o = 3 + 3 * v;
+        let name = format!("f_{}{}", ["x", "y", "i"][*f], v / 3);
+        assert!(*width <= 24, "a {width}-bit port is wider than the packet's field");
+        body.push(wire(&name, 24, format!("{{{}, {}, {}}}", win_byte(o + 2), win_byte(o + 1), win_byte(o))));
+        let top = 24 - width + if *f == 2 { 0 } else { 1 };
+        if top > 0 {
+            let rest = format!("{name}[23:{}]", 24 - top);
+            fits.push(if *f == 2 {
+                format!("({rest} == {})", lit(top, 0))
+            } else {
+                format!("(({rest} == {}) || ({rest} == {{{top}{{1'b1}}}}))", lit(top, 0))
+            });
+        }
+        word.push(format!("{name}[{}:0]", width - 1));
+    }
+    body.push(wire("fits", 1, if fits.is_empty() { "1'b1".into() } else { fits.join(" && ") }));
+    body.push(wire("rx_word", bits, format!("{{{}}}", word.join(", "))));
+    body.extend([
+        Item::Blank,
+        comment("The queue: triangles and clears, in order (the top bit: a clear)."),
+        Item::Memory { name: "queue".into(), width: bits + 1, depth: 1 << qb },
+        reg("wp", qb + 1),
+        reg("rp", qb + 1),
+        reg("q", bits + 1),
+        reg("ld", 1),
+        wire("empty", 1, "wp == rp"),
+        wire("full", 1, format!("(wp[{qb}] != rp[{qb}]) && (wp[{}:0] == rp[{}:0])", qb - 1, qb - 1)),
+        wire("push", 1, "take && (is_clear || (is_tri && fits)) && !full"),
+        Item::Always(vec![
+            set("q", format!("queue[rp[{}:0]]", qb - 1)),
+            Stmt::If("push".into(), vec![set(format!("queue[wp[{}:0]]", qb - 1), "{is_clear, rx_word}")], vec![]),
+        ]),
+        Item::Blank,
+        reg("clearing", 1),
+        reg("drawing", 1),
+        reg("caddr", aw),
+        reg("quiet", QUIET_BITS),
+    ]);
+    body.extend(chain_nets(p, aw));
+    body.extend([
+        wire("avail", 1, "ld && !empty"),
+        wire("head_clear", 1, format!("avail && q[{bits}]")),
+        wire("in_valid", 1, format!("drawing && avail && !q[{bits}]")),
+        wire("accept", 1, "in_valid && in_ready"),
+        wire("quiet_full", 1, format!("quiet == {}", lit(QUIET_BITS, full))),
+    ]);
+    for c in COUNTERS {
+        body.push(reg(c, 16));
+    }
+    let mut on_start = vec![
+        set("fill", "6'd0"),
+        set("clearing", "1'b1"),
+        set("drawing", "1'b0"),
+        set("caddr", lit(aw, 0)),
+        set("wp", lit(qb + 1, 0)),
+        set("rp", lit(qb + 1, 0)),
+        set("ld", "1'b0"),
+        set("quiet", lit(QUIET_BITS, 0)),
+        set("done", "1'b0"),
+        set("err_seen", "1'b0"),
+        set("ferr_seen", "1'b0"),
+        set("bad_seen", "1'b0"),
+    ];
+    on_start.extend(COUNTERS.map(|c| set(c, "16'd0")));
+    let run = vec![
+        Stmt::If(
+            "rx_valid".into(),
+            vec![
+                set("win", format!("{{win[{}:0], rx_byte}}", wb - 9)),
+                Stmt::If("!fill[5]".into(), vec![set("fill", "fill + 6'd1")], vec![]),
+            ],
+            vec![Stmt::If("take".into(), vec![set("fill", "6'd0")], vec![])],
+        ),
+        count("n_ok", "take"),
+        count("n_bad", "chk && sync_ok && !good"),
+        count("n_ferr", "rx_ferr"),
+        count("n_drop", "take && !push && !is_status"),
+        count("n_guard", "tri_err"),
+        Stmt::If("chk && sync_ok && !good".into(), vec![set("bad_seen", "1'b1")], vec![]),
+        Stmt::If("rx_ferr".into(), vec![set("ferr_seen", "1'b1")], vec![]),
+        Stmt::If("(take && !push && !is_status) || tri_err".into(), vec![set("err_seen", "1'b1")], vec![]),
+        Stmt::If("push".into(), vec![set("wp", format!("wp + {}", lit(qb + 1, 1)))], vec![]),
+        clear_step(aw),
+        Stmt::If(
+            "drawing".into(),
+            vec![Stmt::If(
+                "head_clear && quiet_full".into(),
+                vec![
+                    Stmt::Comment("Everything before the clear is drawn: clear, then go on.".into()),
+                    set("rp", format!("rp + {}", lit(qb + 1, 1))),
+                    set("drawing", "1'b0"),
+                    set("clearing", "1'b1"),
+                    set("caddr", lit(aw, 0)),
+                    set("ld", "1'b0"),
+                    set("quiet", lit(QUIET_BITS, 0)),
+                ],
+                vec![
+                    // A read takes a clock, and a word written this clock is read the next:
+                    // `ld` says q holds queue[rp] and rp's word was written before.
+                    set("ld", "!empty && !accept"),
+                    Stmt::If("accept".into(), vec![set("rp", format!("rp + {}", lit(qb + 1, 1)))], vec![]),
+                    Stmt::If(
+                        "in_valid || mem_valid".into(),
+                        vec![set("quiet", lit(QUIET_BITS, 0))],
+                        vec![Stmt::If("!quiet_full".into(), vec![set("quiet", format!("quiet + {}", lit(QUIET_BITS, 1)))], vec![])],
+                    ),
+                ],
+            )],
+            vec![],
+        ),
+        set("done", "drawing && empty && quiet_full"),
+    ];
+    body.push(Item::Always(vec![set("chk", "rx_valid"), Stmt::If("start".into(), on_start, run)]));
+    body.extend([
+        Item::Blank,
+        comment("The status record, sent on a status request: the counts before it, little-endian, and their XOR."),
+        wire(
+            "st_xor",
+            8,
+            format!(
+                "8'h{:02x} ^ {}",
+                uart::STATUS,
+                COUNTERS.iter().map(|c| format!("{c}[7:0] ^ {c}[15:8]")).collect::<Vec<_>>().join(" ^ ")
+            ),
+        ),
+        Item::Instance {
+            module: uart::TX.into(),
+            name: "u_tx".into(),
+            params: vec![],
+            conns: vec![
+                ("clk".into(), "clk".into()),
+                ("rst".into(), "start".into()),
+                ("send".into(), "take && is_status".into()),
+                (
+                    "data".into(),
+                    format!(
+                        "{{st_xor, {}, 8'h{:02x}, 8'h{:02x}, 8'h{:02x}}}",
+                        COUNTERS.iter().rev().copied().collect::<Vec<_>>().join(", "),
+                        uart::STATUS,
+                        uart::STATUS_SYNC[1],
+                        uart::STATUS_SYNC[0]
+                    ),
+                ),
+                ("tx".into(), "tx".into()),
+            ],
+        },
+        assign("pk", "n_ok[2:0]"),
+        Item::Blank,
+        comment("The chain is held in reset while the frame buffer is cleared; the queue word's fields, x0 in the high bits."),
+    ]);
+    body.extend(chain_and_port(fe, names, "q", bits));
+    Module { name: DRAW.into(), header, params: vec![], ports, body }
 }
