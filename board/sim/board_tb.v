@@ -153,6 +153,9 @@ always @(posedge dut.clk_draw) begin
     if (logging && |dut.fb_we) $fwrite(wfd, "%x %x %x\n", dut.fb_waddr, dut.fb_we, dut.fb_wdata);
 end
 
+// The drawing's start (after a clear), for the triangles-per-second figure.
+always @(posedge dut.u_draw.drawing) $display("board_tb: drawing from %0t ps", $time);
+
 // The ROM source: record once drawing is done (after F1's redraw with +redraw).
 always @(posedge led[0]) begin
     if (!$test$plusargs("stream")) begin

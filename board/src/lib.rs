@@ -7,6 +7,7 @@
 //! after drawing ends, and [`frame`] cuts, checks and decodes one whole frame.
 
 pub mod frame;
+pub mod mesh;
 pub mod send;
 pub mod sim;
 pub mod stream;
@@ -141,4 +142,13 @@ pub fn png(pixels: &[u8]) -> Vec<u8> {
     writer.write_image_data(pixels).expect("in-memory PNG encoding");
     writer.finish().expect("in-memory PNG end");
     out
+}
+
+/// Drawing clocks of the last drawing in a ROM run's bench output: from the end of the clear
+/// (`drawing from`) to `done`, less the 2^10 quiet clocks `done` waits for.
+pub fn drawing_clocks(log: &str) -> Option<u64> {
+    let at = |prefix: &str| log.lines().filter_map(|l| l.strip_prefix(prefix)?.strip_suffix(" ps")?.parse::<u64>().ok()).next_back();
+    let (from, done) = (at("board_tb: drawing from ")?, at("board_tb: drawing done at ")?);
+    let period_ps = (1e12 / hdl_gen::board::DRAW_HZ).round() as u64;
+    (done.checked_sub(from)? / period_ps).checked_sub(1 << 10)
 }

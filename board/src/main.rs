@@ -29,6 +29,18 @@ enum Cmd {
     Ulx3s85f(Args),
     /// Send a triangle file to the board's UART source (a tty, or a file or pipe to check the bytes).
     Send(SendArgs),
+    /// Write a Wavefront mesh as a triangle file for the board: lit, culled, back to front.
+    Mesh(MeshArgs),
+}
+
+#[derive(clap::Args)]
+struct MeshArgs {
+    /// The mesh (e.g. meshes/teapot.obj).
+    #[arg(long, value_name = "FILE.obj")]
+    obj: PathBuf,
+    /// The triangle file to write.
+    #[arg(long)]
+    out: PathBuf,
 }
 
 #[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
@@ -80,8 +92,8 @@ struct SendArgs {
     file: PathBuf,
 }
 
-const DEFAULT_TRIANGLES: &str = include_str!("../../docs/triangles.txt");
-const DEFAULT_NAME: &str = "docs/triangles.txt";
+const DEFAULT_TRIANGLES: &str = include_str!("../../docs/teapot-board.txt");
+const DEFAULT_NAME: &str = "docs/teapot-board.txt";
 
 fn usage(e: impl std::fmt::Display) -> ExitCode {
     eprintln!("error: {e}");
@@ -92,7 +104,26 @@ fn main() -> ExitCode {
     match Cli::parse().cmd {
         Cmd::Ulx3s85f(args) => board(&args),
         Cmd::Send(args) => send_file(&args),
+        Cmd::Mesh(args) => mesh_file(&args),
     }
+}
+
+fn mesh_file(args: &MeshArgs) -> ExitCode {
+    let name = args.obj.display().to_string();
+    let text = match std::fs::read_to_string(&args.obj) {
+        Ok(t) => t,
+        Err(e) => return usage(format!("--obj {name}: {e}")),
+    };
+    let (out, faces, front) = match segshade_board::mesh::painter_triangles(&text, &name, frame::WIDTH as f64, frame::HEIGHT as f64) {
+        Ok(r) => r,
+        Err(e) => return usage(format!("--obj {name}: {e}")),
+    };
+    if let Err(e) = hdl_gen::output::write_one(&args.out, out.as_bytes()) {
+        eprintln!("error: --out {}: {e}", args.out.display());
+        return ExitCode::from(1);
+    }
+    println!("wrote       {} ({front} of {faces} triangles facing the viewer, back to front)", args.out.display());
+    ExitCode::SUCCESS
 }
 
 fn send_file(args: &SendArgs) -> ExitCode {
@@ -198,6 +229,15 @@ fn run(
     };
     print!("{log}");
     println!("simulated   {:.1} s", t.elapsed().as_secs_f64());
+    if let (None, Some(clocks)) = (packets, segshade_board::drawing_clocks(&log)) {
+        let secs = clocks as f64 / DRAW_HZ;
+        println!(
+            "drawing:    {} triangles in {clocks} clocks at {:.2} MHz: {:.0} triangles/s",
+            tris.len(),
+            DRAW_HZ / 1e6,
+            tris.len() as f64 / secs
+        );
+    }
     let text = std::fs::read_to_string(&rec).with_context(|| format!("reading {}", rec.display()))?;
     let clocks = frame::parse_recording(&text)?;
     let start = frame::frame_start(&clocks)?;

@@ -119,7 +119,7 @@ fn a_file_too_large_for_the_rom_is_refused() {
         .unwrap();
     let err = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(2), "{err}");
-    assert!(err.contains("2049 triangles") && err.contains("at most 2048"), "{err}");
+    assert!(err.contains("4097 triangles") && err.contains("at most 4096"), "{err}");
     assert!(!dir.path().join("out").exists(), "nothing written");
     // At the limit it is taken.
     std::fs::write(&file, line.repeat(hdl_gen::board::MAX_TRIANGLES)).unwrap();

@@ -73,6 +73,20 @@ fn send_writes_packets_that_decode_to_the_file_and_refuses_bad_input() {
         assert!(err.starts_with("error: ") && err.contains(says), "{a:?}: {err}");
         assert!(!fresh.exists(), "{a:?}: nothing written");
     }
+    // The board's own --baud, for the UART source's RTL.
+    let out = dir.path().join("out");
+    let (code, err, _) = board(&[
+        "ulx3s-85f".as_ref(),
+        "--source".as_ref(),
+        "uart".as_ref(),
+        "--baud".as_ref(),
+        "4000000".as_ref(),
+        "--out".as_ref(),
+        out.as_os_str(),
+    ]);
+    assert_eq!(code, Some(2), "{err}");
+    assert!(err.starts_with("error: --baud 4000000 baud: the board's FT231X takes at most 3000000") && err.lines().count() == 1, "{err}");
+    assert!(!out.exists());
 }
 
 /// The UART source's model at 3 MBd (built once, kept by common::model).
@@ -243,4 +257,23 @@ fn a_receiver_without_its_check_draws_garbage() {
     let (pic, _, st, _) = play(&dir, &exe, &ops);
     let (n, _) = differences(&golden_of(&[a]), &pic);
     assert!(n > 0 && st.packets == 2, "the corrupted packet was taken ({st:?}) and drew {n} pixels");
+}
+
+/// The default picture is what `board mesh` makes of the teapot, and fits the ROM.
+#[test]
+fn the_default_triangles_are_the_teapot_back_to_front() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
+    let obj = std::fs::read_to_string(root.join("meshes/teapot.obj")).unwrap();
+    let (text, faces, front) = segshade_board::mesh::painter_triangles(&obj, "meshes/teapot.obj", 320.0, 240.0).unwrap();
+    assert_eq!(std::fs::read_to_string(root.join("docs/teapot-board.txt")).unwrap(), text, "docs/teapot-board.txt is stale");
+    assert_eq!(faces, 4032);
+    assert!(front > 1000 && front <= hdl_gen::board::MAX_TRIANGLES, "{front} front faces");
+    assert_eq!(golden::setup::parse_triangles(&text).unwrap().len(), front);
+    // Back to front: a near triangle (z = 1, on the right) listed before a far one (z = -1, on
+    // the left) comes out after it; a back face (clockwise) is left out.
+    let two = "v 0 0 1\nv 1 0 1\nv 0 1 1\nv -1 0 -1\nv 0 0 -1\nv -1 1 -1\nv 0 0 0\nv 0 1 0\nv 1 0 0\nf 1 2 3\nf 4 5 6\nf 7 8 9\n";
+    let (text, faces, front) = segshade_board::mesh::painter_triangles(two, "two", 320.0, 240.0).unwrap();
+    assert_eq!((faces, front), (3, 2));
+    let t = golden::setup::parse_triangles(&text).unwrap();
+    assert!(t[0].v[0].x < t[1].v[0].x, "the far (left) triangle first: {text}");
 }
