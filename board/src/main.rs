@@ -88,6 +88,9 @@ struct SendArgs {
     /// The rate the board was built for (`--baud` of ulx3s-85f).
     #[arg(long, default_value_t = uart::DEFAULT_BAUD)]
     baud: u32,
+    /// Then ask the board for its status record and print its counts (a tty only).
+    #[arg(long)]
+    status: bool,
     /// A triangle file (`render --triangles` format).
     file: PathBuf,
 }
@@ -132,13 +135,26 @@ fn send_file(args: &SendArgs) -> ExitCode {
         uart::divider(args.baud, DRAW_HZ)?;
         let text = std::fs::read_to_string(&args.file).map_err(|e| send::SendError::File { what: what.clone(), error: e.to_string() })?;
         let bytes = send::packets(&text, &what)?;
-        send::send(&args.port, args.baud, &bytes)?;
-        Ok::<usize, send::SendError>(bytes.len())
+        let status = send::send(&args.port, args.baud, &bytes, args.status)?;
+        Ok::<_, send::SendError>((bytes.len(), status))
     })();
     match sent {
-        Ok(n) => {
+        Ok((n, status)) => {
             println!("sent        {n} bytes ({} packets) to {} at {} baud", n / uart::LEN, args.port.display(), args.baud);
-            ExitCode::SUCCESS
+            match (args.status, status) {
+                (false, _) => ExitCode::SUCCESS,
+                (true, Some(s)) => {
+                    println!(
+                        "board:      {} packets taken, {} bad windows, {} framing errors, {} triangles dropped on receipt, {} outside the guard band",
+                        s.packets, s.bad, s.framing, s.dropped, s.guard
+                    );
+                    ExitCode::SUCCESS
+                }
+                (true, None) => {
+                    eprintln!("error: --status: no status record from the board within 2 s");
+                    ExitCode::from(1)
+                }
+            }
         }
         Err(e) => {
             eprintln!("error: {e}");

@@ -20,6 +20,8 @@ pub enum SendError {
     Ports { what: String, triangle: usize },
     #[error("--port {port}: {error}")]
     Port { port: String, error: std::io::Error },
+    #[error("--status: {0} is not a serial port (a tty), so no record can come back")]
+    NotTty(String),
 }
 
 impl SendError {
@@ -89,22 +91,66 @@ fn set_tty(f: &std::fs::File, baud: u32) -> std::io::Result<()> {
     Ok(())
 }
 
+/// How long `--status` waits for the board's record.
+const STATUS_WAIT: std::time::Duration = std::time::Duration::from_secs(2);
+
 /// Sends `bytes` to `port`: a tty at `baud`, a pipe or device as it is, a plain file (or a new
-/// one) written whole under a temporary name and renamed.
-pub fn send(port: &Path, baud: u32, bytes: &[u8]) -> Result<(), SendError> {
+/// one) written whole under a temporary name and renamed. With `status` (a tty only), then sends
+/// a status request and returns the board's record.
+pub fn send(port: &Path, baud: u32, bytes: &[u8], status: bool) -> Result<Option<uart::Status>, SendError> {
     let err = |error| SendError::Port { port: port.display().to_string(), error };
     let plain = std::fs::metadata(port).map(|m| m.is_file()).unwrap_or(true);
-    if plain {
-        return hdl_gen::output::write_one(port, bytes).map_err(|e| err(std::io::Error::other(e.to_string())));
+    if plain && status {
+        return Err(SendError::NotTty(port.display().to_string()));
     }
-    let mut f = std::fs::OpenOptions::new().write(true).open(port).map_err(err)?;
+    if plain {
+        hdl_gen::output::write_one(port, bytes).map_err(|e| err(std::io::Error::other(e.to_string())))?;
+        return Ok(None);
+    }
+    let mut f = std::fs::OpenOptions::new().read(status).write(true).open(port).map_err(err)?;
     // SAFETY: isatty only reads the descriptor's kind.
-    if unsafe { libc::isatty(f.as_raw_fd()) } == 1 {
+    let tty = unsafe { libc::isatty(f.as_raw_fd()) } == 1;
+    if status && !tty {
+        return Err(SendError::NotTty(port.display().to_string()));
+    }
+    if tty {
         set_tty(&f, baud).map_err(err)?;
     }
     f.write_all(bytes).map_err(err)?;
     f.flush().map_err(err)?;
     // SAFETY: as above; tcdrain waits until a tty has sent everything (fails harmlessly otherwise).
     unsafe { libc::tcdrain(f.as_raw_fd()) };
-    Ok(())
+    if !status {
+        return Ok(None);
+    }
+    f.write_all(&uart::encode(&uart::Command::Status).expect("a request fits")).map_err(err)?;
+    read_status(&mut f).map_err(err)
+}
+
+/// Reads until a status record has come (the bytes before it skipped) or [`STATUS_WAIT`] passed.
+fn read_status(f: &mut std::fs::File) -> std::io::Result<Option<uart::Status>> {
+    use std::io::Read;
+    // SAFETY: as in set_tty; VMIN 0 and VTIME 2: a read returns after 0.2 s without a byte.
+    unsafe {
+        let mut t: libc::termios = std::mem::zeroed();
+        if libc::tcgetattr(f.as_raw_fd(), &mut t) != 0 {
+            return Err(std::io::Error::last_os_error());
+        }
+        t.c_cc[libc::VMIN] = 0;
+        t.c_cc[libc::VTIME] = 2;
+        if libc::tcsetattr(f.as_raw_fd(), libc::TCSANOW, &t) != 0 {
+            return Err(std::io::Error::last_os_error());
+        }
+    }
+    let start = std::time::Instant::now();
+    let mut got = Vec::new();
+    while start.elapsed() < STATUS_WAIT {
+        let mut buf = [0u8; 64];
+        let n = f.read(&mut buf)?;
+        got.extend_from_slice(&buf[..n]);
+        if let Some(s) = (0..got.len()).find_map(|k| uart::status(&got[k..])) {
+            return Ok(Some(s));
+        }
+    }
+    Ok(None)
 }

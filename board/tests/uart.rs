@@ -277,3 +277,58 @@ fn the_default_triangles_are_the_teapot_back_to_front() {
     let t = golden::setup::parse_triangles(&text).unwrap();
     assert!(t[0].v[0].x < t[1].v[0].x, "the far (left) triangle first: {text}");
 }
+
+/// `board send --status` through a pseudo-terminal: the test is the board's end of the line; it
+/// reads the packets until the status request, answers with a record, and `send` prints its
+/// counts. Without a tty, `--status` is refused.
+#[test]
+fn send_status_reads_the_record_back_through_a_tty() {
+    use std::io::{Read, Write};
+    use std::os::fd::FromRawFd;
+    // SAFETY: the libc calls of a pseudo-terminal's master; the fd is owned by `master` below.
+    let (mut master, slave) = unsafe {
+        let fd = libc::posix_openpt(libc::O_RDWR | libc::O_NOCTTY | libc::O_NONBLOCK);
+        assert!(fd >= 0 && libc::grantpt(fd) == 0 && libc::unlockpt(fd) == 0);
+        let name = std::ffi::CStr::from_ptr(libc::ptsname(fd)).to_str().unwrap().to_string();
+        (std::fs::File::from_raw_fd(fd), name)
+    };
+    let dir = tempfile::tempdir().unwrap();
+    let file = dir.path().join("quick.txt");
+    std::fs::write(&file, QUICK).unwrap();
+    let child = Process::new(env!("CARGO_BIN_EXE_board"))
+        .args(["send", "--status", "--port", &slave])
+        .arg(&file)
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut d = uart::Deframer::default();
+    let (mut cmds, start) = (Vec::new(), std::time::Instant::now());
+    while !cmds.contains(&Command::Status) {
+        assert!(start.elapsed() < std::time::Duration::from_secs(20), "no status request came: {cmds:?}");
+        let mut buf = [0u8; 256];
+        match master.read(&mut buf) {
+            Ok(n) => cmds.extend(buf[..n].iter().filter_map(|&b| match d.push(b) {
+                uart::Verdict::Packet(c) => Some(c),
+                _ => None,
+            })),
+            Err(_) => std::thread::sleep(std::time::Duration::from_millis(10)),
+        }
+    }
+    assert_eq!(cmds.len(), 7, "a clear, five triangles, the request");
+    let mut record = vec![0x13, 0x5A, 0xA5, b'S', 6, 0, 2, 0, 1, 0, 0, 0, 3, 0];
+    record.push(record[3..].iter().fold(0, |a, b| a ^ b));
+    master.write_all(&record).unwrap();
+    let out = child.wait_with_output().unwrap();
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        text.contains("6 packets taken, 2 bad windows, 1 framing errors, 0 triangles dropped on receipt, 3 outside the guard band"),
+        "{text}"
+    );
+    // A plain file cannot answer.
+    let (code, err, _) =
+        board(&["send".as_ref(), "--status".as_ref(), "--port".as_ref(), dir.path().join("x.bin").as_os_str(), file.as_os_str()]);
+    assert_eq!(code, Some(2), "{err}");
+    assert!(err.contains("not a serial port") && !dir.path().join("x.bin").exists(), "{err}");
+}
