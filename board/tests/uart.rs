@@ -197,6 +197,15 @@ fn uart_stream_draws_golden_and_faults_never_hang_it() {
     let full = golden_of(&[big]).iter().filter(|&&v| v != 0).count();
     assert!((1..full).contains(&before), "F1 came mid-draw: {before} of {full} pixels drawn before it");
 
+    // A clear right behind a large triangle waits until it is drawn (else its last writes would
+    // land after the clear); the triangle after the clear is alone in the picture.
+    let mut ops = packet(&big);
+    ops.extend(stream::bytes(&uart::encode(&Command::Clear).unwrap()));
+    ops.extend(packet(&a));
+    let (pic, _, st, _) = play(&dir, &exe, &ops);
+    assert_eq!(differences(&golden_of(&[a]), &pic), (0, None), "a clear after a triangle");
+    assert_eq!(st, uart::Status { packets: 3, ..Default::default() });
+
     // F1 mid-byte: 1.5 us into the fifth byte of a packet (the receiver is reset inside a
     // byte); that packet is lost, the next draws.
     let mut ops = packet(&big)[..4].to_vec();
