@@ -31,8 +31,8 @@ pub enum Source {
 pub const QUEUE_BITS: u32 = 10;
 
 /// Triangles the ROM holds at most: 4096 words of 3 x (x, y, I) bits, 180 at the defaults, so
-/// 40 of the LFE5U-85F's 208 DP16KD blocks (as 512 x 36), beside the 320x240 frame buffer's 40:
-/// room for the teapot's 2176 front faces (docs/teapot-board.txt), and 128 blocks still free.
+/// at most 40 of the LFE5U-85F's 208 DP16KD blocks (as 512 x 36; the teapot's took 36), beside
+/// the 320x240 frame buffer's 40: room for the teapot's 2176 front faces (docs/teapot-board.txt).
 pub const MAX_TRIANGLES: usize = 4096;
 /// The ROM image `board_draw` loads by `$readmemh` (a file beside the Verilog).
 pub const ROM_HEX: &str = "board_tris.hex";
