@@ -11,8 +11,10 @@
 //!   as a register of that width would, so a width too narrow shows as a wrong result.
 //! - **Division by reciprocal** ([`Plan::reciprocal`]): every division by `2A` (dI and the
 //!   steps) is formed as the walker forms `I0`: the dividend normalised by `s` (below 2^K),
-//!   `q~ = (N Rn) >> K`, one product by `2An` and one compare to correct it. `Rn` itself
-//!   stays a restoring division, and so do the edges' (each has its own divisor).
+//!   a product by `Rn`, one product by `2An` and compares to correct it. `Rn` itself
+//!   stays a restoring division, and so do the edges' (each has its own divisor). Only the
+//!   dividend's top `IW + 2` bits enter the product, so the estimate is up to two below and two
+//!   compares correct it (`engine/build.rs`, `ByA::divmod`).
 //! - **The schedule** (`engine/schedule.rs`): a modulo schedule of the program on `M`
 //!   multipliers and `D` dividers of `R` quotient bits a clock; the set-up's *latency* and
 //!   *initiation interval* (clocks between two triangles entering the engine, the sustained
@@ -48,6 +50,19 @@ pub enum MulUnit {
     ShiftAdd { bits: u32 },
 }
 
+/// How a restoring divider is built (the same quotients; the cost differs).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum DivForm {
+    /// Today's (`hdl-gen/src/frontend/divider.rs`): the divisor shifted right across a partial
+    /// remainder of quotient plus divisor bits; the subtractor is that wide.
+    ShiftDivisor,
+    /// The textbook form: the partial remainder shifted left past a fixed divisor, the dividend's
+    /// bits shifted in; the subtractor is one bit wider than the divisor.
+    #[default]
+    ShiftRemainder,
+}
+
 /// The shared set-up engine's parameters: the generator and the manifest print them with the
 /// schedule's clocks.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
@@ -59,6 +74,7 @@ pub struct Plan {
     pub dividers: u32,
     /// Quotient bits a divider takes a clock: radix `2^R`.
     pub div_bits: u32,
+    pub div_form: DivForm,
     /// Divisions by `2A` by the reciprocal `Rn` (a product and one correction).
     pub reciprocal: bool,
     /// The incremental `I0`'s per-source steps are part of the set-up.

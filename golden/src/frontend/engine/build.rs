@@ -105,22 +105,32 @@ struct ByA {
 }
 
 impl ByA {
-    /// `divmod(N, 2An)` of a normalised dividend `N < 2^K`: a restoring division, or the
-    /// walker's reciprocal form (`q~ = (N Rn) >> K`, the quotient or one below it; one product
-    /// by `2An` modulo 2^(AW+2) and a compare correct it).
+    /// `divmod(N, 2An)` of a normalised dividend `N < 2^K`: a restoring division, or by the
+    /// reciprocal. The reciprocal form takes only `N`'s top `K - AW = IW + 2` bits:
+    /// `q~ = ((N >> AW) Rn) >> (IW + 2)` is the quotient or up to two below it (each
+    /// truncation loses less than one: `N < 2^K`, `2An >= 2^AW`), so one product by `2An`
+    /// modulo 2^(AW+3) and two compares correct it. Against the walker's form (all of `N`,
+    /// one compare) the first product is 2 x 2 tile passes instead of 4 x 2.
     fn divmod(&self, b: &mut B, wd: &Widths, n: &str, num: V, qb: u32) -> (V, V) {
         if !self.reciprocal {
             return b.div(n, num, self.an2, qb, qb + wd.aw + 1, wd.aw + 1);
         }
-        let p1 = b.mul(&format!("{n}.nr"), num, self.rn, wd.k + wd.rw, false);
-        let qt = b.op(format!("{n}.qt"), Kind::Shr(p1, wd.k), wd.rw, false);
-        let p2 = b.mul(&format!("{n}.qa"), qt, self.an2, wd.aw + 2, false);
-        let rt = b.op(format!("{n}.rt"), Kind::Sub(num, p2), wd.aw + 2, false);
-        let lo = b.lt(rt, self.an2);
-        let c = b.not(lo);
+        let top = wd.k - wd.aw;
+        let nh = b.op(format!("{n}.nh"), Kind::Shr(num, wd.aw), top, false);
+        let p1 = b.mul(&format!("{n}.nr"), nh, self.rn, top + wd.rw, false);
+        let qt = b.op(format!("{n}.qt"), Kind::Shr(p1, top), wd.rw, false);
+        let p2 = b.mul(&format!("{n}.qa"), qt, self.an2, wd.aw + 3, false);
+        let rt = b.op(format!("{n}.rt"), Kind::Sub(num, p2), wd.aw + 3, false);
+        let an4 = b.shl(&format!("{n}.4An"), self.an2, 1, wd.aw + 2, false);
+        let lo1 = b.lt(rt, self.an2);
+        let lo2 = b.lt(rt, an4);
+        let (c1, c2) = (b.not(lo1), b.not(lo2));
+        let c = b.op(format!("{n}.c"), Kind::Add(c1, c2), 2, false);
         let q = b.op(n, Kind::Add(qt, c), qb, false);
-        let r2 = b.op(format!("{n}.r2"), Kind::Sub(rt, self.an2), wd.aw + 1, false);
-        let r = b.sel(&format!("{n}.rem"), c, r2, rt, wd.aw + 1, false);
+        let r1 = b.op(format!("{n}.r1"), Kind::Sub(rt, self.an2), wd.aw + 1, false);
+        let r2 = b.op(format!("{n}.r2"), Kind::Sub(rt, an4), wd.aw + 1, false);
+        let r = b.sel(&format!("{n}.r12"), c2, r2, r1, wd.aw + 1, false);
+        let r = b.sel(&format!("{n}.rem"), c1, r, rt, wd.aw + 1, false);
         (q, r)
     }
 }

@@ -14,7 +14,7 @@
 //!   triangles (a unit that ran the same operation is preferred, so the binding is static where
 //!   the interval allows); an operation busier than II alternates between units.
 
-use super::{compute, Kind, MulUnit, Plan, Program, V};
+use super::{compute, DivForm, Kind, MulUnit, Plan, Program, V};
 use crate::frontend::incremental::Steps;
 use crate::frontend::{FixedTriangle, FrontEnd, Outcome, TriSetup};
 
@@ -89,6 +89,8 @@ pub struct Schedule {
     pub slots: Vec<Slot>,
     pub copies: Vec<u32>,
     pub cost: Cost,
+    /// Every (operation, unit) of a stretch of steady-state triangles.
+    pub rotation: Vec<(usize, u32)>,
 }
 
 /// What feeds a unit's port: (value, chunk) pairs, or a product's chunk weights.
@@ -157,7 +159,7 @@ impl Schedule {
         let ready: Vec<u32> = (0..n).map(|o| start[o] + timing[o].2).collect();
         let latency = prog.out.all().iter().map(|v| ready[v.0 as usize]).max().unwrap_or(0);
         let slots = (0..n).map(|o| Slot { class: timing[o].0, unit: None, start: start[o], busy: timing[o].1, ready: ready[o] }).collect();
-        let mut s = Schedule { plan, prog, ii, latency, slots, copies: vec![1; n], cost: Cost::default() };
+        let mut s = Schedule { plan, prog, ii, latency, slots, copies: vec![1; n], cost: Cost::default(), rotation: Vec::new() };
         s.copies = s.copies_needed();
         s.bind();
         s.cost = s.cost();
@@ -260,19 +262,58 @@ impl Schedule {
             let cap = if c == Class::Mul { self.plan.mults } else { self.plan.dividers } as usize;
             let mut until = vec![0u32; cap];
             let mut last: Vec<Option<usize>> = vec![None; cap];
-            for (t, o, j) in iv {
-                let free: Vec<usize> = (0..cap).filter(|&u| until[u] <= t).collect();
-                let u = *free
-                    .iter()
-                    .find(|&&u| last[u] == Some(o))
-                    .or(free.first())
-                    .expect("a unit is free: the modulo table holds at most its units");
-                until[u] = t + self.slots[o].busy;
-                last[u] = Some(o);
-                if j == steady {
-                    self.slots[o].unit = Some(u as u32);
+            let mut seen: Vec<Vec<usize>> = vec![Vec::new(); cap];
+            let mut wide = vec![0u32; cap];
+            // Those starting together: first each on the unit it ran on before, if free.
+            for group in iv.chunk_by(|a, b| a.0 == b.0) {
+                let t = group[0].0;
+                let mut todo: Vec<(usize, usize)> = Vec::new();
+                for &(_, o, j) in group {
+                    match (0..cap).find(|&u| until[u] <= t && last[u] == Some(o)) {
+                        Some(u) => {
+                            until[u] = t + self.slots[o].busy;
+                            self.note(o, j, u, steady, span);
+                        }
+                        None => todo.push((o, j)),
+                    }
+                }
+                // The others: a unit that ran this operation before, else one that need not
+                // grow for it, the least oversized.
+                for (o, j) in todo {
+                    let wo = self.unit_width(o);
+                    let u = (0..cap)
+                        .filter(|&u| until[u] <= t)
+                        .min_by_key(|&u| (!seen[u].contains(&o), wo.saturating_sub(wide[u]), wide[u].saturating_sub(wo), u))
+                        .expect("a unit is free: the modulo table holds at most its units");
+                    until[u] = t + self.slots[o].busy;
+                    last[u] = Some(o);
+                    seen[u].push(o);
+                    wide[u] = wide[u].max(wo);
+                    self.note(o, j, u, steady, span);
                 }
             }
+        }
+    }
+
+    /// The subtractor a division needs on a divider of the plan's form (0 for a product).
+    fn unit_width(&self, o: usize) -> u32 {
+        match self.prog.ops[o].kind {
+            Kind::Div { d, pw, .. } => match self.plan.div_form {
+                DivForm::ShiftDivisor => pw,
+                DivForm::ShiftRemainder => self.prog.ops[d.0 as usize].w + 1,
+            },
+            _ => 0,
+        }
+    }
+
+    /// Keeps a binding: the steady triangle's in the slots, and every one of a stretch of
+    /// steady triangles (an operation busier than II alternates) in `rotation`.
+    fn note(&mut self, o: usize, j: usize, u: usize, steady: usize, span: usize) {
+        if j == steady {
+            self.slots[o].unit = Some(u as u32);
+        }
+        if (steady..steady + span).contains(&j) {
+            self.rotation.push((o, u as u32));
         }
     }
 
@@ -284,13 +325,22 @@ impl Schedule {
         let per_bit = lut_per_bit_step();
         // Sources of each unit's ports (a multiplier's: the operand chunks and the weights).
         let mut mul_src: Vec<[Sources; 3]> = vec![Default::default(); plan.mults as usize];
-        let mut div_src: Vec<([Sources; 2], u32)> = vec![Default::default(); plan.dividers as usize];
+        let mut div_src: Vec<([Sources; 2], [u32; 3])> = vec![Default::default(); plan.dividers as usize];
         let mut width = vec![0u32; plan.mults as usize];
         for (o, (op, s)) in ops.iter().zip(&self.slots).enumerate() {
+            match s.class {
+                Class::Mul => c.mul_passes += s.busy,
+                Class::Div => c.div_clocks += s.busy,
+                _ => {}
+            }
+            if s.class != Class::Wire {
+                c.reg_bits += self.copies[o] * op.w;
+            }
+        }
+        for &(o, u) in &self.rotation {
+            let (op, u) = (&ops[o], u as usize);
             match op.kind {
                 Kind::Mul(a, b) => {
-                    c.mul_passes += s.busy;
-                    let u = s.unit.expect("bound") as usize;
                     let m = &mut mul_src[u];
                     match plan.mul {
                         MulUnit::Tile { bits } => {
@@ -308,16 +358,18 @@ impl Schedule {
                     }
                 }
                 Kind::Div { n, d, pw, .. } => {
-                    c.div_clocks += s.busy;
-                    let u = &mut div_src[s.unit.expect("bound") as usize];
+                    let u = &mut div_src[u];
                     u.0[0].push((n.0, 0));
                     u.0[1].push((d.0, 0));
-                    u.1 = u.1.max(pw);
+                    // The subtractor and the ports: today's form shifts the divisor across the
+                    // whole partial remainder; the other shifts the remainder past the divisor.
+                    let ws = match plan.div_form {
+                        DivForm::ShiftDivisor => [pw; 3],
+                        DivForm::ShiftRemainder => [w(d) + 1, w(n), w(d)],
+                    };
+                    (0..3).for_each(|k| u.1[k] = u.1[k].max(ws[k]));
                 }
-                _ => {}
-            }
-            if s.class != Class::Wire {
-                c.reg_bits += self.copies[o] * op.w;
+                _ => unreachable!("only units are bound"),
             }
         }
         let mux = |k: usize, bits: u32| if k < 2 { 0 } else { bits * ceil(k as u32, 2) };
@@ -337,9 +389,9 @@ impl Schedule {
                 }
             }
         }
-        for (src, pw) in div_src.iter_mut() {
-            c.lut_units += (per_bit * (*pw * plan.div_bits) as f64).round() as u32;
-            c.lut_mux += mux(distinct(&mut src[0]), *pw) + mux(distinct(&mut src[1]), *pw);
+        for (src, ws) in div_src.iter_mut() {
+            c.lut_units += (per_bit * (ws[0] * plan.div_bits) as f64).round() as u32;
+            c.lut_mux += mux(distinct(&mut src[0]), ws[1]) + mux(distinct(&mut src[1]), ws[2]);
         }
         c.result_bits = self.prog.out.all().iter().map(|&v| w(v)).sum();
         c
@@ -358,7 +410,8 @@ pub fn lut_per_bit_step() -> f64 {
 /// The sum of today's dividers' partial-remainder widths at the defaults (357).
 pub fn today_pw() -> u32 {
     let fe = FrontEnd::new(Default::default(), Default::default()).expect("the defaults");
-    let plan = Plan { mults: 1, mul: Plan::TILE18, dividers: 1, div_bits: 1, reciprocal: false, i0_steps: false };
+    let plan =
+        Plan { mults: 1, mul: Plan::TILE18, dividers: 1, div_bits: 1, div_form: DivForm::ShiftDivisor, reciprocal: false, i0_steps: false };
     Program::setup(&fe, &plan).ops.iter().map(|o| if let Kind::Div { pw, .. } = o.kind { pw } else { 0 }).sum()
 }
 

@@ -10,7 +10,7 @@ use crate::stimulus::random_fixed_triangles;
 use rand::SeedableRng;
 
 fn plan(mults: u32, dividers: u32, div_bits: u32, reciprocal: bool) -> Plan {
-    Plan { mults, mul: Plan::TILE18, dividers, div_bits, reciprocal, i0_steps: true }
+    Plan { mults, mul: Plan::TILE18, dividers, div_bits, div_form: DivForm::ShiftRemainder, reciprocal, i0_steps: true }
 }
 
 /// The screens of the equivalence: the default, a small one at F = 4 and the widest (2^16).
@@ -162,4 +162,75 @@ fn plans_without_units_are_refused() {
     assert_eq!(plan(0, 2, 1, true).schedule(&fe).unwrap_err(), EngineError::NoMultiplier(34));
     assert!(matches!(plan(2, 0, 1, true).schedule(&fe), Err(EngineError::NoDivider(_))));
     assert!(matches!(plan(2, 2, 0, true).schedule(&fe), Err(EngineError::Range { .. })));
+}
+
+/// One row of docs/design.md's table of plans.
+fn row(s: &Schedule) -> String {
+    let p = &s.plan;
+    let c = &s.cost;
+    let mul = match p.mul {
+        MulUnit::Tile { bits } => format!("{} × {bits}²", p.mults),
+        MulUnit::ShiftAdd { bits } => format!("{} shift-add × {bits}", p.mults),
+    };
+    format!(
+        "| {mul} | {} × {} bit{}{} | {} | {} | **{}** | {} | {} | {} | {} | {} | {} | {} |",
+        p.dividers,
+        p.div_bits,
+        if p.div_bits > 1 { "s" } else { "" },
+        if p.div_form == DivForm::ShiftDivisor { " (today's form)" } else { "" },
+        if p.reciprocal { "yes" } else { "no" },
+        if p.i0_steps { "yes" } else { "no" },
+        s.ii,
+        s.latency,
+        c.tiles,
+        c.mul_passes,
+        c.div_clocks,
+        c.lut_units,
+        c.lut_mux,
+        c.lut_units + c.lut_mux,
+    )
+}
+
+/// docs/design.md's table: `cargo test -p golden --lib engine_grid -- --ignored --nocapture`.
+#[test]
+#[ignore]
+fn engine_grid() {
+    let fe = fe640();
+    eprintln!(
+        "calibration: {:.2} LUT4 per remainder bit per quotient bit a clock; the rest {} LUT4",
+        schedule::lut_per_bit_step(),
+        schedule::lut_rest()
+    );
+    let filter = std::env::var("ENGINE_GRID").unwrap_or_default();
+    // Today's set-up as a plan: 66 tiles (one a pass), eight dividers of 4 bits in today's form.
+    let today = Plan {
+        mults: 66,
+        mul: Plan::TILE18,
+        dividers: 8,
+        div_bits: 4,
+        div_form: DivForm::ShiftDivisor,
+        reciprocal: false,
+        i0_steps: false,
+    };
+    println!("{} (today)", row(&today.schedule(&fe).unwrap()));
+    for steps in [false, true] {
+        for reciprocal in [false, true] {
+            for mul in [Plan::TILE18, MulUnit::Tile { bits: 16 }, MulUnit::ShiftAdd { bits: 1 }, MulUnit::ShiftAdd { bits: 4 }] {
+                for mults in [1, 2, 3, 4, 6, 8, 12] {
+                    for dividers in [1, 2, 3, 4, 6, 8, 10, 12] {
+                        for (div_bits, div_form) in
+                            [1, 2, 4].into_iter().flat_map(|b| [(b, DivForm::ShiftRemainder), (b, DivForm::ShiftDivisor)])
+                        {
+                            let p = Plan { mults, mul, dividers, div_bits, div_form, reciprocal, i0_steps: steps };
+                            let s = p.schedule(&fe).unwrap();
+                            let r = row(&s);
+                            if r.contains(&filter) {
+                                println!("{r}");
+                            }
+                        }
+                    }
+                }
+            }
+        }
+    }
 }
