@@ -215,6 +215,14 @@ fn engine_grid() {
     println!("{} (today)", row(&today.schedule(&fe).unwrap()));
     for steps in [false, true] {
         for reciprocal in [false, true] {
+            let prog = Program::setup(&fe, &Plan { reciprocal, i0_steps: steps, ..plan(1, 1, 1, false) });
+            let count = |f: fn(&Kind) -> bool| prog.ops.iter().filter(|o| f(&o.kind)).count();
+            eprintln!(
+                "reciprocal {reciprocal}, steps {steps}: {} operations, {} products, {} divisions",
+                prog.ops.len(),
+                count(|k| matches!(k, Kind::Mul(..))),
+                count(|k| matches!(k, Kind::Div { .. }))
+            );
             for mul in [Plan::TILE18, MulUnit::Tile { bits: 16 }, MulUnit::ShiftAdd { bits: 1 }, MulUnit::ShiftAdd { bits: 4 }] {
                 for mults in [1, 2, 3, 4, 6, 8, 12] {
                     for dividers in [1, 2, 3, 4, 6, 8, 10, 12] {
