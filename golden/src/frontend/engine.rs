@@ -84,6 +84,38 @@ pub struct Plan {
 impl Plan {
     /// ECP5 MULT18X18D tiles.
     pub const TILE18: MulUnit = MulUnit::Tile { bits: 18 };
+
+    /// docs/design.md's recommendation for the ECP5-25F: 12 clocks a triangle on 12 MULT18X18D
+    /// and twelve 1-bit dividers, the incremental steps left to the walker's start evaluator.
+    pub const ECP5_25F: Plan = Plan {
+        mults: 12,
+        mul: Plan::TILE18,
+        dividers: 12,
+        div_bits: 1,
+        div_form: DivForm::ShiftRemainder,
+        reciprocal: true,
+        i0_steps: false,
+    };
+    /// For the iCE40 UP5K: 2 of its SB_MAC16 and one 1-bit divider, the smallest engine.
+    pub const ICE40_UP5K: Plan = Plan {
+        mults: 2,
+        mul: MulUnit::Tile { bits: 16 },
+        dividers: 1,
+        div_bits: 1,
+        div_form: DivForm::ShiftRemainder,
+        reciprocal: true,
+        i0_steps: false,
+    };
+    /// For the iCE40 HX8K, which has no multiplier: one shift-add unit and one divider, a bit a clock.
+    pub const ICE40_HX8K: Plan = Plan {
+        mults: 1,
+        mul: MulUnit::ShiftAdd { bits: 1 },
+        dividers: 1,
+        div_bits: 1,
+        div_form: DivForm::ShiftRemainder,
+        reciprocal: false,
+        i0_steps: false,
+    };
 }
 
 /// A value of the program: the result of the operation with this index.

@@ -54,18 +54,25 @@ fn first_mismatch(fe: &FrontEnd, s: &Schedule, tris: &[crate::frontend::FixedTri
     })
 }
 
-/// `n` triangles a screen through each plan; returns how many were walked.
+/// `n` triangles a screen through each plan, streamed in runs of at most 10,000 (each from
+/// reset); returns how many were walked.
 fn equivalence(n: usize, seed: u64) -> usize {
     let mut rng = SeedRng::seed_from_u64(seed);
     let mut walked = 0;
     for fe in screens() {
-        let tris = random_fixed_triangles(&mut rng, &fe, n);
-        walked += tris.iter().filter(|t| fe.setup(t).0 == Outcome::Walked).count();
-        for p in plans() {
-            let s = p.schedule(&fe).unwrap();
+        let sched: Vec<Schedule> = plans().iter().map(|p| p.schedule(&fe).unwrap()).collect();
+        for s in &sched {
             s.verify().unwrap();
-            if let Some(m) = first_mismatch(&fe, &s, &tris) {
-                panic!("{p:?} on {:?}: {m}", fe.screen);
+        }
+        let mut left = n;
+        while left > 0 {
+            let tris = random_fixed_triangles(&mut rng, &fe, left.min(10_000));
+            left -= tris.len();
+            walked += tris.iter().filter(|t| fe.setup(t).0 == Outcome::Walked).count();
+            for s in &sched {
+                if let Some(m) = first_mismatch(&fe, s, &tris) {
+                    panic!("{:?} on {:?}: {m}", s.plan, fe.screen);
+                }
             }
         }
     }
@@ -241,4 +248,17 @@ fn engine_grid() {
             }
         }
     }
+}
+
+/// The recommended plans schedule as docs/design.md says: the ECP5-25F's at 12 clocks on at
+/// most 12 tiles, the iCE40s' within the device's multipliers.
+#[test]
+fn the_recommended_plans() {
+    let fe = fe640();
+    let s = Plan::ECP5_25F.schedule(&fe).unwrap();
+    assert!(s.ii <= 12 && s.cost.tiles <= 12, "ECP5-25F: {} clocks, {} tiles", s.ii, s.cost.tiles);
+    let s = Plan::ICE40_UP5K.schedule(&fe).unwrap();
+    assert!(s.cost.tiles <= 8 && s.ii <= 120, "UP5K: {} clocks, {} tiles", s.ii, s.cost.tiles);
+    let s = Plan::ICE40_HX8K.schedule(&fe).unwrap();
+    assert!(s.cost.tiles == 0 && s.ii <= 314, "HX8K: {} clocks", s.ii);
 }
