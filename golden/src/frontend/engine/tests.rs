@@ -262,3 +262,12 @@ fn the_recommended_plans() {
     let s = Plan::ICE40_HX8K.schedule(&fe).unwrap();
     assert!(s.cost.tiles == 0 && s.ii <= 314, "HX8K: {} clocks", s.ii);
 }
+
+/// The ECP5-25F plan's schedule, for reviews: `cargo test -p golden --lib engine_listing --
+/// --ignored --nocapture`.
+#[test]
+#[ignore]
+fn engine_listing() {
+    let s = Plan::ECP5_25F.schedule(&fe640()).unwrap();
+    println!("II {} latency {}\n{}", s.ii, s.latency, s.listing());
+}
