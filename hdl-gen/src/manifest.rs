@@ -82,6 +82,9 @@ pub struct Frontend {
     pub div_bits: u32,
     /// Where `dI` comes from (`--fe-di`): `triangle` (once per triangle) or `scanline`.
     pub di: golden::frontend::DiMode,
+    /// How `I0` is formed (`--fe-i0`); left out for the default, `reciprocal`.
+    #[serde(default, skip_serializing_if = "golden::frontend::I0Form::is_default")]
+    pub i0: golden::frontend::I0Form,
     /// Per-scanline dI only: clocks the span divider runs for a span of two pixels or more.
     pub span_div_clocks: u32,
     /// Clocks from a triangle's transfer to its first span when the walker is idle.
@@ -335,6 +338,7 @@ pub fn render(opts: &Options, names: &Names, modules: &[Module], unit: &Specular
             widths: hw.fe.widths(),
             div_bits: hw.div_bits,
             di: hw.fe.di,
+            i0: hw.fe.i0,
             span_div_clocks: hw.span_div_clocks(),
             latency: hw.latency(),
             setup_clocks_walked: hw.setup_clocks().0,

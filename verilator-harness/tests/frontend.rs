@@ -181,3 +181,76 @@ fn scenes_render_through_the_rtl_chain_as_golden() {
         assert!(differ * 1000 < job.visible_pixels() as usize, "{differ} pixels differ from the host image");
     }
 }
+
+/// The incremental I0 (`--fe-i0 incremental`, issue 27) at `screen` and `level`: asked of
+/// `ondemand` (built once, then cached), or `None` when this build hands out a folder's models.
+fn incremental(screen: golden::setup::Screen, level: u32) -> Option<hdl_gen::Options> {
+    if verilator_harness::ffi::RTL_DIR.is_some() {
+        eprintln!("incremental I0: skipped: COSIM_RTL_DIR provides the models");
+        return None;
+    }
+    let cfg = golden::Config::new(8, golden::Config::default().frac, golden::Config::default().xbits, golden::Align::Span).unwrap();
+    Some(hdl_gen::Options {
+        cfg,
+        screen: Some(screen),
+        fe_i0: golden::frontend::I0Form::Incremental,
+        pipeline: golden::pipeline::Pipeline::new(level).unwrap(),
+        ..Default::default()
+    })
+}
+
+/// Spans of every kind of triangle, under random gaps and backpressure, then under resets,
+/// bit for bit golden's (its spans are the same in both forms); and golden's model of the
+/// incremental form really is what the RTL is compared with.
+fn incremental_spans(screen: golden::setup::Screen, level: u32, n: usize) {
+    let Some(opts) = incremental(screen, level) else { return };
+    let m = verilator_harness::ondemand::frontend(&opts).unwrap_or_else(|e| panic!("{e}"));
+    let seed = verilator_harness::seed("frontend incremental");
+    let fe = frontend(m).with_i0(golden::frontend::I0Form::Incremental);
+    assert_eq!(fe, opts.frontend().unwrap().fe, "the model's front-end is the plan's");
+    let tris = random_triangles(&mut SeedRng::seed_from_u64(seed), &fe, n);
+    let exp = Expected::new(fe, &tris);
+    let report = verilator_harness::frontend::run_frontend_against(m, seed, &tris, &exp);
+    eprintln!("{}: {} triangles, {} spans out, {} clocks", m.tag, report.triangles, report.segments, report.cycles);
+    assert_clean(m.tag, seed, &report);
+    assert_eq!(report.segments, exp.spans.len() as u64);
+    let report = run_frontend(m, seed ^ 5, Traffic::RANDOM, Stress::HARSH, &tris);
+    assert_clean(m.tag, seed, &report);
+    assert!(report.resets > 0, "{}: no reset in {} triangles", m.tag, tris.len());
+    // Negative control: one I0 off by one in the expectation is caught.
+    let mut bad = tris.clone();
+    let k = exp.stims.iter().position(|s| s.count > 0).unwrap();
+    bad[k].i[0] ^= 1 << 10;
+    let report = verilator_harness::frontend::run_frontend_against(m, seed, &tris, &Expected::new(fe, &bad));
+    assert!(!report.ok(), "{}: a wrong expectation went unnoticed", m.tag);
+}
+
+#[test]
+fn incremental_i0_spans_equal_golden_at_640x480() {
+    incremental_spans(golden::setup::Screen::default(), 0, 3000);
+}
+
+/// The slow tier (`--ignored`): an odd small screen, `--pipeline 1`, and the shared-edge mesh
+/// through `tri_fb` written exactly once; each builds a model on first use.
+#[test]
+#[ignore]
+fn incremental_i0_spans_equal_golden_on_a_small_odd_screen_and_pipelined() {
+    incremental_spans(golden::setup::Screen { width: 37, height: 23 }, 0, 3000);
+    incremental_spans(golden::setup::Screen::default(), 1, 3000);
+    incremental_spans(golden::setup::Screen { width: 37, height: 23 }, 1, 3000);
+}
+
+#[test]
+#[ignore]
+fn incremental_i0_mesh_lands_in_memory_once_per_pixel() {
+    for screen in [golden::setup::Screen::default(), golden::setup::Screen { width: 37, height: 23 }] {
+        let Some(opts) = incremental(screen, 0) else { return };
+        let m = verilator_harness::ondemand::tri_writer(&opts).unwrap_or_else(|e| panic!("{e}"));
+        let seed = verilator_harness::seed("tri_fb incremental mesh");
+        let tris: Vec<FixedTriangle> = mesh(&mut SeedRng::seed_from_u64(seed), &m.frontend(), 13, 9);
+        let run = verilator_harness::writer::run_fb(m, seed, Traffic::RANDOM, &tris);
+        assert_clean(m.tag, seed, &run.report);
+        let writes = run.mem.screen_writes();
+        assert!(writes.iter().all(|&n| n == 1), "{}: every pixel of the screen written exactly once", m.tag);
+    }
+}

@@ -2,7 +2,7 @@
 //! rate, pipeline level) and its ports: the types every part of the generator shares.
 
 use crate::verilog::Port;
-use golden::frontend::{DiMode, FrontEnd, Widths};
+use golden::frontend::{DiMode, FrontEnd, I0Form, Widths};
 
 /// Quotient bits the set-up's dividers take per clock (`--fe-div-bits`): area against rate.
 pub const DIV_BITS: [u32; 3] = [1, 2, 4];
@@ -48,7 +48,16 @@ impl Hw {
     /// idle: CALC, the dividers, the hand-off, the walker's clock, the span path's stages (and,
     /// per scanline, the span's division when it has two pixels or more).
     pub fn latency(&self) -> u32 {
-        self.calc_clocks() + self.div_clocks() + 2 + self.i0_stages() + self.span_div_clocks()
+        self.calc_clocks() + self.div_clocks() + 2 + self.i0_stages() + self.span_div_clocks() + self.start_clocks()
+    }
+
+    /// Clocks the walker waits for a source's start in the incremental I0 (at most: a start at
+    /// an edge; one at column 0 is shorter); 0 in the reciprocal form, which has none.
+    pub fn start_clocks(&self) -> u32 {
+        match self.fe.i0 {
+            I0Form::Reciprocal => 0,
+            I0Form::Incremental => super::incremental::START_CLOCKS + 1,
+        }
     }
 
     /// Clocks from a triangle's transfer to the first segment out of `tri_shader_p<P>` when idle:
