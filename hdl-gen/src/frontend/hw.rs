@@ -51,12 +51,15 @@ impl Hw {
         self.calc_clocks() + self.div_clocks() + 2 + self.i0_stages() + self.span_div_clocks() + self.start_clocks()
     }
 
-    /// Clocks the walker waits for a source's start in the incremental I0 (at most: a start at
-    /// an edge; one at column 0 is shorter); 0 in the reciprocal form, which has none.
+    /// Clocks a start takes in the incremental I0 (at most: a start at an edge; one at column 0
+    /// takes fewer); 0 in the reciprocal form, which has none. A triangle's first row is started
+    /// while it is held, before the walker takes it, so each walked triangle's set-up takes
+    /// these clocks more; a later start (an edge taking over the left end) holds the walker
+    /// one clock more than this.
     pub fn start_clocks(&self) -> u32 {
         match self.fe.i0 {
             I0Form::Reciprocal => 0,
-            I0Form::Incremental => super::incremental::START_CLOCKS + 1,
+            I0Form::Incremental => super::incremental::START_CLOCKS,
         }
     }
 
@@ -71,7 +74,7 @@ impl Hw {
     /// and per triangle dropped in set-up (its last CALC clock). CALC's earlier stages overlap
     /// the triangle ahead's division, so neither depends on the pipeline level.
     pub fn setup_clocks(&self) -> (u32, u32) {
-        (self.div_clocks() + 1, 1)
+        (self.div_clocks() + 1 + self.start_clocks(), 1)
     }
 }
 
