@@ -154,9 +154,11 @@ pub(super) fn engine(hw: &Hw, body: &mut Vec<Item>) {
     }
     body.push(wire("ie_psel", 2, "ie_pc0 ? 2'd0 : ie_pc1 ? 2'd1 : ie_pc2 ? 2'd2 : 2'd3"));
     body.push(wire("ie_pneed", 1, "st == HOLD && !ie_pv"));
-    body.push(wire("ie_go", 1, "!ie_busy && (ie_wait || ie_pneed)"));
+    body.push(comment("The walker's start goes first: it takes the engine from a first-row start, which starts again."));
+    body.push(wire("ie_go", 1, "ie_wait ? (!ie_busy || ie_pre) : (!ie_busy && ie_pneed)"));
+    body.push(wire("ie_tt", 4, format!("ie_go ? {} : ie_t", lit(4, 0))));
     body.push(comment("Operands: the set-up's result for a first-row start, the walker's otherwise."));
-    body.push(wire("ie_su", 1, "ie_busy ? ie_pre : !ie_wait"));
+    body.push(wire("ie_su", 1, "ie_go ? !ie_wait : ie_pre"));
     let x = |name: &str, w: u32, su: &str, wk: &str, signed: bool| {
         let v = format!("ie_su ? {su} : {wk}");
         if signed {
@@ -192,7 +194,7 @@ pub(super) fn engine(hw: &Hw, body: &mut Vec<Item>) {
     body.push(wire("ie_pm", sum_w, format!("ie_qneg ? -ie_p[{}:0] : ie_p[{}:0]", sum_w - 1, sum_w - 1)));
     body.push(wire("ie_u0", sum_w, format!("((x_dyn - ie_pm) << 1) + ({} << {iw})", zext("ie_an2", aw + 1, sum_w))));
     body.push(wire("ie_u1", sum_w, "ie_u - (x_gxn << 1)"));
-    let is = |ts: &[u32]| ts.iter().map(|t| format!("ie_t == {}", lit(4, *t as u64))).collect::<Vec<_>>().join(" || ");
+    let is = |ts: &[u32]| ts.iter().map(|t| format!("ie_tt == {}", lit(4, *t as u64))).collect::<Vec<_>>().join(" || ");
     body.push(wire(
         "ie_ma",
         a_w,
