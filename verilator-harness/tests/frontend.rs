@@ -317,3 +317,34 @@ fn incremental_i0_throughput_against_the_reciprocal() {
         }
     }
 }
+
+/// Negative controls of the incremental I0's co-simulation: a fault planted in the generated
+/// RTL's stepping or start logic (each a model built on first use) is caught on the same
+/// 3,000 triangles the clean model passes. Slow tier.
+#[test]
+#[ignore]
+fn incremental_i0_planted_faults_are_caught() {
+    use verilator_harness::ffi::{FeOut, TriIn};
+    let Some(opts) = incremental(golden::setup::Screen::default(), 0) else { return };
+    let base = verilator_harness::ondemand::describe(&opts, verilator_harness::models::Kind::Frontend).unwrap_or_else(|e| panic!("{e}"));
+    let seed = verilator_harness::seed("frontend incremental faults");
+    let fe = opts.frontend().unwrap().fe;
+    let tris = random_triangles(&mut SeedRng::seed_from_u64(seed), &fe, 3000);
+    let faults = [
+        ("ie_q1 + (cy0 ? ie_s1q1 : ie_s0q1) + {19'd0, ie_cy1};", "ie_q1 + (cy0 ? ie_s1q1 : ie_s0q1);", "a step's remainder carry dropped"),
+        ("ie_q2 + (cy1 ? ie_s1q2 : ie_s0q2)", "ie_q2 + (cy1 ? ie_s0q2 : ie_s1q2)", "an edge's steps swapped (DDA carry)"),
+        ("wire [20:0] ie_cq = ie_qt + {20'd0, ie_ge};", "wire [20:0] ie_cq = ie_qt;", "the start's correction dropped"),
+        ("ie_ok0 <= {1'd0, ie_ya0} < ie_lim;", "ie_ok0 <= 1'b1;", "a step out of range taken"),
+    ];
+    for (k, (from, to, what)) in faults.into_iter().enumerate() {
+        let mut m = base.clone();
+        let file = m.sources.iter_mut().find(|(n, _)| n == "tri_frontend.v").expect("the front-end's file");
+        assert!(file.1.contains(from), "{what}: the fault does not apply");
+        file.1 = file.1.replacen(from, to, 1);
+        m.tag = format!("{}_fault{k}", base.tag);
+        let info = verilator_harness::ondemand::load::<TriIn, FeOut>(&m).unwrap_or_else(|e| panic!("{e}"));
+        let report = run_frontend(info, seed, Traffic::RANDOM, Stress::NONE, &tris);
+        eprintln!("{what}: {} mismatches", report.mismatch_count);
+        assert!(!report.ok(), "planted fault not caught: {what}");
+    }
+}
