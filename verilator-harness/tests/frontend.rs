@@ -308,11 +308,15 @@ fn incremental_i0_throughput_against_the_reciprocal() {
             };
             let ((ci, px), (cr, _)) = (busy(inc), busy(rec));
             let cost = ci as f64 / cr as f64 - 1.0;
+            // Golden's count of starts (reciprocal evaluations) for the same triangles.
+            let fe = opts.frontend().unwrap().fe;
+            let starts: u64 = tris.iter().filter_map(|t| fe.setup(t).1).map(|st| fe.walk_incremental(&st, |_, _| {}).starts).sum();
             eprintln!(
-                "p = {p}, ~{area} px: incremental {ci} clocks ({:.2} px/clock, {:.1} triangles/1000 clocks), reciprocal {cr}: {:+.1} %",
+                "p = {p}, ~{area} px: incremental {ci} clocks ({:.2} px/clock, {:.1} triangles/1000 clocks), reciprocal {cr}: {:+.1} %; {:.2} starts a triangle",
                 px as f64 / ci as f64,
                 1000.0 * tris.len() as f64 / ci as f64,
-                100.0 * cost
+                100.0 * cost,
+                starts as f64 / tris.len() as f64
             );
         }
     }
