@@ -204,6 +204,10 @@ fn incremental(screen: golden::setup::Screen, level: u32) -> Option<hdl_gen::Opt
 /// incremental form really is what the RTL is compared with.
 fn incremental_spans(screen: golden::setup::Screen, level: u32, n: usize) {
     let Some(opts) = incremental(screen, level) else { return };
+    incremental_spans_of(opts, n);
+}
+
+fn incremental_spans_of(opts: hdl_gen::Options, n: usize) {
     let m = verilator_harness::ondemand::frontend(&opts).unwrap_or_else(|e| panic!("{e}"));
     let seed = verilator_harness::seed("frontend incremental");
     let fe = frontend(m).with_i0(golden::frontend::I0Form::Incremental);
@@ -238,6 +242,18 @@ fn incremental_i0_spans_equal_golden_on_a_small_odd_screen_and_pipelined() {
     incremental_spans(golden::setup::Screen { width: 37, height: 23 }, 0, 3000);
     incremental_spans(golden::setup::Screen::default(), 1, 3000);
     incremental_spans(golden::setup::Screen { width: 37, height: 23 }, 1, 3000);
+}
+
+/// The slow tier: 1 quotient bit a clock (a longer division ahead of the held start), the
+/// widest formats (F = 20, XW = 16) and the widest screen at the default formats.
+#[test]
+#[ignore]
+fn incremental_i0_spans_equal_golden_at_other_rates_and_formats() {
+    let Some(opts) = incremental(golden::setup::Screen::default(), 0) else { return };
+    incremental_spans_of(hdl_gen::Options { fe_div_bits: Some(1), ..opts.clone() }, 3000);
+    let wide = golden::Config::new(8, 20, 16, golden::Align::Span).unwrap();
+    incremental_spans_of(hdl_gen::Options { cfg: wide, ..opts.clone() }, 3000);
+    incremental_spans(golden::setup::Screen { width: 4096, height: 4096 }, 0, 3000);
 }
 
 #[test]
