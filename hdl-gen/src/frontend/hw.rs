@@ -55,7 +55,7 @@ impl Hw {
     /// takes fewer); 0 in the reciprocal form, which has none. A triangle's first row is started
     /// while it is held, before the walker takes it, so each walked triangle's set-up takes
     /// these clocks more; a later start (an edge taking over the left end) holds the walker
-    /// one clock more than this.
+    /// as long.
     pub fn start_clocks(&self) -> u32 {
         match self.fe.i0 {
             I0Form::Reciprocal => 0,

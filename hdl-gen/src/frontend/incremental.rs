@@ -16,10 +16,11 @@ use super::stager::Stager;
 use crate::verilog::{assign, comment, lit, reg, set, sext, sreg, swire, wire, zext, Item, Stmt};
 use golden::frontend::{I0Form, Widths};
 
-/// Clocks the engine is busy for a start at an edge (the walker waits one more): the product
-/// to the pixel, the exact step product, the modular one, then three reciprocal evaluations
-/// (start, step without and with the DDA's carry) of two products each. Column 0 has one step
-/// and finishes after [`COL0_CLOCKS`].
+/// Clocks of a start at an edge, from the clock it begins (t0) to the one that writes the
+/// source (t9), one product a clock: to the pixel, the exact step product, the modular one, and
+/// three reciprocal evaluations (the start, the step without and with the DDA's carry) of two
+/// products each, chained where their operands allow. Column 0 has one step and takes
+/// [`COL0_CLOCKS`]. A walker's start holds the walker these clocks.
 pub const START_CLOCKS: u32 = 10;
 pub const COL0_CLOCKS: u32 = 8;
 
