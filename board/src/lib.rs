@@ -7,14 +7,17 @@
 //! after drawing ends, and [`frame`] cuts, checks and decodes one whole frame.
 
 pub mod frame;
+pub mod mesh;
+pub mod send;
 pub mod sim;
+pub mod stream;
 pub mod tmds;
 
 use golden::frontend::{FixedTriangle, FrontEnd, FrontEndError};
 use golden::setup::{Screen, Triangle};
 use golden::writer::{Memory, Writer, WriterError};
 use golden::{Align, Config};
-use hdl_gen::board::BoardError;
+use hdl_gen::board::{BoardError, Source};
 use hdl_gen::GeneratedFile;
 
 /// The frame buffer's screen: 640 x 480 with every pixel doubled.
@@ -66,8 +69,9 @@ pub fn fixed(cfg: &Config, tris: &[Triangle]) -> Vec<FixedTriangle> {
     tris.iter().map(|t| FixedTriangle::from_triangle(t, cfg.frac)).collect()
 }
 
-/// Every file of the board's RTL folder: the chain's modules, the board's, the ROM image.
-pub fn rtl_files(cfg: &Config, tris: &[FixedTriangle]) -> Result<Vec<GeneratedFile>, RtlError> {
+/// Every file of the board's RTL folder: the chain's modules, the board's, and for the ROM
+/// source the ROM image of `tris` (the UART source takes its triangles from the serial line).
+pub fn rtl_files(cfg: &Config, tris: &[FixedTriangle], source: Source) -> Result<Vec<GeneratedFile>, RtlError> {
     let opts = hdl_gen::Options {
         cfg: *cfg,
         screen: Some(SCREEN),
@@ -78,14 +82,23 @@ pub fn rtl_files(cfg: &Config, tris: &[FixedTriangle]) -> Result<Vec<GeneratedFi
     let names = hdl_gen::Names::new("", cfg);
     let hw = opts.frontend()?;
     let w = opts.writer()?;
-    let rom = hdl_gen::board::rom_image(&hw.fe, tris)?;
     let chain: Vec<String> =
         [&names.bfpi, &names.segment, &names.frontend, &names.top, &names.writer, &names.fb_top].iter().map(|n| format!("{n}.v")).collect();
     let mut files: Vec<GeneratedFile> = hdl_gen::generate(&opts).into_iter().filter(|f| chain.contains(&f.name)).collect();
-    for m in [hdl_gen::board::draw_module(&hw.fe, &w, &names, tris.len()), hdl_gen::board::top_module(&w)] {
+    let modules = match source {
+        Source::Rom => {
+            let rom = hdl_gen::board::rom_image(&hw.fe, tris)?;
+            files.push(GeneratedFile { name: hdl_gen::board::ROM_HEX.into(), contents: rom });
+            vec![hdl_gen::board::draw_module(&hw.fe, &w, &names, tris.len())]
+        }
+        Source::Uart { div } => {
+            use hdl_gen::board::uart;
+            vec![hdl_gen::board::draw_module_uart(&hw.fe, &w, &names, div), uart::rx_module(div), uart::tx_module(div, uart::STATUS_LEN)]
+        }
+    };
+    for m in modules.into_iter().chain([hdl_gen::board::top_module(&w, source)]) {
         files.push(GeneratedFile { name: format!("{}.v", m.name), contents: m.render() });
     }
-    files.push(GeneratedFile { name: hdl_gen::board::ROM_HEX.into(), contents: rom });
     files.extend(HAND_WRITTEN.iter().map(|(n, c)| GeneratedFile { name: n.to_string(), contents: c.to_string() }));
     Ok(files)
 }
@@ -129,4 +142,13 @@ pub fn png(pixels: &[u8]) -> Vec<u8> {
     writer.write_image_data(pixels).expect("in-memory PNG encoding");
     writer.finish().expect("in-memory PNG end");
     out
+}
+
+/// Drawing clocks of the last drawing in a ROM run's bench output: from the end of the clear
+/// (`drawing from`) to `done`, less the 2^10 quiet clocks `done` waits for.
+pub fn drawing_clocks(log: &str) -> Option<u64> {
+    let at = |prefix: &str| log.lines().filter_map(|l| l.strip_prefix(prefix)?.strip_suffix(" ps")?.parse::<u64>().ok()).next_back();
+    let (from, done) = (at("board_tb: drawing from ")?, at("board_tb: drawing done at ")?);
+    let period_ps = (1e12 / hdl_gen::board::DRAW_HZ).round() as u64;
+    (done.checked_sub(from)? / period_ps).checked_sub(1 << 10)
 }

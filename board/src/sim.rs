@@ -65,19 +65,62 @@ pub fn build(rtl: &Path, work: &Path) -> Result<PathBuf, SimError> {
 /// recording follows the second. Returns the recording's path and the bench's output.
 pub fn simulate(exe: &Path, rtl: &Path, work: &Path, seed: u64, redraw: bool) -> Result<(PathBuf, String), SimError> {
     let rec = work.join("recording.txt");
-    let _ = std::fs::remove_file(&rec);
-    let exe = std::path::absolute(exe).map_err(|error| SimError::Io { what: format!("{}", exe.display()), error })?;
-    let mut cmd = Command::new(exe);
-    cmd.current_dir(rtl)
-        .arg(format!("+out={}", std::path::absolute(&rec).unwrap_or(rec.clone()).display()))
-        .arg("+verilator+rand+reset+2")
-        .arg(format!("+verilator+seed+{}", seed.max(1)));
-    if redraw {
-        cmd.arg("+redraw");
-    }
-    let log = run(&mut cmd, "the simulation")?;
+    let log = bench(exe, rtl, &rec, seed, if redraw { vec!["+redraw".into()] } else { vec![] })?;
     if !log.contains(" words at ") {
         return Err(SimError::NoRecording(log));
     }
     Ok((rec, log))
+}
+
+/// The UART source's run: the bench plays `stimulus` (crate::stream's file) on the serial line.
+#[derive(Debug, Clone)]
+pub struct Stream {
+    pub stimulus: PathBuf,
+    pub baud: u32,
+    /// Log the frame buffer's writes and stop once drawing is done, instead of recording a frame.
+    pub writes: bool,
+    /// The bench gives up after this much simulated time.
+    pub timeout_ms: u32,
+}
+
+/// What a UART run left: the recorded frame or the write log, and the bench's output.
+pub struct StreamRun {
+    pub recording: Option<PathBuf>,
+    pub writes: Option<PathBuf>,
+    pub log: String,
+}
+
+pub fn simulate_stream(exe: &Path, rtl: &Path, work: &Path, seed: u64, s: &Stream) -> Result<StreamRun, SimError> {
+    let rec = work.join("recording.txt");
+    let wlog = work.join("writes.txt");
+    let abs = |p: &Path| std::path::absolute(p).unwrap_or(p.to_path_buf());
+    let mut args =
+        vec![format!("+stream={}", abs(&s.stimulus).display()), format!("+baud={}", s.baud), format!("+timeout_ms={}", s.timeout_ms)];
+    if s.writes {
+        let _ = std::fs::remove_file(&wlog);
+        args.push(format!("+writes={}", abs(&wlog).display()));
+    }
+    let log = bench(exe, rtl, &rec, seed, args)?;
+    if s.writes {
+        if !log.contains("writes logged") {
+            return Err(SimError::NoRecording(log));
+        }
+        return Ok(StreamRun { recording: None, writes: Some(wlog), log });
+    }
+    if !log.contains(" words at ") {
+        return Err(SimError::NoRecording(log));
+    }
+    Ok(StreamRun { recording: Some(rec), writes: None, log })
+}
+
+fn bench(exe: &Path, rtl: &Path, rec: &Path, seed: u64, extra: Vec<String>) -> Result<String, SimError> {
+    let _ = std::fs::remove_file(rec);
+    let exe = std::path::absolute(exe).map_err(|error| SimError::Io { what: format!("{}", exe.display()), error })?;
+    let mut cmd = Command::new(exe);
+    cmd.current_dir(rtl)
+        .arg(format!("+out={}", std::path::absolute(rec).unwrap_or(rec.to_path_buf()).display()))
+        .arg("+verilator+rand+reset+2")
+        .arg(format!("+verilator+seed+{}", seed.max(1)))
+        .args(extra);
+    run(&mut cmd, "the simulation")
 }

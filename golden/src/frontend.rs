@@ -53,6 +53,7 @@
 //! UQ8.F intensities the hardware receives; real-valued vertex intensities add at most
 //! `2^-(F+1)` more when they are rounded onto the port.
 
+pub mod engine;
 pub mod incremental;
 
 use crate::format::{Config, Span};

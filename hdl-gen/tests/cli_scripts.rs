@@ -146,6 +146,7 @@ fn other_scripts_refuse_bad_arguments() {
         ("mutate", &["--seed"], &["--seed needs a value"]),
         ("icarus-tests", &["--vectors"], &["--vectors needs a value"]),
         ("check-fusesoc", &["--p 3"], &["configuration '--p 3'", "power of two"]),
+        ("board", &["ulx3s-85f", "--source", "uart", "--out"], &["--out needs a folder"]),
     ];
     for (name, args, needles) in cases {
         assert_refused(name, args, needles, &dir);

@@ -28,7 +28,7 @@ use std::process::Command;
 use std::sync::OnceLock;
 
 /// The largest `--triangles N` run as written; larger counts are run at this one.
-pub const TRIANGLES: u64 = 1000;
+pub const TRIANGLES: u64 = 200;
 
 fn repo() -> &'static Path {
     Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/.."))

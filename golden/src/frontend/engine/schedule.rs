@@ -1,0 +1,521 @@
+//! The engine's static schedule: a modulo schedule of the set-up program on the plan's units,
+//! its cost, and the clocked evaluation that streams triangles through it.
+//!
+//! - **Timing.** Wiring (constant shifts, a remainder, a copy, a negation of a flag) takes no
+//!   clock; every other logic operation one (a register after it, as CALC's stages have). A
+//!   product takes one clock a pass on its unit and is ready [`MUL_PIPE`] clocks after its last
+//!   pass (operand register, the tile's registered output, the accumulator); a division takes
+//!   a load clock and `ceil(qb / R)` clocks of `R` restoring steps.
+//! - **Overlap.** Triangle `j` enters the engine at clock `j II`. A unit is free for an operation
+//!   when, over the interval's clocks modulo II, fewer operations of its kind are busy than
+//!   there are units; the smallest II that schedules is the sustained rate. A value held longer
+//!   than II needs `copies` registers (the next triangle writes the next one).
+//! - **Units.** The operations are bound to units by start time over an unrolled stretch of
+//!   triangles (a unit that ran the same operation is preferred, so the binding is static where
+//!   the interval allows); an operation busier than II alternates between units.
+
+use super::{compute, DivForm, Kind, MulUnit, Plan, Program, V};
+use crate::frontend::incremental::Steps;
+use crate::frontend::{FixedTriangle, FrontEnd, Outcome, TriSetup};
+
+/// Clocks from a product's last pass to its value: the tile's input and output registers and
+/// the accumulator.
+pub const MUL_PIPE: u32 = 2;
+
+/// The measured anchor of the LUT estimate: `tri_frontend` at `--pipeline 1`, ECP5-85F, with
+/// today's eight dividers at 1 and 4 quotient bits a clock (docs/fpga.md, stop 24:
+/// `scripts/synth --family ecp5 --device 85k --speed 6 --p "" --no-specular --frontend
+/// --pipeline 1 --fe-div-bits "4 2 1"`).
+pub const MEASURED_LUT4: [(u32, u32); 2] = [(1, 4786), (4, 13329)];
+
+/// Why a plan cannot be scheduled.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+pub enum EngineError {
+    #[error("the plan has no multiplier, and the set-up has {0} products")]
+    NoMultiplier(usize),
+    #[error("the plan has no divider, and the set-up has {0} divisions")]
+    NoDivider(usize),
+    #[error("{what} {value} is outside 1..={max}")]
+    Range { what: &'static str, value: u32, max: u32 },
+}
+
+/// What an operation occupies.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Class {
+    Wire,
+    Logic,
+    Mul,
+    Div,
+}
+
+/// One operation's place: its unit (index among the multipliers or the dividers, for a
+/// steady-state triangle), the clock it starts, how long it holds the unit, the clock its
+/// value is ready, counted from the triangle's entry.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Slot {
+    pub class: Class,
+    pub unit: Option<u32>,
+    pub start: u32,
+    pub busy: u32,
+    pub ready: u32,
+}
+
+/// The engine's cost.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Cost {
+    /// Hard multiplier tiles (MULT18X18D or SB_MAC16).
+    pub tiles: u32,
+    /// Tile passes and divider clocks a triangle.
+    pub mul_passes: u32,
+    pub div_clocks: u32,
+    /// Estimated LUT4: the dividers (and shift-add multipliers), the units' operand
+    /// multiplexers.
+    pub lut_units: u32,
+    pub lut_mux: u32,
+    /// Register bits: every value's copies, and one set-up result (a queue entry).
+    pub reg_bits: u32,
+    pub result_bits: u32,
+}
+
+/// A scheduled program.
+#[derive(Clone, Debug)]
+pub struct Schedule {
+    pub plan: Plan,
+    pub prog: Program,
+    /// Clocks between two triangles entering the engine (the sustained set-up rate).
+    pub ii: u32,
+    /// Clocks from a triangle's entry to its result in the queue.
+    pub latency: u32,
+    pub slots: Vec<Slot>,
+    pub copies: Vec<u32>,
+    pub cost: Cost,
+    /// Every (operation, unit) of a stretch of steady-state triangles.
+    pub rotation: Vec<(usize, u32)>,
+}
+
+/// What feeds a unit's port: (value, chunk) pairs, or a product's chunk weights.
+type Sources = Vec<(u32, u32)>;
+
+fn ceil(a: u32, b: u32) -> u32 {
+    a.div_ceil(b)
+}
+
+fn class(k: &Kind) -> Class {
+    use Kind::*;
+    match k {
+        In(_) | Const(_) | Wire(_) | Shl(..) | Shr(..) | Rem(_) | Not(_) => Class::Wire,
+        Mul(..) => Class::Mul,
+        Div { .. } => Class::Div,
+        _ => Class::Logic,
+    }
+}
+
+/// The chunk pairs a product takes on a tile of `bits`: `(i, j)`, low chunks first, those
+/// wholly above the kept bits left out.
+fn pairs(wa: u32, wb: u32, keep: u32, bits: u32) -> Vec<(u32, u32)> {
+    let (ca, cb) = (ceil(wa, bits), ceil(wb, bits));
+    (0..ca).flat_map(|i| (0..cb).map(move |j| (i, j))).filter(|&(i, j)| (i + j) * bits < keep).collect()
+}
+
+impl Plan {
+    fn check(&self) -> Result<(), EngineError> {
+        let r = |what, value, max| if (1..=max).contains(&value) { Ok(()) } else { Err(EngineError::Range { what, value, max }) };
+        r("divider quotient bits a clock", self.div_bits, 16)?;
+        match self.mul {
+            MulUnit::Tile { bits } => r("tile bits", bits, 36),
+            MulUnit::ShiftAdd { bits } => r("shift-add bits a clock", bits, 16),
+        }
+    }
+
+    /// The program for this plan, scheduled.
+    pub fn schedule(&self, fe: &FrontEnd) -> Result<Schedule, EngineError> {
+        self.check()?;
+        Schedule::new(Program::setup(fe, self), *self)
+    }
+}
+
+impl Schedule {
+    /// Schedules `prog` (which need not be `Program::setup`'s: the tests plant faults in it).
+    pub fn new(prog: Program, plan: Plan) -> Result<Schedule, EngineError> {
+        let n = prog.ops.len();
+        let count = |c| prog.ops.iter().filter(|o| class(&o.kind) == c).count();
+        if plan.mults == 0 && count(Class::Mul) > 0 {
+            return Err(EngineError::NoMultiplier(count(Class::Mul)));
+        }
+        if plan.dividers == 0 && count(Class::Div) > 0 {
+            return Err(EngineError::NoDivider(count(Class::Div)));
+        }
+        let timing: Vec<(Class, u32, u32)> = prog.ops.iter().map(|o| timing(&prog, o, &plan)).collect();
+        let caps = |c| if c == Class::Mul { plan.mults } else { plan.dividers };
+        let need = |c| timing.iter().filter(|t| t.0 == c).map(|t| t.1).sum::<u32>();
+        let mut ii =
+            [Class::Mul, Class::Div].iter().map(|&c| if need(c) == 0 { 1 } else { ceil(need(c), caps(c)) }).max().unwrap_or(1).max(1);
+        let start = loop {
+            if let Some(s) = modulo(&prog, &timing, ii, caps) {
+                break s;
+            }
+            ii += 1;
+        };
+        let ready: Vec<u32> = (0..n).map(|o| start[o] + timing[o].2).collect();
+        let latency = prog.out.all().iter().map(|v| ready[v.0 as usize]).max().unwrap_or(0);
+        let slots = (0..n).map(|o| Slot { class: timing[o].0, unit: None, start: start[o], busy: timing[o].1, ready: ready[o] }).collect();
+        let mut s = Schedule { plan, prog, ii, latency, slots, copies: vec![1; n], cost: Cost::default(), rotation: Vec::new() };
+        s.copies = s.copies_needed();
+        s.bind();
+        s.cost = s.cost();
+        Ok(s)
+    }
+
+    /// The clock of an operation's last read of its operands: a product reads a chunk each pass.
+    fn last_read(&self, o: usize) -> u32 {
+        let s = &self.slots[o];
+        s.start + if s.class == Class::Mul { s.busy.saturating_sub(1) } else { 0 }
+    }
+
+    /// Registers each value needs: held from its ready clock to its last reader's, while the
+    /// next triangles' values arrive every II clocks.
+    fn copies_needed(&self) -> Vec<u32> {
+        let mut last: Vec<u32> = self.slots.iter().map(|s| s.ready).collect();
+        for (o, op) in self.prog.ops.iter().enumerate() {
+            for a in op.kind.args() {
+                last[a.0 as usize] = last[a.0 as usize].max(self.last_read(o));
+            }
+        }
+        for v in self.prog.out.all() {
+            last[v.0 as usize] = last[v.0 as usize].max(self.latency);
+        }
+        (0..last.len()).map(|o| (last[o] - self.slots[o].ready) / self.ii + 1).collect()
+    }
+}
+
+/// An operation's class, clocks on its unit and latency.
+fn timing(prog: &Program, op: &super::Op, plan: &Plan) -> (Class, u32, u32) {
+    let c = class(&op.kind);
+    match (c, op.kind) {
+        (Class::Wire, _) => (c, 0, 0),
+        (Class::Logic, _) => (c, 0, 1),
+        (Class::Mul, Kind::Mul(a, b)) => {
+            let (wa, wb) = (prog.ops[a.0 as usize].w, prog.ops[b.0 as usize].w);
+            match plan.mul {
+                MulUnit::Tile { bits } => {
+                    let p = pairs(wa, wb, op.w, bits).len() as u32;
+                    (c, p, p + MUL_PIPE)
+                }
+                MulUnit::ShiftAdd { bits } => {
+                    let p = ceil(wa.min(wb), bits);
+                    (c, p, p + 1)
+                }
+            }
+        }
+        (_, Kind::Div { qb, .. }) => {
+            let b = 1 + ceil(qb, plan.div_bits);
+            (c, b, b)
+        }
+        _ => unreachable!("class of {:?}", op.kind),
+    }
+}
+
+/// Places every operation at its earliest clock where a unit of its kind is free modulo `ii`;
+/// `None` if one does not fit within II clocks of its earliest.
+fn modulo(prog: &Program, timing: &[(Class, u32, u32)], ii: u32, caps: impl Fn(Class) -> u32) -> Option<Vec<u32>> {
+    let mut usage = [vec![0u32; ii as usize], vec![0u32; ii as usize]];
+    let mut start = vec![0u32; prog.ops.len()];
+    let mut ready = vec![0u32; prog.ops.len()];
+    for (o, op) in prog.ops.iter().enumerate() {
+        let earliest = op.kind.args().iter().map(|a| ready[a.0 as usize]).max().unwrap_or(0);
+        let (c, busy, lat) = timing[o];
+        let t = match c {
+            Class::Mul | Class::Div => {
+                let u = &mut usage[(c == Class::Div) as usize];
+                let cap = caps(c);
+                let t = (earliest..earliest + ii).find(|&t| {
+                    let mut add = vec![0u32; ii as usize];
+                    (t..t + busy).for_each(|k| add[(k % ii) as usize] += 1);
+                    add.iter().zip(u.iter()).all(|(a, b)| a + b <= cap)
+                })?;
+                (t..t + busy).for_each(|k| u[(k % ii) as usize] += 1);
+                t
+            }
+            _ => earliest,
+        };
+        start[o] = t;
+        ready[o] = t + lat;
+    }
+    Some(start)
+}
+
+impl Schedule {
+    /// Binds operations to units over an unrolled stretch of triangles, by start clock, and
+    /// keeps a steady-state triangle's binding in the slots.
+    fn bind(&mut self) {
+        let span = ceil(self.latency + 1, self.ii) as usize;
+        let tris = 4 * span + 4;
+        let steady = 2 * span + 2;
+        for c in [Class::Mul, Class::Div] {
+            let mut iv: Vec<(u32, usize, usize)> = Vec::new();
+            for j in 0..tris {
+                for (o, s) in self.slots.iter().enumerate().filter(|(_, s)| s.class == c) {
+                    iv.push((j as u32 * self.ii + s.start, o, j));
+                }
+            }
+            iv.sort();
+            let cap = if c == Class::Mul { self.plan.mults } else { self.plan.dividers } as usize;
+            let mut until = vec![0u32; cap];
+            let mut last: Vec<Option<usize>> = vec![None; cap];
+            let mut seen: Vec<Vec<usize>> = vec![Vec::new(); cap];
+            let mut wide = vec![0u32; cap];
+            // Those starting together: first each on the unit it ran on before, if free.
+            for group in iv.chunk_by(|a, b| a.0 == b.0) {
+                let t = group[0].0;
+                let mut todo: Vec<(usize, usize)> = Vec::new();
+                for &(_, o, j) in group {
+                    match (0..cap).find(|&u| until[u] <= t && last[u] == Some(o)) {
+                        Some(u) => {
+                            until[u] = t + self.slots[o].busy;
+                            self.note(o, j, u, steady, span);
+                        }
+                        None => todo.push((o, j)),
+                    }
+                }
+                // The others: a unit that ran this operation before, else one that need not
+                // grow for it, the least oversized.
+                for (o, j) in todo {
+                    let wo = self.unit_width(o);
+                    let u = (0..cap)
+                        .filter(|&u| until[u] <= t)
+                        .min_by_key(|&u| (!seen[u].contains(&o), wo.saturating_sub(wide[u]), wide[u].saturating_sub(wo), u))
+                        .expect("a unit is free: the modulo table holds at most its units");
+                    until[u] = t + self.slots[o].busy;
+                    last[u] = Some(o);
+                    seen[u].push(o);
+                    wide[u] = wide[u].max(wo);
+                    self.note(o, j, u, steady, span);
+                }
+            }
+        }
+    }
+
+    /// The subtractor a division needs on a divider of the plan's form (0 for a product).
+    fn unit_width(&self, o: usize) -> u32 {
+        match self.prog.ops[o].kind {
+            Kind::Div { d, pw, .. } => match self.plan.div_form {
+                DivForm::ShiftDivisor => pw,
+                DivForm::ShiftRemainder => self.prog.ops[d.0 as usize].w + 1,
+            },
+            _ => 0,
+        }
+    }
+
+    /// Keeps a binding: the steady triangle's in the slots, and every one of a stretch of
+    /// steady triangles (an operation busier than II alternates) in `rotation`.
+    fn note(&mut self, o: usize, j: usize, u: usize, steady: usize, span: usize) {
+        if j == steady {
+            self.slots[o].unit = Some(u as u32);
+        }
+        if (steady..steady + span).contains(&j) {
+            self.rotation.push((o, u as u32));
+        }
+    }
+
+    fn cost(&self) -> Cost {
+        let plan = &self.plan;
+        let ops = &self.prog.ops;
+        let w = |v: V| ops[v.0 as usize].w;
+        let mut c = Cost { tiles: if matches!(plan.mul, MulUnit::Tile { .. }) { plan.mults } else { 0 }, ..Cost::default() };
+        let per_bit = lut_per_bit_step();
+        // Sources of each unit's ports (a multiplier's: the operand chunks and the weights).
+        let mut mul_src: Vec<[Sources; 3]> = vec![Default::default(); plan.mults as usize];
+        let mut div_src: Vec<([Sources; 2], [u32; 3])> = vec![Default::default(); plan.dividers as usize];
+        let mut width = vec![0u32; plan.mults as usize];
+        for (o, (op, s)) in ops.iter().zip(&self.slots).enumerate() {
+            match s.class {
+                Class::Mul => c.mul_passes += s.busy,
+                Class::Div => c.div_clocks += s.busy,
+                _ => {}
+            }
+            if s.class != Class::Wire {
+                c.reg_bits += self.copies[o] * op.w;
+            }
+        }
+        for &(o, u) in &self.rotation {
+            let (op, u) = (&ops[o], u as usize);
+            match op.kind {
+                Kind::Mul(a, b) => {
+                    let m = &mut mul_src[u];
+                    match plan.mul {
+                        MulUnit::Tile { bits } => {
+                            for (i, j) in pairs(w(a), w(b), op.w, bits) {
+                                m[0].push((a.0, i));
+                                m[1].push((b.0, j));
+                                m[2].push((i + j, 0));
+                            }
+                        }
+                        MulUnit::ShiftAdd { .. } => {
+                            m[0].push((a.0, 0));
+                            m[1].push((b.0, 0));
+                            width[u] = width[u].max(op.w.min(w(a) + w(b)));
+                        }
+                    }
+                }
+                Kind::Div { n, d, pw, .. } => {
+                    let u = &mut div_src[u];
+                    u.0[0].push((n.0, 0));
+                    u.0[1].push((d.0, 0));
+                    // The subtractor and the ports: today's form shifts the divisor across the
+                    // whole partial remainder; the other shifts the remainder past the divisor.
+                    let ws = match plan.div_form {
+                        DivForm::ShiftDivisor => [pw; 3],
+                        DivForm::ShiftRemainder => [w(d) + 1, w(n), w(d)],
+                    };
+                    (0..3).for_each(|k| u.1[k] = u.1[k].max(ws[k]));
+                }
+                _ => unreachable!("only units are bound"),
+            }
+        }
+        let mux = |k: usize, bits: u32| if k < 2 { 0 } else { bits * ceil(k as u32, 2) };
+        let distinct = |v: &mut Vec<_>| {
+            v.sort();
+            v.dedup();
+            v.len()
+        };
+        for (u, m) in mul_src.iter_mut().enumerate() {
+            match plan.mul {
+                MulUnit::Tile { bits } => {
+                    c.lut_mux += mux(distinct(&mut m[0]), bits) + mux(distinct(&mut m[1]), bits) + mux(distinct(&mut m[2]), 2 * bits);
+                }
+                MulUnit::ShiftAdd { bits } => {
+                    c.lut_units += (per_bit * (width[u] * bits) as f64).round() as u32;
+                    c.lut_mux += mux(distinct(&mut m[0]), width[u]) + mux(distinct(&mut m[1]), width[u]);
+                }
+            }
+        }
+        for (src, ws) in div_src.iter_mut() {
+            c.lut_units += (per_bit * (ws[0] * plan.div_bits) as f64).round() as u32;
+            c.lut_mux += mux(distinct(&mut src[0]), ws[1]) + mux(distinct(&mut src[1]), ws[2]);
+        }
+        c.result_bits = self.prog.out.all().iter().map(|&v| w(v)).sum();
+        c
+    }
+}
+
+/// The calibration: today's eight dividers (`Plan` without reciprocal or steps, at the default
+/// 640x480) hold `sum pw` partial-remainder bits; between 1 and 4 quotient bits a clock the
+/// measured LUT4 grow by `3 sum pw` bit-steps. Returns LUT4 per partial-remainder bit per
+/// quotient bit a clock.
+pub fn lut_per_bit_step() -> f64 {
+    let [(b1, l1), (b4, l4)] = MEASURED_LUT4;
+    (l4 - l1) as f64 / ((b4 - b1) * today_pw()) as f64
+}
+
+/// The sum of today's dividers' partial-remainder widths at the defaults (357).
+pub fn today_pw() -> u32 {
+    let fe = FrontEnd::new(Default::default(), Default::default()).expect("the defaults");
+    let plan =
+        Plan { mults: 1, mul: Plan::TILE18, dividers: 1, div_bits: 1, div_form: DivForm::ShiftDivisor, reciprocal: false, i0_steps: false };
+    Program::setup(&fe, &plan).ops.iter().map(|o| if let Kind::Div { pw, .. } = o.kind { pw } else { 0 }).sum()
+}
+
+/// What the rest of `tri_frontend` (walker, span path, CALC's logic) takes in the calibration:
+/// the measured 1-bit figure less its dividers.
+pub fn lut_rest() -> u32 {
+    MEASURED_LUT4[0].1 - (lut_per_bit_step() * today_pw() as f64).round() as u32
+}
+
+/// A set-up as the engine hands it on.
+pub type Result3 = (Outcome, Option<TriSetup>, Option<Steps>);
+
+impl Schedule {
+    /// Streams `tris` through the schedule, one entering every II clocks, and returns each one's
+    /// set-up as the queue receives it. Each read takes the register copy the value would be in
+    /// at that clock: the latest triangle's value written by then into that copy (0 before any;
+    /// a later triangle's, which stands as a wrong value, when the copy was overwritten).
+    pub fn run(&self, tris: &[FixedTriangle]) -> Vec<Result3> {
+        let n = self.prog.ops.len();
+        let hold = (self.copies.iter().max().copied().unwrap_or(1) + ceil(self.latency + 1, self.ii) + 4) as i64;
+        let mut hist = vec![(0i128, 0i128); n * hold as usize];
+        let ii = self.ii as i64;
+        let fetch = |hist: &[(i128, i128)], v: usize, u: i64, j: i64| -> (i128, i128) {
+            let (c, r) = (self.copies[v] as i64, self.slots[v].ready as i64);
+            let mut i = j;
+            while i >= 0 && i * ii + r > u {
+                i -= c;
+            }
+            if i < 0 || j - i >= hold {
+                return (0, 0);
+            }
+            let got = hist[v * hold as usize + (i % hold) as usize];
+            // A later triangle wrote this copy by then: its value is not computed yet here, so a
+            // wrong one (the complement) stands for it.
+            if (i + c) * ii + r <= u {
+                (!got.0, !got.1)
+            } else {
+                got
+            }
+        };
+        let mut out = Vec::with_capacity(tris.len());
+        let mut x = Vec::with_capacity(3);
+        for (j, t) in tris.iter().enumerate() {
+            let j = j as i64;
+            let inputs = Program::inputs(t);
+            for (o, op) in self.prog.ops.iter().enumerate() {
+                let u = j * ii + self.slots[o].start as i64;
+                let late = j * ii + self.last_read(o) as i64;
+                x.clear();
+                for a in op.kind.args() {
+                    let (first, second) = (fetch(&hist, a.0 as usize, u, j), fetch(&hist, a.0 as usize, late, j));
+                    // A product reads across its passes: an operand changing meanwhile is torn.
+                    let got = if second != first { second } else { first };
+                    x.push(if matches!(op.kind, Kind::Rem(_)) { got.1 } else { got.0 });
+                }
+                hist[o * hold as usize + (j % hold) as usize] = compute(op, &x, &inputs);
+            }
+            let at = j * ii + self.latency as i64;
+            out.push(self.prog.out.extract(t, |v| fetch(&hist, v.0 as usize, at, j).0));
+        }
+        out
+    }
+
+    /// The unit operations in start order: `clock unit name (busy)`, for documents and reviews.
+    pub fn listing(&self) -> String {
+        let mut rows: Vec<(u32, Class, u32, &str, u32)> = Vec::new();
+        for (s, op) in self.slots.iter().zip(&self.prog.ops) {
+            if let Some(u) = s.unit {
+                rows.push((s.start, s.class, u, &op.name, s.busy));
+            }
+        }
+        rows.sort_by_key(|r| (r.0, r.1 == Class::Div, r.2));
+        rows.iter().map(|(t, c, u, n, b)| format!("{t:3} {}{u} {n} ({b})\n", if *c == Class::Mul { "mul" } else { "div" })).collect()
+    }
+
+    /// Checks the schedule's own rules: every operand ready by its reader's start, no register
+    /// copy overwritten before its last read, never more operations on a kind of unit than it
+    /// has. The tests' planted faults must fail here too.
+    pub fn verify(&self) -> Result<(), String> {
+        for (o, op) in self.prog.ops.iter().enumerate() {
+            for a in op.kind.args() {
+                let s = &self.slots[a.0 as usize];
+                if s.ready > self.slots[o].start {
+                    return Err(format!(
+                        "{} reads {} at clock {}, ready at {}",
+                        op.name, self.prog.ops[a.0 as usize].name, self.slots[o].start, s.ready
+                    ));
+                }
+            }
+        }
+        let need = self.copies_needed();
+        if let Some(o) = (0..need.len()).find(|&o| self.copies[o] < need[o]) {
+            return Err(format!("{} has {} register copies, needs {}", self.prog.ops[o].name, self.copies[o], need[o]));
+        }
+        for c in [Class::Mul, Class::Div] {
+            let cap = if c == Class::Mul { self.plan.mults } else { self.plan.dividers };
+            let mut u = vec![0u32; self.ii as usize];
+            for s in self.slots.iter().filter(|s| s.class == c) {
+                (s.start..s.start + s.busy).for_each(|k| u[(k % self.ii) as usize] += 1);
+            }
+            if let Some(p) = u.iter().position(|&k| k > cap) {
+                return Err(format!("{} {c:?} operations at phase {p} of {} units", u[p], cap));
+            }
+        }
+        Ok(())
+    }
+}
