@@ -105,14 +105,46 @@ impl DiMode {
     }
 }
 
-/// A front-end configuration: the shader's formats, the screen it draws on and where `dI`
-/// comes from.
+/// How the walker forms each span's `I0` (issue 27). The spans are the same bit for bit; the
+/// forms differ in hardware: a reciprocal evaluation a row, or adds a row and an evaluation per
+/// *start* ([`incremental`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
+#[serde(rename_all = "lowercase")]
+pub enum I0Form {
+    /// Per row `S2n = 2 (Tn + Gxn lo) + An`, `q~ = (S2n Rn) >> K` and its correction: three
+    /// wide products a row in the span path.
+    #[default]
+    Reciprocal,
+    /// Per source of the span's left end, quotient and remainder over `2A` stepped by adds; the
+    /// reciprocal formula only at a source's first covered row, on a shared multi-cycle unit.
+    Incremental,
+}
+
+impl I0Form {
+    pub const ALL: [I0Form; 2] = [I0Form::Reciprocal, I0Form::Incremental];
+    pub fn name(self) -> &'static str {
+        match self {
+            I0Form::Reciprocal => "reciprocal",
+            I0Form::Incremental => "incremental",
+        }
+    }
+    /// Whether this is the default (serialised plans leave it out, so theirs stay as they were).
+    pub fn is_default(&self) -> bool {
+        *self == I0Form::default()
+    }
+}
+
+/// A front-end configuration: the shader's formats, the screen it draws on, where `dI` comes
+/// from and how `I0` is formed.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 pub struct FrontEnd {
     pub cfg: Config,
     pub screen: Screen,
     #[serde(default)]
     pub di: DiMode,
+    #[serde(default, skip_serializing_if = "I0Form::is_default")]
+    pub i0: I0Form,
 }
 
 /// Every width of the front-end, derived once from the configuration: the generator declares
@@ -299,12 +331,17 @@ impl FrontEnd {
         if screen.height == 0 || screen.height > 1 << 16 {
             return Err(FrontEndError::Height { height: screen.height });
         }
-        Ok(FrontEnd { cfg, screen, di: DiMode::Triangle })
+        Ok(FrontEnd { cfg, screen, di: DiMode::Triangle, i0: I0Form::Reciprocal })
     }
 
     /// The same front-end with `dI` from `di`.
     pub fn with_di(self, di: DiMode) -> FrontEnd {
         FrontEnd { di, ..self }
+    }
+
+    /// The same front-end with `I0` formed by `i0`.
+    pub fn with_i0(self, i0: I0Form) -> FrontEnd {
+        FrontEnd { i0, ..self }
     }
 
     pub fn widths(&self) -> Widths {
@@ -495,7 +532,12 @@ impl FrontEnd {
     pub fn spans(&self, t: &FixedTriangle, out: impl FnMut(u32, Span)) -> Outcome {
         let (outcome, st) = self.setup(t);
         if let Some(st) = st {
-            self.walk(&st, out);
+            match self.i0 {
+                I0Form::Reciprocal => self.walk(&st, out),
+                I0Form::Incremental => {
+                    self.walk_incremental(&st, out);
+                }
+            }
         }
         outcome
     }

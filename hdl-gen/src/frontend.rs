@@ -25,6 +25,7 @@ mod calc;
 mod chain;
 mod divider;
 mod hw;
+mod incremental;
 mod properties;
 mod setup;
 mod span;

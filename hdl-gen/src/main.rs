@@ -3,7 +3,7 @@
 use anyhow::{bail, Context};
 use clap::builder::{StringValueParser, TypedValueParser};
 use clap::{Args, Parser, Subcommand};
-use golden::frontend::DiMode;
+use golden::frontend::{DiMode, I0Form};
 use golden::rom::RomFormat;
 use golden::specular::{parse_rel_error, BrdfK, SpecularPlan};
 use golden::{Align, Config};
@@ -52,6 +52,14 @@ enum Command {
         /// intensities with the same divider: a comparison option, slower and larger).
         #[arg(long = "fe-di", value_enum, default_value_t = DiMode::Triangle)]
         fe_di: DiMode,
+        /// How the front-end forms each span's I0: `reciprocal` (three wide products a row in
+        /// the span path) or `incremental` (quotient and remainder over 2A stepped by adds per
+        /// source of the span's left end; the reciprocal only at a source's first covered row, on
+        /// one shared multiplier, the walker waiting meanwhile). Same spans bit for bit. The
+        /// default stays `reciprocal` until the incremental form measures better (docs/design.md,
+        /// issue 27). `incremental` takes `--fe-di triangle` only.
+        #[arg(long = "fe-i0", value_enum, default_value_t = I0Form::Reciprocal)]
+        fe_i0: I0Form,
         /// Register stages added for clock rate, 0..3 (golden::pipeline): 1 registers the span and
         /// the shader's increments, splits the specular unit's multiplies, and stages the
         /// front-end (CALC in five clocks, its span path in six), 2 also the shader's lane sums, 3 cuts the shader's adders
@@ -264,7 +272,7 @@ fn owned_files(dir: &std::path::Path) -> Vec<String> {
 
 fn run(command: Command) -> anyhow::Result<()> {
     match command {
-        Command::Generate { config, bfpi_arch, brdf, width, height, fe_div_bits, fe_di, pipeline, bus, out } => {
+        Command::Generate { config, bfpi_arch, brdf, width, height, fe_div_bits, fe_di, fe_i0, pipeline, bus, out } => {
             let opts = config.options(&brdf)?;
             let default = Options::default_screen(&opts.cfg);
             let screen = golden::setup::Screen { width: width.unwrap_or(default.width), height: height.unwrap_or(default.height) };
@@ -272,7 +280,12 @@ fn run(command: Command) -> anyhow::Result<()> {
             if pipeline.span_stage() && bfpi_arch == BfpiArch::Tree {
                 bail!(hdl_gen::segment::TREE_UNPIPELINED);
             }
-            let opts = Options { bfpi_arch, screen: Some(screen), fe_div_bits, fe_di, pipeline, bus, ..opts };
+            if fe_i0 == I0Form::Incremental && fe_di == DiMode::Scanline {
+                bail!(
+                    "--fe-i0 incremental takes --fe-di triangle: the per-scanline dI needs the reciprocal's I0 at every span's last pixel"
+                );
+            }
+            let opts = Options { bfpi_arch, screen: Some(screen), fe_div_bits, fe_di, fe_i0, pipeline, bus, ..opts };
             opts.frontend().context("--width/--height")?;
             output::write_owned(&out, &generate(&opts), &owned_files(&out))?;
             eprintln!("wrote {}", out.display());

@@ -82,6 +82,12 @@ pub struct Frontend {
     pub div_bits: u32,
     /// Where `dI` comes from (`--fe-di`): `triangle` (once per triangle) or `scanline`.
     pub di: golden::frontend::DiMode,
+    /// How `I0` is formed (`--fe-i0`); left out for the default, `reciprocal`.
+    #[serde(default, skip_serializing_if = "golden::frontend::I0Form::is_default")]
+    pub i0: golden::frontend::I0Form,
+    /// Incremental I0 only: clocks of a start on the shared engine (`Hw::start_clocks`).
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub start_clocks: u32,
     /// Per-scanline dI only: clocks the span divider runs for a span of two pixels or more.
     pub span_div_clocks: u32,
     /// Clocks from a triangle's transfer to its first span when the walker is idle.
@@ -335,6 +341,8 @@ pub fn render(opts: &Options, names: &Names, modules: &[Module], unit: &Specular
             widths: hw.fe.widths(),
             div_bits: hw.div_bits,
             di: hw.fe.di,
+            i0: hw.fe.i0,
+            start_clocks: hw.start_clocks(),
             span_div_clocks: hw.span_div_clocks(),
             latency: hw.latency(),
             setup_clocks_walked: hw.setup_clocks().0,
@@ -439,4 +447,8 @@ pub fn core_file(opts: &Options, names: &Names, modules: &[Module], wrappers: &[
         xw = cfg.xbits,
         align = cfg.align,
     )
+}
+
+fn is_zero(v: &u32) -> bool {
+    *v == 0
 }

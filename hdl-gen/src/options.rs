@@ -23,6 +23,9 @@ pub struct Options {
     pub fe_div_bits: Option<u32>,
     /// Where the front-end's `dI` comes from (`--fe-di`); the default is once per triangle.
     pub fe_di: golden::frontend::DiMode,
+    /// How the front-end forms each span's `I0` (`--fe-i0`); the default is today's reciprocal
+    /// a row.
+    pub fe_i0: golden::frontend::I0Form,
     /// Register stages added for clock rate (`--pipeline`); level 0 is SPEC's seed structure.
     pub pipeline: golden::pipeline::Pipeline,
     /// `--bus`: SPEC's ports only, or AXI4-Stream wrappers of the streaming tops as well.
@@ -39,7 +42,8 @@ impl Options {
     /// The front-end these options describe.
     pub fn frontend(&self) -> Result<frontend::Hw, golden::frontend::FrontEndError> {
         let fe = golden::frontend::FrontEnd::new(self.cfg, self.screen.unwrap_or_else(|| Options::default_screen(&self.cfg)))?
-            .with_di(self.fe_di);
+            .with_di(self.fe_di)
+            .with_i0(self.fe_i0);
         Ok(frontend::Hw { fe, div_bits: self.fe_div_bits.unwrap_or(frontend::DEFAULT_DIV_BITS), pipeline: self.pipeline })
     }
 

@@ -73,6 +73,8 @@ fn generate_bad_flags() {
         (&["generate", "--out", d, "--max-rel-error", "1%"], "--brdf-k"),
         (&["generate", "--out"], "--out"),
         (&["generate", "--out", d, "--bogus"], "--bogus"),
+        (&["generate", "--out", d, "--fe-i0", "lazy"], "--fe-i0"),
+        (&["generate", "--out", d, "--fe-i0", "incremental", "--fe-di", "scanline"], "--fe-i0 incremental takes --fe-di triangle"),
     ];
     for (args, needle) in cases {
         assert_rejected(args, needle, &dir);

@@ -6,7 +6,7 @@
 //!
 //! The full sweep (every P, both alignments, every form, plus Yosys) is `scripts/lint-all`.
 
-use golden::frontend::DiMode;
+use golden::frontend::{DiMode, I0Form};
 use golden::pipeline::Pipeline;
 use golden::{Align, Config};
 use hdl_gen::tools::wrapper;
@@ -128,6 +128,10 @@ fn module_names(manifest: &str) -> Vec<String> {
 /// runner runs parts side by side.
 const PARTS: usize = 8;
 
+/// One configuration linted: formats, prefix, increment form, divider rate, the front-end's dI
+/// and I0 forms, pipeline level, bus.
+type Run = (Config, &'static str, BfpiArch, Option<u32>, (DiMode, I0Form), Pipeline, Bus);
+
 fn lint_part(part: usize) {
     // The front-end depends on F, XW, the screen, the prefix and the divider rate, not on P, the
     // alignment or the increment form: it is linted once per front-end configuration, and the
@@ -135,31 +139,53 @@ fn lint_part(part: usize) {
     let mut fe_seen = std::collections::HashSet::new();
     let mut runs = configs()
         .into_iter()
-        .map(|(cfg, prefix, arch, pipe)| (cfg, prefix, arch, None, DiMode::Triangle, pipe, Bus::Native))
+        .map(|(cfg, prefix, arch, pipe)| (cfg, prefix, arch, None, (DiMode::Triangle, I0Form::Reciprocal), pipe, Bus::Native))
         .collect::<Vec<_>>();
     for bits in hdl_gen::frontend::DIV_BITS {
-        runs.push((Config::default(), "", BfpiArch::ShiftAdd, Some(bits), DiMode::Triangle, Pipeline::NONE, Bus::Native));
+        runs.push((
+            Config::default(),
+            "",
+            BfpiArch::ShiftAdd,
+            Some(bits),
+            (DiMode::Triangle, I0Form::Reciprocal),
+            Pipeline::NONE,
+            Bus::Native,
+        ));
     }
     // The per-scanline dI (`--fe-di scanline`) at the slowest and the fastest divider.
     for bits in [1, 4] {
-        runs.push((Config::default(), "", BfpiArch::ShiftAdd, Some(bits), DiMode::Scanline, Pipeline::NONE, Bus::Native));
+        runs.push((
+            Config::default(),
+            "",
+            BfpiArch::ShiftAdd,
+            Some(bits),
+            (DiMode::Scanline, I0Form::Reciprocal),
+            Pipeline::NONE,
+            Bus::Native,
+        ));
+    }
+    // The incremental I0 (`--fe-i0 incremental`) at level 0 and staged, and at the slowest divider.
+    for (bits, pipe) in [(None, Pipeline::NONE), (None, Pipeline::new(1).unwrap()), (Some(1), Pipeline::NONE)] {
+        runs.push((Config::default(), "", BfpiArch::ShiftAdd, bits, (DiMode::Triangle, I0Form::Incremental), pipe, Bus::Native));
     }
     // `--bus axis`: only the wrappers are linted as tops (their cores are the native modules of
     // the same options, linted above), at the default P and at P = 1 with a prefix and the
     // deepest pipeline.
-    runs.push((Config::default(), "", BfpiArch::ShiftAdd, None, DiMode::Triangle, Pipeline::NONE, Bus::Axis));
+    runs.push((Config::default(), "", BfpiArch::ShiftAdd, None, (DiMode::Triangle, I0Form::Reciprocal), Pipeline::NONE, Bus::Axis));
     let deepest = Pipeline::new(Pipeline::MAX).unwrap();
     runs.push((
         Config { p: 1, align: Align::Screen, ..Config::default() },
         "acme_",
         BfpiArch::ShiftAdd,
         None,
-        DiMode::Triangle,
+        (DiMode::Triangle, I0Form::Reciprocal),
         deepest,
         Bus::Axis,
     ));
     // Which run lints each front-end is decided over the whole sweep, then each part takes its own.
-    let firsts: Vec<bool> = runs.iter().map(|r| r.6 == Bus::Native && fe_seen.insert((r.0.frac, r.0.xbits, r.1, r.3, r.4))).collect();
+    // The incremental I0's staged front-end is its own (its engine beside the stages).
+    let fe_key = |r: &Run| (r.0.frac, r.0.xbits, r.1, r.3, r.4, if r.4 .1 == I0Form::Incremental { r.5 } else { Pipeline::NONE });
+    let firsts: Vec<bool> = runs.iter().map(|r| r.6 == Bus::Native && fe_seen.insert(fe_key(r))).collect();
     for (k, ((cfg, prefix, arch, fe_div_bits, fe_di, pipe, bus), fe_first)) in runs.into_iter().zip(firsts).enumerate() {
         if k % PARTS == part {
             lint_one(k, cfg, prefix, arch, (fe_div_bits, fe_di), (pipe, bus), fe_first);
@@ -188,17 +214,17 @@ fn lint_one(
     cfg: Config,
     prefix: &str,
     arch: BfpiArch,
-    (fe_div_bits, fe_di): (Option<u32>, DiMode),
+    (fe_div_bits, (fe_di, fe_i0)): (Option<u32>, (DiMode, I0Form)),
     (pipeline, bus): (Pipeline, Bus),
     fe_first: bool,
 ) {
     {
         let what = format!(
-            "{cfg:?}, prefix '{prefix}', --bfpi-arch {arch}, --fe-div-bits {fe_div_bits:?}, --fe-di {fe_di:?}, --pipeline {pipeline}, --bus {bus}"
+            "{cfg:?}, prefix '{prefix}', --bfpi-arch {arch}, --fe-div-bits {fe_div_bits:?}, --fe-di {fe_di:?}, --fe-i0 {fe_i0:?}, --pipeline {pipeline}, --bus {bus}"
         );
         let dir = std::env::temp_dir().join(format!("hdl-gen-lint-{}-{k}", std::process::id()));
         let _ = std::fs::remove_dir_all(&dir);
-        let opts = Options { cfg, prefix: prefix.into(), bfpi_arch: arch, fe_div_bits, fe_di, pipeline, bus, ..Default::default() };
+        let opts = Options { cfg, prefix: prefix.into(), bfpi_arch: arch, fe_div_bits, fe_di, fe_i0, pipeline, bus, ..Default::default() };
         let names = hdl_gen::Names::new(prefix, &cfg);
         let chain = fe_first || (arch == BfpiArch::ShiftAdd && [1, 256].contains(&cfg.p));
         let axis = bus == Bus::Axis;

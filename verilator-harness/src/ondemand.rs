@@ -274,6 +274,9 @@ pub fn tag_suffix(opts: &hdl_gen::Options) -> String {
     if opts.fe_di != golden::frontend::DiMode::Triangle {
         s += "_scan";
     }
+    if opts.fe_i0 != golden::frontend::I0Form::Reciprocal {
+        s += "_inc";
+    }
     if opts.bfpi_arch != hdl_gen::BfpiArch::ShiftAdd {
         s += &format!("_{:?}", opts.bfpi_arch).to_lowercase();
     }

@@ -374,3 +374,23 @@ fn incremental_i0_negative_controls() {
         assert!(caught, "planted fault not caught: {what}");
     }
 }
+
+/// The plan's I0 form decides what `spans` evaluates, with the same spans; a plan without the
+/// field (every one written before it) reads as the reciprocal form, and the default form is
+/// left out when written, so those plans' bytes stay as they were.
+#[test]
+fn the_plan_names_its_i0_form() {
+    let rec = FrontEnd::new(Config::default(), Screen::default()).unwrap();
+    let inc = rec.with_i0(I0Form::Incremental);
+    let mut rng = Rng(27);
+    for _ in 0..2000 {
+        let t = random_tri(&mut rng, &rec);
+        assert_eq!(rec.span_list(&t), inc.span_list(&t), "{t:?}");
+    }
+    let text = serde_json::to_string(&rec).unwrap();
+    assert!(!text.contains("i0"), "{text}");
+    assert_eq!(serde_json::from_str::<FrontEnd>(&text).unwrap(), rec);
+    let text = serde_json::to_string(&inc).unwrap();
+    assert!(text.contains("\"i0\":\"incremental\""), "{text}");
+    assert_eq!(serde_json::from_str::<FrontEnd>(&text).unwrap(), inc);
+}

@@ -2,7 +2,7 @@
 //! rate, pipeline level) and its ports: the types every part of the generator shares.
 
 use crate::verilog::Port;
-use golden::frontend::{DiMode, FrontEnd, Widths};
+use golden::frontend::{DiMode, FrontEnd, I0Form, Widths};
 
 /// Quotient bits the set-up's dividers take per clock (`--fe-div-bits`): area against rate.
 pub const DIV_BITS: [u32; 3] = [1, 2, 4];
@@ -48,7 +48,19 @@ impl Hw {
     /// idle: CALC, the dividers, the hand-off, the walker's clock, the span path's stages (and,
     /// per scanline, the span's division when it has two pixels or more).
     pub fn latency(&self) -> u32 {
-        self.calc_clocks() + self.div_clocks() + 2 + self.i0_stages() + self.span_div_clocks()
+        self.calc_clocks() + self.div_clocks() + 2 + self.i0_stages() + self.span_div_clocks() + self.start_clocks()
+    }
+
+    /// Clocks a start takes in the incremental I0 (at most: a start at an edge; one at column 0
+    /// takes fewer); 0 in the reciprocal form, which has none. A triangle's first row is started
+    /// while it is held, before the walker takes it, so each walked triangle's set-up takes
+    /// these clocks more; a later start (an edge taking over the left end) holds the walker
+    /// as long.
+    pub fn start_clocks(&self) -> u32 {
+        match self.fe.i0 {
+            I0Form::Reciprocal => 0,
+            I0Form::Incremental => super::incremental::START_CLOCKS,
+        }
     }
 
     /// Clocks from a triangle's transfer to the first segment out of `tri_shader_p<P>` when idle:
@@ -62,7 +74,7 @@ impl Hw {
     /// and per triangle dropped in set-up (its last CALC clock). CALC's earlier stages overlap
     /// the triangle ahead's division, so neither depends on the pipeline level.
     pub fn setup_clocks(&self) -> (u32, u32) {
-        (self.div_clocks() + 1, 1)
+        (self.div_clocks() + 1 + self.start_clocks(), 1)
     }
 }
 

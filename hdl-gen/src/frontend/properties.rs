@@ -47,6 +47,7 @@ pub(super) fn emit(hw: &Hw, set_up: Setup, sp: &Stager) -> Item {
                 SpanStage { valid: span::valid(j), y: held("y"), x: held("x"), len: held("len"), di: held("di") }
             })
             .collect(),
+        starts: super::incremental::on(hw).then_some(super::incremental::START_CLOCKS),
     })
 }
 
@@ -79,6 +80,11 @@ pub struct FrontendShape {
     pub cull: String,
     /// The span path's register stages between the walker and the output, in order.
     pub span_stages: Vec<SpanStage>,
+    /// The incremental I0 (`--fe-i0 incremental`): its start engine's clocks. The walker then
+    /// waits while a source starts (`ie_wait`, a data decision taken as given, like a row's
+    /// coverage) and the held triangle is taken once its first row is started (`ie_pv`); the
+    /// engine's own properties bound both waits.
+    pub starts: Option<u32>,
 }
 
 /// A register stage of the front-end's span path: where it holds a span's valid, row, columns
@@ -297,7 +303,15 @@ impl Reference<'_> {
 
         b.push(wire("f_adv", 1, "!out_valid || out_ready"));
         b.push(wire("f_wend", 1, "f_wrow == f_wlast"));
-        b.push(wire("f_take", 1, "f_sb && f_sh && f_adv && (!f_wv || f_wend)"));
+        b.push(wire(
+            "f_take",
+            1,
+            if self.s.starts.is_some() {
+                "f_sb && f_sh && ie_pv && f_adv && !ie_wait && (!f_wv || f_wend)"
+            } else {
+                "f_sb && f_sh && f_adv && (!f_wv || f_wend)"
+            },
+        ));
         b.push(wire("f_calc", 1, format!("{} && (!f_sb || f_take)", f_v(last))));
         for j in (0..last).rev() {
             b.push(wire(&f_mv(j), 1, format!("{} && (!{} || {})", f_v(j), f_v(j + 1), f_mv(j + 1))));
@@ -316,6 +330,11 @@ impl Reference<'_> {
         let Reference { nsp, last, cw, nw, .. } = *self;
         let f_mv = |j: usize| f_mv(j, last);
         let inc1 = |n: &str| set(n, format!("{n} + {}", one(cw)));
+        // The walker moves when the output is free (and, with starts, no source is starting).
+        let (wgo, row) = match self.s.starts {
+            Some(_) => ("f_adv && !ie_wait", "f_wv && f_cover && !ie_wait"),
+            None => ("f_adv", "f_wv && f_cover"),
+        };
         let inc = |n: &str, c: &str| when(c, vec![inc1(n)]);
         let calc_go = vec![
             set("f_sb", "1'b1"),
@@ -356,16 +375,16 @@ impl Reference<'_> {
                 inc1("f_nwalk"),
             ],
             vec![
-                when("f_adv && f_wv && f_cover", vec![set("f_wnew", "1'b0")]),
+                when(format!("f_adv && {row}"), vec![set("f_wnew", "1'b0")]),
                 when(
-                    "f_adv && f_wv",
+                    format!("{wgo} && f_wv"),
                     vec![Stmt::If("f_wend".into(), vec![set("f_wv", "1'b0")], vec![set("f_wrow", format!("f_wrow + {}", one(yw)))])],
                 ),
             ],
         );
         let spans = when(
             "f_adv",
-            vec![set("f_1v", "f_wv && f_cover"), set("f_1y", "f_wrow"), set("f_1n", "f_wnew")]
+            vec![set("f_1v", row), set("f_1y", "f_wrow"), set("f_1n", "f_wnew")]
                 .into_iter()
                 .chain((2..=nsp).flat_map(|i| ["v", "y", "n"].map(|f| set(format!("f_{i}{f}"), format!("f_{}{f}", i - 1)))))
                 .chain(["v", "y", "n"].map(|f| set(format!("f_o{f}"), format!("f_{nsp}{f}"))))
@@ -413,7 +432,7 @@ impl Reference<'_> {
                 set("f_errp", "1'b0"),
                 inc("f_nacc", "f_acc"),
                 inc("f_nerr", "err"),
-                inc("f_nrow", "f_adv && f_wv && f_cover"),
+                inc("f_nrow", &format!("f_adv && {row}")),
                 inc("f_nout", "out_valid && out_ready"),
                 input,
             ]
@@ -449,11 +468,18 @@ impl Reference<'_> {
         b.push(comment("Rate (SPEC §6), in the design's terms: the walker takes a row every clock the output is"));
         b.push(comment("free; a set-up result waiting when the walker is on its last row follows it with no"));
         b.push(comment("bubble (set-up overlapped with the walk); a dropped or culled triangle costs its CALC clock."));
+        let (go, held) = if self.s.starts.is_some() { (" && !ie_wait", " && ie_pv") } else { ("", "") };
         b.push(Item::Always(vec![when(
             "f_past && !$past(rst)",
             vec![
-                when("$past(w_valid && adv && !w_end)", vec![assert("w_valid"), assert(format!("w_row == $past(w_row) + {}", one(yw)))]),
-                when("$past(w_valid && adv && w_end && st == HOLD)", vec![assert("w_valid"), assert("w_row == $past(s_first)")]),
+                when(
+                    format!("$past(w_valid && adv && !w_end{go})"),
+                    vec![assert("w_valid"), assert(format!("w_row == $past(w_row) + {}", one(yw)))],
+                ),
+                when(
+                    format!("$past(w_valid && adv && w_end && st == HOLD{held}{go})"),
+                    vec![assert("w_valid"), assert("w_row == $past(s_first)")],
+                ),
                 // The triangle behind a dropped one moves up in the same clock: into the last CALC
                 // stage, or (CALC in one clock) straight into it from the port.
                 when(
@@ -466,6 +492,9 @@ impl Reference<'_> {
                 ),
             ],
         )]));
+        if let Some(clocks) = self.s.starts {
+            b.extend(starts(clocks));
+        }
         b.push(comment("Nothing lost or invented: every accepted triangle was flagged, culled or walked, or is"));
         b.push(comment("still waiting or in set-up (counts modulo 16)."));
         b.push(Item::Comb(vec![when(
@@ -572,4 +601,33 @@ impl Reference<'_> {
         b.push(Item::Comb(vec![when("f_past", link)]));
         b
     }
+}
+
+/// The incremental I0's start engine (`--fe-i0 incremental`): what bounds the walker's waits
+/// and the held triangle's. A walker's start runs at once, taking the engine from a held
+/// triangle's start; the engine's job counts its clocks and ends within `clocks`, and then the
+/// source is started (the walker goes on); a held triangle's start runs whenever the walker
+/// needs no start, and a held start belongs to the held triangle.
+fn starts(clocks: u32) -> Vec<Item> {
+    let t = |v: u32| lit(4, v as u64);
+    vec![
+        comment("Starts (incremental I0): the walker's start runs at once and ends within the engine's clocks,"),
+        comment("then the walker goes on; the held triangle's start runs when the walker needs none."),
+        Item::Comb(vec![when(
+            "f_past",
+            vec![
+                assert(format!("ie_busy ? (ie_t >= {} && ie_t <= {}) : ie_t == {}", t(1), t(clocks - 1), t(0))),
+                when("ie_busy && !ie_pre", vec![assert("ie_wait"), assert("ie_src == ie_sel")]),
+                when("ie_busy && ie_pre", vec![assert("st == HOLD"), assert("!ie_pv")]),
+                when("ie_pv", vec![assert("st == HOLD")]),
+            ],
+        )]),
+        Item::Always(vec![when(
+            "f_past && !$past(rst)",
+            vec![
+                when("$past(ie_wait) && ie_wait", vec![assert("ie_busy && !ie_pre")]),
+                when("$past(st == HOLD && !ie_pv && !ie_wait && !ie_busy)", vec![assert("ie_busy && ie_pre")]),
+            ],
+        )]),
+    ]
 }

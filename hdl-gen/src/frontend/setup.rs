@@ -144,6 +144,9 @@ fn calc_load(hw: &Hw, st: &Stager, divs: &[Div], cnt_w: u32) -> Vec<Stmt> {
     ] {
         calc_load.push(set(r, st.at(v)));
     }
+    if super::incremental::on(hw) {
+        calc_load.extend(super::incremental::setup_load(st));
+    }
     calc_load
 }
 
@@ -204,6 +207,9 @@ fn divider_regs(hw: &Hw, divs: &[Div], cnt_w: u32, body: &mut Vec<Item>) {
     }
     body.push(reg("s_sat", 1));
     body.push(reg("s_dineg", 1));
+    if super::incremental::on(hw) {
+        super::incremental::setup_regs(hw, body);
+    }
     body.push(Item::Blank);
 }
 

@@ -34,6 +34,9 @@ pub(super) fn valid(j: usize) -> String {
 /// The span path's stages, from the walker's row to I0; returns them for the output and the
 /// properties.
 pub(super) fn path(hw: &Hw, body: &mut Vec<Item>) -> Stager {
+    if super::incremental::on(hw) {
+        return super::incremental::span_path(hw);
+    }
     let fe = &hw.fe;
     let Widths { yw: row_w, aw: area_w, k: sum_w, rw: recip_w, .. } = fe.widths();
     let (xw, iw, dw) = (fe.cfg.xbits, fe.cfg.iw(), fe.cfg.dw());

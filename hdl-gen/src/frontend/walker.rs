@@ -42,7 +42,10 @@ pub(super) fn emit(hw: &Hw, body: &mut Vec<Item>) {
         body.push(wire("adv", 1, "!out_valid || out_ready"));
     }
     body.push(wire("w_end", 1, "w_row == w_last"));
-    body.push(assign("take", "st == HOLD && adv && (!w_valid || w_end)"));
+    let inc = super::incremental::on(hw);
+    if !inc {
+        body.push(assign("take", "st == HOLD && adv && (!w_valid || w_end)"));
+    }
     let end_w = bound_w + 1;
     body.push(swire("lo0", end_w, slit(end_w, 0)));
     body.push(swire("hi0", end_w, slit(end_w, w - 1)));
@@ -67,7 +70,13 @@ pub(super) fn emit(hw: &Hw, body: &mut Vec<Item>) {
     body.push(swire("room", end_w + 1, format!("{} + {}", sext("hi3", end_w, end_w + 1), sext("mg", end_w, end_w + 1))));
     body.push(wire("len_w", end_w, "hi3 + mg + 1"));
     body.push(comment("verilator lint_on UNUSEDSIGNAL"));
-    body.push(wire("emit", 1, format!("w_valid && !room[{end_w}]")));
+    if inc {
+        body.push(wire("px", 1, format!("w_valid && !room[{end_w}]")));
+        super::incremental::select(hw, body);
+        body.push(wire("emit", 1, "px && !ie_wait"));
+    } else {
+        body.push(wire("emit", 1, format!("w_valid && !room[{end_w}]")));
+    }
     body.push(wire("lo_u", xw, format!("lo3[{}:0]", xw - 1)));
     for k in 0..3 {
         body.push(wire(
@@ -125,8 +134,15 @@ pub(super) fn emit(hw: &Hw, body: &mut Vec<Item>) {
         vec![Stmt::If(
             "take".into(),
             load,
-            vec![Stmt::If("adv && w_valid".into(), vec![Stmt::If("w_end".into(), vec![set("w_valid", "1'b0")], step)], vec![])],
+            vec![Stmt::If(
+                if inc { "adv && w_valid && !ie_wait" } else { "adv && w_valid" }.into(),
+                vec![Stmt::If("w_end".into(), vec![set("w_valid", "1'b0")], step)],
+                vec![],
+            )],
         )],
     )]));
     body.push(Item::Blank);
+    if inc {
+        super::incremental::engine(hw, body);
+    }
 }
