@@ -3,7 +3,7 @@
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
-use verilator_harness::ffi::{default_model_args, require, require_segment_model, SEGMENT_MODELS};
+use verilator_harness::registry::{default_model_args, require, require_segment_model, SEGMENT_MODELS};
 
 fn run(bin: &str, args: &[&str]) -> Output {
     Command::new(bin).args(args).output().unwrap_or_else(|e| panic!("running {bin}: {e}"))

@@ -4,8 +4,8 @@
 use golden::frontend::{FixedTriangle, FrontEnd, Outcome};
 use golden::rng::SeedRng;
 use rand::SeedableRng;
-use verilator_harness::ffi::{require, require_models, FRONTEND_MODELS, TRISHADER_MODELS};
 use verilator_harness::frontend::{mesh, random_triangles, run_chain, run_frontend, Expected};
+use verilator_harness::registry::{require, require_models, FRONTEND_MODELS, TRISHADER_MODELS};
 use verilator_harness::segment::{assert_clean, Stress, Traffic};
 
 fn frontend(m: &verilator_harness::ffi::ModelInfo<impl Sized, impl Sized>) -> FrontEnd {
@@ -15,7 +15,7 @@ fn frontend(m: &verilator_harness::ffi::ModelInfo<impl Sized, impl Sized>) -> Fr
 #[test]
 fn spans_equal_golden_for_every_kind_of_triangle() {
     let seed = verilator_harness::seed("frontend spans");
-    let Some(models) = require_models(FRONTEND_MODELS, "tri_frontend", "frontend spans") else { return };
+    let Some(models) = require_models(&FRONTEND_MODELS, "tri_frontend", "frontend spans") else { return };
     for m in models {
         let fe = frontend(m);
         let tris = random_triangles(&mut SeedRng::seed_from_u64(seed), &fe, 3000);
@@ -41,7 +41,7 @@ fn spans_equal_golden_for_every_kind_of_triangle() {
 #[test]
 fn resets_in_the_middle_of_triangles_drop_them_cleanly() {
     let seed = verilator_harness::seed("frontend resets");
-    let Some(models) = require_models(FRONTEND_MODELS, "tri_frontend", "frontend resets") else { return };
+    let Some(models) = require_models(&FRONTEND_MODELS, "tri_frontend", "frontend resets") else { return };
     for m in models {
         let fe = frontend(m);
         // Rounds of 1,500 triangles until a reset came, so the test always has one. Each triangle
@@ -65,7 +65,7 @@ fn resets_in_the_middle_of_triangles_drop_them_cleanly() {
 #[test]
 fn segments_and_frames_through_the_chain() {
     let seed = verilator_harness::seed("tri_shader");
-    let Some(models) = require_models(TRISHADER_MODELS, "tri_shader", "tri_shader segments") else { return };
+    let Some(models) = require_models(&TRISHADER_MODELS, "tri_shader", "tri_shader segments") else { return };
     for m in models {
         let fe = frontend(m);
         let mut rng = SeedRng::seed_from_u64(seed ^ m.cfg.p as u64);
@@ -83,7 +83,7 @@ fn segments_and_frames_through_the_chain() {
 #[test]
 fn a_shared_edge_mesh_writes_every_covered_pixel_exactly_once() {
     let seed = verilator_harness::seed("tri_shader mesh");
-    let Some(models) = require_models(TRISHADER_MODELS, "tri_shader", "tri_shader mesh") else { return };
+    let Some(models) = require_models(&TRISHADER_MODELS, "tri_shader", "tri_shader mesh") else { return };
     for m in models {
         let fe = frontend(m);
         let tris: Vec<FixedTriangle> = mesh(&mut SeedRng::seed_from_u64(seed), &fe, 17, 11);
@@ -122,7 +122,7 @@ fn set_up_costs_what_the_manifest_says() {
     // Triangles of one row each are set-up bound; zero-area ones cost their CALC clock only.
     // The same with CALC in stages (they overlap the division of the triangle ahead), at every
     // divider rate and in both dI modes.
-    let Some(models) = require_models(FRONTEND_MODELS, "tri_frontend", "frontend set-up clocks") else { return };
+    let Some(models) = require_models(&FRONTEND_MODELS, "tri_frontend", "frontend set-up clocks") else { return };
     for m in models {
         set_up_costs(m);
     }
@@ -169,7 +169,7 @@ fn scenes_render_through_the_rtl_chain_as_golden() {
     else {
         return;
     };
-    let Some(seg) = verilator_harness::ffi::require_segment_model(8, golden::Align::Span, what) else { return };
+    let Some(seg) = verilator_harness::registry::require_segment_model(8, golden::Align::Span, what) else { return };
     for kind in [SceneKind::Sphere, SceneKind::Torus] {
         let job = scene_job(kind, 40, &seg.cfg, &Screen::default()).unwrap();
         let o = run_with(&job, seg, Chain::Rtl(chain), None, |_| {});

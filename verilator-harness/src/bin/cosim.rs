@@ -10,9 +10,10 @@ use rand::SeedableRng;
 use std::path::PathBuf;
 use std::process::ExitCode;
 use std::time::Instant;
-use verilator_harness::ffi::{specular_unit, ModelInfo, SPECULAR_MODELS};
+use verilator_harness::ffi::ModelInfo;
 use verilator_harness::frontend::{random_triangles, run_chain_at};
 use verilator_harness::ondemand;
+use verilator_harness::registry::{specular_unit, SPECULAR_MODELS};
 use verilator_harness::segment::{Report, SegmentCosim, Traffic};
 use verilator_harness::specular::{random_span, SpecularCosim};
 use verilator_harness::stimulus::random_triangle;
@@ -97,7 +98,7 @@ struct Args {
 /// status 2 when `info` has no traced twin in this build or DIR cannot be made.
 fn start_trace<I, O>(args: &Args, info: &ModelInfo<I, O>) -> Result<(), ExitCode> {
     let Some(dir) = &args.trace else { return Ok(()) };
-    info.require_traced().and_then(|()| waveform::trace_everything(dir)).map_err(|e| {
+    ondemand::require_traced(info).and_then(|()| waveform::trace_everything(dir)).map_err(|e| {
         eprintln!("error: --trace: {e}");
         ExitCode::from(2)
     })
@@ -118,6 +119,11 @@ enum Frontend {
 
 fn main() -> ExitCode {
     let args = Args::parse();
+    // A COSIM_RTL_DIR that describes no models is a usage error, said before anything runs.
+    if let Err(e) = verilator_harness::registry::check_folder() {
+        eprintln!("error: {e}");
+        return ExitCode::from(2);
+    }
     if args.specular {
         return specular(&args);
     }
@@ -126,7 +132,7 @@ fn main() -> ExitCode {
     }
     let align = args.align;
     // The compiled catalogue's model, or one built (once, then cached) for this configuration.
-    let info = match ondemand::options(args.p, align, None).and_then(|o| ondemand::segment(&o)) {
+    let info = match ondemand::options(args.p, align, None).and_then(|o| verilator_harness::registry::segment(&o)) {
         Ok(info) => info,
         Err(e) => return ondemand::exit(&format!("--p {} --align {align}", args.p), &e),
     };
@@ -186,7 +192,7 @@ fn rtl_frontend(args: &Args) -> ExitCode {
     let align = args.align;
     // The chain on the screen asked for: the catalogue's, or built for it.
     let screen = Screen { width: args.width, height: args.height };
-    let info = match ondemand::options(args.p, align, Some(screen)).and_then(|o| ondemand::tri_shader(&o)) {
+    let info = match ondemand::options(args.p, align, Some(screen)).and_then(|o| verilator_harness::registry::tri_shader(&o)) {
         Ok(info) => info,
         Err(e) => return ondemand::exit(&format!("--frontend rtl --p {} --align {align}", args.p), &e),
     };

@@ -12,9 +12,10 @@ use golden::Align;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::time::Instant;
-use verilator_harness::ffi::{ModelInfo, SPECULAR_MODELS};
+use verilator_harness::ffi::ModelInfo;
 use verilator_harness::models::ModelError;
 use verilator_harness::ondemand;
+use verilator_harness::registry::SPECULAR_MODELS;
 use verilator_harness::render::{busy_cycles, difference_image, obj_job, run_with, scene_job, triangles_job, Chain, Job, SceneKind};
 use verilator_harness::waveform::trace_everything;
 
@@ -171,12 +172,17 @@ fn model_for<I, O>(
 
 fn main() -> ExitCode {
     let args = Args::parse();
+    // A COSIM_RTL_DIR that describes no models is a usage error, said before anything runs.
+    if let Err(e) = verilator_harness::registry::check_folder() {
+        eprintln!("error: {e}");
+        return ExitCode::from(2);
+    }
     if let Err(e) = check_args(&args) {
         return fail(e);
     }
     let start = Instant::now();
     let align = args.align;
-    let info = match ondemand::options(args.p, align, None).and_then(|o| ondemand::segment(&o)) {
+    let info = match ondemand::options(args.p, align, None).and_then(|o| verilator_harness::registry::segment(&o)) {
         Ok(info) => info,
         Err(e) => return ondemand::exit(&format!("--p {} --align {align}", args.p), &e),
     };
@@ -189,13 +195,14 @@ fn main() -> ExitCode {
     let chain = match (args.frontend, args.writer) {
         (Frontend::Host, Writer::Host) => Ok(Chain::Host),
         (Frontend::Host, Writer::Rtl) => {
-            model_for(on_screen().and_then(|o| ondemand::writer(&o)), screen, "--writer rtl").map(Chain::HostToMemory)
+            model_for(on_screen().and_then(|o| verilator_harness::registry::writer(&o)), screen, "--writer rtl").map(Chain::HostToMemory)
         }
         (Frontend::Rtl, Writer::Host) => {
-            model_for(on_screen().and_then(|o| ondemand::tri_shader(&o)), screen, "--frontend rtl").map(Chain::Rtl)
+            model_for(on_screen().and_then(|o| verilator_harness::registry::tri_shader(&o)), screen, "--frontend rtl").map(Chain::Rtl)
         }
         (Frontend::Rtl, Writer::Rtl) => {
-            model_for(on_screen().and_then(|o| ondemand::tri_writer(&o)), screen, "--frontend rtl --writer rtl").map(Chain::RtlToMemory)
+            model_for(on_screen().and_then(|o| verilator_harness::registry::tri_writer(&o)), screen, "--frontend rtl --writer rtl")
+                .map(Chain::RtlToMemory)
         }
     };
     let chain = match chain {
@@ -228,13 +235,13 @@ fn main() -> ExitCode {
     if let Some(trace) = &args.trace {
         // The models this run builds instances of must have traced twins.
         let mut need = match chain {
-            Chain::Host => vec![info.require_traced()],
-            Chain::HostToMemory(w) => vec![info.require_traced(), w.require_traced()],
-            Chain::Rtl(m) => vec![m.require_traced()],
-            Chain::RtlToMemory(m) => vec![m.require_traced()],
+            Chain::Host => vec![ondemand::require_traced(info)],
+            Chain::HostToMemory(w) => vec![ondemand::require_traced(info), ondemand::require_traced(w)],
+            Chain::Rtl(m) => vec![ondemand::require_traced(m)],
+            Chain::RtlToMemory(m) => vec![ondemand::require_traced(m)],
         };
         if args.scene.is_some() || args.obj.is_some() {
-            need.extend(SPECULAR_MODELS.first().map(ModelInfo::require_traced));
+            need.extend(SPECULAR_MODELS.first().map(ondemand::require_traced));
         }
         if let Err(e) = need.into_iter().collect::<Result<Vec<()>, _>>().and_then(|_| trace_everything(trace)) {
             return fail(format!("--trace: {e}"));

@@ -16,10 +16,11 @@ use std::fmt::Write as _;
 use std::path::PathBuf;
 use std::process::ExitCode;
 use std::time::Instant;
-use verilator_harness::ffi::{ModelInfo, TriIn, TriSegOut, WrIn, WrOut, RTL_DIR, SEGMENT_MODELS, TRISHADER_MODELS, WRITER_MODELS};
+use verilator_harness::ffi::{ModelInfo, TriIn, TriSegOut, WrIn, WrOut};
 use verilator_harness::frontend::{drain_clocks, run_chain};
 use verilator_harness::models::{catalogue, ModelError};
 use verilator_harness::ondemand;
+use verilator_harness::registry::{SEGMENT_MODELS, TRISHADER_MODELS, WRITER_MODELS};
 use verilator_harness::render::{busy_cycles, scene_job, SceneKind};
 use verilator_harness::segment::Stress;
 use verilator_harness::segment::{Report, SegmentCosim, Stim, Traffic};
@@ -52,13 +53,16 @@ struct Args {
 fn on_screen(screen: Screen) -> Result<(Vec<&'static ModelInfo<TriIn, TriSegOut>>, Vec<&'static ModelInfo<WrIn, WrOut>>), ModelError> {
     let chains: Vec<_> = TRISHADER_MODELS.iter().filter(|m| m.screen == screen).collect();
     let writers: Vec<_> = WRITER_MODELS.iter().filter(|m| m.screen == screen && m.cfg.p > 1).collect();
-    if !chains.is_empty() || RTL_DIR.is_some() {
+    if !chains.is_empty() || verilator_harness::registry::rtl_dir().is_some() {
         return Ok((chains, writers));
     }
     let built = || -> Result<_, ModelError> {
-        let chains = catalogue::BUILT_TRI.iter().map(|&(p, a)| ondemand::tri_shader(&ondemand::options(p, a, Some(screen))?));
-        let writers =
-            catalogue::BUILT_WR.iter().filter(|(p, _)| *p > 1).map(|&(p, a)| ondemand::writer(&ondemand::options(p, a, Some(screen))?));
+        let chains =
+            catalogue::BUILT_TRI.iter().map(|&(p, a)| verilator_harness::registry::tri_shader(&ondemand::options(p, a, Some(screen))?));
+        let writers = catalogue::BUILT_WR
+            .iter()
+            .filter(|(p, _)| *p > 1)
+            .map(|&(p, a)| verilator_harness::registry::writer(&ondemand::options(p, a, Some(screen))?));
         Ok((chains.collect::<Result<Vec<_>, _>>()?, writers.collect::<Result<Vec<_>, _>>()?))
     };
     match built() {
@@ -122,6 +126,11 @@ impl Cell {
 
 fn main() -> ExitCode {
     let args = Args::parse();
+    // A COSIM_RTL_DIR that describes no models is a usage error, said before anything runs.
+    if let Err(e) = verilator_harness::registry::check_folder() {
+        eprintln!("error: {e}");
+        return ExitCode::from(2);
+    }
     // A bad --out is refused now, not after the sweep's minutes.
     if let Some(Err(e)) = args.out.as_deref().map(hdl_gen::output::check_writable) {
         eprintln!("error: --out: {e}");

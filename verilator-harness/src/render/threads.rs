@@ -5,8 +5,9 @@
 use super::image::{compose, memory_image};
 use super::visibility::Job;
 use crate::driver::{Stress, DRAIN_CLOCKS};
-use crate::ffi::{specular_unit, ModelInfo, SegIn, SegOut, SpecIn, SpecOut, TriIn, TriSegOut, WrIn, WrOut};
+use crate::ffi::{ModelInfo, SegIn, SegOut, SpecIn, SpecOut, TriIn, TriSegOut, WrIn, WrOut};
 use crate::frontend::{stream_chain, Expected};
+use crate::registry::specular_unit;
 use crate::report::Report;
 use crate::segment::{SegView, SegmentCosim, Stim};
 use crate::specular::SpecularCosim;
