@@ -34,7 +34,31 @@ pub fn cache_root() -> PathBuf {
 
 fn verilator() -> Result<&'static Verilator, ModelError> {
     static FOUND: OnceLock<Option<Verilator>> = OnceLock::new();
-    FOUND.get_or_init(|| Verilator::find().ok()).as_ref().ok_or(ModelError::NoVerilator)
+    FOUND.get_or_init(|| remembered_verilator().or_else(|| Verilator::find().ok())).as_ref().ok_or(ModelError::NoVerilator)
+}
+
+/// What `verilator --version` and `--getenv VERILATOR_ROOT` said of the `verilator` on PATH,
+/// remembered in the cache by that file's path, size and time (and VERILATOR_ROOT): Verilator's
+/// front end is a Perl script, a noticeable part of a second to start, and a test process that
+/// only loads built models would otherwise start it twice. A changed or other Verilator is
+/// another file, asked anew.
+fn remembered_verilator() -> Option<Verilator> {
+    let path = std::env::var_os("PATH")?;
+    let exe = std::env::split_paths(&path).map(|d| d.join("verilator")).find(|f| f.is_file())?;
+    let meta = fs::metadata(&exe).ok()?;
+    let stamp = format!("{}\n{}\n{:?}\n{:?}\n", exe.display(), meta.len(), meta.modified().ok()?, std::env::var_os("VERILATOR_ROOT"));
+    let file = cache_root().join(format!("verilator-{:016x}.txt", crate::models::model::hash(&stamp)));
+    if let Some((version, root)) = fs::read_to_string(&file).ok().as_deref().and_then(|t| t.split_once('\n')) {
+        return Some(Verilator { version: version.to_string(), root: PathBuf::from(root) });
+    }
+    let v = Verilator::find().ok()?;
+    // Written whole or not at all: a temporary file renamed into place.
+    let tmp = file.with_extension(format!("tmp{}", std::process::id()));
+    let written = fs::create_dir_all(cache_root()).and_then(|()| fs::write(&tmp, format!("{}\n{}", v.version, v.root.display())));
+    if written.and_then(|()| fs::rename(&tmp, &file)).is_err() {
+        let _ = fs::remove_file(&tmp);
+    }
+    Some(v)
 }
 
 /// Whether [`shared_object`] found the model built or built it.
@@ -319,6 +343,48 @@ pub fn twin<I: 'static, O: 'static>(info: &ModelInfo<I, O>) -> Result<&'static T
         return Ok(t);
     }
     let id = info.identity();
+    let tag = format!("{}{TRACED_SUFFIX}", info.tag);
+    // The twin of this circuit built before (under this Verilator, shims and layout): its shared
+    // object, found without describing the model again (generating a configuration takes a
+    // good part of a second).
+    let v = verilator()?;
+    let stamp = format!("{id}\n{}\n{}\n{}\n{}\n{}", v.version, Link::Shared.layout(), verilator::SHIM_H, verilator::TRACE_H, TRACE_LAYOUT);
+    let index = cache_root().join(format!("{tag}-{:016x}.twin", crate::models::model::hash(&stamp)));
+    let known = fs::read_to_string(&index).ok().map(PathBuf::from).filter(|so| so.exists());
+    let so = match known {
+        Some(so) => so,
+        None => {
+            let so = build(&describe_again(info)?, true)?.0;
+            let tmp = index.with_extension(format!("tmp{}", std::process::id()));
+            if fs::write(&tmp, so.as_os_str().as_encoded_bytes()).and_then(|()| fs::rename(&tmp, &index)).is_err() {
+                let _ = fs::remove_file(&tmp);
+            }
+            so
+        }
+    };
+    let lib = open(&so)?;
+    let sym = |name: &str| symbol(lib, &so, &tag, name);
+    // SAFETY: csrc/trace.h's SEGSHADE_TRACE_SHIM defines these five with exactly these
+    // signatures, on the same structs as the model's (the description is the model's own).
+    let twin = unsafe {
+        TracedModel::from_symbols(
+            leak(&tag),
+            std::mem::transmute::<*const (), unsafe extern "C" fn(u64) -> *mut std::ffi::c_void>(sym("new")?),
+            std::mem::transmute::<*const (), unsafe extern "C" fn(*mut std::ffi::c_void)>(sym("free")?),
+            std::mem::transmute::<*const (), StepFn<I, O>>(sym("step")?),
+            std::mem::transmute::<*const (), unsafe extern "C" fn(*mut std::ffi::c_void, *const std::ffi::c_char, u64) -> std::ffi::c_int>(
+                sym("trace_open")?,
+            ),
+            std::mem::transmute::<*const (), unsafe extern "C" fn(*mut std::ffi::c_void) -> std::ffi::c_int>(sym("trace_close")?),
+        )
+    };
+    Ok(info.enter_twin(twin))
+}
+
+/// `info`'s description as its twin is built from: the one it was loaded from, or the
+/// catalogue's entry of its tag (checked to be the circuit compiled in), under the twin's tag.
+fn describe_again<I, O>(info: &ModelInfo<I, O>) -> Result<Model, ModelError> {
+    let id = info.identity();
     let loaded = described().lock().unwrap_or_else(|e| e.into_inner()).get(&id).copied();
     let m = match loaded {
         Some(m) => m.clone(),
@@ -333,25 +399,7 @@ pub fn twin<I: 'static, O: 'static>(info: &ModelInfo<I, O>) -> Result<&'static T
     if m.kind == Kind::Bfpi {
         return Err(ModelError::Config(format!("{}: a combinational block has no traced twin", m.tag)));
     }
-    let m = Model { tag: format!("{}{TRACED_SUFFIX}", m.tag), ..m };
-    let (so, _) = build(&m, true)?;
-    let lib = open(&so)?;
-    let sym = |name: &str| symbol(lib, &so, &m.tag, name);
-    // SAFETY: csrc/trace.h's SEGSHADE_TRACE_SHIM defines these five with exactly these
-    // signatures, on the same structs as the model's (the description is the model's own).
-    let twin = unsafe {
-        TracedModel::from_symbols(
-            leak(&m.tag),
-            std::mem::transmute::<*const (), unsafe extern "C" fn(u64) -> *mut std::ffi::c_void>(sym("new")?),
-            std::mem::transmute::<*const (), unsafe extern "C" fn(*mut std::ffi::c_void)>(sym("free")?),
-            std::mem::transmute::<*const (), StepFn<I, O>>(sym("step")?),
-            std::mem::transmute::<*const (), unsafe extern "C" fn(*mut std::ffi::c_void, *const std::ffi::c_char, u64) -> std::ffi::c_int>(
-                sym("trace_open")?,
-            ),
-            std::mem::transmute::<*const (), unsafe extern "C" fn(*mut std::ffi::c_void) -> std::ffi::c_int>(sym("trace_close")?),
-        )
-    };
-    Ok(info.enter_twin(twin))
+    Ok(Model { tag: format!("{}{TRACED_SUFFIX}", m.tag), ..m })
 }
 
 /// For `--trace` and a failure's waveform: `info`'s traced twin built ([`twin`]), as a
