@@ -206,6 +206,30 @@ pub fn tri_writer(opts: &hdl_gen::Options) -> Result<&'static ModelInfo<TriIn, W
     model(&TRIWRITER_MODELS, opts, Kind::TriWriter)
 }
 
+/// `specular_unit` (or its AXI4-Stream wrapper) of `opts`; [`unit_of`] is then the golden unit
+/// of its table set and pipeline.
+pub fn specular(opts: &hdl_gen::Options) -> Result<&'static ModelInfo<SpecIn, SpecOut>, ModelError> {
+    let list = if opts.bus == hdl_gen::Bus::Axis { &AXIS_SPECULAR_MODELS } else { &SPECULAR_MODELS };
+    let info = model(list, opts, Kind::Specular)?;
+    if rtl_dir().is_none() {
+        units().lock().unwrap_or_else(|e| e.into_inner()).entry(info.identity()).or_insert_with(|| opts.specular_unit());
+    }
+    Ok(info)
+}
+
+/// The golden units of the specular models [`specular`] handed out, by circuit.
+fn units() -> &'static std::sync::Mutex<std::collections::HashMap<u64, SpecularUnit>> {
+    static UNITS: OnceLock<std::sync::Mutex<std::collections::HashMap<u64, SpecularUnit>>> = OnceLock::new();
+    UNITS.get_or_init(Default::default)
+}
+
+/// The golden unit the specular model `info` is checked against: that of the options
+/// [`specular`] built it for, else the run's table set ([`specular_unit`]).
+pub fn unit_of(info: &ModelInfo<SpecIn, SpecOut>) -> SpecularUnit {
+    let known = units().lock().unwrap_or_else(|e| e.into_inner()).get(&info.identity()).cloned();
+    known.unwrap_or_else(specular_unit)
+}
+
 /// The golden specular unit the specular model is checked against: the plan of the run's table
 /// set (the default, or the COSIM_RTL_DIR folder's manifest's, which the folder's description
 /// checked golden rebuilds), built once, not `SpecularUnit::default()`, which is right only for

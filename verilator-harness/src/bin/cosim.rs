@@ -5,7 +5,7 @@
 use clap::{Parser, ValueEnum};
 use golden::rng::SeedRng;
 use golden::setup::Screen;
-use golden::Align;
+use hdl_gen::cli::ModelArgs;
 use rand::SeedableRng;
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -13,7 +13,7 @@ use std::time::Instant;
 use verilator_harness::ffi::ModelInfo;
 use verilator_harness::frontend::{random_triangles, run_chain_at};
 use verilator_harness::ondemand;
-use verilator_harness::registry::{specular_unit, SPECULAR_MODELS};
+use verilator_harness::registry::unit_of;
 use verilator_harness::segment::{Report, SegmentCosim, Traffic};
 use verilator_harness::specular::{random_span, SpecularCosim};
 use verilator_harness::stimulus::random_triangle;
@@ -49,12 +49,10 @@ impl TrafficArg {
 #[derive(Parser)]
 #[command(about = "Co-simulate the generated segment shader against the golden model", allow_negative_numbers = true)]
 struct Args {
-    /// Segment width of the model to run.
-    #[arg(long, default_value_t = 8)]
-    p: u32,
-    /// Segmentation of the model to run.
-    #[arg(long, value_enum, default_value_t = Align::Span)]
-    align: Align,
+    // The model to run: any configuration `generate` accepts, by the same flags (the compiled
+    // catalogue's model when it has it, else built the first time, then cached).
+    #[command(flatten)]
+    model: ModelArgs,
     /// Random triangles to stream.
     #[arg(long, default_value_t = 10_000)]
     triangles: usize,
@@ -130,11 +128,11 @@ fn main() -> ExitCode {
     if args.frontend == Frontend::Rtl {
         return rtl_frontend(&args);
     }
-    let align = args.align;
     // The compiled catalogue's model, or one built (once, then cached) for this configuration.
-    let info = match ondemand::options(args.p, align, None).and_then(|o| verilator_harness::registry::segment(&o)) {
-        Ok(info) => info,
-        Err(e) => return ondemand::exit(&format!("--p {} --align {align}", args.p), &e),
+    let info = match options(&args, None).map(|o| verilator_harness::registry::segment(&o)) {
+        Err(code) => return code,
+        Ok(Ok(info)) => info,
+        Ok(Err(e)) => return ondemand::exit(&model_flags(&args), &e),
     };
     let screen = Screen { width: args.width, height: args.height };
     if let Err(e) = screen.check_for(&info.cfg) {
@@ -189,12 +187,12 @@ fn finish(seed: u64, report: &Report, triangles: &str, spans: Option<u64>, speed
 
 /// Random triangles of every kind into `tri_shader_p<P>`; every segment, `y` and frame checked.
 fn rtl_frontend(args: &Args) -> ExitCode {
-    let align = args.align;
     // The chain on the screen asked for: the catalogue's, or built for it.
     let screen = Screen { width: args.width, height: args.height };
-    let info = match ondemand::options(args.p, align, Some(screen)).and_then(|o| verilator_harness::registry::tri_shader(&o)) {
-        Ok(info) => info,
-        Err(e) => return ondemand::exit(&format!("--frontend rtl --p {} --align {align}", args.p), &e),
+    let info = match options(args, Some(screen)).map(|o| verilator_harness::registry::tri_shader(&o)) {
+        Err(code) => return code,
+        Ok(Ok(info)) => info,
+        Ok(Err(e)) => return ondemand::exit(&format!("--frontend rtl {}", model_flags(args)), &e),
     };
     if (args.width, args.height) != (info.screen.width, info.screen.height) {
         eprintln!("error: --width/--height: the front-end model draws on {}x{}", info.screen.width, info.screen.height);
@@ -238,10 +236,24 @@ fn exit_code(report: &Report) -> ExitCode {
     }
 }
 
+/// The options of the model to run (`screen`: a front-end's), or exit status 2 with the reason.
+fn options(args: &Args, screen: Option<Screen>) -> Result<hdl_gen::Options, ExitCode> {
+    args.model.options(screen).map_err(|e| {
+        eprintln!("error: {e}");
+        ExitCode::from(2)
+    })
+}
+
+/// `--p P --align A`: how a model's error names the configuration.
+fn model_flags(args: &Args) -> String {
+    format!("--p {} --align {}", args.model.seg.p, args.model.seg.align)
+}
+
 fn specular(args: &Args) -> ExitCode {
-    let Some(info) = SPECULAR_MODELS.first() else {
-        eprintln!("error: --specular: this build has no specular unit");
-        return ExitCode::from(2);
+    let info = match options(args, None).map(|o| verilator_harness::registry::specular(&o)) {
+        Err(code) => return code,
+        Ok(Ok(info)) => info,
+        Ok(Err(e)) => return ondemand::exit("--specular", &e),
     };
     if let Err(code) = start_trace(args, info) {
         return code;
@@ -250,7 +262,7 @@ fn specular(args: &Args) -> ExitCode {
     let traffic = args.traffic.traffic();
     println!("model {} ({}), seed {seed}, traffic {}", info.tag, info.top, args.traffic.name());
     let mut rng = SeedRng::seed_from_u64(seed);
-    let mut sim = SpecularCosim::new(info, specular_unit(), seed, traffic);
+    let mut sim = SpecularCosim::new(info, unit_of(info), seed, traffic);
     let mut report = Report::default();
     let start = Instant::now();
     while report.pixels < args.pixels {
