@@ -155,7 +155,10 @@ fn model<I: 'static, O: 'static>(
     if let Some(dir) = rtl_dir() {
         let (p, align) = (opts.cfg.p, opts.cfg.align);
         let models = list.get()?;
-        return models.iter().find(|m| (m.cfg.p, m.cfg.align) == (p, align)).ok_or_else(|| {
+        // A block whose circuit P and the alignment do not change may be the catalogue's model
+        // of another P (the folder's circuit is the same): any of the folder's will do.
+        let any = matches!(kind, Kind::Specular | Kind::Frontend);
+        return models.iter().find(|m| any || (m.cfg.p, m.cfg.align) == (p, align)).ok_or_else(|| {
             let built: Vec<&str> = models.iter().map(|m| m.tag).collect();
             ModelError::Config(format!(
                 "--p {p} --align {align}: COSIM_RTL_DIR={} has no such {kind:?} model (it has: {})",

@@ -216,14 +216,6 @@ fn main() -> ExitCode {
     let golden_path = sibling(&args.out, ".golden.png");
     let diff_path = sibling(&args.out, ".diff.png");
 
-    // A scene's or mesh's highlight: the specular unit of the same options.
-    let spec = match args.scene.is_some() || args.obj.is_some() {
-        false => None,
-        true => match verilator_harness::registry::specular(&opts) {
-            Ok(info) => Some(info),
-            Err(e) => return ondemand::exit("--scene/--obj: the specular unit", &e),
-        },
-    };
     let job = match (&args.scene, &args.triangles, &args.obj) {
         (Some(kind), _, _) => scene_job(*kind, args.shininess, &info.cfg, &screen).map_err(|e| format!("--scene {}: {e}", kind.name())),
         (None, Some(file), _) => {
@@ -237,6 +229,14 @@ fn main() -> ExitCode {
     let job = match job {
         Ok(j) => j,
         Err(e) => return fail(e),
+    };
+    // A scene's or mesh's highlight: the specular unit of the same options.
+    let spec = match args.scene.is_some() || args.obj.is_some() {
+        false => None,
+        true => match verilator_harness::registry::specular(&opts) {
+            Ok(info) => Some(info),
+            Err(e) => return ondemand::exit("--scene/--obj: the specular unit", &e),
+        },
     };
     if let Some(trace) = &args.trace {
         // The models this run builds instances of must have traced twins.

@@ -159,16 +159,22 @@ impl Cell {
     }
 }
 
+/// What is refused before anything runs: a COSIM_RTL_DIR that describes no models, options
+/// `generate` refuses (whichever models the run has), and a bad --out (now, not after the
+/// sweep's minutes).
+fn refused(args: &Args) -> Result<(), String> {
+    verilator_harness::registry::check_folder().map_err(|e| e.to_string())?;
+    args.variant.options(8, Align::Span, None).map_err(|e| e.to_string())?;
+    match args.out.as_deref().map(hdl_gen::output::check_writable) {
+        Some(Err(e)) => Err(format!("--out: {e}")),
+        _ => Ok(()),
+    }
+}
+
 fn main() -> ExitCode {
     let args = Args::parse();
-    // A COSIM_RTL_DIR that describes no models is a usage error, said before anything runs.
-    if let Err(e) = verilator_harness::registry::check_folder() {
+    if let Err(e) = refused(&args) {
         eprintln!("error: {e}");
-        return ExitCode::from(2);
-    }
-    // A bad --out is refused now, not after the sweep's minutes.
-    if let Some(Err(e)) = args.out.as_deref().map(hdl_gen::output::check_writable) {
-        eprintln!("error: --out: {e}");
         return ExitCode::from(2);
     }
     let start = Instant::now();
