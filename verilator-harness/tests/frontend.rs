@@ -162,7 +162,6 @@ fn set_up_costs(m: &'static verilator_harness::ffi::ModelInfo<verilator_harness:
 
 #[test]
 fn scenes_render_through_the_rtl_chain_as_golden() {
-    use golden::setup::Screen;
     use verilator_harness::render::{run_with, scene_job, Chain, SceneKind};
     let what = "render through the chain";
     let Some(chain) = require(TRISHADER_MODELS.iter().find(|m| m.cfg.p == 8 && m.cfg.align == golden::Align::Span), "tris_p8_span", what)
@@ -171,7 +170,8 @@ fn scenes_render_through_the_rtl_chain_as_golden() {
     };
     let Some(seg) = verilator_harness::registry::require_segment_model(8, golden::Align::Span, what) else { return };
     for kind in [SceneKind::Sphere, SceneKind::Torus] {
-        let job = scene_job(kind, 40, &seg.cfg, &Screen::default()).unwrap();
+        // On the chain's own screen (a COSIM_RTL_DIR folder's may be another than 640x480).
+        let job = scene_job(kind, 40, &seg.cfg, &chain.screen).unwrap();
         let o = run_with(&job, seg, Chain::Rtl(chain), None, |_| {});
         assert!(o.cosim_ok(), "{:?}", o.segment.iter().flat_map(|r| &r.mismatches).next());
         assert_eq!(o.differing_pixels(3), 0, "RTL image differs from golden's front-end image");

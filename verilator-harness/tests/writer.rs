@@ -229,7 +229,8 @@ fn scenes_render_into_memory_as_golden() {
         return;
     };
     for chain in [Chain::HostToMemory(wr), Chain::RtlToMemory(fb)] {
-        let job = scene_job(SceneKind::Torus, 40, &seg.cfg, &Screen::default()).unwrap();
+        // On the chain's own screen (a COSIM_RTL_DIR folder's may be another than 640x480).
+        let job = scene_job(SceneKind::Torus, 40, &seg.cfg, &fb.screen).unwrap();
         let o = run_with(&job, seg, chain, None, |_| {});
         let first = o.segment.iter().chain(&o.writer).flat_map(|r| &r.mismatches).next();
         assert!(o.cosim_ok(), "{first:?}");
