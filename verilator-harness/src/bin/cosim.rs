@@ -86,8 +86,8 @@ struct Args {
     pixels: u64,
     /// Write every clock of the run into FST files in DIR (`<model>-seed<seed>.fst`, one per model
     /// instance), for GTKWave or Surfer. For small runs: about 45 bytes per clock for
-    /// seg_p8_span, 27 for the specular unit, and a run 4 to 8 times slower (docs/regressions.md). Needs
-    /// traced models (built when COSIM_TRACE is set at build time).
+    /// seg_p8_span, 27 for the specular unit, and a run 4 to 8 times slower (docs/regressions.md). The
+    /// models' traced twins are built first, the first time (seconds each), then cached.
     #[arg(long, value_name = "DIR")]
     trace: Option<PathBuf>,
 }

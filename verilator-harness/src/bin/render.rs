@@ -71,8 +71,8 @@ struct Args {
     quiet: bool,
     /// Write every clock of every model instance into FST files in DIR (`<model>-seed<seed>.fst`),
     /// for GTKWave or Surfer. For small renders (try --width 64 --height 48): tens of bytes per
-    /// clock (45 for seg_p8_span, docs/regressions.md). Needs traced models (built when
-    /// COSIM_TRACE is set at build time).
+    /// clock (45 for seg_p8_span, docs/regressions.md). The models' traced twins are
+    /// built first, the first time (seconds each), then cached.
     #[arg(long, value_name = "DIR")]
     trace: Option<PathBuf>,
 }
