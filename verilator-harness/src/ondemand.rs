@@ -7,10 +7,13 @@
 //! being that of everything the build depends on: the RTL, the shim, csrc/shim.h, the compiler
 //! set-up and `verilator --version`. A second run finds them (a few milliseconds); a changed
 //! configuration, RTL or Verilator builds anew. A build happens in a temporary folder renamed
-//! into place at the end, so two processes building the same model at once (two tests under
-//! nextest) each finish, and one of the two identical folders stays; nothing half-built is ever
+//! into place at the end, under a lock file (`<entry>.lock`): processes that want the same model
+//! at once (tests under nextest) wait for the one building it, and nothing half-built is ever
 //! found under the final name. While a model builds, a spinner on stderr says so (a plain line
 //! when stderr is not a terminal: a log shows why a run took seconds longer).
+//!
+//! The same builder makes a `COSIM_RTL_DIR` folder's models (`crate::registry`) and every traced
+//! twin (COSIM_TRACE, `--trace`: [`twin`]), the first time a run needs one.
 //!
 //! `SEGSHADE_MODEL_CACHE=DIR` puts the cache elsewhere.
 
