@@ -222,7 +222,13 @@ fn build(m: &Model, traced: bool) -> Result<(PathBuf, Outcome), ModelError> {
     let tmp = temp_dir(&root, &m.tag)?;
     let (all, globals) = verilator::verilate(m, traced, &tmp.join("obj"), &tmp.join("rtl"), &dir.join("rtl"))?;
     let verilated = start.elapsed().as_secs_f64();
-    let runtime = pic_runtime(v, &root, &globals, traced)?;
+    // Verilator's runtime as every model has it, and for a twin the FST writer's files beside it
+    // in an archive of their own (as build.rs linked twins): the plain runtime is compiled once.
+    let (fst, plain): (Vec<String>, Vec<String>) = globals.into_iter().partition(|g| traced && g.contains("fst"));
+    let mut runtime = vec![pic_runtime(v, &root, &plain, false)?];
+    if !fst.is_empty() {
+        runtime.insert(0, pic_runtime(v, &root, &fst, true)?);
+    }
     let mut b = compiler(v, traced);
     b.include(tmp.join("obj")).include(Path::new(env!("CARGO_MANIFEST_DIR")).join("csrc"));
     let tool = b.try_get_compiler().map_err(|e| ModelError::Compile { tag: m.tag.clone(), dir: tmp.clone(), log: e.to_string() })?;
@@ -234,7 +240,7 @@ fn build(m: &Model, traced: bool) -> Result<(PathBuf, Outcome), ModelError> {
         .arg("-o")
         .arg(tmp.join(&name))
         .arg(&all)
-        .arg(&runtime)
+        .args(&runtime)
         .args(["-Wl,-Bsymbolic", "-Wl,--exclude-libs,ALL", "-lpthread", "-latomic"])
         // The FST writer compresses its hierarchy with zlib.
         .args(traced.then_some("-lz"))
