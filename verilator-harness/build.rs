@@ -1,19 +1,15 @@
-//! Compiles the catalogue of models the test suites use into the crate: generate the Verilog
-//! (or take it from COSIM_RTL_DIR), verilate it, compile each model at -O2 and link it
-//! statically. Any other configuration is built when it is first asked for, at run time
-//! (`verilator_harness::ondemand`). Both describe, verilate and compile a model in one way, the
+//! Compiles the catalogue of models the test suites use into the crate: generate the Verilog,
+//! verilate it, compile each model at -O2 and link it statically. Any other configuration, a
+//! `COSIM_RTL_DIR` folder's models and every traced twin (COSIM_TRACE, `--trace`) are built when
+//! first asked for, at run time (`verilator_harness::ondemand`, `verilator_harness::registry`):
+//! nothing here reads the environment the runs are configured by, so checking a folder or
+//! tracing recompiles nothing. Both describe, verilate and compile a model in one way, the
 //! module tree in `build/` (which the library includes too): here only the linking and the Rust
 //! tables (`build/codegen.rs`) are build.rs's own.
 //!
 //! A model whose inputs (RTL, shim, Verilator version) are unchanged since the last build is
 //! neither re-verilated nor recompiled. Models are built on as many threads as cargo gives jobs,
 //! and each records its build time in `OUT_DIR/obj/<tag>/build.time` (read by the `bench` binary).
-//!
-//! Traced twins (`verilator --trace-fst`, symbols `<tag>_tr_*`, see `csrc/trace.h` and
-//! `verilator_harness::waveform`): with COSIM_TRACE set, every streaming model gets one; without
-//! it, only [`ALWAYS_TRACED`], so the suite's waveform test has one to run. The untraced models
-//! are built exactly as without twins (same flags, same keys): twins are models of their own,
-//! with a runtime of their own for the FST writer (`libverilated_fst_rt.a`, linked with zlib).
 
 // The library uses the rest of the tree (models built at run time).
 #[allow(dead_code)]
@@ -24,26 +20,18 @@ mod models;
 mod codegen;
 
 use models::catalogue::{self, SpecTables};
-use models::model::TRACED_SUFFIX;
-use models::verilator::{self, cc_build, Classes, Link, Verilator, TRACE_LAYOUT};
+use models::verilator::{self, cc_build, Classes, Link, Verilator};
 use models::{Kind, Model};
 use std::fs;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
-
-/// The model that has a traced twin in every default build (no COSIM_RTL_DIR): a small one, cheap
-/// to compile, for the suite's waveform test.
-const ALWAYS_TRACED: &str = "seg_p2_span";
 
 fn main() {
     println!("cargo:rerun-if-changed=build.rs");
     println!("cargo:rerun-if-changed=build");
     println!("cargo:rerun-if-changed=csrc/shim.h");
     println!("cargo:rerun-if-changed=csrc/trace.h");
-    println!("cargo:rerun-if-env-changed=COSIM_RTL_DIR");
     println!("cargo:rerun-if-env-changed=SEGSHADE_ALL_CHAINS");
-    // Only whether it is set matters here (its folder is read at run time).
-    println!("cargo:rerun-if-env-changed=COSIM_TRACE");
     let out = PathBuf::from(std::env::var("OUT_DIR").unwrap());
     // OUT_DIR is <target>/<profile>/build/<package>-<hash>/out: the cache is one folder per
     // profile, shared by every OUT_DIR of the profile (`cargo clippy` and `cargo test` run this
@@ -52,59 +40,24 @@ fn main() {
     let root = out.ancestors().nth(3).map_or_else(|| out.join("cache"), |p| p.join("segshade-models"));
     println!("cargo:rustc-env=SEGSHADE_MODEL_CACHE={}", root.display());
     println!("cargo:rustc-env=SEGSHADE_TARGET={}", std::env::var("TARGET").unwrap());
-    let package = Path::new(env!("CARGO_MANIFEST_DIR"));
-    let rtl_dir = std::env::var_os("COSIM_RTL_DIR").map(|d| {
-        let dir = catalogue::resolve_rtl_dir(Path::new(&d), package, package);
-        dir.canonicalize().unwrap_or_else(|e| panic!("COSIM_RTL_DIR={}: {e}", dir.display()))
-    });
-    let manifest = rtl_dir.as_deref().map(|dir| {
-        println!("cargo:rerun-if-changed={}", dir.display());
-        (dir, catalogue::read_manifest(dir))
-    });
-    let models = match &manifest {
-        Some((dir, m)) => catalogue::models_from_dir(dir, m).unwrap_or_else(|e| panic!("COSIM_RTL_DIR={}: {e}", dir.display())),
-        None => catalogue::generated_models(),
-    };
-    let trace_all = std::env::var_os("COSIM_TRACE").is_some();
-    let twins: Vec<Model> = models
-        .iter()
-        .filter(|m| m.kind != Kind::Bfpi && (trace_all || (rtl_dir.is_none() && m.tag == ALWAYS_TRACED)))
-        .map(|m| Model { tag: format!("{}{TRACED_SUFFIX}", m.tag), ..m.clone() })
-        .collect();
+    let models = catalogue::generated_models();
     let verilator = Verilator::find().unwrap_or_else(|e| panic!("\n\n{e}\n\n"));
-    let jobs: Vec<(&Model, bool)> = models.iter().map(|m| (m, false)).chain(twins.iter().map(|m| (m, true))).collect();
-    let globals = build_models(&verilator, &out, &root, &jobs);
-    let plain: Vec<String> = union(globals.iter().filter(|(traced, _)| !traced).map(|(_, g)| g));
-    build_runtime(&verilator, &out, &root, Runtime::PLAIN, &plain);
-    // The twins' runtime files beyond the plain models' (the FST writer), with their defines.
-    let fst: Vec<String> = union(globals.iter().filter(|(traced, _)| *traced).map(|(_, g)| g));
-    let fst: Vec<String> = fst.into_iter().filter(|g| !plain.contains(g)).collect();
-    if !twins.is_empty() {
-        build_runtime(&verilator, &out, &root, Runtime::FST, &fst);
-    }
+    let globals = build_models(&verilator, &out, &root, &models);
+    build_runtime(&verilator, &out, &root, &union(globals.iter()));
     println!("cargo:rustc-link-search=native={}", out.display());
-    for m in models.iter().chain(&twins) {
+    for m in &models {
         println!("cargo:rustc-link-lib=static={}", m.tag);
     }
-    if !twins.is_empty() {
-        println!("cargo:rustc-link-lib=static={}", Runtime::FST.lib);
-    }
-    println!("cargo:rustc-link-lib=static={}", Runtime::PLAIN.lib);
+    println!("cargo:rustc-link-lib=static={RUNTIME_LIB}");
     println!("cargo:rustc-link-lib=stdc++");
-    if !twins.is_empty() {
-        // The FST writer compresses its hierarchy with zlib.
-        println!("cargo:rustc-link-lib=z");
-    }
     println!("cargo:rustc-link-lib=pthread");
     println!("cargo:rustc-link-lib=atomic");
-    let tables = match &manifest {
-        Some((dir, m)) => catalogue::tables_from_dir(dir, m),
-        None => SpecTables::of(hdl_gen::Options::default().specular_unit().plan(), None),
-    };
-    fs::write(out.join("models.rs"), codegen::models_rs(&models, &twins, trace_all, rtl_dir.as_deref(), &tables)).unwrap();
+    let tables = SpecTables::of(hdl_gen::Options::default().specular_unit().plan(), None);
+    fs::write(out.join("models.rs"), codegen::models_rs(&models, &tables)).unwrap();
     // The segment suite's random test is one test per (model, soak slice), so that nextest can
     // deal a configuration's soak out to several machines (`verilator_harness::soak`): its list
-    // of models is this build's, written where verilator-harness/tests/segment.rs includes it.
+    // of models is the catalogue's, written where verilator-harness/tests/segment.rs includes it
+    // (a COSIM_RTL_DIR folder's other shaders run in one test of their own there).
     let seg: Vec<&str> = models.iter().filter(|m| m.kind == Kind::Segment && m.axis.is_none()).map(|m| m.tag.as_str()).collect();
     fs::write(out.join("segment_slices.rs"), format!("random_triangle_slices!({});\n", seg.join(", "))).unwrap();
 }
@@ -120,33 +73,32 @@ fn union<'a>(lists: impl Iterator<Item = &'a Vec<String>>) -> Vec<String> {
     all
 }
 
-/// Builds every model, (model, traced twin or not), as many at once as cargo allows jobs (each
-/// model is one verilator run and one compiler run). Returns, for each, whether it is traced and
-/// the runtime files its makefile asks for.
-fn build_models(v: &Verilator, out: &Path, root: &Path, models: &[(&Model, bool)]) -> Vec<(bool, Vec<String>)> {
+/// Builds every model, as many at once as cargo allows jobs (each model is one verilator run and
+/// one compiler run). Returns, for each, the runtime files its makefile asks for.
+fn build_models(v: &Verilator, out: &Path, root: &Path, models: &[Model]) -> Vec<Vec<String>> {
     let jobs = std::env::var("NUM_JOBS").ok().and_then(|j| j.parse().ok()).unwrap_or(1usize).clamp(1, models.len().max(1));
     let next = std::sync::atomic::AtomicUsize::new(0);
-    let globals = std::sync::Mutex::new(vec![(false, Vec::new()); models.len()]);
+    let globals = std::sync::Mutex::new(vec![Vec::new(); models.len()]);
     std::thread::scope(|s| {
         for _ in 0..jobs {
             s.spawn(|| loop {
                 let k = next.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-                let Some(&(m, traced)) = models.get(k) else { break };
-                let g = build_model(v, out, root, m, traced);
-                globals.lock().unwrap()[k] = (traced, g);
+                let Some(m) = models.get(k) else { break };
+                let g = build_model(v, out, root, m);
+                globals.lock().unwrap()[k] = g;
             });
         }
     });
     globals.into_inner().unwrap()
 }
 
-/// Verilates and compiles one model (`traced`: a traced twin) into a static library unless its
+/// Verilates and compiles one model into a static library unless its
 /// key (everything the result depends on) is the one recorded by the last build. Returns the
 /// runtime files its makefile asks for. (Two cargo processes building the same new key at the
 /// same moment would race; scripts/test runs them one after the other.)
-fn build_model(v: &Verilator, out: &Path, root: &Path, m: &Model, traced: bool) -> Vec<String> {
+fn build_model(v: &Verilator, out: &Path, root: &Path, m: &Model) -> Vec<String> {
     let class = format!("V{}", m.tag);
-    let key = verilator::key(v, m, traced, Link::Static);
+    let key = verilator::key(v, m, false, Link::Static);
     let cache = verilator::cache_dir(root, &m.tag, &key);
     let (obj, rtl) = (cache.join("obj"), cache.join("rtl"));
     let key_file = obj.join("build.key");
@@ -157,9 +109,9 @@ fn build_model(v: &Verilator, out: &Path, root: &Path, m: &Model, traced: bool) 
         let start = Instant::now();
         let _ = fs::remove_dir_all(&obj);
         let _ = fs::remove_dir_all(&rtl);
-        let (all, _) = verilator::verilate(m, traced, &obj, &rtl, &rtl).unwrap_or_else(|e| panic!("{e}"));
+        let (all, _) = verilator::verilate(m, false, &obj, &rtl, &rtl).unwrap_or_else(|e| panic!("{e}"));
         let verilated = start.elapsed().as_secs_f64();
-        let mut b = cc_build(v, traced, Link::Static);
+        let mut b = cc_build(v, false, Link::Static);
         b.include(&obj).include(Path::new(env!("CARGO_MANIFEST_DIR")).join("csrc")).out_dir(&obj).file(&all);
         b.compile(&m.tag);
         let total = start.elapsed().as_secs_f64();
@@ -180,49 +132,29 @@ fn build_model(v: &Verilator, out: &Path, root: &Path, m: &Model, traced: bool) 
     mk.global
 }
 
-/// One of Verilator's runtime libraries.
-struct Runtime {
-    /// Its cache folder's tag (`cache_dir`).
-    tag: &'static str,
-    /// The static library's name.
-    lib: &'static str,
-    traced: bool,
-}
+/// Verilator's runtime library (`verilated.cpp`, `verilated_threads.cpp`, as the makefiles list
+/// them), compiled once for every model.
+const RUNTIME_LIB: &str = "verilated_rt";
 
-impl Runtime {
-    /// Verilator's runtime (`verilated.cpp`, `verilated_threads.cpp`, as the makefile lists them),
-    /// compiled once for every model.
-    const PLAIN: Runtime = Runtime { tag: "runtime", lib: "verilated_rt", traced: false };
-    /// What traced twins need beyond it: the FST writer (`verilated_fst_c.cpp`, which includes
-    /// GTKWave's `fstapi.c` and its compressors).
-    const FST: Runtime = Runtime { tag: "fst-runtime", lib: "verilated_fst_rt", traced: true };
-}
-
-/// Compiles `globals`, runtime files the models' makefiles ask for, into `rt`'s library, once for
-/// every model.
-fn build_runtime(v: &Verilator, out: &Path, root: &Path, rt: Runtime, globals: &[String]) {
-    let mut key = format!("{}\n{}\n{}\n", v.version, Link::Static.layout(), globals.join(" "));
-    if rt.traced {
-        key.push_str(TRACE_LAYOUT);
-    }
-    let obj = verilator::cache_dir(root, rt.tag, &key);
-    let lib = obj.join(format!("lib{}.a", rt.lib));
-    let linked = out.join(format!("lib{}.a", rt.lib));
+/// Compiles `globals`, runtime files the models' makefiles ask for, into [`RUNTIME_LIB`], once
+/// for every model.
+fn build_runtime(v: &Verilator, out: &Path, root: &Path, globals: &[String]) {
+    let key = format!("{}\n{}\n{}\n", v.version, Link::Static.layout(), globals.join(" "));
+    let obj = verilator::cache_dir(root, "runtime", &key);
+    let lib = obj.join(format!("lib{RUNTIME_LIB}.a"));
+    let linked = out.join(format!("lib{RUNTIME_LIB}.a"));
     if fs::read_to_string(obj.join("build.key")).is_ok_and(|k| k == key) && lib.exists() {
         fs::copy(&lib, &linked).unwrap();
         return;
     }
     fs::create_dir_all(&obj).unwrap();
     let start = Instant::now();
-    let mut b = cc_build(v, rt.traced, Link::Static);
+    let mut b = cc_build(v, false, Link::Static);
     b.out_dir(&obj);
-    if rt.traced {
-        verilator::require_zlib(v, &obj).unwrap_or_else(|e| panic!("\n\n{e}\n\n"));
-    }
     for g in globals {
         b.file(v.root.join("include").join(format!("{g}.cpp")));
     }
-    b.compile(rt.lib);
+    b.compile(RUNTIME_LIB);
     fs::copy(&lib, &linked).unwrap();
     let secs = start.elapsed().as_secs_f64();
     fs::write(obj.join("build.time"), format!("compile {secs:.3}\ntotal {secs:.3}\n")).unwrap();

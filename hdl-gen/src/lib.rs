@@ -4,6 +4,7 @@
 pub mod axis;
 pub mod bfpi;
 pub mod board;
+pub mod cli;
 pub mod formal;
 pub mod frontend;
 pub mod manifest;

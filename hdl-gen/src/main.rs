@@ -1,13 +1,10 @@
 //! `hdl-gen`: the command line of the segshade generator.
 
 use anyhow::{bail, Context};
-use clap::builder::{StringValueParser, TypedValueParser};
-use clap::{Args, Parser, Subcommand};
-use golden::frontend::{DiMode, I0Form};
+use clap::{Parser, Subcommand};
 use golden::rom::RomFormat;
-use golden::specular::{parse_rel_error, BrdfK, SpecularPlan};
-use golden::{Align, Config};
-use hdl_gen::{check_prefix, generate, output, BfpiArch, Bus, Options};
+use hdl_gen::cli::{BrdfArgs, ConfigArgs, ModelArgs};
+use hdl_gen::{generate, output, Options};
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -29,13 +26,7 @@ enum Command {
     /// as it is.
     Generate {
         #[command(flatten)]
-        config: ConfigArgs,
-        /// Increments: shift-add (SPEC's BFPI), or the comparison forms naive (`*` by constants)
-        /// and tree (doubling tree in the shader, no BFPI) used by scripts/synth.
-        #[arg(long = "bfpi-arch", value_enum, default_value_t = BfpiArch::ShiftAdd)]
-        bfpi_arch: BfpiArch,
-        #[command(flatten)]
-        brdf: BrdfArgs,
+        model: ModelArgs,
         /// Screen width of the triangle front-end (tri_frontend, tri_shader_p<P>), at most 2^XW
         /// and 2^F pixels. Default: 640, or the widest the configuration allows when less.
         #[arg(long, value_parser = clap::value_parser!(u32).range(1..=65536))]
@@ -43,36 +34,6 @@ enum Command {
         /// Screen height of the triangle front-end (1..65536). Default: 480.
         #[arg(long, value_parser = clap::value_parser!(u32).range(1..=65536))]
         height: Option<u32>,
-        /// Quotient bits per clock of the front-end's set-up dividers: 1, 2 or 4. More bits,
-        /// fewer set-up clocks per triangle (tiny triangles go faster), longer paths. Default: 4.
-        #[arg(long = "fe-div-bits", value_parser = clap::builder::PossibleValuesParser::new(["1", "2", "4"]).map(|b| b.parse::<u32>().expect("a listed value")))]
-        fe_div_bits: Option<u32>,
-        /// Where the front-end's dI comes from: `triangle` (the constant-increment theorem, once
-        /// per triangle) or `scanline` (classical Gouraud, a division per span from the edge
-        /// intensities with the same divider: a comparison option, slower and larger).
-        #[arg(long = "fe-di", value_enum, default_value_t = DiMode::Triangle)]
-        fe_di: DiMode,
-        /// How the front-end forms each span's I0: `reciprocal` (three wide products a row in
-        /// the span path) or `incremental` (quotient and remainder over 2A stepped by adds per
-        /// source of the span's left end; the reciprocal only at a source's first covered row, on
-        /// one shared multiplier, the walker waiting meanwhile). Same spans bit for bit. The
-        /// default stays `reciprocal` until the incremental form measures better (docs/design.md,
-        /// issue 27). `incremental` takes `--fe-di triangle` only.
-        #[arg(long = "fe-i0", value_enum, default_value_t = I0Form::Reciprocal)]
-        fe_i0: I0Form,
-        /// Register stages added for clock rate, 0..3 (golden::pipeline): 1 registers the span and
-        /// the shader's increments, splits the specular unit's multiplies, and stages the
-        /// front-end (CALC in five clocks, its span path in six), 2 also the shader's lane sums, 3 cuts the shader's adders
-        /// so no clock has two in a row (same stages as 2). Values and throughput are the same at every
-        /// level; latency grows (manifest.json). 0, the default: SPEC's seed structure, smallest
-        /// and shortest (docs/fpga.md compares the levels).
-        #[arg(long, default_value_t = 0, value_parser = clap::value_parser!(u32).range(0..=golden::pipeline::Pipeline::MAX as i64))]
-        pipeline: u32,
-        /// Stream interfaces: `native` (SPEC's ports only) or `axis`, which also writes an
-        /// AXI4-Stream wrapper `<module>_axis` of the segment shader, the front-end, its chain
-        /// and the specular unit, with Vivado interface attributes (docs/axis.md).
-        #[arg(long, value_enum, default_value_t = Bus::Native)]
-        bus: Bus,
         /// Output folder (created if missing; see above for one that exists).
         #[arg(long)]
         out: PathBuf,
@@ -155,62 +116,6 @@ enum Report {
     },
 }
 
-/// The configuration and module prefix, shared by `generate` and `testbench`.
-#[derive(Args)]
-struct ConfigArgs {
-    /// Segment width: pixels per clock, a power of two in 1..256.
-    #[arg(long, default_value_t = golden::format::DEFAULT_P,
-          value_parser = clap::value_parser!(u32).try_map(|p| golden::format::check_p(p).map(|()| p)))]
-    p: u32,
-    /// Fraction bits F of the intensity format UQ8.F (4..20).
-    #[arg(long = "frac", default_value_t = golden::format::DEFAULT_FRAC, value_parser = clap::value_parser!(u32).range(4..=20))]
-    frac: u32,
-    /// Screen-x bits XW (4..16).
-    #[arg(long = "xbits", default_value_t = golden::format::DEFAULT_XBITS, value_parser = clap::value_parser!(u32).range(4..=16))]
-    xbits: u32,
-    /// Segmentation: span (the seed's) or screen (segments on multiples of P).
-    #[arg(long, value_enum, default_value_t = Align::Span)]
-    align: Align,
-    /// String prepended to every module name.
-    #[arg(long, default_value = "", value_parser = StringValueParser::new().try_map(|s| check_prefix(&s).map(|()| s)))]
-    prefix: String,
-}
-
-impl ConfigArgs {
-    /// Options for this configuration with the table set `brdf`; the rest default.
-    fn options(self, brdf: &BrdfArgs) -> anyhow::Result<Options> {
-        let cfg = Config::new(self.p, self.frac, self.xbits, self.align)?;
-        Ok(Options { cfg, prefix: self.prefix, brdf: brdf.plan()?, ..Options::default() })
-    }
-}
-
-/// The specular unit's table set, shared by every command that builds the unit.
-#[derive(Args)]
-struct BrdfArgs {
-    /// BRDF table set: a list of k (ascending, 1..64; each n then takes its least-error table),
-    /// or `auto` to choose the set with the least ROM that meets --max-rel-error.
-    /// Default: the patent's 1,2,4,16 with its n ranges.
-    #[arg(long = "brdf-k")]
-    brdf_k: Option<BrdfK>,
-    /// With `--brdf-k auto`: largest relative error of the approximation inside the epicentre,
-    /// as a fraction (0.01) or a percentage (1%).
-    #[arg(long = "max-rel-error", value_parser = parse_rel_error, requires = "brdf_k")]
-    max_rel_error: Option<f64>,
-}
-
-impl BrdfArgs {
-    /// The plan, or `None` for the patent's own (the default).
-    fn plan(&self) -> anyhow::Result<Option<SpecularPlan>> {
-        let choice = match (&self.brdf_k, self.max_rel_error) {
-            (None, _) => return Ok(None),
-            (Some(BrdfK::Auto { .. }), Some(e)) => BrdfK::Auto { max_err: e },
-            (Some(BrdfK::List(_)), Some(_)) => bail!("--max-rel-error goes with --brdf-k auto"),
-            (Some(b), None) => b.clone(),
-        };
-        SpecularPlan::from_brdf_k(&choice).map(Some).with_context(|| format!("--brdf-k {choice}"))
-    }
-}
-
 /// The command line, every subcommand reading a negative number as a value (which its flag's
 /// range then rejects by name) rather than as an unknown flag.
 fn parse_cli() -> Cli {
@@ -272,21 +177,10 @@ fn owned_files(dir: &std::path::Path) -> Vec<String> {
 
 fn run(command: Command) -> anyhow::Result<()> {
     match command {
-        Command::Generate { config, bfpi_arch, brdf, width, height, fe_div_bits, fe_di, fe_i0, pipeline, bus, out } => {
-            let opts = config.options(&brdf)?;
-            let default = Options::default_screen(&opts.cfg);
+        Command::Generate { model, width, height, out } => {
+            let default = Options::default_screen(&model.options(None)?.cfg);
             let screen = golden::setup::Screen { width: width.unwrap_or(default.width), height: height.unwrap_or(default.height) };
-            let pipeline = golden::pipeline::Pipeline::new(pipeline).expect("clap checked the range");
-            if pipeline.span_stage() && bfpi_arch == BfpiArch::Tree {
-                bail!(hdl_gen::segment::TREE_UNPIPELINED);
-            }
-            if fe_i0 == I0Form::Incremental && fe_di == DiMode::Scanline {
-                bail!(
-                    "--fe-i0 incremental takes --fe-di triangle: the per-scanline dI needs the reciprocal's I0 at every span's last pixel"
-                );
-            }
-            let opts = Options { bfpi_arch, screen: Some(screen), fe_div_bits, fe_di, fe_i0, pipeline, bus, ..opts };
-            opts.frontend().context("--width/--height")?;
+            let opts = model.options(Some(screen))?;
             output::write_owned(&out, &generate(&opts), &owned_files(&out))?;
             eprintln!("wrote {}", out.display());
         }

@@ -60,12 +60,12 @@ pub fn resolve_rtl_dir(dir: &Path, cwd: &Path, package: &Path) -> std::path::Pat
     }
 }
 
-/// `DIR/manifest.json`, read as the generator's own schema (`hdl_gen::manifest::Manifest`), or
-/// the build stops saying why.
-pub fn read_manifest(dir: &Path) -> Manifest {
+/// `DIR/manifest.json`, read as the generator's own schema (`hdl_gen::manifest::Manifest`); the
+/// error says why not, in one line.
+pub fn read_manifest(dir: &Path) -> Result<Manifest, String> {
     let path = dir.join(MANIFEST_FILE);
-    let text = fs::read_to_string(&path).unwrap_or_else(|e| panic!("COSIM_RTL_DIR={}: cannot read {MANIFEST_FILE}: {e}", dir.display()));
-    Manifest::parse(&text).unwrap_or_else(|e| panic!("COSIM_RTL_DIR={}: {e}", dir.display()))
+    let text = fs::read_to_string(&path).map_err(|e| format!("cannot read {MANIFEST_FILE}: {e}"))?;
+    Manifest::parse(&text).map_err(|e| e.to_string())
 }
 
 /// The table set of COSIM_RTL_DIR's manifest (its `specular` section, golden's typed
@@ -73,14 +73,14 @@ pub fn read_manifest(dir: &Path) -> Manifest {
 /// widths, and the pipeline of `parameters.pipeline`), so the checkers compare the RTL with the
 /// unit it was generated as. The default set when the folder has no specular unit (no checker
 /// then uses it).
-pub fn tables_from_dir(dir: &Path, m: &Manifest) -> SpecTables {
-    let fail = |what: String| -> ! { panic!("COSIM_RTL_DIR={}: {MANIFEST_FILE}: specular: {what}", dir.display()) };
+pub fn tables_from_dir(m: &Manifest) -> Result<SpecTables, String> {
+    let fail = |what: String| format!("{MANIFEST_FILE}: specular: {what}");
     if m.by_role(Role::SpecularUnit).is_none() {
-        return SpecTables::of(&SpecularPlan::patent(), None);
+        return Ok(SpecTables::of(&SpecularPlan::patent(), None));
     }
     let stated = &m.specular.geometry;
     let decoder =
-        Decoder::try_from(DecoderRepr { ks: stated.ks.clone(), ranges: stated.k_ranges.clone() }).unwrap_or_else(|e| fail(e.to_string()));
+        Decoder::try_from(DecoderRepr { ks: stated.ks.clone(), ranges: stated.k_ranges.clone() }).map_err(|e| fail(e.to_string()))?;
     // hdl-gen builds with the builder's word width, or for some `auto` sets the search's.
     let mut last = String::new();
     for w in [None, Some(stated.brdf_word_bits)] {
@@ -89,20 +89,20 @@ pub fn tables_from_dir(dir: &Path, m: &Manifest) -> SpecTables {
                 let plan = plan.with_pipeline(m.parameters.pipeline);
                 let mut built = plan.geometry();
                 // f64::powi rounds differently at different opt-levels (hdl-gen's against this
-                // build script's): the approximation error may differ in its last digits.
+                // crate's): the approximation error may differ in its last digits.
                 let (a, b) = (built.approx_error.0, stated.approx_error.0);
                 if (a - b).abs() <= 1e-9 * a.abs().max(b.abs()) {
                     built.approx_error.0 = b;
                 }
                 if built == *stated {
-                    return SpecTables::of(&plan, w);
+                    return Ok(SpecTables::of(&plan, w));
                 }
                 last = format!("with word_bits {w:?}, {}", geometry_diff(stated, &built));
             }
             Err(e) => last = e.to_string(),
         }
     }
-    fail(format!("golden's plan for k = {:?} and these k_ranges is not the one the manifest states: {last}", stated.ks))
+    Err(fail(format!("golden's plan for k = {:?} and these k_ranges is not the one the manifest states: {last}", stated.ks)))
 }
 
 /// The fields of two geometries that differ, as `field: manifest X, golden Y`.
@@ -125,7 +125,7 @@ fn geometry_diff(stated: &SpecularGeometry, built: &SpecularGeometry) -> String 
 /// its own tag. Its order is the lists' order in `ffi`.
 pub fn generated_models() -> Vec<Model> {
     let mut described: std::collections::HashMap<String, Vec<Model>> = std::collections::HashMap::new();
-    entries()
+    entries(std::env::var_os("SEGSHADE_ALL_CHAINS").is_some())
         .into_iter()
         .map(|(tag, kind, opts)| {
             // One generation per configuration: many entries share one.
@@ -139,10 +139,10 @@ pub fn generated_models() -> Vec<Model> {
         .collect()
 }
 
-/// The catalogue's entries: (tag, kind, configuration).
-fn entries() -> Vec<(String, Kind, hdl_gen::Options)> {
+/// The catalogue's entries: (tag, kind, configuration); `all_chains`: as SEGSHADE_ALL_CHAINS
+/// builds it (a superset: the same tags for the same configurations, and more).
+pub fn entries(all_chains: bool) -> Vec<(String, Kind, hdl_gen::Options)> {
     use hdl_gen::Options;
-    let all_chains = std::env::var_os("SEGSHADE_ALL_CHAINS").is_some();
     let mut e: Vec<(String, Kind, Options)> = Vec::new();
     // The specular unit as SPEC's seed builds it, then split for clock rate (`--pipeline 1`;
     // level 2 adds nothing to the unit).
@@ -206,6 +206,14 @@ fn entries() -> Vec<(String, Kind, hdl_gen::Options)> {
     e.push(("seg_p8_span_axis".into(), Kind::Segment, axis.clone()));
     e.push(("spec_axis".into(), Kind::Specular, axis));
     e
+}
+
+/// The catalogue's model `tag` (whichever SEGSHADE_ALL_CHAINS built it), described again: a
+/// compiled model's description, for what is built from it at run time (its traced twin).
+pub fn catalogue_model(tag: &str) -> Result<Model, String> {
+    let (tag, kind, opts) =
+        entries(true).into_iter().find(|(t, _, _)| t == tag).ok_or_else(|| format!("{tag}: not a model of the catalogue"))?;
+    Ok(Model { tag, options: Some(options_key(&opts)), ..model_of(&opts, kind, "")? })
 }
 
 /// `opts` in one text, the same for options that generate the same files: the screen and the

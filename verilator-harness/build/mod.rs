@@ -19,7 +19,7 @@ use std::path::PathBuf;
 
 /// Why a model could not be described or built. `build.rs` stops with it; the library hands it
 /// to the binary, which prints it and exits 2 (a configuration) or 1 (a tool failing).
-#[derive(Debug, thiserror::Error)]
+#[derive(Clone, Debug, thiserror::Error)]
 pub enum ModelError {
     #[error(
         "verilator was not found on PATH; the co-simulation harness needs it: install Debian's package \
@@ -30,8 +30,9 @@ pub enum ModelError {
     Verilate { top: String, dir: PathBuf, log: String },
     #[error("the C++ compiler failed on model {tag} ({dir}):\n{log}")]
     Compile { tag: String, dir: PathBuf, log: String },
+    /// (An `Arc`: the registry hands one error to every test that asks for a folder's models.)
     #[error("{path}: {error}")]
-    Io { path: PathBuf, error: std::io::Error },
+    Io { path: PathBuf, error: std::sync::Arc<std::io::Error> },
     /// A `COSIM_RTL_DIR` folder (or its manifest) that does not describe a model.
     #[error("COSIM_RTL_DIR={dir}: {what}")]
     RtlDir { dir: PathBuf, what: String },
@@ -42,5 +43,5 @@ pub enum ModelError {
 
 /// `f`'s error as [`ModelError::Io`] on `path`.
 pub fn io<T>(path: impl Into<PathBuf>, r: std::io::Result<T>) -> Result<T, ModelError> {
-    r.map_err(|error| ModelError::Io { path: path.into(), error })
+    r.map_err(|error| ModelError::Io { path: path.into(), error: std::sync::Arc::new(error) })
 }

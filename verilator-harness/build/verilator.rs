@@ -198,18 +198,18 @@ impl Classes {
         }
         if model.is_empty() {
             let error = std::io::Error::new(std::io::ErrorKind::InvalidData, "lists no model files");
-            return Err(ModelError::Io { path: path.to_path_buf(), error });
+            return Err(ModelError::Io { path: path.to_path_buf(), error: error.into() });
         }
         Ok(Classes { model, global })
     }
 }
 
-/// Whether the compiler finds zlib's header (the FST writer's); the error says which package to
-/// install, rather than a compiler error deep in GTKWave's code.
-pub fn require_zlib(v: &Verilator, obj: &Path) -> Result<(), String> {
+/// Whether the compiler `b` finds zlib's header (the FST writer's); the error says which package
+/// to install, rather than a compiler error deep in GTKWave's code.
+pub fn require_zlib(mut b: cc::Build, obj: &Path) -> Result<(), String> {
     let probe = obj.join("zlib-probe.cpp");
     fs::write(&probe, "#include <zlib.h>\n").map_err(|e| format!("{}: {e}", probe.display()))?;
-    match cc_build(v, true, Link::Static).file(&probe).try_expand() {
+    match b.file(&probe).try_expand() {
         Ok(_) => Ok(()),
         Err(_) => Err("zlib's header (zlib.h) was not found. The traced models' FST writer needs it.\n\
              Install Debian's package:   apt-get install -y zlib1g-dev\n\

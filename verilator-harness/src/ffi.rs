@@ -3,11 +3,10 @@
 //! another, so a clock costs one FFI call whatever the port count.
 
 use crate::waveform::TraceError;
-use golden::specular::{Decoder, DecoderRepr, KRange, PlanError, SpecularPlan, SpecularUnit};
+use golden::specular::{Decoder, DecoderRepr, KRange, PlanError, SpecularPlan};
 use golden::{Align, Config};
 use std::ffi::{c_char, c_int, c_void, CString};
 use std::path::{Path, PathBuf};
-use std::sync::OnceLock;
 
 /// Inputs of `segment_shader_p<P>` for one clock.
 #[repr(C)]
@@ -275,8 +274,6 @@ pub struct ModelInfo<I: 'static, O: 'static> {
     new: unsafe extern "C" fn(u64) -> *mut c_void,
     free: unsafe extern "C" fn(*mut c_void),
     step: unsafe extern "C" fn(*mut c_void, *const I, *mut O),
-    /// Its traced twin, when this build has one (see [`crate::waveform`]).
-    pub traced: Option<TracedModel<I, O>>,
     /// The circuit's identity (`Model::identity`): a model asked for at run time is this one
     /// when its identity is.
     identity: u64,
@@ -285,9 +282,19 @@ pub struct ModelInfo<I: 'static, O: 'static> {
     options: Option<&'static str>,
 }
 
+// Function pointers, names and plain values: copied whatever I and O are (a derive would ask
+// I, O: Copy). The registry hands out copies of the catalogue's entries.
+impl<I, O> Clone for ModelInfo<I, O> {
+    fn clone(&self) -> Self {
+        *self
+    }
+}
+impl<I, O> Copy for ModelInfo<I, O> {}
+
 /// A model's traced twin (`verilator --trace-fst`, `csrc/trace.h`): the same RTL and the same
-/// per-clock structs, and an FST file it dumps every clock into while one is open. build.rs
-/// builds one for every streaming model when COSIM_TRACE is set, and for `seg_p2_span` always.
+/// per-clock structs, and an FST file it dumps every clock into while one is open. Built, like a
+/// model of a configuration outside the catalogue, the first time it is asked for
+/// ([`ModelInfo::twin`], `crate::ondemand`), and cached.
 pub struct TracedModel<I: 'static, O: 'static> {
     /// `<tag>_tr`: its symbol prefix and the suffix of its Verilator class.
     pub tag: &'static str,
@@ -301,6 +308,24 @@ pub struct TracedModel<I: 'static, O: 'static> {
     trace_close: unsafe extern "C" fn(*mut c_void) -> c_int,
 }
 
+impl<I, O> TracedModel<I, O> {
+    /// A twin loaded at run time (`crate::ondemand::twin`), from its shim's symbols.
+    ///
+    /// # Safety
+    /// The functions are the traced shim's `<tag>_new`, `_free`, `_step`, `_trace_open` and
+    /// `_trace_close` (csrc/trace.h) of a model driven through `I` and `O`.
+    pub(crate) unsafe fn from_symbols(
+        tag: &'static str,
+        new: unsafe extern "C" fn(u64) -> *mut c_void,
+        free: unsafe extern "C" fn(*mut c_void),
+        step: StepFn<I, O>,
+        trace_open: unsafe extern "C" fn(*mut c_void, *const c_char, u64) -> c_int,
+        trace_close: unsafe extern "C" fn(*mut c_void) -> c_int,
+    ) -> Self {
+        TracedModel { tag, new, free, step, trace_open, trace_close }
+    }
+}
+
 // Function pointers and a name: copied whatever I and O are (a derive would ask I, O: Copy).
 impl<I, O> Clone for TracedModel<I, O> {
     fn clone(&self) -> Self {
@@ -309,9 +334,9 @@ impl<I, O> Clone for TracedModel<I, O> {
 }
 impl<I, O> Copy for TracedModel<I, O> {}
 
-/// The table set the specular model was generated with (`--brdf-k`): build.rs takes it from
-/// the generator's default or from COSIM_RTL_DIR's manifest, where it checks that golden
-/// rebuilds from it the very plan the manifest states.
+/// The table set a specular model was generated with (`--brdf-k`): the generator's default for
+/// the compiled catalogue, or a COSIM_RTL_DIR folder's manifest's (`crate::registry`, which
+/// checks that golden rebuilds from it the very plan the manifest states).
 pub struct SpecularTables {
     pub ks: &'static [u32],
     /// The decoder: which n uses which table.
@@ -329,11 +354,11 @@ impl SpecularTables {
 
 include!(concat!(env!("OUT_DIR"), "/models.rs"));
 
-/// The golden specular unit the built specular model is checked against: [`SPECULAR_TABLES`]'
-/// plan (built once), not `SpecularUnit::default()`, which is right only for the default set.
-pub fn specular_unit() -> SpecularUnit {
-    static UNIT: OnceLock<SpecularUnit> = OnceLock::new();
-    UNIT.get_or_init(|| SpecularUnit::new(SPECULAR_TABLES.plan().expect("build.rs rebuilt this plan"))).clone()
+/// The traced twins this process has, by their circuit's identity ([`ModelInfo::built_twin`]).
+fn twins() -> &'static std::sync::Mutex<std::collections::HashMap<u64, &'static (dyn std::any::Any + Send + Sync)>> {
+    static TWINS: std::sync::OnceLock<std::sync::Mutex<std::collections::HashMap<u64, &'static (dyn std::any::Any + Send + Sync)>>> =
+        std::sync::OnceLock::new();
+    TWINS.get_or_init(Default::default)
 }
 
 /// A model's clock: `(handle, inputs, outputs)`, as `<tag>_step` in the shim.
@@ -359,7 +384,7 @@ impl<I, O> ModelInfo<I, O> {
         step: StepFn<I, O>,
         identity: u64,
     ) -> Self {
-        ModelInfo { tag, top, latency, pipeline, cfg, screen, di, new, free, step, traced: None, identity, options: None }
+        ModelInfo { tag, top, latency, pipeline, cfg, screen, di, new, free, step, identity, options: None }
     }
 
     /// A catalogue model's configuration (`catalogue::options_key`); `None` for the others.
@@ -377,7 +402,7 @@ impl<I, O> ModelInfo<I, O> {
         self.step
     }
 
-    /// This model with `step` as its clock (its traced twin unchanged): a test's mutant, whose
+    /// This model with `step` as its clock (its traced twin the model's own): a test's mutant, whose
     /// step calls [`ModelInfo::step_fn`]'s and then changes an output.
     ///
     /// # Safety
@@ -387,100 +412,24 @@ impl<I, O> ModelInfo<I, O> {
         ModelInfo { step, ..*self }
     }
 
-    /// For `--trace`: whether this model has a traced twin in this build.
-    pub fn require_traced(&self) -> Result<(), TraceError> {
-        match self.traced {
-            Some(_) => Ok(()),
-            None => Err(TraceError::NoTwin(self.tag)),
-        }
+    /// The model's traced twin, if this process has built (or loaded) it: `crate::ondemand::twin`
+    /// builds it, the first time, and enters it here.
+    pub fn built_twin(&self) -> Option<&'static TracedModel<I, O>> {
+        let twins = twins().lock().unwrap_or_else(|e| e.into_inner());
+        twins.get(&self.identity).and_then(|t| t.downcast_ref::<TracedModel<I, O>>())
+    }
+
+    /// Enters `twin` as this model's traced twin (its circuit's: a mutant made with
+    /// [`ModelInfo::with_step`] shares it).
+    pub(crate) fn enter_twin(&self, twin: TracedModel<I, O>) -> &'static TracedModel<I, O> {
+        let mut twins = twins().lock().unwrap_or_else(|e| e.into_inner());
+        let entry = twins.entry(self.identity).or_insert_with(|| Box::leak(Box::new(twin)));
+        entry.downcast_ref::<TracedModel<I, O>>().expect("one circuit, one kind of structs")
     }
 
     /// Golden's front-end for a front-end model (`tri_frontend`, `tri_shader_p<P>`, `tri_fb_p<P>`).
     pub fn frontend(&self) -> golden::frontend::FrontEnd {
         golden::frontend::FrontEnd::new(self.cfg, self.screen).expect("the model's front-end").with_di(self.di)
-    }
-}
-
-/// The segment-shader model built for `p` and `align` with SPEC's seed structure (or, from
-/// `COSIM_RTL_DIR`, whatever pipeline level the folder has), if this build has one.
-pub fn segment_model(p: u32, align: Align) -> Option<&'static ModelInfo<SegIn, SegOut>> {
-    let seed = |m: &&ModelInfo<SegIn, SegOut>| m.pipeline == golden::pipeline::Pipeline::NONE;
-    let matching = || SEGMENT_MODELS.iter().filter(|m| m.cfg.p == p && m.cfg.align == align);
-    matching().find(seed).or_else(|| matching().next())
-}
-
-/// The segment-shader model for `p` and `align`, for a test that needs it (`what` names that
-/// test); see [`require`] for what happens when this build has none.
-pub fn require_segment_model(p: u32, align: Align, what: &str) -> Option<&'static ModelInfo<SegIn, SegOut>> {
-    require(segment_model(p, align), &format!("seg_p{p}_{align}"), what)
-}
-
-/// The specular unit's model, for a test that needs it; see [`require`].
-pub fn require_specular_model(what: &str) -> Option<&'static ModelInfo<SpecIn, SpecOut>> {
-    require(SPECULAR_MODELS.first(), "specular_unit", what)
-}
-
-/// Every model of one kind (`kind`: "segment shader", "bfpi"), for a test that runs them all;
-/// `None` when there are none, see [`require`].
-pub fn require_models<I, O>(models: &'static [ModelInfo<I, O>], kind: &str, what: &str) -> Option<&'static [ModelInfo<I, O>]> {
-    require((!models.is_empty()).then_some(models), kind, what)
-}
-
-/// For a test of the `cosim` or `render` binary run with their default model (p = 8 span): the
-/// `--p`/`--align` arguments to add. None when that model is built (a default build must have
-/// it, see [`require`]); else, under COSIM_RTL_DIR, those of the folder's first segment shader.
-/// `None` when there is no segment shader at all.
-pub fn default_model_args(what: &str) -> Option<Vec<String>> {
-    let other = SEGMENT_MODELS.first().filter(|_| RTL_DIR.is_some() && segment_model(8, Align::Span).is_none());
-    let Some(m) = other else { return require_segment_model(8, Align::Span, what).map(|_| Vec::new()) };
-    let args = vec!["--p".into(), m.cfg.p.to_string(), "--align".into(), m.cfg.align.to_string()];
-    use std::io::Write;
-    let _ = writeln!(
-        std::io::stderr().lock(),
-        "{what}: this build has no seg_p8_span model (the default): runs {} ({})",
-        m.tag,
-        args.join(" ")
-    );
-    Some(args)
-}
-
-/// The one rule every suite follows for a model it needs. A default build (no COSIM_RTL_DIR)
-/// builds every model, so a missing one is a bug: panic. A build against COSIM_RTL_DIR has only
-/// what that folder provides: say on stderr what is skipped and why, and return `None`.
-///
-/// The note goes to stderr directly, not through `eprintln!`, which the test harness captures
-/// and shows only for failing tests: a skip must be visible when everything passes.
-pub fn require<T>(found: Option<T>, model: &str, what: &str) -> Option<T> {
-    if found.is_some() {
-        return found;
-    }
-    let built: Vec<&str> = SEGMENT_MODELS
-        .iter()
-        .map(|m| m.tag)
-        .chain(BFPI_MODELS.iter().map(|m| m.tag))
-        .chain(SPECULAR_MODELS.iter().map(|m| m.tag))
-        .chain(FRONTEND_MODELS.iter().map(|m| m.tag))
-        .chain(TRISHADER_MODELS.iter().map(|m| m.tag))
-        .chain(WRITER_MODELS.iter().map(|m| m.tag))
-        .chain(TRIWRITER_MODELS.iter().map(|m| m.tag))
-        .chain(AXIS_SEGMENT_MODELS.iter().map(|m| m.tag))
-        .chain(AXIS_SPECULAR_MODELS.iter().map(|m| m.tag))
-        .chain(AXIS_FRONTEND_MODELS.iter().map(|m| m.tag))
-        .chain(AXIS_TRISHADER_MODELS.iter().map(|m| m.tag))
-        .collect();
-    let built = if built.is_empty() { "nothing".to_string() } else { built.join(", ") };
-    match RTL_DIR {
-        None => {
-            panic!("{what}: this build has no {model} model, and a default build (no COSIM_RTL_DIR) must have every model (built: {built})")
-        }
-        Some(dir) => {
-            use std::io::Write;
-            let _ = writeln!(
-                std::io::stderr().lock(),
-                "{what}: skipped: this build has no {model} model (COSIM_RTL_DIR={dir} provides {built} only)"
-            );
-            None
-        }
     }
 }
 
@@ -506,8 +455,8 @@ impl<I, O: Default> Rtl<I, O> {
     /// `seed` randomizes the registers' power-up values, so only a real reset makes them known.
     ///
     /// Under [`crate::waveform::trace_everything`] (`--trace DIR`) this is the traced twin with
-    /// a file of its own in DIR open from its first clock; it panics when the build has no twin
-    /// (the binaries check first, [`crate::waveform::require_traced`]).
+    /// a file of its own in DIR open from its first clock; it panics when the twin is not built
+    /// (the binaries build it first, `crate::ondemand::require_traced`).
     pub fn new(info: &'static ModelInfo<I, O>, seed: u64) -> Self {
         let Some(dir) = crate::waveform::everything() else {
             let handle = unsafe { (info.new)(seed) };
@@ -522,7 +471,9 @@ impl<I, O: Default> Rtl<I, O> {
 
     /// The traced twin of `info` (no file open yet), or why there is none.
     pub fn traced(info: &'static ModelInfo<I, O>, seed: u64) -> Result<Self, TraceError> {
-        let Some(twin) = &info.traced else { return Err(TraceError::NoTwin(info.tag)) };
+        let Some(twin) = info.built_twin() else {
+            return Err(TraceError::NoTwin { tag: info.tag, why: "not built in this process (crate::ondemand::twin builds it)".into() });
+        };
         // SAFETY: the twin's constructor; a null handle (it caught an exception) is refused.
         let handle = unsafe { (twin.new)(seed) };
         if handle.is_null() {
@@ -590,39 +541,4 @@ impl<I, O> Drop for Rtl<I, O> {
 /// A two's complement value masked to `width` bits, as Verilator stores a signed port.
 pub fn to_port(v: i64, width: u32) -> u32 {
     (v as u64 & ((1u64 << width) - 1)) as u32
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// [`require`]'s rule: a missing model fails a default build and is skipped (`None`) in a
-    /// COSIM_RTL_DIR build; a built one is returned either way.
-    #[test]
-    fn a_missing_model_fails_only_a_default_build() {
-        let missing = std::panic::catch_unwind(|| {
-            require_segment_model(3, Align::Span, "ffi: the rule's own test (a p = 3 shader is never built)").map(|m| m.tag)
-        });
-        match RTL_DIR {
-            None => {
-                let e = missing.expect_err("a default build with a model missing must fail");
-                let msg = e.downcast_ref::<String>().expect("a formatted message");
-                assert!(msg.contains("this build has no seg_p3_span model"), "{msg}");
-            }
-            Some(_) => assert!(missing.unwrap().is_none()),
-        }
-        // A default build also has pipelined twins of some shaders: (p, align) names the seed's
-        // structure (pipeline level 0), which a default build always has.
-        for m in SEGMENT_MODELS {
-            let found = require_segment_model(m.cfg.p, m.cfg.align, "ffi").expect("built");
-            assert_eq!((found.cfg.p, found.cfg.align), (m.cfg.p, m.cfg.align));
-            if RTL_DIR.is_none() {
-                assert_eq!(found.pipeline, golden::pipeline::Pipeline::NONE, "{} for {}", found.tag, m.tag);
-            }
-            if m.pipeline == golden::pipeline::Pipeline::NONE {
-                assert_eq!(found.tag, m.tag);
-            }
-        }
-        assert_eq!(require_specular_model("ffi").map(|x| x.tag), SPECULAR_MODELS.first().map(|x| x.tag));
-    }
 }

@@ -1,8 +1,9 @@
 //! Co-simulation of segshade's generated RTL against the golden model, through Verilator.
 //!
 //! `build.rs` verilates and links the catalogue of models the suites use, and [`ondemand`] builds
-//! any other configuration when it is first asked for, both through one description of a model
-//! ([`models`]); [`ffi`] wraps them; [`stimulus`] makes random
+//! any other configuration, a `COSIM_RTL_DIR` folder's models and every traced twin when first
+//! asked for, both through one description of a model ([`models`]); [`registry`] is the run's
+//! list of models, decided at run time; [`ffi`] wraps them; [`stimulus`] makes random
 //! and directed triangles; [`driver`] is the clock loop every unit shares (random valid gaps
 //! and backpressure, the protocol monitor, the scoreboard on a second thread); [`segment`]
 //! checks every segment of a segment shader and the final frames; [`specular`] does the same
@@ -19,6 +20,7 @@ pub mod frontend;
 #[path = "../build/mod.rs"]
 pub mod models;
 pub mod ondemand;
+pub mod registry;
 pub mod render;
 pub mod report;
 pub mod segment;

@@ -1,8 +1,9 @@
 //! Waveforms: FST files of the verilated models, to look at a failure in GTKWave or Surfer.
 //!
-//! **On failure (`COSIM_TRACE=DIR`).** Built with COSIM_TRACE set, every streaming model has a
-//! traced twin (`verilator --trace-fst`: [`crate::ffi::TracedModel`]; a default build has one for
-//! `seg_p2_span` only). Run with it set, every driver keeps a tape (`tape.rs`) of what it put on its
+//! **On failure (`COSIM_TRACE=DIR`).** Every streaming model has a traced twin (`verilator
+//! --trace-fst`: [`crate::ffi::TracedModel`]), built at run time the first time it is needed and
+//! cached like any model built on demand ([`crate::ffi::ModelInfo::twin`]). Run with COSIM_TRACE
+//! set, every driver keeps a tape (`tape.rs`) of what it put on its
 //! model's ports, and when a check fails, it replays the tape into the twin and writes the failing
 //! window to `DIR/<tag>-seed<seed>-clock<N>.fst`; the mismatch's message names the file and the
 //! clock N of the first mismatch. One file per model instance: its first failure's.
@@ -42,11 +43,8 @@ use std::sync::{Mutex, OnceLock};
 /// Why a waveform was not written (or a traced model not made).
 #[derive(Debug, thiserror::Error)]
 pub enum TraceError {
-    #[error(
-        "this build has no traced model of {0} (traced models are built when COSIM_TRACE is set at build time, e.g. \
-         COSIM_TRACE=target/waves cargo run --release -p verilator-harness --bin ...)"
-    )]
-    NoTwin(&'static str),
+    #[error("no traced model of {tag}: {why}")]
+    NoTwin { tag: &'static str, why: String },
     #[error("the traced model {0} failed to construct")]
     Construct(&'static str),
     #[error("{0} is not a traced model")]
@@ -90,9 +88,9 @@ static EVERYTHING: OnceLock<PathBuf> = OnceLock::new();
 static WRITTEN: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
 
 /// From now on every model instance this process builds ([`Rtl::new`]) is its traced twin,
-/// writing every clock to a file of its own in `dir` (created if missing). Check first that the
-/// models to run have twins ([`crate::ffi::ModelInfo::require_traced`]): an instance without
-/// one panics.
+/// writing every clock to a file of its own in `dir` (created if missing). Build the models'
+/// twins first ([`crate::ffi::ModelInfo::require_traced`]): an instance whose twin cannot be
+/// built panics.
 pub fn trace_everything(dir: &Path) -> Result<(), TraceError> {
     std::fs::create_dir_all(dir).map_err(|error| TraceError::Io { path: dir.to_path_buf(), error })?;
     EVERYTHING.set(dir.to_path_buf()).map_err(|_| TraceError::Twice)

@@ -9,17 +9,18 @@ use golden::rng::SeedRng;
 use golden::setup::Screen;
 use golden::specular::SpecularSpan;
 use rand::SeedableRng;
-use verilator_harness::ffi::{
-    require_models, specular_unit, ModelInfo, SegIn, SegOut, AXIS_FRONTEND_MODELS, AXIS_SEGMENT_MISPACKED, AXIS_SEGMENT_MODELS,
-    AXIS_SPECULAR_MODELS, AXIS_TRISHADER_MODELS,
-};
+use verilator_harness::ffi::{ModelInfo, SegIn, SegOut};
 use verilator_harness::frontend::{random_triangles, run_chain, run_frontend};
+use verilator_harness::registry::{
+    require_models, specular_unit, AXIS_FRONTEND_MODELS, AXIS_SEGMENT_MISPACKED, AXIS_SEGMENT_MODELS, AXIS_SPECULAR_MODELS,
+    AXIS_TRISHADER_MODELS,
+};
 use verilator_harness::segment::{assert_clean, Report, SegmentCosim, Stim, Stress, Traffic, DRAIN_CLOCKS};
 use verilator_harness::specular::{random_span, SpecularCosim};
 use verilator_harness::stimulus::random_triangle;
 
 fn shaders(what: &str) -> &'static [ModelInfo<SegIn, SegOut>] {
-    require_models(AXIS_SEGMENT_MODELS, "AXI4-Stream segment shader", &format!("axis: {what}")).unwrap_or_default()
+    require_models(&AXIS_SEGMENT_MODELS, "AXI4-Stream segment shader", &format!("axis: {what}")).unwrap_or_default()
 }
 
 /// Random triangles under random gaps and backpressure, every segment bit-exact, and a
@@ -84,7 +85,7 @@ fn a_mispacked_field_is_caught() {
 #[test]
 fn specular_wrappers_equal_golden() {
     let seed = verilator_harness::seed("axis specular");
-    let Some(models) = require_models(AXIS_SPECULAR_MODELS, "AXI4-Stream specular unit", "axis: specular") else { return };
+    let Some(models) = require_models(&AXIS_SPECULAR_MODELS, "AXI4-Stream specular unit", "axis: specular") else { return };
     for info in models {
         let mut rng = SeedRng::seed_from_u64(seed);
         let mut spans: Vec<SpecularSpan> = (0..150).map(|_| random_span(&mut rng, info.cfg.max_len())).collect();
@@ -114,11 +115,11 @@ fn specular_wrappers_equal_golden() {
 #[test]
 fn triangle_wrappers_equal_golden() {
     let seed = verilator_harness::seed("axis triangles");
-    for m in AXIS_FRONTEND_MODELS {
+    for m in AXIS_FRONTEND_MODELS.iter() {
         let tris = random_triangles(&mut SeedRng::seed_from_u64(seed), &m.frontend(), 500);
         assert_clean(m.tag, seed, &run_frontend(m, seed, Traffic::RANDOM, Stress::NONE, &tris));
     }
-    for m in AXIS_TRISHADER_MODELS {
+    for m in AXIS_TRISHADER_MODELS.iter() {
         let tris = random_triangles(&mut SeedRng::seed_from_u64(seed), &m.frontend(), 150);
         let run = run_chain(m, seed, Traffic::RANDOM, &tris);
         assert_clean(m.tag, seed, &run.report);

@@ -2,11 +2,12 @@
 //! equals golden's bit-exact evaluation of the same adder graph, and that is `(i+1)*di`.
 
 use golden::bfpi::BfpiPlan;
-use verilator_harness::ffi::{require_models, to_port, BfpiIn, BfpiOut, Rtl, BFPI_MODELS};
+use verilator_harness::ffi::{to_port, BfpiIn, BfpiOut, Rtl};
+use verilator_harness::registry::{require_models, BFPI_MODELS};
 
 #[test]
 fn bfpi_matches_golden_for_every_increment() {
-    let Some(models) = require_models(BFPI_MODELS, "bfpi", "bfpi: every increment") else { return };
+    let Some(models) = require_models(&BFPI_MODELS, "bfpi", "bfpi: every increment") else { return };
     for info in models {
         let cfg = info.cfg;
         let (dw, mw, p) = (cfg.dw(), cfg.mw(), cfg.p as usize);

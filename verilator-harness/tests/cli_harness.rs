@@ -3,7 +3,7 @@
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
-use verilator_harness::ffi::{default_model_args, require, require_segment_model, SEGMENT_MODELS};
+use verilator_harness::registry::{default_model_args, require, require_segment_model, SEGMENT_MODELS};
 
 fn run(bin: &str, args: &[&str]) -> Output {
     Command::new(bin).args(args).output().unwrap_or_else(|e| panic!("running {bin}: {e}"))
@@ -66,8 +66,8 @@ fn cosim_rejects_every_bad_flag() {
         (&["--p"], "--p"),
         (&["--p", "eight"], "--p"),
         (&["--p", "-8"], "--p"),
-        (&["--p", "3"], "--p 3"),
-        (&["--p", "512"], "--p 512"),
+        (&["--p", "3"], "--p"),
+        (&["--p", "512"], "--p"),
         (&["--align"], "--align"),
         (&["--align", "diagonal"], "--align"),
         (&["--triangles"], "--triangles"),
@@ -98,6 +98,23 @@ fn cosim_rejects_every_bad_flag() {
         (&["--specular", "--specular"], "--specular"),
         (&["--frobnicate"], "--frobnicate"),
         (&["extra"], "extra"),
+        // generate's options (hdl_gen::cli), each refused as generate refuses it.
+        (&["--frac", "3"], "--frac"),
+        (&["--frac", "21"], "--frac"),
+        (&["--xbits", "17"], "--xbits"),
+        (&["--pipeline", "4"], "--pipeline"),
+        (&["--pipeline", "-1"], "--pipeline"),
+        (&["--bus", "pci"], "--bus"),
+        (&["--fe-div-bits", "3"], "--fe-div-bits"),
+        (&["--fe-di", "vertex"], "--fe-di"),
+        (&["--bfpi-arch", "abacus"], "--bfpi-arch"),
+        (&["--bfpi-arch", "tree", "--pipeline", "1"], "--pipeline above 0"),
+        (&["--brdf-k", "0"], "--brdf-k"),
+        (&["--max-rel-error", "1%"], "--brdf-k"),
+        (&["--brdf-k", "1,2", "--max-rel-error", "1%"], "--max-rel-error goes with --brdf-k auto"),
+        (&["--prefix", "9lives"], "--prefix"),
+        // The front-end's screen is cosim's: 640 pixels is wider than 4 fraction bits shade.
+        (&["--frontend", "rtl", "--frac", "4"], "--width/--height"),
     ];
     let Some(model) = default_model_args("cli_harness: cosim's bad flags") else { return };
     for (args, needle) in cases {
@@ -113,6 +130,43 @@ fn cosim_runs_a_few_triangles() {
     let text = String::from_utf8_lossy(&out.stdout);
     assert!(out.status.success(), "{text}{}", String::from_utf8_lossy(&out.stderr));
     assert!(text.trim_end().ends_with("5 passed, 0 failed"), "{text}");
+}
+
+/// The negative control of the rows above: generate's options, valid, reach the model. Each
+/// configuration here is in the compiled catalogue (nothing is built), and its model's tag is
+/// printed: a flag parsed and then dropped would run the default model instead.
+#[test]
+fn cosim_and_render_run_the_model_generate_options_name() {
+    if verilator_harness::registry::rtl_dir().is_some() {
+        eprintln!("cli_harness: generate's options: skipped under COSIM_RTL_DIR (the folder's models are the run's)");
+        return;
+    }
+    let cases: &[(&[&str], &str)] = &[
+        (&["--pipeline", "1", "--triangles", "5"], "model seg_p8_span_pl1 (segment_shader_p8)"),
+        (&["--align", "screen", "--pipeline", "2", "--triangles", "5"], "model seg_p8_screen_pl2 (segment_shader_p8)"),
+        (&["--bus", "axis", "--triangles", "5"], "model seg_p8_span_axis (segment_shader_p8_axis)"),
+        (&["--specular", "--pipeline", "1", "--pixels", "2000"], "model spec_pl1 (specular_unit)"),
+        (&["--specular", "--bus", "axis", "--pixels", "2000"], "model spec_axis (specular_unit_axis)"),
+    ];
+    for (args, model) in cases {
+        let out = run(COSIM, &[&["--seed", "1"], *args].concat());
+        let text = String::from_utf8_lossy(&out.stdout);
+        assert!(out.status.success(), "{args:?}: {text}{}", String::from_utf8_lossy(&out.stderr));
+        assert!(text.starts_with(&format!("{model},")) && text.trim_end().ends_with(" 0 failed"), "{args:?}: {text}");
+    }
+    let dir = scratch("render-options");
+    let (tri, png) = (dir.join("t.txt"), dir.join("t.png"));
+    std::fs::write(
+        &tri,
+        "0 0 0 60 0 128 0 40 255
+",
+    )
+    .unwrap();
+    let args = ["--triangles", tri.to_str().unwrap(), "--out", png.to_str().unwrap(), "--width", "64", "--height", "48", "--quiet"];
+    let out = run(RENDER, &[&args[..], &["--pipeline", "2", "--align", "screen"]].concat());
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success() && text.contains("seg_p8_screen_pl2"), "{text}{}", String::from_utf8_lossy(&out.stderr));
+    let _ = std::fs::remove_dir_all(&dir);
 }
 
 /// `render`: every flag, and triangle files that are missing, not files, not text, malformed
@@ -160,7 +214,13 @@ fn render_rejects_every_bad_flag_and_input_file() {
         (vec!["--scene", "sphere"], "--out".into()),
         (vec!["--scene", "cube", "--out", o], "--scene".into()),
         (vec!["--scene", "sphere", "--triangles", g, "--out", o], "--triangles".into()),
-        (vec!["--triangles", g, "--out", o, "--p", "3"], "--p 3".into()),
+        (vec!["--triangles", g, "--out", o, "--p", "3"], "--p".into()),
+        (vec!["--triangles", g, "--out", o, "--frac", "30"], "--frac".into()),
+        (vec!["--triangles", g, "--out", o, "--pipeline", "9"], "--pipeline".into()),
+        (vec!["--triangles", g, "--out", o, "--bus", "wishbone"], "--bus".into()),
+        (vec!["--triangles", g, "--out", o, "--fe-div-bits", "8"], "--fe-div-bits".into()),
+        (vec!["--triangles", g, "--out", o, "--brdf-k", "64,1"], "--brdf-k".into()),
+        (vec!["--triangles", g, "--out", o, "--bfpi-arch", "tree", "--pipeline", "2"], "--pipeline above 0".into()),
         (vec!["--triangles", g, "--out", o, "--p", "x"], "--p".into()),
         (vec!["--triangles", g, "--out", o, "--align", "middle"], "--align".into()),
         (vec!["--triangles", g, "--out", o, "--width", "0"], "--width".into()),
@@ -223,6 +283,13 @@ fn sweep_rejects_every_bad_flag() {
         (vec!["--height", "65536"], "--height"),
         (vec!["--out"], "--out"),
         (vec!["--bogus"], "--bogus"),
+        // generate's options but P and the alignment (sweep runs every P in both).
+        (vec!["--p", "8"], "--p"),
+        (vec!["--align", "screen"], "--align"),
+        (vec!["--frac", "3"], "--frac"),
+        (vec!["--pipeline", "4"], "--pipeline"),
+        (vec!["--fe-di", "sideways"], "--fe-di"),
+        (vec!["--bfpi-arch", "tree", "--pipeline", "1"], "--pipeline above 0"),
         // A bad --out is refused before the sweep, not after its minutes.
         (vec!["--out", dir.to_str().unwrap()], "is a folder"),
         (vec!["--triangles", "1000000", "--out", missing.to_str().unwrap()], "no/such"),

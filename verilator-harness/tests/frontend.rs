@@ -4,8 +4,8 @@
 use golden::frontend::{FixedTriangle, FrontEnd, Outcome};
 use golden::rng::SeedRng;
 use rand::SeedableRng;
-use verilator_harness::ffi::{require, require_models, FRONTEND_MODELS, TRISHADER_MODELS};
 use verilator_harness::frontend::{mesh, random_triangles, run_chain, run_frontend, Expected};
+use verilator_harness::registry::{require, require_models, FRONTEND_MODELS, TRISHADER_MODELS};
 use verilator_harness::segment::{assert_clean, Stress, Traffic};
 
 fn frontend(m: &verilator_harness::ffi::ModelInfo<impl Sized, impl Sized>) -> FrontEnd {
@@ -15,7 +15,7 @@ fn frontend(m: &verilator_harness::ffi::ModelInfo<impl Sized, impl Sized>) -> Fr
 #[test]
 fn spans_equal_golden_for_every_kind_of_triangle() {
     let seed = verilator_harness::seed("frontend spans");
-    let Some(models) = require_models(FRONTEND_MODELS, "tri_frontend", "frontend spans") else { return };
+    let Some(models) = require_models(&FRONTEND_MODELS, "tri_frontend", "frontend spans") else { return };
     for m in models {
         let fe = frontend(m);
         let tris = random_triangles(&mut SeedRng::seed_from_u64(seed), &fe, 3000);
@@ -41,7 +41,7 @@ fn spans_equal_golden_for_every_kind_of_triangle() {
 #[test]
 fn resets_in_the_middle_of_triangles_drop_them_cleanly() {
     let seed = verilator_harness::seed("frontend resets");
-    let Some(models) = require_models(FRONTEND_MODELS, "tri_frontend", "frontend resets") else { return };
+    let Some(models) = require_models(&FRONTEND_MODELS, "tri_frontend", "frontend resets") else { return };
     for m in models {
         let fe = frontend(m);
         // Rounds of 1,500 triangles until a reset came, so the test always has one. Each triangle
@@ -65,7 +65,7 @@ fn resets_in_the_middle_of_triangles_drop_them_cleanly() {
 #[test]
 fn segments_and_frames_through_the_chain() {
     let seed = verilator_harness::seed("tri_shader");
-    let Some(models) = require_models(TRISHADER_MODELS, "tri_shader", "tri_shader segments") else { return };
+    let Some(models) = require_models(&TRISHADER_MODELS, "tri_shader", "tri_shader segments") else { return };
     for m in models {
         let fe = frontend(m);
         let mut rng = SeedRng::seed_from_u64(seed ^ m.cfg.p as u64);
@@ -85,7 +85,7 @@ fn segments_and_frames_through_the_chain() {
 #[test]
 fn a_shared_edge_mesh_writes_every_covered_pixel_exactly_once() {
     let seed = verilator_harness::seed("tri_shader mesh");
-    let Some(models) = require_models(TRISHADER_MODELS, "tri_shader", "tri_shader mesh") else { return };
+    let Some(models) = require_models(&TRISHADER_MODELS, "tri_shader", "tri_shader mesh") else { return };
     for m in models {
         let fe = frontend(m);
         let tris: Vec<FixedTriangle> = mesh(&mut SeedRng::seed_from_u64(seed), &fe, 17, 11);
@@ -124,7 +124,7 @@ fn set_up_costs_what_the_manifest_says() {
     // Triangles of one row each are set-up bound; zero-area ones cost their CALC clock only.
     // The same with CALC in stages (they overlap the division of the triangle ahead), at every
     // divider rate and in both dI modes.
-    let Some(models) = require_models(FRONTEND_MODELS, "tri_frontend", "frontend set-up clocks") else { return };
+    let Some(models) = require_models(&FRONTEND_MODELS, "tri_frontend", "frontend set-up clocks") else { return };
     for m in models {
         set_up_costs(m);
     }
@@ -164,16 +164,16 @@ fn set_up_costs(m: &'static verilator_harness::ffi::ModelInfo<verilator_harness:
 
 #[test]
 fn scenes_render_through_the_rtl_chain_as_golden() {
-    use golden::setup::Screen;
     use verilator_harness::render::{run_with, scene_job, Chain, SceneKind};
     let what = "render through the chain";
     let Some(chain) = require(TRISHADER_MODELS.iter().find(|m| m.cfg.p == 8 && m.cfg.align == golden::Align::Span), "tris_p8_span", what)
     else {
         return;
     };
-    let Some(seg) = verilator_harness::ffi::require_segment_model(8, golden::Align::Span, what) else { return };
+    let Some(seg) = verilator_harness::registry::require_segment_model(8, golden::Align::Span, what) else { return };
     for kind in [SceneKind::Sphere, SceneKind::Torus] {
-        let job = scene_job(kind, 40, &seg.cfg, &Screen::default()).unwrap();
+        // On the chain's own screen (a COSIM_RTL_DIR folder's may be another than 640x480).
+        let job = scene_job(kind, 40, &seg.cfg, &chain.screen).unwrap();
         let o = run_with(&job, seg, Chain::Rtl(chain), None, |_| {});
         assert!(o.cosim_ok(), "{:?}", o.segment.iter().flat_map(|r| &r.mismatches).next());
         assert_eq!(o.differing_pixels(3), 0, "RTL image differs from golden's front-end image");
@@ -187,7 +187,7 @@ fn scenes_render_through_the_rtl_chain_as_golden() {
 /// The incremental I0 (`--fe-i0 incremental`, issue 27) at `screen` and `level`: asked of
 /// `ondemand` (built once, then cached), or `None` when this build hands out a folder's models.
 fn incremental(screen: golden::setup::Screen, level: u32) -> Option<hdl_gen::Options> {
-    if verilator_harness::ffi::RTL_DIR.is_some() {
+    if verilator_harness::registry::rtl_dir().is_some() {
         eprintln!("incremental I0: skipped: COSIM_RTL_DIR provides the models");
         return None;
     }
@@ -210,7 +210,7 @@ fn incremental_spans(screen: golden::setup::Screen, level: u32, n: usize) {
 }
 
 fn incremental_spans_of(opts: hdl_gen::Options, n: usize) {
-    let m = verilator_harness::ondemand::frontend(&opts).unwrap_or_else(|e| panic!("{e}"));
+    let m = verilator_harness::registry::frontend(&opts).unwrap_or_else(|e| panic!("{e}"));
     let seed = verilator_harness::seed("frontend incremental");
     let fe = frontend(m).with_i0(golden::frontend::I0Form::Incremental);
     assert_eq!(fe, opts.frontend().unwrap().fe, "the model's front-end is the plan's");
@@ -263,7 +263,7 @@ fn incremental_i0_spans_equal_golden_at_other_rates_and_formats() {
 fn incremental_i0_mesh_lands_in_memory_once_per_pixel() {
     for screen in [golden::setup::Screen::default(), golden::setup::Screen { width: 37, height: 23 }] {
         let Some(opts) = incremental(screen, 0) else { return };
-        let m = verilator_harness::ondemand::tri_writer(&opts).unwrap_or_else(|e| panic!("{e}"));
+        let m = verilator_harness::registry::tri_writer(&opts).unwrap_or_else(|e| panic!("{e}"));
         let seed = verilator_harness::seed("tri_fb incremental mesh");
         let tris: Vec<FixedTriangle> = mesh(&mut SeedRng::seed_from_u64(seed), &m.frontend(), 13, 9);
         let run = verilator_harness::writer::run_fb(m, seed, Traffic::RANDOM, &tris);
@@ -311,9 +311,9 @@ fn incremental_i0_throughput_against_the_reciprocal() {
     for p in [8, 16] {
         let Some(mut opts) = incremental(screen, 0) else { return };
         opts.cfg = golden::Config::new(p, opts.cfg.frac, opts.cfg.xbits, golden::Align::Span).unwrap();
-        let inc = verilator_harness::ondemand::tri_shader(&opts).unwrap_or_else(|e| panic!("{e}"));
+        let inc = verilator_harness::registry::tri_shader(&opts).unwrap_or_else(|e| panic!("{e}"));
         let rec =
-            verilator_harness::ondemand::tri_shader(&hdl_gen::Options { fe_i0: golden::frontend::I0Form::Reciprocal, ..opts.clone() })
+            verilator_harness::registry::tri_shader(&hdl_gen::Options { fe_i0: golden::frontend::I0Form::Reciprocal, ..opts.clone() })
                 .unwrap_or_else(|e| panic!("{e}"));
         for area in [10.0, 100.0, 1000.0] {
             let mut rng = SeedRng::seed_from_u64(1);

@@ -6,9 +6,10 @@
 use golden::setup::Screen;
 use golden::{Align, Config};
 use std::sync::OnceLock;
-use verilator_harness::ffi::{ModelInfo, SegIn, SegOut, StepFn, RTL_DIR, SEGMENT_MODELS};
+use verilator_harness::ffi::{ModelInfo, SegIn, SegOut, StepFn};
 use verilator_harness::models::Kind;
 use verilator_harness::ondemand::{self, Outcome};
+use verilator_harness::registry::SEGMENT_MODELS;
 use verilator_harness::segment::{assert_clean, Report, SegmentCosim, Traffic};
 use verilator_harness::stimulus::random_triangle;
 
@@ -18,12 +19,12 @@ fn options() -> hdl_gen::Options {
     hdl_gen::Options { cfg: Config::new(2, 10, 12, Align::Span).expect("a valid configuration"), ..Default::default() }
 }
 
-/// Whether this build asks models of `ondemand` (under a build-time COSIM_RTL_DIR it hands out the
-/// folder's models only); says so on stderr when it does not.
+/// Whether this run asks models of `ondemand` (under COSIM_RTL_DIR it hands out the folder's
+/// models only); says so on stderr when it does not.
 fn on_demand(what: &str) -> bool {
-    if let Some(dir) = RTL_DIR {
+    if let Some(dir) = verilator_harness::registry::rtl_dir() {
         use std::io::Write;
-        let _ = writeln!(std::io::stderr().lock(), "{what}: skipped: COSIM_RTL_DIR={dir} provides the models");
+        let _ = writeln!(std::io::stderr().lock(), "{what}: skipped: COSIM_RTL_DIR={} provides the models", dir.display());
         return false;
     }
     true
@@ -62,7 +63,7 @@ fn a_configuration_outside_the_catalogue_is_built_runs_bit_exact_and_is_cached()
 fn built_and_bit_exact() {
     let m = ondemand::describe(&options(), Kind::Segment).expect("the model of p = 2, frac 10");
     assert!(SEGMENT_MODELS.iter().all(|c| c.identity() != m.identity()), "{}: the catalogue has it, pick another", m.tag);
-    let info = ondemand::segment(&options()).unwrap_or_else(|e| panic!("{e}"));
+    let info = verilator_harness::registry::segment(&options()).unwrap_or_else(|e| panic!("{e}"));
     assert_eq!((info.tag, info.top, info.cfg), ("seg_p2_span_f10", "segment_shader_p2", options().cfg));
     let seed = verilator_harness::seed("ondemand::a_configuration_outside_the_catalogue");
     let report = run(info, seed, 200);
@@ -84,8 +85,8 @@ fn second_ask_loads_from_the_cache() {
     assert_eq!((&again, outcome), (&so, Outcome::Cached), "the second ask rebuilt it");
     assert_eq!(std::fs::metadata(&so).and_then(|f| f.modified()).expect("the shared object"), built, "rewritten");
     // Loaded once per process: the same ModelInfo.
-    let a = ondemand::segment(&options()).unwrap_or_else(|e| panic!("{e}"));
-    let b = ondemand::segment(&options()).unwrap_or_else(|e| panic!("{e}"));
+    let a = verilator_harness::registry::segment(&options()).unwrap_or_else(|e| panic!("{e}"));
+    let b = verilator_harness::registry::segment(&options()).unwrap_or_else(|e| panic!("{e}"));
     assert!(std::ptr::eq(a, b));
     // Another configuration is another cache entry (and would be built on its own).
     let other = hdl_gen::Options { cfg: Config::new(2, 11, 12, Align::Span).expect("valid"), ..Default::default() };
@@ -100,15 +101,15 @@ fn the_catalogue_answers_what_it_has() {
     }
     for (p, align) in [(8, Align::Span), (1, Align::Screen), (64, Align::Span)] {
         let opts = ondemand::options(p, align, None).expect("a valid configuration");
-        let found = ondemand::segment(&opts).unwrap_or_else(|e| panic!("{e}"));
+        let found = verilator_harness::registry::segment(&opts).unwrap_or_else(|e| panic!("{e}"));
         let compiled = SEGMENT_MODELS.iter().find(|m| m.tag == format!("seg_p{p}_{align}")).expect("in the catalogue");
         assert!(std::ptr::eq(found, compiled), "seg_p{p}_{align}: {} was loaded, not the catalogue's", found.tag);
     }
     // The pipelined ones too, and the front-end's chain on its default screen.
     let opts = hdl_gen::Options { pipeline: golden::pipeline::Pipeline::at(1), ..Default::default() };
-    assert_eq!(ondemand::segment(&opts).map(|m| m.tag).unwrap_or_else(|e| panic!("{e}")), "seg_p8_span_pl1");
+    assert_eq!(verilator_harness::registry::segment(&opts).map(|m| m.tag).unwrap_or_else(|e| panic!("{e}")), "seg_p8_span_pl1");
     let opts = ondemand::options(8, Align::Span, Some(Screen::default())).expect("valid");
-    assert_eq!(ondemand::tri_shader(&opts).map(|m| m.tag).unwrap_or_else(|e| panic!("{e}")), "tris_p8_span");
+    assert_eq!(verilator_harness::registry::tri_shader(&opts).map(|m| m.tag).unwrap_or_else(|e| panic!("{e}")), "tris_p8_span");
 }
 
 #[test]
@@ -141,10 +142,50 @@ fn a_relative_cosim_rtl_dir_is_found_from_the_workspace_root() {
     assert_eq!(resolve_rtl_dir(Path::new("rtl"), root, package), root.join("rtl"));
     // The folder's models, described from it, are the catalogue's circuits: checking an
     // unmodified generate folder builds nothing.
-    let manifest = verilator_harness::models::catalogue::read_manifest(&rtl);
+    let manifest = verilator_harness::models::catalogue::read_manifest(&rtl).unwrap_or_else(|e| panic!("{e}"));
     let models = verilator_harness::models::catalogue::models_from_dir(&rtl, &manifest).unwrap_or_else(|e| panic!("{e}"));
     let seg = models.iter().find(|m| m.kind == Kind::Segment && m.axis.is_none()).expect("rtl/ has a segment shader");
     if on_demand("ondemand: rtl/ against the catalogue") {
         assert!(SEGMENT_MODELS.iter().any(|c| c.identity() == seg.identity()), "rtl/'s {} is not the catalogue's", seg.tag);
     }
+}
+
+/// The binaries read COSIM_RTL_DIR when they run (the crate is built without it): `cosim` on a
+/// folder of p = 2 runs that folder's shader, relative paths included (from the process's folder,
+/// else from the workspace's root), and refuses, exit status 2 in one line, what the folder does
+/// not have (the default p = 8: the negative control that the folder, not the catalogue, was
+/// used) and a folder that does not exist. The folder's shader is the catalogue's circuit, so
+/// nothing is built: a few tenths of a second.
+#[test]
+fn cosim_reads_cosim_rtl_dir_when_it_runs() {
+    use std::process::Command;
+    let package = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    let root = package.parent().expect("the workspace");
+    let dir = std::env::temp_dir().join(format!("ondemand-{}-rtl-dir", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    let opts = ondemand::options(2, Align::Span, None).expect("valid");
+    for f in hdl_gen::generate(&opts) {
+        std::fs::create_dir_all(dir.join(&f.name).parent().expect("a folder")).unwrap();
+        std::fs::write(dir.join(&f.name), &f.contents).unwrap();
+    }
+    let cosim = |cwd: &std::path::Path, rtl: &std::path::Path, args: &[&str]| {
+        Command::new(env!("CARGO_BIN_EXE_cosim")).current_dir(cwd).env("COSIM_RTL_DIR", rtl).args(args).output().unwrap()
+    };
+    // From the folder's parent (relative to the process's folder) and, for rtl/, from the package's
+    // folder where no rtl/ is (relative to the workspace's root).
+    let name = std::path::Path::new(dir.file_name().expect("a name"));
+    for (cwd, rtl, p) in [(dir.parent().expect("temp"), name, "2"), (package, std::path::Path::new("rtl"), "8")] {
+        let out = cosim(cwd, rtl, &["--p", p, "--triangles", "5", "--seed", "1"]);
+        let stdout = String::from_utf8_lossy(&out.stdout);
+        assert!(out.status.success(), "{}: {stdout}{}", rtl.display(), String::from_utf8_lossy(&out.stderr));
+        assert!(stdout.contains(&format!("model seg_p{p}_span")) && stdout.contains("5 passed, 0 failed"), "{stdout}");
+    }
+    assert!(root.join("rtl").is_dir());
+    for (rtl, needle) in [(dir.as_path(), "has no such Segment model (it has: seg_p2_span)"), (&dir.join("missing"), "no such folder")] {
+        let out = cosim(package, rtl, &["--triangles", "5"]);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{err}");
+        assert!(err.contains(needle) && err.lines().count() == 1 && out.stdout.is_empty(), "{err}");
+    }
+    let _ = std::fs::remove_dir_all(&dir);
 }

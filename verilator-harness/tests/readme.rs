@@ -233,7 +233,7 @@ fn the_parser_finds_commands_joins_continuations_and_drops_comments() {
 
 #[test]
 fn every_readme_command_runs() {
-    if verilator_harness::ffi::RTL_DIR.is_some() {
+    if verilator_harness::registry::rtl_dir().is_some() {
         eprintln!("readme: skipped under COSIM_RTL_DIR: the README's commands name the default models");
         return;
     }
@@ -296,7 +296,7 @@ fn files_under(dir: &Path, base: &Path, out: &mut Vec<PathBuf>) {
 /// command makes today (`render` and `report` are deterministic).
 #[test]
 fn the_documents_commands_run_and_remake_the_committed_files() {
-    if verilator_harness::ffi::RTL_DIR.is_some() {
+    if verilator_harness::registry::rtl_dir().is_some() {
         eprintln!("readme: the documents' commands skipped under COSIM_RTL_DIR: they name the default models");
         return;
     }

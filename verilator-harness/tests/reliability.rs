@@ -18,9 +18,8 @@ use golden::setup::{triangle_spans, Screen, Triangle, Vertex, COORD_LIMIT};
 use golden::specular::{SpecularSpan, N_BITS};
 use golden::{Config, Span, SpanError};
 use rand::{Rng, SeedableRng};
-use verilator_harness::ffi::{
-    require_models, require_specular_model, specular_unit, to_port, ModelInfo, Rtl, SegIn, SegOut, SpecIn, SpecOut, RTL_DIR, SEGMENT_MODELS,
-};
+use verilator_harness::ffi::{to_port, ModelInfo, Rtl, SegIn, SegOut, SpecIn, SpecOut};
+use verilator_harness::registry::{require_models, require_specular_model, specular_unit, SEGMENT_MODELS};
 use verilator_harness::segment::{assert_clean, Report, SegmentCosim, SpanRejected, Stim, Stress, Traffic};
 use verilator_harness::specular::{random_span, SpecSpanRejected, SpecularCosim};
 use verilator_harness::stimulus::{directed, random_triangle};
@@ -72,7 +71,7 @@ fn enough_stress(report: &Report, rounds: u32, min_rounds: u32, min_resets: u64)
 
 #[test]
 fn segment_shaders_survive_resets_stalls_and_gaps() {
-    let Some(models) = require_models(SEGMENT_MODELS, "segment shader", "reliability: segment shaders under stress") else { return };
+    let Some(models) = require_models(&SEGMENT_MODELS, "segment shader", "reliability: segment shaders under stress") else { return };
     let seed = verilator_harness::seed("segment_shaders_survive_resets_stalls_and_gaps");
     let screen = Screen::default();
     for (m, info) in models.iter().enumerate() {
@@ -185,7 +184,7 @@ fn specular_unit_survives_resets_stalls_and_gaps() {
 /// stays there, unchanged, until taken.
 #[test]
 fn out_valid_does_not_wait_for_out_ready() {
-    for info in SEGMENT_MODELS {
+    for info in SEGMENT_MODELS.iter() {
         let cfg = info.cfg;
         let mut rtl = Rtl::new(info, 11);
         let mut out = SegOut::default();
@@ -304,7 +303,7 @@ impl<'a, I: Iterator<Item = &'a bool>> PositionsFalse for I {
 /// and returns before the first clock; `stream` panics with the same message.
 #[test]
 fn harness_rejects_spans_the_rtl_cannot_take() {
-    for info in SEGMENT_MODELS {
+    for info in SEGMENT_MODELS.iter() {
         let cfg = info.cfg;
         let max = cfg.max_len();
         let good = Span { x0: 0, len: 4, i0: 0, di: 0 };
@@ -373,10 +372,11 @@ fn extreme_triangles_are_clipped_not_garbled() {
     let mut rng = SeedRng::seed_from_u64(seed);
     let l = COORD_LIMIT;
     // Three widths at level 0 with native ports bound a default build's time (the spans are the
-    // point here, and every model sees them in the random slices); a COSIM_RTL_DIR build runs
+    // point here, and every model sees them in the random slices); a COSIM_RTL_DIR run runs
     // what it has.
     let base = |m: &&ModelInfo<SegIn, SegOut>| m.pipeline == Pipeline::default() && !m.tag.ends_with("_axis");
-    for info in SEGMENT_MODELS.iter().filter(|m| (base(m) && matches!(m.cfg.p, 1 | 8 | 64)) || RTL_DIR.is_some()) {
+    let folder = verilator_harness::registry::rtl_dir().is_some();
+    for info in SEGMENT_MODELS.iter().filter(|m| (base(m) && matches!(m.cfg.p, 1 | 8 | 64)) || folder) {
         let wide = Screen { width: info.cfg.max_len(), height: 64 };
         for screen in [Screen::default(), wide] {
             let mut tris = vec![

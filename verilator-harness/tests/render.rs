@@ -10,7 +10,7 @@ use golden::Align;
 use rand::{Rng, SeedableRng};
 use std::path::{Path, PathBuf};
 use std::process::Command;
-use verilator_harness::ffi::{default_model_args, require_segment_model, require_specular_model, RTL_DIR, SEGMENT_MODELS};
+use verilator_harness::registry::{default_model_args, require_segment_model, require_specular_model, SEGMENT_MODELS};
 use verilator_harness::render::{run, scene_job, triangles_job_of, SceneKind, BACKGROUND};
 
 const SCREEN: Screen = Screen { width: 64, height: 64 };
@@ -77,7 +77,7 @@ fn triangle_files_follow_the_fill_rule_exactly() {
     let mut models: Vec<_> =
         wanted.iter().filter_map(|&(p, a)| require_segment_model(p, a, &format!("render: triangle files on p = {p} {a}"))).collect();
     // A COSIM_RTL_DIR build also runs the folder's own shader, whatever its p and alignment.
-    if RTL_DIR.is_some() {
+    if verilator_harness::registry::rtl_dir().is_some() {
         models.extend(SEGMENT_MODELS.iter().filter(|m| !wanted.contains(&(m.cfg.p, m.cfg.align))));
     }
     for info in models {

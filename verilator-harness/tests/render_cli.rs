@@ -4,7 +4,7 @@
 use golden::Align;
 use std::path::PathBuf;
 use std::process::{Command, Output};
-use verilator_harness::ffi::{require, require_segment_model, require_specular_model, TRISHADER_MODELS};
+use verilator_harness::registry::{require, require_segment_model, require_specular_model, TRISHADER_MODELS};
 
 fn render(args: &[&str]) -> Output {
     let out = Command::new(env!("CARGO_BIN_EXE_render")).args(args).output().expect("render runs");

@@ -7,7 +7,7 @@ use golden::rng::SeedRng;
 use golden::setup::Screen;
 use golden::Span;
 use rand::{Rng, SeedableRng};
-use verilator_harness::ffi::{require, SEGMENT_MODELS};
+use verilator_harness::registry::{require, SEGMENT_MODELS};
 use verilator_harness::segment::{assert_clean, Report, SegmentCosim, Stim, Traffic, DRAIN_CLOCKS};
 use verilator_harness::soak;
 use verilator_harness::stimulus::{directed, random_triangle};
@@ -47,10 +47,11 @@ fn random_slice(tag: &str, k: u32) {
     );
 }
 
-/// `segment::random_triangles::<model>::slice_<k>`: one module per segment-shader model this
-/// build has (build.rs lists them), one test per soak slice.
+/// `segment::random_triangles::<model>::slice_<k>`: one module per segment-shader model of the
+/// compiled catalogue (build.rs lists them), one test per soak slice; and `SLICED`, their tags.
 macro_rules! random_triangle_slices {
     ($($tag:ident),* $(,)?) => {
+        const SLICED: &[&str] = &[$(stringify!($tag)),*];
         mod random_triangles {
             $(
                 mod $tag {
@@ -62,13 +63,26 @@ macro_rules! random_triangle_slices {
 }
 include!(concat!(env!("OUT_DIR"), "/segment_slices.rs"));
 
+/// The shaders of a COSIM_RTL_DIR run whose tags the catalogue has no slice tests for (a folder
+/// of another P, or another F: `seg_p8_span` of `--frac 12` is the catalogue's tag with another
+/// circuit, and runs in its slices above), every slice in turn. None in a default run.
+#[test]
+fn random_triangles_of_other_models() {
+    for info in SEGMENT_MODELS.iter().filter(|m| !SLICED.contains(&m.tag)) {
+        assert!(verilator_harness::registry::rtl_dir().is_some(), "{}: a catalogue model without slice tests", info.tag);
+        for k in 0..soak::SLICES {
+            random_slice(info.tag, k);
+        }
+    }
+}
+
 /// Each directed case on its own frame, on the default screen and on the widest screen the
 /// configuration allows (so spans reach x = 2^XW - 1). The wide screen is 16 rows high: its
 /// point is the width, and each row of its screen-covering triangle costs 2^XW / P clocks.
 #[test]
 fn directed_triangles_every_model() {
     let seed = verilator_harness::seed("directed_triangles_every_model");
-    for info in SEGMENT_MODELS {
+    for info in SEGMENT_MODELS.iter() {
         let wide = Screen { width: info.cfg.max_len(), height: 16 };
         for screen in [Screen::default(), wide] {
             let mut sim = SegmentCosim::new(info, seed, Traffic::RANDOM);
@@ -85,7 +99,7 @@ fn directed_triangles_every_model() {
 #[test]
 fn spans_reaching_the_last_column() {
     let seed = verilator_harness::seed("spans_reaching_the_last_column");
-    for info in SEGMENT_MODELS {
+    for info in SEGMENT_MODELS.iter() {
         let cfg = info.cfg;
         let end = cfg.max_len();
         let stims: Vec<Stim> = (1..=3 * cfg.p + 1)
@@ -110,7 +124,7 @@ fn spans_reaching_the_last_column() {
 fn zero_length_spans_yield_nothing() {
     let seed = verilator_harness::seed("zero_length_spans_yield_nothing");
     let mut rng = SeedRng::seed_from_u64(seed);
-    for info in SEGMENT_MODELS {
+    for info in SEGMENT_MODELS.iter() {
         let cfg = info.cfg;
         let stims: Vec<Stim> = (0..400)
             .map(|k| {
@@ -136,7 +150,7 @@ fn zero_length_spans_yield_nothing() {
 fn one_segment_per_clock_at_full_rate() {
     let seed = verilator_harness::seed("one_segment_per_clock_at_full_rate");
     let mut rng = SeedRng::seed_from_u64(seed);
-    for info in SEGMENT_MODELS {
+    for info in SEGMENT_MODELS.iter() {
         let cfg = info.cfg;
         let stims: Vec<Stim> = (0..300)
             .map(|k| {

@@ -7,7 +7,8 @@ use golden::rng::SeedRng;
 use golden::specular::reference::epicentre;
 use golden::specular::{n_valid, theta_at, SpecularSpan, THETA_FRAC};
 use rand::{Rng, SeedableRng};
-use verilator_harness::ffi::{require_models, require_specular_model, specular_unit, ModelInfo, SpecIn, SpecOut, SPECULAR_MODELS};
+use verilator_harness::ffi::{ModelInfo, SpecIn, SpecOut};
+use verilator_harness::registry::{require_models, require_specular_model, specular_unit, SPECULAR_MODELS};
 use verilator_harness::segment::{assert_clean, Report, Traffic, DRAIN_CLOCKS};
 use verilator_harness::soak;
 use verilator_harness::specular::{random_span, SpecularCosim};
@@ -24,7 +25,7 @@ fn model(what: &str) -> Option<&'static ModelInfo<SpecIn, SpecOut>> {
 
 /// Every specular model built: SPEC's seed structure and each `--pipeline` form.
 fn models(what: &str) -> &'static [ModelInfo<SpecIn, SpecOut>] {
-    require_models(SPECULAR_MODELS, "specular unit", &format!("specular: {what}")).unwrap_or_default()
+    require_models(&SPECULAR_MODELS, "specular unit", &format!("specular: {what}")).unwrap_or_default()
 }
 
 /// Slice `k` of the random spans, for every specular model: exactly its [`soak::share`] of

@@ -1,10 +1,10 @@
 //! Waveforms ([`verilator_harness::waveform`]): a planted fault's mismatch names an FST file of
 //! the failing window and its clock, and the file parses and holds the top-level ports around
-//! that clock; `cosim --trace` writes a whole run, and refuses a model with no traced twin.
+//! that clock; `cosim --trace` writes a whole run, and refuses a folder it cannot make.
 //!
 //! The fault is planted at the FFI: a copy of `seg_p2_span`'s model whose step flips a pixel bit
-//! of one output transfer, with the real model's traced twin (every default build has that one
-//! twin, so this costs no extra verilating). The mutant through COSIM_RTL_DIR, a real RTL
+//! of one output transfer, with the real model's traced twin (built on demand the first time,
+//! a few seconds, then cached under target/). The mutant through COSIM_RTL_DIR, a real RTL
 //! fault replayed into its own twin, is `scripts/check-rtl-dir --trace`.
 
 use golden::rng::SeedRng;
@@ -17,7 +17,8 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::sync::atomic::{AtomicU32, Ordering};
 use std::sync::OnceLock;
-use verilator_harness::ffi::{require, require_segment_model, ModelInfo, SegIn, SegOut, SEGMENT_MODELS};
+use verilator_harness::ffi::{ModelInfo, SegIn, SegOut};
+use verilator_harness::registry::require_segment_model;
 use verilator_harness::segment::{Report, SegmentCosim, Stim, Stress, Traffic};
 use verilator_harness::stimulus::random_triangle;
 use verilator_harness::waveform::{check_fst, AFTER, BEFORE, TIME_PER_CLOCK};
@@ -45,10 +46,12 @@ unsafe extern "C" fn flipped_step(h: *mut c_void, i: *const SegIn, o: *mut SegOu
     }
 }
 
-/// `seg_p2_span` with its traced twin, for a test that needs them (see `ffi::require`).
+/// `seg_p2_span` with its traced twin (built on demand the first time, then cached), for a test
+/// that needs them (see `ffi::require`).
 fn traced_p2(what: &str) -> Option<&'static ModelInfo<SegIn, SegOut>> {
     let info = require_segment_model(2, Align::Span, what)?;
-    require(info.traced.as_ref().map(|_| info), "traced seg_p2_span", what)
+    verilator_harness::ondemand::require_traced(info).unwrap_or_else(|e| panic!("{what}: {e}"));
+    Some(info)
 }
 
 fn scratch(name: &str) -> PathBuf {
@@ -230,8 +233,8 @@ fn planted_fault(mutant: &'static ModelInfo<SegIn, SegOut>, seed: u64, stress: S
 
 const COSIM: &str = env!("CARGO_BIN_EXE_cosim");
 
-/// `cosim --trace DIR` writes the whole run of a model with a twin from its first clock, and
-/// refuses, with exit status 2 and one message, a model without one.
+/// `cosim --trace DIR` writes the whole run of a model's twin from its first clock, and refuses,
+/// with exit status 2 and one message, a DIR it cannot make.
 #[test]
 fn cosim_trace_writes_the_whole_run() {
     let Some(info) = traced_p2("waveforms: cosim --trace") else { return };
@@ -249,13 +252,13 @@ fn cosim_trace_writes_the_whole_run() {
     assert_eq!((ports.first, ports.last), (0, cycles + 2 - 1), "every clock of the run");
     assert_eq!(ports.value("rst", 0), Some(1));
 
-    // A model without a twin (every other one in a build without COSIM_TRACE).
-    let Some(untraced) = SEGMENT_MODELS.iter().find(|m| m.traced.is_none()) else { return };
-    let (p, align) = (untraced.cfg.p.to_string(), untraced.cfg.align.to_string());
-    let out = Command::new(COSIM).args(["--p", &p, "--align", &align, "--triangles", "1", "--trace"]).arg(&dir).output().unwrap();
+    // Negative control: DIR under a regular file cannot be made.
+    let file = dir.join("a-file");
+    std::fs::write(&file, "x").unwrap();
+    let out = Command::new(COSIM).args(["--p", "2", "--triangles", "1", "--trace"]).arg(file.join("waves")).output().unwrap();
     let err = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(2), "{err}");
-    assert!(err.starts_with("error: --trace: this build has no traced model of") && err.contains("COSIM_TRACE"), "{err}");
+    assert!(err.starts_with("error: --trace: ") && err.contains("a-file") && err.lines().count() == 1, "{err}");
     assert!(out.stdout.is_empty());
     let _ = std::fs::remove_dir_all(&dir);
 }

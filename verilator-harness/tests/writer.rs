@@ -9,8 +9,9 @@ use golden::setup::Screen;
 use golden::writer::Writer;
 use golden::Span;
 use rand::{Rng, SeedableRng};
-use verilator_harness::ffi::{require_models, Rtl, WrIn, WrOut, TRIWRITER_MODELS, WRITER_MODELS};
+use verilator_harness::ffi::{Rtl, WrIn, WrOut};
 use verilator_harness::frontend::{mesh, random_triangles};
+use verilator_harness::registry::{require_models, TRIWRITER_MODELS, WRITER_MODELS};
 use verilator_harness::segment::{assert_clean, Stress, Traffic};
 use verilator_harness::writer::{run_fb, run_writer, run_writer_against};
 
@@ -62,7 +63,7 @@ fn writer_of(m: &verilator_harness::ffi::ModelInfo<WrIn, WrOut>) -> Writer {
 #[test]
 fn writes_equal_golden_under_memory_stalls() {
     let seed = verilator_harness::seed("writer writes");
-    let Some(models) = require_models(WRITER_MODELS, "fb_writer", "writer writes") else { return };
+    let Some(models) = require_models(&WRITER_MODELS, "fb_writer", "writer writes") else { return };
     for m in models {
         let w = writer_of(m);
         let spans = random_spans(&mut SeedRng::seed_from_u64(seed ^ m.cfg.p as u64), &w, 4000);
@@ -83,7 +84,7 @@ fn writes_equal_golden_under_memory_stalls() {
 #[test]
 fn one_write_per_clock_at_full_rate() {
     let seed = verilator_harness::seed("writer rate");
-    let Some(models) = require_models(WRITER_MODELS, "fb_writer", "writer rate") else { return };
+    let Some(models) = require_models(&WRITER_MODELS, "fb_writer", "writer rate") else { return };
     for m in models {
         let w = writer_of(m);
         let spans = random_spans(&mut SeedRng::seed_from_u64(seed), &w, 2000);
@@ -101,7 +102,7 @@ fn one_write_per_clock_at_full_rate() {
 #[test]
 fn the_scoreboard_catches_a_wrong_writer() {
     let seed = verilator_harness::seed("writer negative control");
-    let Some(models) = require_models(WRITER_MODELS, "fb_writer", "writer negative control") else { return };
+    let Some(models) = require_models(&WRITER_MODELS, "fb_writer", "writer negative control") else { return };
     for m in models {
         let w = writer_of(m);
         let spans = random_spans(&mut SeedRng::seed_from_u64(seed), &w, 300);
@@ -119,7 +120,7 @@ fn the_scoreboard_catches_a_wrong_writer() {
 /// written after the reset, and the next span is written as golden says.
 #[test]
 fn a_reset_drops_a_pending_tail() {
-    let Some(models) = require_models(WRITER_MODELS, "fb_writer", "writer reset") else { return };
+    let Some(models) = require_models(&WRITER_MODELS, "fb_writer", "writer reset") else { return };
     for m in models.iter().filter(|m| m.cfg.p > 1 && m.cfg.align == golden::Align::Span) {
         let w = writer_of(m);
         let p = m.cfg.p;
@@ -185,7 +186,7 @@ fn frontend(m: &verilator_harness::ffi::ModelInfo<verilator_harness::ffi::TriIn,
 #[test]
 fn triangles_to_memory_equal_golden_and_the_f64_reference() {
     let seed = verilator_harness::seed("tri_fb");
-    let Some(models) = require_models(TRIWRITER_MODELS, "tri_fb", "tri_fb frames") else { return };
+    let Some(models) = require_models(&TRIWRITER_MODELS, "tri_fb", "tri_fb frames") else { return };
     for m in models {
         let fe = frontend(m);
         let mut rng = SeedRng::seed_from_u64(seed ^ m.cfg.p as u64);
@@ -201,7 +202,7 @@ fn triangles_to_memory_equal_golden_and_the_f64_reference() {
 #[test]
 fn a_shared_edge_mesh_lands_in_memory_once_per_pixel() {
     let seed = verilator_harness::seed("tri_fb mesh");
-    let Some(models) = require_models(TRIWRITER_MODELS, "tri_fb", "tri_fb mesh") else { return };
+    let Some(models) = require_models(&TRIWRITER_MODELS, "tri_fb", "tri_fb mesh") else { return };
     for m in models {
         let fe = frontend(m);
         let tris: Vec<FixedTriangle> = mesh(&mut SeedRng::seed_from_u64(seed), &fe, 13, 9);
@@ -216,10 +217,10 @@ fn a_shared_edge_mesh_lands_in_memory_once_per_pixel() {
 /// model equals golden's in every pixel, with the hidden surfaces hidden.
 #[test]
 fn scenes_render_into_memory_as_golden() {
-    use verilator_harness::ffi::require;
+    use verilator_harness::registry::require;
     use verilator_harness::render::{run_with, scene_job, Chain, SceneKind};
     let what = "render into memory";
-    let Some(seg) = verilator_harness::ffi::require_segment_model(8, golden::Align::Span, what) else { return };
+    let Some(seg) = verilator_harness::registry::require_segment_model(8, golden::Align::Span, what) else { return };
     let Some(wr) = require(WRITER_MODELS.iter().find(|m| m.cfg.p == 8 && m.cfg.align == golden::Align::Span), "wr_p8_span", what) else {
         return;
     };
@@ -228,7 +229,8 @@ fn scenes_render_into_memory_as_golden() {
         return;
     };
     for chain in [Chain::HostToMemory(wr), Chain::RtlToMemory(fb)] {
-        let job = scene_job(SceneKind::Torus, 40, &seg.cfg, &Screen::default()).unwrap();
+        // On the chain's own screen (a COSIM_RTL_DIR folder's may be another than 640x480).
+        let job = scene_job(SceneKind::Torus, 40, &seg.cfg, &fb.screen).unwrap();
         let o = run_with(&job, seg, chain, None, |_| {});
         let first = o.segment.iter().chain(&o.writer).flat_map(|r| &r.mismatches).next();
         assert!(o.cosim_ok(), "{first:?}");

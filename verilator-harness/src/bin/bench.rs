@@ -38,8 +38,9 @@ use std::io::{BufReader, Read};
 use std::path::PathBuf;
 use std::process::ExitCode;
 use std::time::Instant;
-use verilator_harness::ffi::{segment_model, specular_unit, to_port, SPECULAR_MODELS};
+use verilator_harness::ffi::to_port;
 use verilator_harness::ondemand;
+use verilator_harness::registry::{segment_model, specular_unit, SPECULAR_MODELS};
 use verilator_harness::segment::{Report, SegmentCosim, Stim};
 use verilator_harness::specular::{random_span, SpecularCosim};
 use verilator_harness::stimulus::random_triangle;
@@ -111,7 +112,13 @@ enum Cmd {
 type Bad = String;
 
 fn main() -> ExitCode {
-    let run = match Args::parse().cmd {
+    let args = Args::parse();
+    // A COSIM_RTL_DIR that describes no models is a usage error, said before anything runs.
+    if let Err(e) = verilator_harness::registry::check_folder() {
+        eprintln!("error: {e}");
+        return ExitCode::from(2);
+    }
+    let run = match args.cmd {
         Cmd::Gen { design, p, spans, seed, traffic, out } => {
             let traffic = match traffic {
                 TrafficArg::Random => Traffic::RANDOM,
@@ -310,11 +317,13 @@ fn segment_spans(cfg: &golden::Config, count: u32, seed: u64, mut f: impl FnMut(
 }
 
 fn gen_segment(p: u32, count: u32, seed: u64, traffic: Traffic, out: &std::path::Path) -> Result<ExitCode, Bad> {
-    let info = ondemand::options(p, Align::Span, None).and_then(|o| ondemand::segment(&o)).map_err(|e| format!("--p {p}: {e}"))?;
-    let cfg = info.cfg;
+    let opts = ondemand::options(p, Align::Span, None).map_err(|e| format!("--p {p}: {e}"))?;
     let rec = seg_record_bytes(p);
-    // Every span yields at least one record.
+    // Every span yields at least one record. A bad --out is refused before the model is asked
+    // for (which may take a build, or not exist in a COSIM_RTL_DIR run).
     check_out(out, count, (HEADER + 24) as u64 + (32 + rec as u64) * count as u64)?;
+    let info = verilator_harness::registry::segment(&opts).map_err(|e| format!("--p {p}: {e}"))?;
+    let cfg = info.cfg;
     let mut outputs = 0u64;
     segment_spans(&cfg, count, seed, |s| {
         outputs += cfg.segment_count(s.span.x0, s.span.len) as u64;
@@ -458,7 +467,7 @@ fn harness(path: &std::path::Path, limit: usize) -> Result<ExitCode, Bad> {
     let (tag, (secs, cpu)) = match h.design {
         0 => {
             let info = ondemand::options(h.p, Align::Span, None)
-                .and_then(|o| ondemand::segment(&o))
+                .and_then(|o| verilator_harness::registry::segment(&o))
                 .map_err(|e| format!("{}: the segment shader for p = {}: {e}", path.display(), h.p))?;
             if h.dw != info.cfg.dw() {
                 return Err(format!("{}: in_di is {} bits in the file, {} in {}", path.display(), h.dw, info.cfg.dw(), info.tag));

@@ -5,14 +5,15 @@
 use clap::{Parser, ValueEnum};
 use golden::rng::SeedRng;
 use golden::setup::Screen;
-use golden::Align;
+use hdl_gen::cli::ModelArgs;
 use rand::SeedableRng;
 use std::path::PathBuf;
 use std::process::ExitCode;
 use std::time::Instant;
-use verilator_harness::ffi::{specular_unit, ModelInfo, SPECULAR_MODELS};
+use verilator_harness::ffi::ModelInfo;
 use verilator_harness::frontend::{random_triangles, run_chain_at};
 use verilator_harness::ondemand;
+use verilator_harness::registry::unit_of;
 use verilator_harness::segment::{Report, SegmentCosim, Traffic};
 use verilator_harness::specular::{random_span, SpecularCosim};
 use verilator_harness::stimulus::random_triangle;
@@ -48,12 +49,10 @@ impl TrafficArg {
 #[derive(Parser)]
 #[command(about = "Co-simulate the generated segment shader against the golden model", allow_negative_numbers = true)]
 struct Args {
-    /// Segment width of the model to run.
-    #[arg(long, default_value_t = 8)]
-    p: u32,
-    /// Segmentation of the model to run.
-    #[arg(long, value_enum, default_value_t = Align::Span)]
-    align: Align,
+    // The model to run: any configuration `generate` accepts, by the same flags (the compiled
+    // catalogue's model when it has it, else built the first time, then cached).
+    #[command(flatten)]
+    model: ModelArgs,
     /// Random triangles to stream.
     #[arg(long, default_value_t = 10_000)]
     triangles: usize,
@@ -87,8 +86,8 @@ struct Args {
     pixels: u64,
     /// Write every clock of the run into FST files in DIR (`<model>-seed<seed>.fst`, one per model
     /// instance), for GTKWave or Surfer. For small runs: about 45 bytes per clock for
-    /// seg_p8_span, 27 for the specular unit, and a run 4 to 8 times slower (docs/regressions.md). Needs
-    /// traced models (built when COSIM_TRACE is set at build time).
+    /// seg_p8_span, 27 for the specular unit, and a run 4 to 8 times slower (docs/regressions.md). The
+    /// models' traced twins are built first, the first time (seconds each), then cached.
     #[arg(long, value_name = "DIR")]
     trace: Option<PathBuf>,
 }
@@ -97,7 +96,7 @@ struct Args {
 /// status 2 when `info` has no traced twin in this build or DIR cannot be made.
 fn start_trace<I, O>(args: &Args, info: &ModelInfo<I, O>) -> Result<(), ExitCode> {
     let Some(dir) = &args.trace else { return Ok(()) };
-    info.require_traced().and_then(|()| waveform::trace_everything(dir)).map_err(|e| {
+    ondemand::require_traced(info).and_then(|()| waveform::trace_everything(dir)).map_err(|e| {
         eprintln!("error: --trace: {e}");
         ExitCode::from(2)
     })
@@ -118,17 +117,22 @@ enum Frontend {
 
 fn main() -> ExitCode {
     let args = Args::parse();
+    // A COSIM_RTL_DIR that describes no models is a usage error, said before anything runs.
+    if let Err(e) = verilator_harness::registry::check_folder() {
+        eprintln!("error: {e}");
+        return ExitCode::from(2);
+    }
     if args.specular {
         return specular(&args);
     }
     if args.frontend == Frontend::Rtl {
         return rtl_frontend(&args);
     }
-    let align = args.align;
     // The compiled catalogue's model, or one built (once, then cached) for this configuration.
-    let info = match ondemand::options(args.p, align, None).and_then(|o| ondemand::segment(&o)) {
-        Ok(info) => info,
-        Err(e) => return ondemand::exit(&format!("--p {} --align {align}", args.p), &e),
+    let info = match options(&args, None).map(|o| verilator_harness::registry::segment(&o)) {
+        Err(code) => return code,
+        Ok(Ok(info)) => info,
+        Ok(Err(e)) => return ondemand::exit(&model_flags(&args), &e),
     };
     let screen = Screen { width: args.width, height: args.height };
     if let Err(e) = screen.check_for(&info.cfg) {
@@ -183,12 +187,12 @@ fn finish(seed: u64, report: &Report, triangles: &str, spans: Option<u64>, speed
 
 /// Random triangles of every kind into `tri_shader_p<P>`; every segment, `y` and frame checked.
 fn rtl_frontend(args: &Args) -> ExitCode {
-    let align = args.align;
     // The chain on the screen asked for: the catalogue's, or built for it.
     let screen = Screen { width: args.width, height: args.height };
-    let info = match ondemand::options(args.p, align, Some(screen)).and_then(|o| ondemand::tri_shader(&o)) {
-        Ok(info) => info,
-        Err(e) => return ondemand::exit(&format!("--frontend rtl --p {} --align {align}", args.p), &e),
+    let info = match options(args, Some(screen)).map(|o| verilator_harness::registry::tri_shader(&o)) {
+        Err(code) => return code,
+        Ok(Ok(info)) => info,
+        Ok(Err(e)) => return ondemand::exit(&format!("--frontend rtl {}", model_flags(args)), &e),
     };
     if (args.width, args.height) != (info.screen.width, info.screen.height) {
         eprintln!("error: --width/--height: the front-end model draws on {}x{}", info.screen.width, info.screen.height);
@@ -232,10 +236,24 @@ fn exit_code(report: &Report) -> ExitCode {
     }
 }
 
+/// The options of the model to run (`screen`: a front-end's), or exit status 2 with the reason.
+fn options(args: &Args, screen: Option<Screen>) -> Result<hdl_gen::Options, ExitCode> {
+    args.model.options(screen).map_err(|e| {
+        eprintln!("error: {e}");
+        ExitCode::from(2)
+    })
+}
+
+/// `--p P --align A`: how a model's error names the configuration.
+fn model_flags(args: &Args) -> String {
+    format!("--p {} --align {}", args.model.seg.p, args.model.seg.align)
+}
+
 fn specular(args: &Args) -> ExitCode {
-    let Some(info) = SPECULAR_MODELS.first() else {
-        eprintln!("error: --specular: this build has no specular unit");
-        return ExitCode::from(2);
+    let info = match options(args, None).map(|o| verilator_harness::registry::specular(&o)) {
+        Err(code) => return code,
+        Ok(Ok(info)) => info,
+        Ok(Err(e)) => return ondemand::exit("--specular", &e),
     };
     if let Err(code) = start_trace(args, info) {
         return code;
@@ -244,7 +262,7 @@ fn specular(args: &Args) -> ExitCode {
     let traffic = args.traffic.traffic();
     println!("model {} ({}), seed {seed}, traffic {}", info.tag, info.top, args.traffic.name());
     let mut rng = SeedRng::seed_from_u64(seed);
-    let mut sim = SpecularCosim::new(info, specular_unit(), seed, traffic);
+    let mut sim = SpecularCosim::new(info, unit_of(info), seed, traffic);
     let mut report = Report::default();
     let start = Instant::now();
     while report.pixels < args.pixels {

@@ -8,11 +8,11 @@
 
 use clap::{ArgGroup, Parser, ValueEnum};
 use golden::setup::Screen;
-use golden::Align;
+use hdl_gen::cli::ModelArgs;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::time::Instant;
-use verilator_harness::ffi::{ModelInfo, SPECULAR_MODELS};
+use verilator_harness::ffi::ModelInfo;
 use verilator_harness::models::ModelError;
 use verilator_harness::ondemand;
 use verilator_harness::render::{busy_cycles, difference_image, obj_job, run_with, scene_job, triangles_job, Chain, Job, SceneKind};
@@ -45,12 +45,10 @@ struct Args {
     /// the faces), scaled to fill the view and lit like the scenes.
     #[arg(long, value_name = "FILE.obj")]
     obj: Option<PathBuf>,
-    /// Segment width of the shader model.
-    #[arg(long, default_value_t = 8)]
-    p: u32,
-    /// Segmentation of the shader model.
-    #[arg(long, value_enum, default_value_t = Align::Span)]
-    align: Align,
+    // The models to run: any configuration `generate` accepts, by the same flags (the compiled
+    // catalogue's when it has them, else built the first time, then cached).
+    #[command(flatten)]
+    model: ModelArgs,
     /// Image width (1..=32768; see --height).
     #[arg(long, default_value_t = 640, value_parser = clap::value_parser!(u32).range(1..=MAX_SIDE))]
     width: u32,
@@ -73,8 +71,8 @@ struct Args {
     quiet: bool,
     /// Write every clock of every model instance into FST files in DIR (`<model>-seed<seed>.fst`),
     /// for GTKWave or Surfer. For small renders (try --width 64 --height 48): tens of bytes per
-    /// clock (45 for seg_p8_span, docs/regressions.md). Needs traced models (built when
-    /// COSIM_TRACE is set at build time).
+    /// clock (45 for seg_p8_span, docs/regressions.md). The models' traced twins are
+    /// built first, the first time (seconds each), then cached.
     #[arg(long, value_name = "DIR")]
     trace: Option<PathBuf>,
 }
@@ -171,31 +169,41 @@ fn model_for<I, O>(
 
 fn main() -> ExitCode {
     let args = Args::parse();
+    // A COSIM_RTL_DIR that describes no models is a usage error, said before anything runs.
+    if let Err(e) = verilator_harness::registry::check_folder() {
+        eprintln!("error: {e}");
+        return ExitCode::from(2);
+    }
     if let Err(e) = check_args(&args) {
         return fail(e);
     }
     let start = Instant::now();
-    let align = args.align;
-    let info = match ondemand::options(args.p, align, None).and_then(|o| ondemand::segment(&o)) {
+    let (p, align) = (args.model.seg.p, args.model.seg.align);
+    let opts = match args.model.options(None) {
+        Ok(opts) => opts,
+        Err(e) => return fail(e.to_string()),
+    };
+    let info = match verilator_harness::registry::segment(&opts) {
         Ok(info) => info,
-        Err(e) => return ondemand::exit(&format!("--p {} --align {align}", args.p), &e),
+        Err(e) => return ondemand::exit(&format!("--p {p} --align {align}"), &e),
     };
     let screen = Screen { width: args.width, height: args.height };
     if let Err(e) = screen.check_for(&info.cfg) {
         return fail(format!("--width/--height: {e}"));
     }
     // The RTL blocks on this screen: the catalogue's, or built for it.
-    let on_screen = || ondemand::options(args.p, align, Some(screen));
+    let on_screen = || args.model.options(Some(screen)).map_err(|e| ModelError::Config(e.to_string()));
     let chain = match (args.frontend, args.writer) {
         (Frontend::Host, Writer::Host) => Ok(Chain::Host),
         (Frontend::Host, Writer::Rtl) => {
-            model_for(on_screen().and_then(|o| ondemand::writer(&o)), screen, "--writer rtl").map(Chain::HostToMemory)
+            model_for(on_screen().and_then(|o| verilator_harness::registry::writer(&o)), screen, "--writer rtl").map(Chain::HostToMemory)
         }
         (Frontend::Rtl, Writer::Host) => {
-            model_for(on_screen().and_then(|o| ondemand::tri_shader(&o)), screen, "--frontend rtl").map(Chain::Rtl)
+            model_for(on_screen().and_then(|o| verilator_harness::registry::tri_shader(&o)), screen, "--frontend rtl").map(Chain::Rtl)
         }
         (Frontend::Rtl, Writer::Rtl) => {
-            model_for(on_screen().and_then(|o| ondemand::tri_writer(&o)), screen, "--frontend rtl --writer rtl").map(Chain::RtlToMemory)
+            model_for(on_screen().and_then(|o| verilator_harness::registry::tri_writer(&o)), screen, "--frontend rtl --writer rtl")
+                .map(Chain::RtlToMemory)
         }
     };
     let chain = match chain {
@@ -208,9 +216,6 @@ fn main() -> ExitCode {
     let golden_path = sibling(&args.out, ".golden.png");
     let diff_path = sibling(&args.out, ".diff.png");
 
-    if (args.scene.is_some() || args.obj.is_some()) && SPECULAR_MODELS.is_empty() {
-        return fail("--scene/--obj: this build has no specular unit");
-    }
     let job = match (&args.scene, &args.triangles, &args.obj) {
         (Some(kind), _, _) => scene_job(*kind, args.shininess, &info.cfg, &screen).map_err(|e| format!("--scene {}: {e}", kind.name())),
         (None, Some(file), _) => {
@@ -225,16 +230,24 @@ fn main() -> ExitCode {
         Ok(j) => j,
         Err(e) => return fail(e),
     };
+    // A scene's or mesh's highlight: the specular unit of the same options.
+    let spec = match args.scene.is_some() || args.obj.is_some() {
+        false => None,
+        true => match verilator_harness::registry::specular(&opts) {
+            Ok(info) => Some(info),
+            Err(e) => return ondemand::exit("--scene/--obj: the specular unit", &e),
+        },
+    };
     if let Some(trace) = &args.trace {
         // The models this run builds instances of must have traced twins.
         let mut need = match chain {
-            Chain::Host => vec![info.require_traced()],
-            Chain::HostToMemory(w) => vec![info.require_traced(), w.require_traced()],
-            Chain::Rtl(m) => vec![m.require_traced()],
-            Chain::RtlToMemory(m) => vec![m.require_traced()],
+            Chain::Host => vec![ondemand::require_traced(info)],
+            Chain::HostToMemory(w) => vec![ondemand::require_traced(info), ondemand::require_traced(w)],
+            Chain::Rtl(m) => vec![ondemand::require_traced(m)],
+            Chain::RtlToMemory(m) => vec![ondemand::require_traced(m)],
         };
         if args.scene.is_some() || args.obj.is_some() {
-            need.extend(SPECULAR_MODELS.first().map(ModelInfo::require_traced));
+            need.extend(spec.map(ondemand::require_traced));
         }
         if let Err(e) = need.into_iter().collect::<Result<Vec<()>, _>>().and_then(|_| trace_everything(trace)) {
             return fail(format!("--trace: {e}"));
@@ -247,7 +260,7 @@ fn main() -> ExitCode {
         false => indicatif::ProgressBar::new(1000)
             .with_style(indicatif::ProgressStyle::with_template("rendering [{bar:40}] {percent:>3}%").expect("a valid template")),
     };
-    let outcome = run_with(&job, info, chain, SPECULAR_MODELS.first(), |f| bar.set_position((f * 1000.0) as u64));
+    let outcome = run_with(&job, info, chain, spec, |f| bar.set_position((f * 1000.0) as u64));
     bar.finish_and_clear();
 
     let channels = job.channels();
@@ -329,7 +342,12 @@ fn summary(args: &Args, job: &Job, o: &verilator_harness::render::Outcome, tag: 
     println!("pixels:     {} shaded per channel, {} visible", seg.pixels, job.visible_pixels());
     println!("RTL clocks: {cycles} ({unit}, each channel's instance)");
     if let Some(w) = o.writer.first() {
-        println!("writer:     {} block writes in {} clocks per channel (fb_writer_p{}, memory model)", w.segments, busy_cycles(w), args.p);
+        println!(
+            "writer:     {} block writes in {} clocks per channel (fb_writer_p{}, memory model)",
+            w.segments,
+            busy_cycles(w),
+            args.model.seg.p
+        );
     }
     println!("pixels per clock: {:.3}", seg.pixels as f64 / cycles.max(1) as f64);
     if let Some(s) = &o.specular {

@@ -11,15 +11,17 @@ use golden::rng::SeedRng;
 use golden::schemes::{fill, workload_count, Scheme};
 use golden::setup::{Screen, Triangle, Vertex};
 use golden::Align;
+use hdl_gen::cli::VariantArgs;
 use rand::{Rng, SeedableRng};
 use std::fmt::Write as _;
 use std::path::PathBuf;
 use std::process::ExitCode;
 use std::time::Instant;
-use verilator_harness::ffi::{ModelInfo, TriIn, TriSegOut, WrIn, WrOut, RTL_DIR, SEGMENT_MODELS, TRISHADER_MODELS, WRITER_MODELS};
+use verilator_harness::ffi::{ModelInfo, SegIn, SegOut, TriIn, TriSegOut, WrIn, WrOut};
 use verilator_harness::frontend::{drain_clocks, run_chain};
 use verilator_harness::models::{catalogue, ModelError};
 use verilator_harness::ondemand;
+use verilator_harness::registry::{self, SEGMENT_MODELS, TRISHADER_MODELS, WRITER_MODELS};
 use verilator_harness::render::{busy_cycles, scene_job, SceneKind};
 use verilator_harness::segment::Stress;
 use verilator_harness::segment::{Report, SegmentCosim, Stim, Traffic};
@@ -43,28 +45,65 @@ struct Args {
     /// Write the table here (atomically) instead of to standard output.
     #[arg(long, value_name = "FILE.md")]
     out: Option<PathBuf>,
+    // The models swept, at every P and alignment: any options `generate` accepts but those,
+    // by the same flags (the catalogue's models at the defaults; others built the first time,
+    // then cached).
+    #[command(flatten)]
+    variant: VariantArgs,
 }
 
-/// The chains and writers (p > 1) to sweep on `screen`: the compiled catalogue's on its own
-/// screen; on another, the same configurations built for it (once, then cached:
-/// `verilator_harness::ondemand`). None on a screen the front-end cannot draw on.
+/// The chains and writers (p > 1) to sweep on `screen`: with the default options the compiled
+/// catalogue's on its own screen; else, or on another screen, the catalogue's configurations
+/// built with `variant` for it (once, then cached: `verilator_harness::ondemand`). A
+/// COSIM_RTL_DIR folder's own. None on a screen the front-end cannot draw on.
 #[allow(clippy::type_complexity)]
-fn on_screen(screen: Screen) -> Result<(Vec<&'static ModelInfo<TriIn, TriSegOut>>, Vec<&'static ModelInfo<WrIn, WrOut>>), ModelError> {
+fn on_screen(
+    screen: Screen,
+    variant: &VariantArgs,
+) -> Result<(Vec<&'static ModelInfo<TriIn, TriSegOut>>, Vec<&'static ModelInfo<WrIn, WrOut>>), ModelError> {
+    let key = |o: &hdl_gen::Options| catalogue::options_key(o);
+    let plain = variant.options(8, Align::Span, None).is_ok_and(|o| key(&o) == key(&Default::default()));
     let chains: Vec<_> = TRISHADER_MODELS.iter().filter(|m| m.screen == screen).collect();
     let writers: Vec<_> = WRITER_MODELS.iter().filter(|m| m.screen == screen && m.cfg.p > 1).collect();
-    if !chains.is_empty() || RTL_DIR.is_some() {
+    if (plain && !chains.is_empty()) || registry::rtl_dir().is_some() {
         return Ok((chains, writers));
     }
+    let opts = |p, a| variant.options(p, a, Some(screen)).map_err(|e| ModelError::Config(e.to_string()));
     let built = || -> Result<_, ModelError> {
-        let chains = catalogue::BUILT_TRI.iter().map(|&(p, a)| ondemand::tri_shader(&ondemand::options(p, a, Some(screen))?));
-        let writers =
-            catalogue::BUILT_WR.iter().filter(|(p, _)| *p > 1).map(|&(p, a)| ondemand::writer(&ondemand::options(p, a, Some(screen))?));
+        let chains = catalogue::BUILT_TRI.iter().map(|&(p, a)| registry::tri_shader(&opts(p, a)?));
+        let writers = catalogue::BUILT_WR.iter().filter(|(p, _)| *p > 1).map(|&(p, a)| registry::writer(&opts(p, a)?));
         Ok((chains.collect::<Result<Vec<_>, _>>()?, writers.collect::<Result<Vec<_>, _>>()?))
     };
     match built() {
         Err(ModelError::Config(_)) => Ok((Vec::new(), Vec::new())),
         other => other,
     }
+}
+
+/// The segment shaders to sweep: every P and alignment of the catalogue with `variant`'s
+/// options (SPEC's seed structure unless `--pipeline` says otherwise: it only adds fill clocks),
+/// or a COSIM_RTL_DIR folder's level-0 shaders; those whose screen `screen` fits.
+fn shaders(screen: &Screen, variant: &VariantArgs) -> Result<Vec<&'static ModelInfo<SegIn, SegOut>>, ModelError> {
+    let mut models: Vec<_> = match registry::rtl_dir() {
+        Some(_) => SEGMENT_MODELS.iter().filter(|m| m.pipeline == golden::pipeline::Pipeline::NONE).collect(),
+        None => {
+            let mut all = Vec::new();
+            for p in catalogue::BUILT_P {
+                for align in Align::ALL {
+                    let opts = variant.options(p, align, None).map_err(|e| ModelError::Config(e.to_string()))?;
+                    // A configuration that cannot shade this screen is not swept (nor built).
+                    if screen.check_for(&opts.cfg).is_err() {
+                        continue;
+                    }
+                    all.push(registry::segment(&opts)?);
+                }
+            }
+            all
+        }
+    };
+    models.retain(|m| screen.check_for(&m.cfg).is_ok());
+    models.sort_by_key(|m| (m.cfg.p, m.cfg.align == Align::Screen));
+    Ok(models)
 }
 
 /// The size classes: target area in pixels.
@@ -120,20 +159,30 @@ impl Cell {
     }
 }
 
+/// What is refused before anything runs: a COSIM_RTL_DIR that describes no models, options
+/// `generate` refuses (whichever models the run has), and a bad --out (now, not after the
+/// sweep's minutes).
+fn refused(args: &Args) -> Result<(), String> {
+    verilator_harness::registry::check_folder().map_err(|e| e.to_string())?;
+    args.variant.options(8, Align::Span, None).map_err(|e| e.to_string())?;
+    match args.out.as_deref().map(hdl_gen::output::check_writable) {
+        Some(Err(e)) => Err(format!("--out: {e}")),
+        _ => Ok(()),
+    }
+}
+
 fn main() -> ExitCode {
     let args = Args::parse();
-    // A bad --out is refused now, not after the sweep's minutes.
-    if let Some(Err(e)) = args.out.as_deref().map(hdl_gen::output::check_writable) {
-        eprintln!("error: --out: {e}");
+    if let Err(e) = refused(&args) {
+        eprintln!("error: {e}");
         return ExitCode::from(2);
     }
     let start = Instant::now();
     let screen = Screen { width: args.width, height: args.height };
-    // SPEC's seed structure: the schemes are compared as the seeds describe them (`--pipeline`
-    // only adds fill clocks).
-    let mut models: Vec<_> =
-        SEGMENT_MODELS.iter().filter(|m| m.pipeline == golden::pipeline::Pipeline::NONE && screen.check_for(&m.cfg).is_ok()).collect();
-    models.sort_by_key(|m| (m.cfg.p, m.cfg.align == Align::Screen));
+    let models = match shaders(&screen, &args.variant) {
+        Ok(models) => models,
+        Err(e) => return ondemand::exit("the segment shaders", &e),
+    };
     if models.is_empty() {
         eprintln!("error: no segment shader model in this build fits a {}x{} screen", screen.width, screen.height);
         return ExitCode::from(2);
@@ -142,7 +191,7 @@ fn main() -> ExitCode {
     let mut rng = SeedRng::seed_from_u64(args.seed);
     let workloads: Vec<Vec<Triangle>> =
         CLASSES.iter().map(|&a| (0..args.triangles).map(|_| sized_triangle(&mut rng, &screen, a)).collect()).collect();
-    let (mut chain_models, wr_models) = match on_screen(screen) {
+    let (mut chain_models, wr_models) = match on_screen(screen, &args.variant) {
         Ok(models) => models,
         Err(e) => return ondemand::exit("--width/--height", &e),
     };

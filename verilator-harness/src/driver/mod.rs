@@ -104,12 +104,11 @@ impl<U: Unit> Driver<U> {
     }
 
     /// A new tape, starting with the next clock, when waveforms need one: a traced model's file
-    /// needs the output clocks, a failure's replay every input (if the model has a twin to
-    /// replay into: else there is nothing to tape for).
+    /// needs the output clocks, a failure's replay every input (into the model's twin, built
+    /// when a failure first needs it).
     fn start_tape(&mut self) {
         let needed = match self.waves {
-            Waves::Live => true,
-            Waves::OnFailure(_) => self.rtl.info().traced.is_some(),
+            Waves::Live | Waves::OnFailure(_) => true,
             Waves::Off | Waves::Done => false,
         };
         self.tape = needed.then(|| Box::new(Tape::new(self.clock)));
@@ -192,10 +191,10 @@ impl<U: Unit> Driver<U> {
         let tape = match (&self.waves, tape) {
             (Waves::Off | Waves::Done, _) => return,
             (_, Some(tape)) => tape,
-            // Nothing was taped: the model has no twin to replay into (a traced model always
-            // has a tape). The note goes on this stream's first mismatch.
+            // Nothing was taped (a driver with waveforms on always tapes; kept for safety). The
+            // note goes on this stream's first mismatch.
             (_, None) => {
-                let note = format!("COSIM_TRACE: no waveform: {}", TraceError::NoTwin(self.rtl.info().tag));
+                let note = format!("COSIM_TRACE: no waveform: {} kept no tape", self.rtl.info().tag);
                 annotate(report.mismatches.get_mut(kept).or(checked.mismatches.first_mut()), &note);
                 self.waves = Waves::Done;
                 return;
@@ -234,6 +233,7 @@ impl<U: Unit> Driver<U> {
         let info = self.rtl.info();
         std::fs::create_dir_all(dir).map_err(|error| TraceError::Io { path: dir.clone(), error })?;
         let path = dir.join(format!("{}-seed{}-clock{clock}.fst", info.tag, self.rtl.seed()));
+        crate::ondemand::require_traced(info)?;
         let mut twin = Rtl::traced(info, self.rtl.seed())?;
         tape.replay(&mut twin, from, to, &path)?;
         drop(twin);
@@ -369,7 +369,8 @@ fn annotate(m: Option<&mut Mismatch>, note: &str) {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::ffi::{require_segment_model, to_port, SegIn, SegOut};
+    use crate::ffi::{to_port, SegIn, SegOut};
+    use crate::registry::require_segment_model;
     use crate::traffic::Traffic;
     use golden::{Align, Config, Span};
     use std::sync::{Arc, Mutex};

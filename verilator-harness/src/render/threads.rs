@@ -5,8 +5,9 @@
 use super::image::{compose, memory_image};
 use super::visibility::Job;
 use crate::driver::{Stress, DRAIN_CLOCKS};
-use crate::ffi::{specular_unit, ModelInfo, SegIn, SegOut, SpecIn, SpecOut, TriIn, TriSegOut, WrIn, WrOut};
+use crate::ffi::{ModelInfo, SegIn, SegOut, SpecIn, SpecOut, TriIn, TriSegOut, WrIn, WrOut};
 use crate::frontend::{stream_chain, Expected};
+use crate::registry::unit_of;
 use crate::report::Report;
 use crate::segment::{SegView, SegmentCosim, Stim};
 use crate::specular::SpecularCosim;
@@ -130,7 +131,7 @@ pub fn run_with(
             let done = &done;
             s.spawn(move || {
                 let mut out = vec![0u16; npix];
-                let mut sim = SpecularCosim::new(info, specular_unit(), SEED, Traffic::FULL);
+                let mut sim = SpecularCosim::new(info, unit_of(info), SEED, Traffic::FULL);
                 let mut report = Report { triangles: job.drawn, ..Report::default() };
                 let stims = &job.stims[0];
                 sim.stream_with(&job.specular, &mut report, |k, j, o| {
@@ -166,7 +167,7 @@ pub fn run_with(
         (diffuse, coverage, reports, writers, spec_out)
     });
 
-    let GoldenImages { host_diffuse, gold_diffuse, gold_spec } = golden_images(job, seg.cfg.frac, exps, with_spec);
+    let GoldenImages { host_diffuse, gold_diffuse, gold_spec } = golden_images(job, seg.cfg.frac, exps, spec.filter(|_| with_spec));
     let (spec_img, spec_report) = match spec_out {
         Some((img, r)) => (Some(img), Some(r)),
         None => (None, None),
@@ -272,7 +273,7 @@ fn channel(
 /// Golden's images from the same spans and the same ownership: the host's spans, and with the
 /// RTL front-end golden's front-end spans (the host's image then kept beside); the specular
 /// channel from golden's unit.
-fn golden_images(job: &Job, frac: u32, exps: &Option<Vec<Expected>>, with_spec: bool) -> GoldenImages {
+fn golden_images(job: &Job, frac: u32, exps: &Option<Vec<Expected>>, spec: Option<&ModelInfo<SpecIn, SpecOut>>) -> GoldenImages {
     let screen = job.screen;
     let (width, npix) = (screen.width, (screen.width * screen.height) as usize);
     let channels = job.channels();
@@ -305,8 +306,8 @@ fn golden_images(job: &Job, frac: u32, exps: &Option<Vec<Expected>>, with_spec: 
         }
         None => host_diffuse.clone(),
     };
-    let gold_spec = with_spec.then(|| {
-        let unit = specular_unit();
+    let gold_spec = spec.map(|info| {
+        let unit = unit_of(info);
         let mut out = vec![0u16; npix];
         for (st, sp) in job.stims[0].iter().zip(&job.specular) {
             for (j, px) in unit.span(sp).enumerate() {

@@ -1,0 +1,193 @@
+//! The command-line options of one `generate` configuration, as clap `Args`: the one definition
+//! of the flags that `hdl-gen generate` and the co-simulation binaries (`cosim`, `render`,
+//! `sweep`, `bench gen`) share. Each binary flattens [`ModelArgs`] into its own arguments, so a
+//! flag, its range and its help read alike everywhere, and a value one refuses, all refuse.
+//! `--width`/`--height` are each program's own: `generate`'s default to the configuration's
+//! widest screen up to 640 × 480, the binaries' also bound the random triangles.
+
+use crate::{check_prefix, BfpiArch, Bus, Options};
+use clap::builder::{StringValueParser, TypedValueParser};
+use clap::Args;
+use golden::frontend::{DiMode, I0Form};
+use golden::pipeline::Pipeline;
+use golden::setup::Screen;
+use golden::specular::{parse_rel_error, BrdfK, PlanError, SpecularPlan};
+use golden::{Align, Config, ConfigError};
+
+/// A configuration the flags describe but `generate` refuses (the ranges clap checks, it refuses
+/// itself). Its message names the flag.
+#[derive(Debug, thiserror::Error)]
+pub enum ArgsError {
+    #[error("{0}")]
+    Config(#[from] ConfigError),
+    #[error("--max-rel-error goes with --brdf-k auto")]
+    RelErrorWithList,
+    #[error("--brdf-k {choice}: {source}")]
+    Brdf { choice: BrdfK, source: PlanError },
+    #[error("{}", crate::segment::TREE_UNPIPELINED)]
+    TreeUnpipelined,
+    #[error("--fe-i0 incremental takes --fe-di triangle: the per-scanline dI needs the reciprocal's I0 at every span's last pixel")]
+    IncrementalScanline,
+    #[error("--width/--height: {0}")]
+    Screen(#[from] golden::frontend::FrontEndError),
+}
+
+/// The segment width and its alignment: what names a model (`seg_p8_span`).
+#[derive(Args, Clone, Debug)]
+pub struct SegArgs {
+    /// Segment width: pixels per clock, a power of two in 1..256.
+    #[arg(long, default_value_t = golden::format::DEFAULT_P,
+          value_parser = clap::value_parser!(u32).try_map(|p| golden::format::check_p(p).map(|()| p)))]
+    pub p: u32,
+    /// Segmentation: span (the seed's) or screen (segments on multiples of P).
+    #[arg(long, value_enum, default_value_t = Align::Span)]
+    pub align: Align,
+}
+
+/// The formats and the module prefix.
+#[derive(Args, Clone, Debug)]
+pub struct FormatArgs {
+    /// Fraction bits F of the intensity format UQ8.F (4..20).
+    #[arg(long = "frac", default_value_t = golden::format::DEFAULT_FRAC, value_parser = clap::value_parser!(u32).range(4..=20))]
+    pub frac: u32,
+    /// Screen-x bits XW (4..16).
+    #[arg(long = "xbits", default_value_t = golden::format::DEFAULT_XBITS, value_parser = clap::value_parser!(u32).range(4..=16))]
+    pub xbits: u32,
+    /// String prepended to every module name.
+    #[arg(long, default_value = "", value_parser = StringValueParser::new().try_map(|s| check_prefix(&s).map(|()| s)))]
+    pub prefix: String,
+}
+
+/// The configuration and module prefix (`generate`'s, `testbench`'s).
+#[derive(Args, Clone, Debug)]
+pub struct ConfigArgs {
+    #[command(flatten)]
+    pub seg: SegArgs,
+    #[command(flatten)]
+    pub format: FormatArgs,
+}
+
+impl ConfigArgs {
+    /// Options for this configuration with the table set `brdf`; the rest default.
+    pub fn options(&self, brdf: &BrdfArgs) -> Result<Options, ArgsError> {
+        let cfg = Config::new(self.seg.p, self.format.frac, self.format.xbits, self.seg.align)?;
+        Ok(Options { cfg, prefix: self.format.prefix.clone(), brdf: brdf.plan()?, ..Options::default() })
+    }
+}
+
+/// The specular unit's table set, shared by every command that builds the unit.
+#[derive(Args, Clone, Debug)]
+pub struct BrdfArgs {
+    /// BRDF table set: a list of k (ascending, 1..64; each n then takes its least-error table),
+    /// or `auto` to choose the set with the least ROM that meets --max-rel-error.
+    /// Default: the patent's 1,2,4,16 with its n ranges.
+    #[arg(long = "brdf-k")]
+    pub brdf_k: Option<BrdfK>,
+    /// With `--brdf-k auto`: largest relative error of the approximation inside the epicentre,
+    /// as a fraction (0.01) or a percentage (1%).
+    #[arg(long = "max-rel-error", value_parser = parse_rel_error, requires = "brdf_k")]
+    pub max_rel_error: Option<f64>,
+}
+
+impl BrdfArgs {
+    /// The plan, or `None` for the patent's own (the default).
+    pub fn plan(&self) -> Result<Option<SpecularPlan>, ArgsError> {
+        let choice = match (&self.brdf_k, self.max_rel_error) {
+            (None, _) => return Ok(None),
+            (Some(BrdfK::Auto { .. }), Some(e)) => BrdfK::Auto { max_err: e },
+            (Some(BrdfK::List(_)), Some(_)) => return Err(ArgsError::RelErrorWithList),
+            (Some(b), None) => b.clone(),
+        };
+        SpecularPlan::from_brdf_k(&choice).map(Some).map_err(|source| ArgsError::Brdf { choice, source })
+    }
+}
+
+/// Every option of one `generate` configuration but P, the alignment, the screen
+/// (`--width`/`--height`, each program's own) and the output folder: what `sweep` applies to
+/// every P and alignment it sweeps.
+#[derive(Args, Clone, Debug)]
+pub struct VariantArgs {
+    #[command(flatten)]
+    pub format: FormatArgs,
+    /// Increments: shift-add (SPEC's BFPI), or the comparison forms naive (`*` by constants)
+    /// and tree (doubling tree in the shader, no BFPI) used by scripts/synth.
+    #[arg(long = "bfpi-arch", value_enum, default_value_t = BfpiArch::ShiftAdd)]
+    pub bfpi_arch: BfpiArch,
+    #[command(flatten)]
+    pub brdf: BrdfArgs,
+    /// Quotient bits per clock of the front-end's set-up dividers: 1, 2 or 4. More bits,
+    /// fewer set-up clocks per triangle (tiny triangles go faster), longer paths. Default: 4.
+    #[arg(long = "fe-div-bits", value_parser = clap::builder::PossibleValuesParser::new(["1", "2", "4"]).map(|b| b.parse::<u32>().expect("a listed value")))]
+    pub fe_div_bits: Option<u32>,
+    /// Where the front-end's dI comes from: `triangle` (the constant-increment theorem, once
+    /// per triangle) or `scanline` (classical Gouraud, a division per span from the edge
+    /// intensities with the same divider: a comparison option, slower and larger).
+    #[arg(long = "fe-di", value_enum, default_value_t = DiMode::Triangle)]
+    pub fe_di: DiMode,
+    /// How the front-end forms each span's I0: `reciprocal` (three wide products a row in
+    /// the span path) or `incremental` (quotient and remainder over 2A stepped by adds per
+    /// source of the span's left end; the reciprocal only at a source's first covered row, on
+    /// one shared multiplier, the walker waiting meanwhile). Same spans bit for bit. The
+    /// default stays `reciprocal` until the incremental form measures better (docs/design.md,
+    /// issue 27). `incremental` takes `--fe-di triangle` only.
+    #[arg(long = "fe-i0", value_enum, default_value_t = I0Form::Reciprocal)]
+    pub fe_i0: I0Form,
+    /// Register stages added for clock rate, 0..3 (golden::pipeline): 1 registers the span and
+    /// the shader's increments, splits the specular unit's multiplies, and stages the
+    /// front-end (CALC in five clocks, its span path in six), 2 also the shader's lane sums, 3 cuts the shader's adders
+    /// so no clock has two in a row (same stages as 2). Values and throughput are the same at every
+    /// level; latency grows (manifest.json). 0, the default: SPEC's seed structure, smallest
+    /// and shortest (docs/fpga.md compares the levels).
+    #[arg(long, default_value_t = 0, value_parser = clap::value_parser!(u32).range(0..=Pipeline::MAX as i64))]
+    pub pipeline: u32,
+    /// Stream interfaces: `native` (SPEC's ports only) or `axis`, which also writes an
+    /// AXI4-Stream wrapper `<module>_axis` of the segment shader, the front-end, its chain
+    /// and the specular unit, with Vivado interface attributes (docs/axis.md).
+    #[arg(long, value_enum, default_value_t = Bus::Native)]
+    pub bus: Bus,
+}
+
+impl VariantArgs {
+    /// The options of P and `align` with these flags, on `screen` (`None`:
+    /// [`Options::default_screen`]), checked as `generate` checks them.
+    pub fn options(&self, p: u32, align: Align, screen: Option<Screen>) -> Result<Options, ArgsError> {
+        let config = ConfigArgs { seg: SegArgs { p, align }, format: self.format.clone() };
+        let opts = config.options(&self.brdf)?;
+        let pipeline = Pipeline::new(self.pipeline).expect("clap checked the range");
+        if pipeline.span_stage() && self.bfpi_arch == BfpiArch::Tree {
+            return Err(ArgsError::TreeUnpipelined);
+        }
+        if self.fe_i0 == I0Form::Incremental && self.fe_di == DiMode::Scanline {
+            return Err(ArgsError::IncrementalScanline);
+        }
+        let opts = Options {
+            bfpi_arch: self.bfpi_arch,
+            screen,
+            fe_div_bits: self.fe_div_bits,
+            fe_di: self.fe_di,
+            fe_i0: self.fe_i0,
+            pipeline,
+            bus: self.bus,
+            ..opts
+        };
+        opts.frontend()?;
+        Ok(opts)
+    }
+}
+
+/// Every option of one `generate` configuration but the screen and the output folder: the
+/// model a binary runs.
+#[derive(Args, Clone, Debug)]
+pub struct ModelArgs {
+    #[command(flatten)]
+    pub seg: SegArgs,
+    #[command(flatten)]
+    pub variant: VariantArgs,
+}
+
+impl ModelArgs {
+    /// The options these flags give, on `screen` (`None`: [`Options::default_screen`]).
+    pub fn options(&self, screen: Option<Screen>) -> Result<Options, ArgsError> {
+        self.variant.options(self.seg.p, self.seg.align, screen)
+    }
+}
