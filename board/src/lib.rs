@@ -80,7 +80,10 @@ pub fn rtl_files(cfg: &Config, tris: &[FixedTriangle]) -> Result<Vec<GeneratedFi
     let w = opts.writer()?;
     let rom = hdl_gen::board::rom_image(&hw.fe, tris)?;
     let chain: Vec<String> =
-        [&names.bfpi, &names.segment, &names.frontend, &names.top, &names.writer, &names.fb_top].iter().map(|n| format!("{n}.v")).collect();
+        [&names.bfpi, &names.segment, &names.frontend, &names.fe_edge, &names.fe_div, &names.top, &names.writer, &names.fb_top]
+            .iter()
+            .map(|n| format!("{n}.v"))
+            .collect();
     let mut files: Vec<GeneratedFile> = hdl_gen::generate(&opts).into_iter().filter(|f| chain.contains(&f.name)).collect();
     for m in [hdl_gen::board::draw_module(&hw.fe, &w, &names, tris.len()), hdl_gen::board::top_module(&w)] {
         files.push(GeneratedFile { name: format!("{}.v", m.name), contents: m.render() });
