@@ -273,7 +273,7 @@ module tri_frontend (
   wire [2:0] e_right = {!dyneg2, !dyneg1, !dyneg0};
   wire [26:0] e_rs = {rsu2, rsu1, rsu0};
   wire [26:0] e_re = {re2[8:0], re1[8:0], re0[8:0]};
-  // The set-up result, complete when the dividers are (HOLD): the edges' in each tri_fe_edge, and:
+  // The set-up result, complete when the dividers are (HOLD): the edges' in g_edge[k].u_edge, and:
   reg [8:0] s_first;
   reg [8:0] s_last;
   reg [41:0] s_an;
@@ -372,7 +372,7 @@ module tri_frontend (
 
   wire [20:0] r_di = s_sat ? (s_dineg ? {1'b1, 20'd0} : {1'b0, {20{1'b1}}}) : (s_dineg ? -{1'd0, ddi_q} : {1'd0, ddi_q});
 
-  // Walker: the triangle being walked, one row per clock (each edge's DDA in its tri_fe_edge).
+  // Walker: the triangle being walked, one row per clock (each edge's DDA in g_edge[k].u_edge).
   reg w_valid;
   reg [8:0] w_row;
   reg [8:0] w_last;

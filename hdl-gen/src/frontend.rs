@@ -71,7 +71,7 @@ pub fn module(hw: &Hw, names: &Names) -> Module {
 /// divider (its parameters' defaults those of an edge's first-bound divider).
 pub fn submodules(hw: &Hw, names: &Names) -> Vec<Module> {
     let [ei, _] = edge::dividers(hw);
-    vec![edge::module(hw, names), divider::module(&names.fe_div, &ei, hw.div_bits, setup::counter_width(&hw.fe.widths()))]
+    vec![edge::module(hw, names), divider::module(names, &ei, hw.div_bits, setup::counter_width(&hw.fe.widths()))]
 }
 
 /// The module, and its register stages when it is pipelined ([`stages`]): the set-up, the

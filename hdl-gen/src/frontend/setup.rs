@@ -201,7 +201,7 @@ fn calc_stages(st: &Stager, body: &mut Vec<Item>) -> String {
 /// The set-up result's triangle-wide registers, and its dividers.
 fn results_regs(hw: &Hw, divs: Vec<Item>, body: &mut Vec<Item>) {
     let Widths { yw: row_w, aw: area_w, k: sum_w, .. } = hw.fe.widths();
-    body.push(comment("The set-up result, complete when the dividers are (HOLD): the edges' in each tri_fe_edge, and:"));
+    body.push(comment("The set-up result, complete when the dividers are (HOLD): the edges' in g_edge[k].u_edge, and:"));
     for (n, ww) in [("s_first", row_w), ("s_last", row_w), ("s_an", area_w), ("s_tn", sum_w), ("s_gxn", sum_w), ("s_dyn", sum_w)] {
         body.push(reg(n, ww));
     }

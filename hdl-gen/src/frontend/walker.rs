@@ -21,7 +21,7 @@ pub(super) fn emit(hw: &Hw, names: &Names, body: &mut Vec<Item>) {
     let Widths { yw: row_w, aw: area_w, k: sum_w, rw: recip_w, .. } = fe.widths();
     let (xw, dw) = (fe.cfg.xbits, fe.cfg.dw());
     let w = fe.screen.width as i64;
-    body.push(comment("Walker: the triangle being walked, one row per clock (each edge's DDA in its tri_fe_edge)."));
+    body.push(comment("Walker: the triangle being walked, one row per clock (each edge's DDA in g_edge[k].u_edge)."));
     body.push(reg("w_valid", 1));
     body.push(reg("w_row", row_w));
     body.push(reg("w_last", row_w));
