@@ -13,6 +13,11 @@
 // Spans: the walker, then 2 register stages to the output register (I0's path).
 // Walker: one row per clock (rows with no covered pixel make a bubble); the next triangle's set-up overlaps it.
 // Widths: |A| 42, edge bound 15 signed, edge divisor 27, intensity sums modulo 2^64, reciprocal 23.
+//
+// Structure, in this file's order: the vertex registers; CALC (its stages' registers c<j>_*); the set-up state
+// machine (IDLE, DIV, HOLD) with dI's and the reciprocal's dividers (u_ddi, u_drn: tri_fe_div); the walker, whose
+// three edges are a generate loop (g_edge[k].u_edge: tri_fe_edge, each with its set-up result, its two tri_fe_div and its
+// DDA); the span path (stages p<j>_*); the output register.
 
 `default_nettype none
 
@@ -257,208 +262,18 @@ module tri_frontend (
   wire [63:0] dyn0 = ({{19{ony[44]}}, ony} << 8) << lz;
   // verilator lint_on UNUSEDSIGNAL
 
-  // Eight restoring dividers, one quotient bit per clock, sharing one counter: per edge its first
-  // bound (ei) and its step (es), then dI (ddi) and the reciprocal Rn = 2^K / (2 An) (drn).
-  reg [41:0] ei0_p;
-  reg [41:0] ei0_d;
-  reg [14:0] ei0_q;
-  reg [33:0] es0_p;
-  reg [33:0] es0_d;
-  reg [14:0] es0_q;
-  reg [41:0] ei1_p;
-  reg [41:0] ei1_d;
-  reg [14:0] ei1_q;
-  reg [33:0] es1_p;
-  reg [33:0] es1_d;
-  reg [14:0] es1_q;
-  reg [41:0] ei2_p;
-  reg [41:0] ei2_d;
-  reg [14:0] ei2_q;
-  reg [33:0] es2_p;
-  reg [33:0] es2_d;
-  reg [14:0] es2_q;
-  reg [62:0] ddi_p;
-  reg [62:0] ddi_d;
-  reg [19:0] ddi_q;
-  reg [65:0] drn_p;
-  reg [65:0] drn_d;
-  reg [22:0] drn_q;
-  wire ei0_on0 = div_cnt < 5'd15;
-  wire ei0_ge0 = ei0_p >= ei0_d;
-  wire [41:0] ei0_p1 = (ei0_on0 && ei0_ge0) ? ei0_p - ei0_d : ei0_p;
-  wire [41:0] ei0_d1 = ei0_on0 ? ei0_d >> 1 : ei0_d;
-  wire [14:0] ei0_q1 = ei0_on0 ? {ei0_q[13:0], ei0_ge0} : ei0_q;
-  wire ei0_on1 = div_cnt >= 5'd1 && div_cnt - 5'd1 < 5'd15;
-  wire ei0_ge1 = ei0_p1 >= ei0_d1;
-  wire [41:0] ei0_p2 = (ei0_on1 && ei0_ge1) ? ei0_p1 - ei0_d1 : ei0_p1;
-  wire [41:0] ei0_d2 = ei0_on1 ? ei0_d1 >> 1 : ei0_d1;
-  wire [14:0] ei0_q2 = ei0_on1 ? {ei0_q1[13:0], ei0_ge1} : ei0_q1;
-  wire ei0_on2 = div_cnt >= 5'd2 && div_cnt - 5'd2 < 5'd15;
-  wire ei0_ge2 = ei0_p2 >= ei0_d2;
-  wire [41:0] ei0_p3 = (ei0_on2 && ei0_ge2) ? ei0_p2 - ei0_d2 : ei0_p2;
-  wire [41:0] ei0_d3 = ei0_on2 ? ei0_d2 >> 1 : ei0_d2;
-  wire [14:0] ei0_q3 = ei0_on2 ? {ei0_q2[13:0], ei0_ge2} : ei0_q2;
-  wire ei0_on3 = div_cnt >= 5'd3 && div_cnt - 5'd3 < 5'd15;
-  wire ei0_ge3 = ei0_p3 >= ei0_d3;
-  wire [41:0] ei0_p4 = (ei0_on3 && ei0_ge3) ? ei0_p3 - ei0_d3 : ei0_p3;
-  wire [41:0] ei0_d4 = ei0_on3 ? ei0_d3 >> 1 : ei0_d3;
-  wire [14:0] ei0_q4 = ei0_on3 ? {ei0_q3[13:0], ei0_ge3} : ei0_q3;
-  wire es0_on0 = div_cnt < 5'd15;
-  wire es0_ge0 = es0_p >= es0_d;
-  wire [33:0] es0_p1 = (es0_on0 && es0_ge0) ? es0_p - es0_d : es0_p;
-  wire [33:0] es0_d1 = es0_on0 ? es0_d >> 1 : es0_d;
-  wire [14:0] es0_q1 = es0_on0 ? {es0_q[13:0], es0_ge0} : es0_q;
-  wire es0_on1 = div_cnt >= 5'd1 && div_cnt - 5'd1 < 5'd15;
-  wire es0_ge1 = es0_p1 >= es0_d1;
-  wire [33:0] es0_p2 = (es0_on1 && es0_ge1) ? es0_p1 - es0_d1 : es0_p1;
-  wire [33:0] es0_d2 = es0_on1 ? es0_d1 >> 1 : es0_d1;
-  wire [14:0] es0_q2 = es0_on1 ? {es0_q1[13:0], es0_ge1} : es0_q1;
-  wire es0_on2 = div_cnt >= 5'd2 && div_cnt - 5'd2 < 5'd15;
-  wire es0_ge2 = es0_p2 >= es0_d2;
-  wire [33:0] es0_p3 = (es0_on2 && es0_ge2) ? es0_p2 - es0_d2 : es0_p2;
-  wire [33:0] es0_d3 = es0_on2 ? es0_d2 >> 1 : es0_d2;
-  wire [14:0] es0_q3 = es0_on2 ? {es0_q2[13:0], es0_ge2} : es0_q2;
-  wire es0_on3 = div_cnt >= 5'd3 && div_cnt - 5'd3 < 5'd15;
-  wire es0_ge3 = es0_p3 >= es0_d3;
-  wire [33:0] es0_p4 = (es0_on3 && es0_ge3) ? es0_p3 - es0_d3 : es0_p3;
-  wire [33:0] es0_d4 = es0_on3 ? es0_d3 >> 1 : es0_d3;
-  wire [14:0] es0_q4 = es0_on3 ? {es0_q3[13:0], es0_ge3} : es0_q3;
-  wire ei1_on0 = div_cnt < 5'd15;
-  wire ei1_ge0 = ei1_p >= ei1_d;
-  wire [41:0] ei1_p1 = (ei1_on0 && ei1_ge0) ? ei1_p - ei1_d : ei1_p;
-  wire [41:0] ei1_d1 = ei1_on0 ? ei1_d >> 1 : ei1_d;
-  wire [14:0] ei1_q1 = ei1_on0 ? {ei1_q[13:0], ei1_ge0} : ei1_q;
-  wire ei1_on1 = div_cnt >= 5'd1 && div_cnt - 5'd1 < 5'd15;
-  wire ei1_ge1 = ei1_p1 >= ei1_d1;
-  wire [41:0] ei1_p2 = (ei1_on1 && ei1_ge1) ? ei1_p1 - ei1_d1 : ei1_p1;
-  wire [41:0] ei1_d2 = ei1_on1 ? ei1_d1 >> 1 : ei1_d1;
-  wire [14:0] ei1_q2 = ei1_on1 ? {ei1_q1[13:0], ei1_ge1} : ei1_q1;
-  wire ei1_on2 = div_cnt >= 5'd2 && div_cnt - 5'd2 < 5'd15;
-  wire ei1_ge2 = ei1_p2 >= ei1_d2;
-  wire [41:0] ei1_p3 = (ei1_on2 && ei1_ge2) ? ei1_p2 - ei1_d2 : ei1_p2;
-  wire [41:0] ei1_d3 = ei1_on2 ? ei1_d2 >> 1 : ei1_d2;
-  wire [14:0] ei1_q3 = ei1_on2 ? {ei1_q2[13:0], ei1_ge2} : ei1_q2;
-  wire ei1_on3 = div_cnt >= 5'd3 && div_cnt - 5'd3 < 5'd15;
-  wire ei1_ge3 = ei1_p3 >= ei1_d3;
-  wire [41:0] ei1_p4 = (ei1_on3 && ei1_ge3) ? ei1_p3 - ei1_d3 : ei1_p3;
-  wire [41:0] ei1_d4 = ei1_on3 ? ei1_d3 >> 1 : ei1_d3;
-  wire [14:0] ei1_q4 = ei1_on3 ? {ei1_q3[13:0], ei1_ge3} : ei1_q3;
-  wire es1_on0 = div_cnt < 5'd15;
-  wire es1_ge0 = es1_p >= es1_d;
-  wire [33:0] es1_p1 = (es1_on0 && es1_ge0) ? es1_p - es1_d : es1_p;
-  wire [33:0] es1_d1 = es1_on0 ? es1_d >> 1 : es1_d;
-  wire [14:0] es1_q1 = es1_on0 ? {es1_q[13:0], es1_ge0} : es1_q;
-  wire es1_on1 = div_cnt >= 5'd1 && div_cnt - 5'd1 < 5'd15;
-  wire es1_ge1 = es1_p1 >= es1_d1;
-  wire [33:0] es1_p2 = (es1_on1 && es1_ge1) ? es1_p1 - es1_d1 : es1_p1;
-  wire [33:0] es1_d2 = es1_on1 ? es1_d1 >> 1 : es1_d1;
-  wire [14:0] es1_q2 = es1_on1 ? {es1_q1[13:0], es1_ge1} : es1_q1;
-  wire es1_on2 = div_cnt >= 5'd2 && div_cnt - 5'd2 < 5'd15;
-  wire es1_ge2 = es1_p2 >= es1_d2;
-  wire [33:0] es1_p3 = (es1_on2 && es1_ge2) ? es1_p2 - es1_d2 : es1_p2;
-  wire [33:0] es1_d3 = es1_on2 ? es1_d2 >> 1 : es1_d2;
-  wire [14:0] es1_q3 = es1_on2 ? {es1_q2[13:0], es1_ge2} : es1_q2;
-  wire es1_on3 = div_cnt >= 5'd3 && div_cnt - 5'd3 < 5'd15;
-  wire es1_ge3 = es1_p3 >= es1_d3;
-  wire [33:0] es1_p4 = (es1_on3 && es1_ge3) ? es1_p3 - es1_d3 : es1_p3;
-  wire [33:0] es1_d4 = es1_on3 ? es1_d3 >> 1 : es1_d3;
-  wire [14:0] es1_q4 = es1_on3 ? {es1_q3[13:0], es1_ge3} : es1_q3;
-  wire ei2_on0 = div_cnt < 5'd15;
-  wire ei2_ge0 = ei2_p >= ei2_d;
-  wire [41:0] ei2_p1 = (ei2_on0 && ei2_ge0) ? ei2_p - ei2_d : ei2_p;
-  wire [41:0] ei2_d1 = ei2_on0 ? ei2_d >> 1 : ei2_d;
-  wire [14:0] ei2_q1 = ei2_on0 ? {ei2_q[13:0], ei2_ge0} : ei2_q;
-  wire ei2_on1 = div_cnt >= 5'd1 && div_cnt - 5'd1 < 5'd15;
-  wire ei2_ge1 = ei2_p1 >= ei2_d1;
-  wire [41:0] ei2_p2 = (ei2_on1 && ei2_ge1) ? ei2_p1 - ei2_d1 : ei2_p1;
-  wire [41:0] ei2_d2 = ei2_on1 ? ei2_d1 >> 1 : ei2_d1;
-  wire [14:0] ei2_q2 = ei2_on1 ? {ei2_q1[13:0], ei2_ge1} : ei2_q1;
-  wire ei2_on2 = div_cnt >= 5'd2 && div_cnt - 5'd2 < 5'd15;
-  wire ei2_ge2 = ei2_p2 >= ei2_d2;
-  wire [41:0] ei2_p3 = (ei2_on2 && ei2_ge2) ? ei2_p2 - ei2_d2 : ei2_p2;
-  wire [41:0] ei2_d3 = ei2_on2 ? ei2_d2 >> 1 : ei2_d2;
-  wire [14:0] ei2_q3 = ei2_on2 ? {ei2_q2[13:0], ei2_ge2} : ei2_q2;
-  wire ei2_on3 = div_cnt >= 5'd3 && div_cnt - 5'd3 < 5'd15;
-  wire ei2_ge3 = ei2_p3 >= ei2_d3;
-  wire [41:0] ei2_p4 = (ei2_on3 && ei2_ge3) ? ei2_p3 - ei2_d3 : ei2_p3;
-  wire [41:0] ei2_d4 = ei2_on3 ? ei2_d3 >> 1 : ei2_d3;
-  wire [14:0] ei2_q4 = ei2_on3 ? {ei2_q3[13:0], ei2_ge3} : ei2_q3;
-  wire es2_on0 = div_cnt < 5'd15;
-  wire es2_ge0 = es2_p >= es2_d;
-  wire [33:0] es2_p1 = (es2_on0 && es2_ge0) ? es2_p - es2_d : es2_p;
-  wire [33:0] es2_d1 = es2_on0 ? es2_d >> 1 : es2_d;
-  wire [14:0] es2_q1 = es2_on0 ? {es2_q[13:0], es2_ge0} : es2_q;
-  wire es2_on1 = div_cnt >= 5'd1 && div_cnt - 5'd1 < 5'd15;
-  wire es2_ge1 = es2_p1 >= es2_d1;
-  wire [33:0] es2_p2 = (es2_on1 && es2_ge1) ? es2_p1 - es2_d1 : es2_p1;
-  wire [33:0] es2_d2 = es2_on1 ? es2_d1 >> 1 : es2_d1;
-  wire [14:0] es2_q2 = es2_on1 ? {es2_q1[13:0], es2_ge1} : es2_q1;
-  wire es2_on2 = div_cnt >= 5'd2 && div_cnt - 5'd2 < 5'd15;
-  wire es2_ge2 = es2_p2 >= es2_d2;
-  wire [33:0] es2_p3 = (es2_on2 && es2_ge2) ? es2_p2 - es2_d2 : es2_p2;
-  wire [33:0] es2_d3 = es2_on2 ? es2_d2 >> 1 : es2_d2;
-  wire [14:0] es2_q3 = es2_on2 ? {es2_q2[13:0], es2_ge2} : es2_q2;
-  wire es2_on3 = div_cnt >= 5'd3 && div_cnt - 5'd3 < 5'd15;
-  wire es2_ge3 = es2_p3 >= es2_d3;
-  wire [33:0] es2_p4 = (es2_on3 && es2_ge3) ? es2_p3 - es2_d3 : es2_p3;
-  wire [33:0] es2_d4 = es2_on3 ? es2_d3 >> 1 : es2_d3;
-  wire [14:0] es2_q4 = es2_on3 ? {es2_q3[13:0], es2_ge3} : es2_q3;
-  wire ddi_on0 = div_cnt < 5'd20;
-  wire ddi_ge0 = ddi_p >= ddi_d;
-  wire [62:0] ddi_p1 = (ddi_on0 && ddi_ge0) ? ddi_p - ddi_d : ddi_p;
-  wire [62:0] ddi_d1 = ddi_on0 ? ddi_d >> 1 : ddi_d;
-  wire [19:0] ddi_q1 = ddi_on0 ? {ddi_q[18:0], ddi_ge0} : ddi_q;
-  wire ddi_on1 = div_cnt >= 5'd1 && div_cnt - 5'd1 < 5'd20;
-  wire ddi_ge1 = ddi_p1 >= ddi_d1;
-  wire [62:0] ddi_p2 = (ddi_on1 && ddi_ge1) ? ddi_p1 - ddi_d1 : ddi_p1;
-  wire [62:0] ddi_d2 = ddi_on1 ? ddi_d1 >> 1 : ddi_d1;
-  wire [19:0] ddi_q2 = ddi_on1 ? {ddi_q1[18:0], ddi_ge1} : ddi_q1;
-  wire ddi_on2 = div_cnt >= 5'd2 && div_cnt - 5'd2 < 5'd20;
-  wire ddi_ge2 = ddi_p2 >= ddi_d2;
-  wire [62:0] ddi_p3 = (ddi_on2 && ddi_ge2) ? ddi_p2 - ddi_d2 : ddi_p2;
-  wire [62:0] ddi_d3 = ddi_on2 ? ddi_d2 >> 1 : ddi_d2;
-  wire [19:0] ddi_q3 = ddi_on2 ? {ddi_q2[18:0], ddi_ge2} : ddi_q2;
-  wire ddi_on3 = div_cnt >= 5'd3 && div_cnt - 5'd3 < 5'd20;
-  wire ddi_ge3 = ddi_p3 >= ddi_d3;
-  wire [62:0] ddi_p4 = (ddi_on3 && ddi_ge3) ? ddi_p3 - ddi_d3 : ddi_p3;
-  wire [62:0] ddi_d4 = ddi_on3 ? ddi_d3 >> 1 : ddi_d3;
-  wire [19:0] ddi_q4 = ddi_on3 ? {ddi_q3[18:0], ddi_ge3} : ddi_q3;
-  wire drn_on0 = div_cnt < 5'd23;
-  wire drn_ge0 = drn_p >= drn_d;
-  wire [65:0] drn_p1 = (drn_on0 && drn_ge0) ? drn_p - drn_d : drn_p;
-  wire [65:0] drn_d1 = drn_on0 ? drn_d >> 1 : drn_d;
-  wire [22:0] drn_q1 = drn_on0 ? {drn_q[21:0], drn_ge0} : drn_q;
-  wire drn_on1 = div_cnt >= 5'd1 && div_cnt - 5'd1 < 5'd23;
-  wire drn_ge1 = drn_p1 >= drn_d1;
-  wire [65:0] drn_p2 = (drn_on1 && drn_ge1) ? drn_p1 - drn_d1 : drn_p1;
-  wire [65:0] drn_d2 = drn_on1 ? drn_d1 >> 1 : drn_d1;
-  wire [22:0] drn_q2 = drn_on1 ? {drn_q1[21:0], drn_ge1} : drn_q1;
-  wire drn_on2 = div_cnt >= 5'd2 && div_cnt - 5'd2 < 5'd23;
-  wire drn_ge2 = drn_p2 >= drn_d2;
-  wire [65:0] drn_p3 = (drn_on2 && drn_ge2) ? drn_p2 - drn_d2 : drn_p2;
-  wire [65:0] drn_d3 = drn_on2 ? drn_d2 >> 1 : drn_d2;
-  wire [22:0] drn_q3 = drn_on2 ? {drn_q2[21:0], drn_ge2} : drn_q2;
-  wire drn_on3 = div_cnt >= 5'd3 && div_cnt - 5'd3 < 5'd23;
-  wire drn_ge3 = drn_p3 >= drn_d3;
-  wire [65:0] drn_p4 = (drn_on3 && drn_ge3) ? drn_p3 - drn_d3 : drn_p3;
-  wire [65:0] drn_d4 = drn_on3 ? drn_d3 >> 1 : drn_d3;
-  wire [22:0] drn_q4 = drn_on3 ? {drn_q3[21:0], drn_ge3} : drn_q3;
-  // The set-up result, complete when the dividers are (HOLD).
-  reg s_act0;
-  reg s_right0;
-  reg [8:0] s_rs0;
-  reg [8:0] s_re0;
-  reg [26:0] s_d0;
-  reg s_act1;
-  reg s_right1;
-  reg [8:0] s_rs1;
-  reg [8:0] s_re1;
-  reg [26:0] s_d1;
-  reg s_act2;
-  reg s_right2;
-  reg [8:0] s_rs2;
-  reg [8:0] s_re2;
-  reg [26:0] s_d2;
+  // The set-up's load (CALC's last clock, the triangle kept) and its dividers' clocks.
+  wire calc_go = !rst && calc && guard_ok && !cull;
+  wire div_run = !rst && !calc && st == DIV;
+  // CALC's values for the edges, edge k in lane k.
+  wire [125:0] e_n = {n2[41:0], n1[41:0], n0[41:0]};
+  wire [101:0] e_sn = {sn2[33:0], sn1[33:0], sn0[33:0]};
+  wire [56:0] e_ady = {ady2, ady1, ady0};
+  wire [2:0] e_act = {act2, act1, act0};
+  wire [2:0] e_right = {!dyneg2, !dyneg1, !dyneg0};
+  wire [26:0] e_rs = {rsu2, rsu1, rsu0};
+  wire [26:0] e_re = {re2[8:0], re1[8:0], re0[8:0]};
+  // The set-up result, complete when the dividers are (HOLD): the edges' in g_edge[k].u_edge, and:
   reg [8:0] s_first;
   reg [8:0] s_last;
   reg [41:0] s_an;
@@ -467,6 +282,39 @@ module tri_frontend (
   reg [63:0] s_dyn;
   reg s_sat;
   reg s_dineg;
+  // Its dividers: dI's quotient (ddi) and the reciprocal Rn = 2^K / (2 An) (drn).
+  wire [19:0] ddi_q;
+  // verilator lint_off UNUSEDSIGNAL
+  wire [62:0] ddi_p;
+  wire [19:0] ddi_q_next;
+  // verilator lint_on UNUSEDSIGNAL
+  tri_fe_div #(.PW(63), .QB(20), .BITS(4), .CW(5)) u_ddi (
+    .clk(clk),
+    .load(calc_go),
+    .run(div_run),
+    .cnt(div_cnt),
+    .dividend({12'd0, x2}),
+    .divisor({21'd0, aabs} << 20),
+    .p(ddi_p),
+    .q(ddi_q),
+    .q_next(ddi_q_next)
+  );
+  wire [22:0] drn_q;
+  // verilator lint_off UNUSEDSIGNAL
+  wire [65:0] drn_p;
+  wire [22:0] drn_q_next;
+  // verilator lint_on UNUSEDSIGNAL
+  tri_fe_div #(.PW(66), .QB(23), .BITS(4), .CW(5)) u_drn (
+    .clk(clk),
+    .load(calc_go),
+    .run(div_run),
+    .cnt(div_cnt),
+    .dividend(66'd1 << 64),
+    .divisor({24'd0, an} << 23),
+    .p(drn_p),
+    .q(drn_q),
+    .q_next(drn_q_next)
+  );
 
   always @(posedge clk) begin
     if (rst) begin
@@ -498,45 +346,6 @@ module tri_frontend (
         end else begin
           div_cnt <= 5'd22;
           st <= DIV;
-          ei0_p <= n0[41:0];
-          ei0_d <= {23'd0, ady0} << 22;
-          ei0_q <= 15'd0;
-          es0_p <= sn0[33:0];
-          es0_d <= {15'd0, ady0} << 14;
-          es0_q <= 15'd0;
-          s_act0 <= act0;
-          s_right0 <= !dyneg0;
-          s_rs0 <= rsu0;
-          s_re0 <= re0[8:0];
-          s_d0 <= {ady0, 8'd0};
-          ei1_p <= n1[41:0];
-          ei1_d <= {23'd0, ady1} << 22;
-          ei1_q <= 15'd0;
-          es1_p <= sn1[33:0];
-          es1_d <= {15'd0, ady1} << 14;
-          es1_q <= 15'd0;
-          s_act1 <= act1;
-          s_right1 <= !dyneg1;
-          s_rs1 <= rsu1;
-          s_re1 <= re1[8:0];
-          s_d1 <= {ady1, 8'd0};
-          ei2_p <= n2[41:0];
-          ei2_d <= {23'd0, ady2} << 22;
-          ei2_q <= 15'd0;
-          es2_p <= sn2[33:0];
-          es2_d <= {15'd0, ady2} << 14;
-          es2_q <= 15'd0;
-          s_act2 <= act2;
-          s_right2 <= !dyneg2;
-          s_rs2 <= rsu2;
-          s_re2 <= re2[8:0];
-          s_d2 <= {ady2, 8'd0};
-          ddi_p <= {12'd0, x2};
-          ddi_d <= {21'd0, aabs} << 20;
-          ddi_q <= 20'd0;
-          drn_p <= 66'd1 << 64;
-          drn_d <= {24'd0, an} << 23;
-          drn_q <= 23'd0;
           s_first <= first_u;
           s_last <= last_u;
           s_an <= an;
@@ -548,30 +357,6 @@ module tri_frontend (
         end
       end else begin
         if (st == DIV) begin
-          ei0_p <= ei0_p4;
-          ei0_d <= ei0_d4;
-          ei0_q <= ei0_q4;
-          es0_p <= es0_p4;
-          es0_d <= es0_d4;
-          es0_q <= es0_q4;
-          ei1_p <= ei1_p4;
-          ei1_d <= ei1_d4;
-          ei1_q <= ei1_q4;
-          es1_p <= es1_p4;
-          es1_d <= es1_d4;
-          es1_q <= es1_q4;
-          ei2_p <= ei2_p4;
-          ei2_d <= ei2_d4;
-          ei2_q <= ei2_q4;
-          es2_p <= es2_p4;
-          es2_d <= es2_d4;
-          es2_q <= es2_q4;
-          ddi_p <= ddi_p4;
-          ddi_d <= ddi_d4;
-          ddi_q <= ddi_q4;
-          drn_p <= drn_p4;
-          drn_d <= drn_d4;
-          drn_q <= drn_q4;
           if (div_cnt < 5'd4) begin
             st <= HOLD;
           end else begin
@@ -585,54 +370,12 @@ module tri_frontend (
     end
   end
 
-  // Divider results: bounds and steps (q - B), the remainders, dI with its sign and saturation.
-  // verilator lint_off UNUSEDSIGNAL
-  wire [14:0] r_g0 = {~ei0_q[14], ei0_q[13:0]};
-  wire [26:0] r_rem0 = ei0_p[26:0];
-  wire [14:0] r_qs0 = {~es0_q[14], es0_q[13:0]};
-  wire [26:0] r_rs256_0 = {es0_p[18:0], 8'd0};
-  wire [14:0] r_g1 = {~ei1_q[14], ei1_q[13:0]};
-  wire [26:0] r_rem1 = ei1_p[26:0];
-  wire [14:0] r_qs1 = {~es1_q[14], es1_q[13:0]};
-  wire [26:0] r_rs256_1 = {es1_p[18:0], 8'd0};
-  wire [14:0] r_g2 = {~ei2_q[14], ei2_q[13:0]};
-  wire [26:0] r_rem2 = ei2_p[26:0];
-  wire [14:0] r_qs2 = {~es2_q[14], es2_q[13:0]};
-  wire [26:0] r_rs256_2 = {es2_p[18:0], 8'd0};
-  // verilator lint_on UNUSEDSIGNAL
   wire [20:0] r_di = s_sat ? (s_dineg ? {1'b1, 20'd0} : {1'b0, {20{1'b1}}}) : (s_dineg ? -{1'd0, ddi_q} : {1'd0, ddi_q});
 
-  // Walker: the triangle being walked, one row per clock.
+  // Walker: the triangle being walked, one row per clock (each edge's DDA in g_edge[k].u_edge).
   reg w_valid;
   reg [8:0] w_row;
   reg [8:0] w_last;
-  reg w_act0;
-  reg w_right0;
-  reg [8:0] w_rs0;
-  reg [8:0] w_re0;
-  reg [26:0] w_d0;
-  reg [26:0] w_rem0;
-  reg [26:0] w_rs256_0;
-  reg signed [14:0] w_g0;
-  reg signed [14:0] w_qs0;
-  reg w_act1;
-  reg w_right1;
-  reg [8:0] w_rs1;
-  reg [8:0] w_re1;
-  reg [26:0] w_d1;
-  reg [26:0] w_rem1;
-  reg [26:0] w_rs256_1;
-  reg signed [14:0] w_g1;
-  reg signed [14:0] w_qs1;
-  reg w_act2;
-  reg w_right2;
-  reg [8:0] w_rs2;
-  reg [8:0] w_re2;
-  reg [26:0] w_d2;
-  reg [26:0] w_rem2;
-  reg [26:0] w_rs256_2;
-  reg signed [14:0] w_g2;
-  reg signed [14:0] w_qs2;
   reg [20:0] w_di;
   reg [41:0] w_an;
   reg [22:0] w_rn;
@@ -644,18 +387,42 @@ module tri_frontend (
   assign take = st == HOLD && adv && (!w_valid || w_end);
   wire signed [15:0] lo0 = 16'sd0;
   wire signed [15:0] hi0 = 16'sd639;
-  wire in0 = w_act0 && w_row >= w_rs0 && w_row <= w_re0;
-  wire signed [15:0] gg0 = {{1{w_g0[14]}}, w_g0};
-  wire signed [15:0] lg0 = (in0 && !w_right0 && gg0 < lo0) ? gg0 : lo0;
-  wire signed [15:0] ha0 = (in0 && w_right0 && gg0 < hi0) ? gg0 : hi0;
-  wire in1 = w_act1 && w_row >= w_rs1 && w_row <= w_re1;
-  wire signed [15:0] gg1 = {{1{w_g1[14]}}, w_g1};
-  wire signed [15:0] lg1 = (in1 && !w_right1 && gg1 < lo0) ? gg1 : lo0;
-  wire signed [15:0] ha1 = (in1 && w_right1 && gg1 < hi0) ? gg1 : hi0;
-  wire in2 = w_act2 && w_row >= w_rs2 && w_row <= w_re2;
-  wire signed [15:0] gg2 = {{1{w_g2[14]}}, w_g2};
-  wire signed [15:0] lg2 = (in2 && !w_right2 && gg2 < lo0) ? gg2 : lo0;
-  wire signed [15:0] ha2 = (in2 && w_right2 && gg2 < hi0) ? gg2 : hi0;
+  // The edges: loaded with the set-up result, stepped a row; each one's bound on the row.
+  wire w_load = !rst && take;
+  wire w_step = !rst && !take && adv && w_valid && !w_end;
+  wire [47:0] e_lg;
+  wire [47:0] e_ha;
+  genvar k;
+  generate
+    for (k = 0; k < 3; k = k + 1) begin : g_edge
+      tri_fe_edge u_edge (
+        .clk(clk),
+        .calc_go(calc_go),
+        .div_run(div_run),
+        .div_cnt(div_cnt),
+        .take(w_load),
+        .step(w_step),
+        .row(w_row),
+        .lo(lo0),
+        .hi(hi0),
+        .n(e_n[k*42 +: 42]),
+        .sn(e_sn[k*34 +: 34]),
+        .ady(e_ady[k*19 +: 19]),
+        .act(e_act[k]),
+        .right(e_right[k]),
+        .rs(e_rs[k*9 +: 9]),
+        .re(e_re[k*9 +: 9]),
+        .lg(e_lg[k*16 +: 16]),
+        .ha(e_ha[k*16 +: 16])
+      );
+    end
+  endgenerate
+  wire signed [15:0] lg0 = e_lg[15:0];
+  wire signed [15:0] ha0 = e_ha[15:0];
+  wire signed [15:0] lg1 = e_lg[31:16];
+  wire signed [15:0] ha1 = e_ha[31:16];
+  wire signed [15:0] lg2 = e_lg[47:32];
+  wire signed [15:0] ha2 = e_ha[47:32];
   // The span's ends, the edges compared side by side: x = lo3 = -mg (the smallest left-edge g),
   // hi3 the smallest right bound; the row has a pixel when hi3 + mg >= 0.
   wire signed [15:0] mg = (lg0 <= lg1 && lg0 <= lg2) ? lg0 : (lg1 <= lg2) ? lg1 : lg2;
@@ -667,21 +434,6 @@ module tri_frontend (
   // verilator lint_on UNUSEDSIGNAL
   wire emit = w_valid && !room[16];
   wire [11:0] lo_u = lo3[11:0];
-  wire [27:0] rsum0 = {1'd0, w_rem0} + {1'd0, w_rs256_0};
-  wire cy0 = rsum0 >= {1'd0, w_d0};
-  // verilator lint_off UNUSEDSIGNAL
-  wire [27:0] rnext0 = cy0 ? rsum0 - {1'd0, w_d0} : rsum0;
-  // verilator lint_on UNUSEDSIGNAL
-  wire [27:0] rsum1 = {1'd0, w_rem1} + {1'd0, w_rs256_1};
-  wire cy1 = rsum1 >= {1'd0, w_d1};
-  // verilator lint_off UNUSEDSIGNAL
-  wire [27:0] rnext1 = cy1 ? rsum1 - {1'd0, w_d1} : rsum1;
-  // verilator lint_on UNUSEDSIGNAL
-  wire [27:0] rsum2 = {1'd0, w_rem2} + {1'd0, w_rs256_2};
-  wire cy2 = rsum2 >= {1'd0, w_d2};
-  // verilator lint_off UNUSEDSIGNAL
-  wire [27:0] rnext2 = cy2 ? rsum2 - {1'd0, w_d2} : rsum2;
-  // verilator lint_on UNUSEDSIGNAL
   always @(posedge clk) begin
     if (rst) begin
       w_valid <= 1'b0;
@@ -689,33 +441,6 @@ module tri_frontend (
       w_valid <= 1'b1;
       w_row <= s_first;
       w_last <= s_last;
-      w_act0 <= s_act0;
-      w_right0 <= s_right0;
-      w_rs0 <= s_rs0;
-      w_re0 <= s_re0;
-      w_d0 <= s_d0;
-      w_g0 <= r_g0;
-      w_rem0 <= r_rem0;
-      w_qs0 <= r_qs0;
-      w_rs256_0 <= r_rs256_0;
-      w_act1 <= s_act1;
-      w_right1 <= s_right1;
-      w_rs1 <= s_rs1;
-      w_re1 <= s_re1;
-      w_d1 <= s_d1;
-      w_g1 <= r_g1;
-      w_rem1 <= r_rem1;
-      w_qs1 <= r_qs1;
-      w_rs256_1 <= r_rs256_1;
-      w_act2 <= s_act2;
-      w_right2 <= s_right2;
-      w_rs2 <= s_rs2;
-      w_re2 <= s_re2;
-      w_d2 <= s_d2;
-      w_g2 <= r_g2;
-      w_rem2 <= r_rem2;
-      w_qs2 <= r_qs2;
-      w_rs256_2 <= r_rs256_2;
       w_di <= r_di;
       w_an <= s_an;
       w_rn <= drn_q;
@@ -728,18 +453,6 @@ module tri_frontend (
       end else begin
         w_row <= w_row + 9'd1;
         w_tn <= w_tn + w_dyn;
-        if (w_act0 && w_row >= w_rs0) begin
-          w_rem0 <= rnext0[26:0];
-          w_g0 <= w_g0 + w_qs0 + {14'd0, cy0};
-        end
-        if (w_act1 && w_row >= w_rs1) begin
-          w_rem1 <= rnext1[26:0];
-          w_g1 <= w_g1 + w_qs1 + {14'd0, cy1};
-        end
-        if (w_act2 && w_row >= w_rs2) begin
-          w_rem2 <= rnext2[26:0];
-          w_g2 <= w_g2 + w_qs2 + {14'd0, cy2};
-        end
       end
     end
   end
@@ -818,7 +531,7 @@ module tri_frontend (
     end
   end
 `ifdef FORMAL
-  // scripts/prove: cutpoint t:$mul w:ei0_p w:ei0_d w:ei0_q w:es0_p w:es0_d w:es0_q w:ei1_p w:ei1_d w:ei1_q w:es1_p w:es1_d w:es1_q w:ei2_p w:ei2_d w:ei2_q w:es2_p w:es2_d w:es2_q w:ddi_p w:ddi_d w:ddi_q w:drn_p w:drn_d w:drn_q
+  // scripts/prove: cutpoint t:$mul w:g_edge*.u_edge.u_ei.p w:g_edge*.u_edge.u_ei.d w:g_edge*.u_edge.u_ei.q w:g_edge*.u_edge.u_es.p w:g_edge*.u_edge.u_es.d w:g_edge*.u_edge.u_es.q w:u_ddi.p w:u_ddi.d w:u_ddi.q w:u_drn.p w:u_drn.d w:u_drn.q
   // (the multipliers: area, edges, plane, I0; and the set-up dividers' registers, free every clock:
   // only the coverage decision, taken as given, depends on them; values are left to co-simulation)
   // Clocks since the start: $past is meaningful once f_past is set.

@@ -83,7 +83,10 @@ pub fn rtl_files(cfg: &Config, tris: &[FixedTriangle], source: Source) -> Result
     let hw = opts.frontend()?;
     let w = opts.writer()?;
     let chain: Vec<String> =
-        [&names.bfpi, &names.segment, &names.frontend, &names.top, &names.writer, &names.fb_top].iter().map(|n| format!("{n}.v")).collect();
+        [&names.bfpi, &names.segment, &names.frontend, &names.fe_edge, &names.fe_div, &names.top, &names.writer, &names.fb_top]
+            .iter()
+            .map(|n| format!("{n}.v"))
+            .collect();
     let mut files: Vec<GeneratedFile> = hdl_gen::generate(&opts).into_iter().filter(|f| chain.contains(&f.name)).collect();
     let modules = match source {
         Source::Rom => {

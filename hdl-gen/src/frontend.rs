@@ -6,7 +6,8 @@
 //! Structure of `tri_frontend`:
 //! - **set-up**: a triangle waits in the vertex registers until the dividers are free; in that
 //!   clock CALC checks the guard band, computes the area, orients the edges, finds the rows,
-//!   culls, and loads eight restoring dividers (`--fe-div-bits` quotient bits a clock); `DIV`
+//!   culls, and loads eight restoring dividers (`--fe-div-bits` quotient bits a clock; one module,
+//!   [`divider`], two in each edge's module, [`edge`], the edges a `generate` loop); `DIV`
 //!   runs them together; `HOLD` offers the result to the walker. The hand-off clock is also the
 //!   next triangle's CALC, and the next triangle is latched while the dividers run. At
 //!   `--pipeline 1` and above CALC is five register stages ([`golden::pipeline::SETUP_STAGES`],
@@ -24,6 +25,7 @@
 mod calc;
 mod chain;
 mod divider;
+mod edge;
 mod hw;
 mod incremental;
 mod properties;
@@ -66,16 +68,23 @@ pub fn module(hw: &Hw, names: &Names) -> Module {
     build(hw, names).0
 }
 
+/// `tri_frontend`'s parts, one file each: the edge (instanced three times) and the restoring
+/// divider (its parameters' defaults those of an edge's first-bound divider).
+pub fn submodules(hw: &Hw, names: &Names) -> Vec<Module> {
+    let [ei, _] = edge::dividers(hw);
+    vec![edge::module(hw, names), divider::module(names, &ei, hw.div_bits, setup::counter_width(&hw.fe.widths()))]
+}
+
 /// The module, and its register stages when it is pipelined ([`stages`]): the set-up, the
 /// walker, the span path and the output register, then the properties.
 fn build(hw: &Hw, names: &Names) -> (Module, Vec<golden::pipeline::PipeStage>) {
     let fe = &hw.fe;
     let wd = fe.widths();
     let mut body = Vec::new();
-    let set_up = setup::emit(hw, &mut body);
-    walker::emit(hw, &mut body);
+    let set_up = setup::emit(hw, names, &mut body);
+    walker::emit(hw, names, &mut body);
     let sp = span::path(hw, &mut body);
-    let sp = span::output(hw, sp, &mut body);
+    let sp = span::output(hw, names, sp, &mut body);
     // Every boundary is registered above level 0, so stage j's logic is logical step j - 1's.
     let stages = if hw.calc_clocks() > 1 {
         let mut v = stage_list(&set_up.st, "calc", &golden::pipeline::SETUP_STAGES);
@@ -133,5 +142,54 @@ fn header(hw: &Hw, names: &Names) -> Vec<String> {
         format!("Spans: the walker, then {} register stages to the output register (I0's path).", hw.i0_stages()),
         "Walker: one row per clock (rows with no covered pixel make a bubble); the next triangle's set-up overlaps it.".into(),
         format!("Widths: |A| {area_w}, edge bound {bound_w} signed, edge divisor {ediv_w}, intensity sums modulo 2^{sum_w}, reciprocal {recip_w}."),
+        String::new(),
+        "Structure, in this file's order: the vertex registers; CALC (its stages' registers c<j>_*); the set-up state".into(),
+        format!(
+            "machine (IDLE, DIV, HOLD) with dI's and the reciprocal's dividers (u_ddi, u_drn: {}); the walker, whose",
+            names.fe_div
+        ),
+        format!(
+            "three edges are a generate loop (g_edge[k].u_edge: {}, each with its set-up result, its two {} and its",
+            names.fe_edge, names.fe_div
+        ),
+        format!(
+            "DDA); the span path (stages p<j>_*){}; the output register.",
+            if fe.di == DiMode::Scanline { format!(" and the span's dI divider (u_sdv: {})", names.fe_div) } else { String::new() }
+        ),
     ]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Issue 27's review criterion, kept: the dividers are instances of one module and the edges
+    /// one `generate` loop, at every form (a copy of a divider's step or of an edge fails it).
+    #[test]
+    fn dividers_and_edges_are_instances_not_copies() {
+        for (di, pipeline, bits) in [(DiMode::Triangle, 0, 4), (DiMode::Triangle, 1, 1), (DiMode::Scanline, 0, 2), (DiMode::Scanline, 2, 4)]
+        {
+            let opts = crate::Options {
+                prefix: "x_".into(),
+                fe_di: di,
+                fe_div_bits: Some(bits),
+                pipeline: golden::pipeline::Pipeline::at(pipeline),
+                ..Default::default()
+            };
+            let (hw, names) = (opts.frontend().unwrap(), Names::new("x_", &opts.cfg));
+            let top = module(&hw, &names).render();
+            let what = format!("{di:?}, level {pipeline}, {bits} bits");
+            let scan = di == DiMode::Scanline;
+            assert_eq!(top.matches("x_tri_fe_div #(").count(), if scan { 3 } else { 2 }, "{what}: u_ddi, u_drn (u_sdv)");
+            assert_eq!(top.matches("x_tri_fe_edge u_edge (").count(), 1, "{what}");
+            assert!(top.contains("for (k = 0; k < 3; k = k + 1) begin : g_edge\n"), "{what}");
+            let parts: Vec<String> = submodules(&hw, &names).iter().map(|m| m.render()).collect();
+            assert_eq!(parts[0].matches("x_tri_fe_div #(").count(), 2, "{what}: an edge's first bound and step");
+            assert_eq!(parts[1].matches("for (j = 0; j < BITS; j = j + 1) begin").count(), 1, "{what}: the steps a loop");
+            for text in parts.iter().chain([&top]) {
+                assert!(!text.contains("_p1 ") && !text.contains("_on0 "), "{what}: an unrolled divider step");
+                assert_eq!(text.matches("\nmodule ").count(), 1, "{what}: one module per file");
+            }
+        }
+    }
 }

@@ -32,6 +32,7 @@ pub fn generate(opts: &Options) -> Vec<GeneratedFile> {
     // The CLI validates the screen; a library caller with a bad one gets no front-end.
     if let (Ok(fe), Ok(w)) = (opts.frontend(), opts.writer()) {
         modules.push(frontend::module(&fe, &names));
+        modules.extend(frontend::submodules(&fe, &names));
         modules.push(frontend::top_module(&fe, &names));
         modules.push(writer::module(&w, &names));
         modules.push(writer::top_module(&fe, &w, &names));

@@ -45,6 +45,9 @@ pub enum Role {
     Bfpi,
     SegmentShader,
     Frontend,
+    /// A part of the front-end (`tri_fe_div`, `tri_fe_edge`): no model of its own; its file is
+    /// among the front-end's sources.
+    FrontendPart,
     TriangleShader,
     Writer,
     TriangleWriter,
@@ -181,6 +184,17 @@ pub struct ModuleEntry {
     /// fixes (the specular unit's are in `specular`).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub stages: Vec<golden::pipeline::PipeStage>,
+    /// A front-end part's parameters (the divider's widths and rate): `ports` are at their
+    /// defaults.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub parameters: Vec<ParamEntry>,
+}
+
+#[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub struct ParamEntry {
+    pub name: String,
+    pub default: String,
+    pub description: String,
 }
 
 #[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
@@ -265,6 +279,10 @@ pub fn render(opts: &Options, names: &Names, modules: &[Module], unit: &Specular
             (Role::SegmentShader, seg_latency, "one segment per clock")
         } else if name == &names.frontend {
             (Role::Frontend, fe_latency, "one span per clock; set-up per walked triangle as in frontend.setup_clocks")
+        } else if name == &names.fe_div {
+            (Role::FrontendPart, 1, "BITS quotient bits a clock; the quotient after ceil(QB / BITS) run clocks")
+        } else if name == &names.fe_edge {
+            (Role::FrontendPart, 1, "one row per clock")
         } else if name == &names.top {
             (Role::TriangleShader, fe_latency + seg_latency, "one segment per clock")
         } else if name == &names.writer {
@@ -290,6 +308,14 @@ pub fn render(opts: &Options, names: &Names, modules: &[Module], unit: &Specular
             throughput: throughput.into(),
             ports: ports(m),
             stages,
+            // The ROMs' and the specular unit's file-name parameters are not widths: only the
+            // front-end's divider states its parameters (its ports are at their defaults).
+            parameters: m
+                .params
+                .iter()
+                .filter(|_| role == Role::FrontendPart)
+                .map(|p| ParamEntry { name: p.name.clone(), default: p.value.clone(), description: p.doc.clone() })
+                .collect(),
         }
     };
     let manifest = Manifest {

@@ -10,6 +10,10 @@ pub struct Names {
     pub segment: String,
     /// SPEC §6's front-end (set-up and edge walker), and the chain of it with the shader.
     pub frontend: String,
+    /// The front-end's parts, one file each: the restoring divider (parameterised: every set-up
+    /// division and the per-scanline dI's) and one edge (its set-up result and its walker step).
+    pub fe_div: String,
+    pub fe_edge: String,
     pub top: String,
     /// SPEC §7's segment writer, and the chain from triangles to memory.
     pub writer: String,
@@ -23,6 +27,8 @@ impl Names {
             bfpi: format!("{prefix}bfpi_p{}", cfg.p),
             segment: format!("{prefix}segment_shader_p{}", cfg.p),
             frontend: format!("{prefix}tri_frontend"),
+            fe_div: format!("{prefix}tri_fe_div"),
+            fe_edge: format!("{prefix}tri_fe_edge"),
             top: format!("{prefix}tri_shader_p{}", cfg.p),
             writer: format!("{prefix}fb_writer_p{}", cfg.p),
             fb_top: format!("{prefix}tri_fb_p{}", cfg.p),

@@ -28,6 +28,9 @@ pub struct Port {
     /// Verilog-2005 attribute instances printed before the declaration, one per line, each the
     /// text between `(*` and `*)`: vendor tools read interfaces from them (`--bus axis`).
     pub attrs: Vec<String>,
+    /// A parameterised module's port: its width as a parameter expression, printed `[w-1:0]`;
+    /// `width` is then its width at the parameters' defaults (what the manifest states).
+    pub param_width: Option<String>,
 }
 
 impl Port {
@@ -42,6 +45,7 @@ impl Port {
             format: format.into(),
             doc: doc.into(),
             attrs: Vec::new(),
+            param_width: None,
         }
     }
     pub fn output(name: &str, width: u32, format: &str, doc: &str) -> Port {
@@ -59,6 +63,12 @@ impl Port {
         self.vector = true;
         self
     }
+    /// Declares the port `[width-1:0]`, `width` a parameter expression; `self.width` stays its
+    /// width at the parameters' defaults.
+    pub fn param_width(mut self, width: &str) -> Port {
+        self.param_width = Some(width.into());
+        self
+    }
     /// Adds the attribute instance `(* attr *)` before the declaration.
     pub fn attr(mut self, attr: impl Into<String>) -> Port {
         self.attrs.push(attr.into());
@@ -73,7 +83,7 @@ pub enum Stmt {
     Set(String, String),
     If(String, Vec<Stmt>, Vec<Stmt>),
     Comment(String),
-    /// Testbench only: blocking assignment `lhs = rhs;`.
+    /// Blocking assignment `lhs = rhs;`: testbenches, and the variables of an [`Item::Comb`].
     Blocking(String, String),
     /// Testbench only: a system task call such as `$display("...", x)`, printed with its `;`.
     Call(String),
@@ -81,6 +91,13 @@ pub enum Stmt {
     Delay(u32),
     /// Testbench only: `forever begin ... end`.
     Forever(Vec<Stmt>),
+    /// `for (var = 0; var < count; var = var + 1) begin ... end` over an [`Item::Integer`], in a
+    /// combinational block ([`Item::Comb`]): the steps of a chain written once.
+    For {
+        var: String,
+        count: String,
+        body: Vec<Stmt>,
+    },
     /// Formal only (inside [`Item::Formal`]): an immediate `assert(cond);`.
     Assert(String),
     /// Formal only: an immediate `assume(cond);`, a rule the environment is held to.
@@ -123,6 +140,16 @@ pub enum Item {
         width: u32,
         value: String,
     },
+    /// A parameterised module's declaration, its width a parameter expression:
+    /// `wire|reg [width-1:0] name [= value];` or `localparam [width-1:0] name = value;`.
+    Sized {
+        kind: Kind,
+        name: String,
+        width: String,
+        value: Option<String>,
+    },
+    /// `integer name;`: the variable of a [`Stmt::For`].
+    Integer(String),
     Assign(String, String),
     /// `always @(posedge clk)`.
     Always(Vec<Stmt>),
@@ -184,6 +211,19 @@ pub enum Item {
         then: Vec<Item>,
         els: Vec<Item>,
     },
+}
+
+/// What an [`Item::Sized`] declares.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Kind {
+    Wire,
+    Reg,
+    Localparam,
+}
+
+/// `kind [width-1:0] name [= value];`, `width` a parameter expression.
+pub fn sized(kind: Kind, name: &str, width: &str, value: Option<String>) -> Item {
+    Item::Sized { kind, name: name.into(), width: width.into(), value }
 }
 
 pub fn wire(name: &str, width: u32, value: impl Into<String>) -> Item {
@@ -341,7 +381,11 @@ impl Module {
                     Dir::Output if p.reg => "output reg  ",
                     Dir::Output => "output wire ",
                 };
-                format!("{dir}{}{}{}", sign(p.signed), vrange(p.width, p.vector), p.name)
+                let range = match &p.param_width {
+                    Some(w) => format!("[{w}-1:0] "),
+                    None => vrange(p.width, p.vector),
+                };
+                format!("{dir}{}{range}{}", sign(p.signed), p.name)
             })
             .collect();
         let pad = decls.iter().map(|d| d.len()).max().unwrap_or(0) + 1;
@@ -391,6 +435,19 @@ fn render_items(o: &mut String, items: &[Item], level: usize) {
                 let r = if *width == 0 { String::new() } else { range(*width) };
                 writeln!(o, "localparam {r}{name} = {value};").unwrap()
             }
+            Item::Sized { kind, name, width, value } => {
+                let kind = match kind {
+                    Kind::Wire => "wire",
+                    Kind::Reg => "reg",
+                    Kind::Localparam => "localparam",
+                };
+                write!(o, "{kind} [{width}-1:0] {name}").unwrap();
+                match value {
+                    Some(v) => writeln!(o, " = {v};").unwrap(),
+                    None => o.push_str(";\n"),
+                }
+            }
+            Item::Integer(name) => writeln!(o, "integer {name};").unwrap(),
             Item::Assign(l, r) => writeln!(o, "assign {l} = {r};").unwrap(),
             Item::Always(stmts) => {
                 o.push_str("always @(posedge clk) begin\n");
@@ -587,6 +644,12 @@ fn render_stmts(o: &mut String, stmts: &[Stmt], level: usize) {
                 render_stmts(&mut inner, std::slice::from_ref(stmt), level);
                 write!(o, "{label}: {}", inner.trim_start()).unwrap();
             }
+            Stmt::For { var, count, body } => {
+                writeln!(o, "for ({var} = 0; {var} < {count}; {var} = {var} + 1) begin").unwrap();
+                render_stmts(o, body, level + 1);
+                indent(o, level);
+                o.push_str("end\n");
+            }
             Stmt::Forever(body) => {
                 o.push_str("forever begin\n");
                 render_stmts(o, body, level + 1);
@@ -670,6 +733,29 @@ mod tests {
         assert!(render(3).contains("  always @(*) begin\n    b = {l2, l1, l0};\n  end\n"), "{}", render(3));
         let two = render(10);
         assert!(two.contains("    b = {\n      {l9, l8},\n      {l7, l6, l5, l4, l3, l2, l1, l0}\n    };\n  end\n"), "{two}");
+    }
+
+    #[test]
+    fn parameterised_widths_and_loops() {
+        let m = Module {
+            name: "t".into(),
+            header: vec![],
+            params: vec![Param { name: "W".into(), value: "4".into(), doc: "bits".into() }],
+            ports: vec![Port::input("a", 4, "", "").param_width("W"), Port::output("y", 4, "", "").param_width("W").reg()],
+            body: vec![
+                sized(Kind::Localparam, "ONE", "W", Some("1".into())),
+                Item::Integer("j".into()),
+                Item::Comb(vec![
+                    Stmt::Blocking("y".into(), "a".into()),
+                    Stmt::For { var: "j".into(), count: "2".into(), body: vec![Stmt::Blocking("y".into(), "y + ONE".into())] },
+                ]),
+            ],
+        };
+        let text = m.render();
+        assert!(text.contains("input  wire [W-1:0] a,"), "{text}");
+        assert!(text.contains("output reg  [W-1:0] y "), "{text}");
+        assert!(text.contains("  localparam [W-1:0] ONE = 1;\n  integer j;\n"), "{text}");
+        assert!(text.contains("    for (j = 0; j < 2; j = j + 1) begin\n      y = y + ONE;\n    end\n"), "{text}");
     }
 
     #[test]

@@ -42,7 +42,8 @@ struct PortDecl {
     signed: bool,
 }
 
-/// The ports of `module` as its ANSI header in `text` declares them.
+/// The ports of `module` as its ANSI header in `text` declares them; a width given by a parameter
+/// (`[PW-1:0]`) at the parameter's default, as the manifest states it.
 fn verilog_ports(text: &str, module: &str) -> Vec<PortDecl> {
     let mut lines = text.lines().skip_while(|l| {
         let mut t = l.split_whitespace();
@@ -50,10 +51,17 @@ fn verilog_ports(text: &str, module: &str) -> Vec<PortDecl> {
     });
     assert!(lines.next().is_some(), "no `module {module}` in its file");
     let mut ports = Vec::new();
+    let mut params = std::collections::HashMap::new();
     for line in lines {
         let code = line.split("//").next().unwrap().trim().trim_end_matches(',').trim();
         if code == ");" {
             return ports;
+        }
+        if let Some((name, value)) = code.strip_prefix("parameter ").and_then(|p| p.split_once(" = ")) {
+            if let Ok(v) = value.trim().parse::<u32>() {
+                params.insert(name.trim().to_string(), v);
+            }
+            continue;
         }
         let tokens: Vec<&str> = code.split_whitespace().collect();
         let direction = match tokens.first() {
@@ -72,7 +80,11 @@ fn verilog_ports(text: &str, module: &str) -> Vec<PortDecl> {
             Some(r) if r.starts_with('[') => {
                 let (hi, lo) = r.trim_matches(['[', ']']).split_once(':').unwrap_or_else(|| panic!("range {r}"));
                 rest = &rest[1..];
-                hi.parse::<u32>().unwrap() - lo.parse::<u32>().unwrap() + 1
+                let hi = hi.parse::<u32>().unwrap_or_else(|_| {
+                    let (p, minus) = hi.split_once('-').unwrap_or_else(|| panic!("{module}: range {r}"));
+                    params.get(p).unwrap_or_else(|| panic!("{module}: {r}: no parameter {p}")) - minus.parse::<u32>().unwrap()
+                });
+                hi - lo.parse::<u32>().unwrap() + 1
             }
             _ => 1,
         };

@@ -278,7 +278,7 @@ pub fn models_of_manifest(m: &Manifest, read: &dyn Fn(&str) -> Result<String, St
     if let (Some(fe_mod), Some(tri)) = (m.by_role(Role::Frontend), m.by_role(Role::TriangleShader)) {
         let fe = m.frontend.as_ref().ok_or_else(|| format!("{MANIFEST_FILE} lists a front-end module but no frontend section"))?;
         let (screen, di) = (fe.screen, fe.di);
-        let fe_src = files_of(&[Role::Frontend])?;
+        let fe_src = files_of(&[Role::Frontend, Role::FrontendPart])?;
         let mut all = sources.clone();
         all.extend(fe_src.iter().cloned());
         all.extend(files_of(&[Role::TriangleShader])?);

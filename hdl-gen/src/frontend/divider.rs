@@ -1,57 +1,124 @@
-//! The set-up's restoring dividers: `--fe-div-bits` quotient bits a clock, each bit one
-//! compare-and-subtract step chained in the same clock, sharing one down-counter.
+//! `tri_fe_div`: the front-end's restoring divider, one module for every division it makes (the
+//! set-up's eight, the per-scanline dI's), parameterised by its widths and rate. `--fe-div-bits`
+//! quotient bits a clock, each bit one compare-and-subtract step chained in the same clock; the
+//! counter that says which quotient bits are due is its owner's, shared by the dividers it runs.
 
-use crate::verilog::{lit, reg, set, wire, Item, Stmt};
+use crate::verilog::{comment, net, set, sized, Item, Kind, Module, Param, Port, Stmt};
+use crate::Names;
 
-/// One restoring divider: registers `<n>_p` (partial remainder), `<n>_d` (shifted divisor),
-/// `<n>_q`; it takes quotient bits while the shared counter is below `qb`.
+/// One divider: its instance name, partial remainder (and shifted divisor) bits `pw`, quotient
+/// bits `qb`.
 pub(super) struct Div {
     pub name: &'static str,
     pub pw: u32,
     pub qb: u32,
 }
 
-pub(super) fn div_regs(d: &Div) -> Vec<Item> {
-    vec![reg(&format!("{}_p", d.name), d.pw), reg(&format!("{}_d", d.name), d.pw), reg(&format!("{}_q", d.name), d.qb)]
+/// What a divider's inputs connect to: its counter, load and run, operands.
+pub(super) struct DivConns<'a> {
+    pub cnt: &'a str,
+    pub load: &'a str,
+    pub run: &'a str,
+    pub dividend: &'a str,
+    pub divisor: &'a str,
 }
 
-/// Statements that load a divider: dividend and divisor, both `pw` bits wide already.
-pub(super) fn div_load(d: &Div, dividend: &str, divisor_shifted: &str) -> Vec<Stmt> {
-    vec![set(format!("{}_p", d.name), dividend), set(format!("{}_d", d.name), divisor_shifted), set(format!("{}_q", d.name), lit(d.qb, 0))]
-}
+/// A divider's outputs: the partial remainder (the remainder once done), the quotient, and the
+/// quotient after this clock's steps.
+const OUTPUTS: [&str; 3] = ["p", "q", "q_next"];
 
-/// `bits` restoring steps in one clock, chained: step j takes quotient bit `cnt - j`, if
-/// that bit exists and is one of this divider's `qb`.
-pub(super) fn div_chain(d: &Div, cnt: &str, cnt_w: u32, bits: u32) -> Vec<Item> {
-    let n = d.name;
-    let mut items = Vec::new();
-    for j in 0..bits {
-        let (p, dd, q) = if j == 0 {
-            (format!("{n}_p"), format!("{n}_d"), format!("{n}_q"))
-        } else {
-            (format!("{n}_p{j}"), format!("{n}_d{j}"), format!("{n}_q{j}"))
-        };
-        let on = if j == 0 {
-            format!("{cnt} < {}", lit(cnt_w, d.qb as u64))
-        } else {
-            format!("{cnt} >= {} && {cnt} - {} < {}", lit(cnt_w, j as u64), lit(cnt_w, j as u64), lit(cnt_w, d.qb as u64))
-        };
-        items.push(wire(&format!("{n}_on{j}"), 1, on));
-        items.push(wire(&format!("{n}_ge{j}"), 1, format!("{p} >= {dd}")));
-        let k = j + 1;
-        let shifted = if d.qb == 1 { format!("{n}_ge{j}") } else { format!("{{{q}[{}:0], {n}_ge{j}}}", d.qb - 2) };
-        items.push(wire(&format!("{n}_p{k}"), d.pw, format!("({n}_on{j} && {n}_ge{j}) ? {p} - {dd} : {p}")));
-        items.push(wire(&format!("{n}_d{k}"), d.pw, format!("{n}_on{j} ? {dd} >> 1 : {dd}")));
-        items.push(wire(&format!("{n}_q{k}"), d.qb, format!("{n}_on{j} ? {shifted} : {q}")));
+impl Div {
+    /// The wire of output `port` (one of [`OUTPUTS`]): `<instance without u_>_<port>`.
+    pub fn out(&self, port: &str) -> String {
+        format!("{}_{port}", self.name.trim_start_matches("u_"))
     }
-    items
+
+    /// The instance (its parameters the divider's widths, `bits` a clock, a `cnt_w`-bit counter)
+    /// and the wires of its outputs, those not in `used` declared as unused for the linter.
+    pub fn instance(&self, module: &str, bits: u32, cnt_w: u32, c: &DivConns, used: &[&str]) -> Vec<Item> {
+        assert!(self.qb >= 2, "divider {}: {} quotient bits (at least 2: the quotient shifts)", self.name, self.qb);
+        let width = |port: &str| if port == "p" { self.pw } else { self.qb };
+        let mut items: Vec<Item> = OUTPUTS.iter().filter(|o| used.contains(o)).map(|o| net(&self.out(o), width(o))).collect();
+        items.push(comment("verilator lint_off UNUSEDSIGNAL"));
+        items.extend(OUTPUTS.iter().filter(|o| !used.contains(o)).map(|o| net(&self.out(o), width(o))));
+        items.push(comment("verilator lint_on UNUSEDSIGNAL"));
+        items.push(Item::Instance {
+            module: module.into(),
+            name: self.name.into(),
+            params: [("PW", self.pw), ("QB", self.qb), ("BITS", bits), ("CW", cnt_w)].map(|(k, v)| (k.to_string(), v.to_string())).into(),
+            conns: [("clk", "clk"), ("load", c.load), ("run", c.run), ("cnt", c.cnt), ("dividend", c.dividend), ("divisor", c.divisor)]
+                .map(|(k, v)| (k.to_string(), v.to_string()))
+                .into_iter()
+                .chain(OUTPUTS.map(|o| (o.to_string(), self.out(o))))
+                .collect(),
+        });
+        items
+    }
 }
 
-pub(super) fn div_iter(d: &Div, bits: u32) -> Vec<Stmt> {
-    let n = d.name;
-    vec![
-        set(format!("{n}_p"), format!("{n}_p{bits}")),
-        set(format!("{n}_d"), format!("{n}_d{bits}")),
-        set(format!("{n}_q"), format!("{n}_q{bits}")),
-    ]
+/// The divider module, its parameters' defaults those of `d` (what the manifest states its ports
+/// at).
+pub(super) fn module(names: &Names, d: &Div, bits: u32, cnt_w: u32) -> Module {
+    let name = &names.fe_div;
+    let header = vec![
+        format!("{name} — restoring divider of {}: quotient = dividend / divisor, BITS quotient bits a clock.", names.frontend),
+        "Generated by segshade hdl-gen; do not edit.".into(),
+        String::new(),
+        "load: p = dividend, d = divisor (already shifted left to the quotient's top bit), q = 0.".into(),
+        "run: BITS restoring steps in the clock, chained; step j takes quotient bit cnt - j when that bit is".into(),
+        "one of the QB (the owner counts cnt down by BITS a clock from QB - 1; one counter serves all the".into(),
+        "dividers it runs). Each step: if p >= d then p -= d and the bit is 1; d >>= 1.".into(),
+        "Done after ceil(QB / BITS) run clocks: q the quotient, p the remainder. q_next is q after this".into(),
+        "clock's steps (the per-scanline dI reads it in its last clock).".into(),
+        "Holds its registers otherwise (load has priority); no reset: load sets every register.".into(),
+    ];
+    let (pw, qb) = (d.pw, d.qb);
+    let params = vec![
+        Param { name: "PW".into(), value: pw.to_string(), doc: "partial remainder and divisor bits".into() },
+        Param { name: "QB".into(), value: qb.to_string(), doc: "quotient bits (at least 2)".into() },
+        Param { name: "BITS".into(), value: bits.to_string(), doc: "quotient bits a clock".into() },
+        Param { name: "CW".into(), value: cnt_w.to_string(), doc: "counter bits".into() },
+    ];
+    let ports = vec![
+        Port::input("clk", 1, "", "rising edge"),
+        Port::input("load", 1, "", "start: take the operands"),
+        Port::input("run", 1, "", "take this clock's quotient bits"),
+        Port::input("cnt", cnt_w, "unsigned integer", "the owner's counter: the first quotient bit due this clock").param_width("CW"),
+        Port::input("dividend", pw, "unsigned integer", "").param_width("PW"),
+        Port::input("divisor", pw, "unsigned integer", "shifted left by QB - 1").param_width("PW"),
+        Port::output("p", pw, "unsigned integer", "partial remainder; the remainder when done").param_width("PW").reg(),
+        Port::output("q", qb, "unsigned integer", "quotient bits so far; the quotient when done").param_width("QB").reg(),
+        Port::output("q_next", qb, "unsigned integer", "q after this clock's steps").param_width("QB").reg(),
+    ];
+    let step = vec![
+        Stmt::Blocking("q_next".into(), "{q_next[QB-2:0], p_next >= d_next}".into()),
+        Stmt::If("p_next >= d_next".into(), vec![Stmt::Blocking("p_next".into(), "p_next - d_next".into())], vec![]),
+        Stmt::Blocking("d_next".into(), "d_next >> 1".into()),
+    ];
+    let body = vec![
+        sized(Kind::Localparam, "QB_CNT", "CW", Some("QB".into())),
+        sized(Kind::Reg, "d", "PW", None),
+        sized(Kind::Reg, "p_next", "PW", None),
+        sized(Kind::Reg, "d_next", "PW", None),
+        Item::Integer("j".into()),
+        Item::Blank,
+        Item::Comment("The clock's BITS steps, chained: step j takes quotient bit cnt - j if it is one of the QB.".into()),
+        Item::Comb(vec![
+            Stmt::Blocking("p_next".into(), "p".into()),
+            Stmt::Blocking("d_next".into(), "d".into()),
+            Stmt::Blocking("q_next".into(), "q".into()),
+            Stmt::For {
+                var: "j".into(),
+                count: "BITS".into(),
+                body: vec![Stmt::If("cnt >= j[CW-1:0] && cnt - j[CW-1:0] < QB_CNT".into(), step, vec![])],
+            },
+        ]),
+        Item::Blank,
+        Item::Always(vec![Stmt::If(
+            "load".into(),
+            vec![set("p", "dividend"), set("d", "divisor"), set("q", "{QB{1'b0}}")],
+            vec![Stmt::If("run".into(), vec![set("p", "p_next"), set("d", "d_next"), set("q", "q_next")], vec![])],
+        )]),
+    ];
+    Module { name: name.clone(), header, params, ports, body }
 }

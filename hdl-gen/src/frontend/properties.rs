@@ -12,7 +12,7 @@ use crate::verilog::{comment, lit, reg, set, sext, wire, zext, Item, Stmt};
 pub(super) fn emit(hw: &Hw, set_up: Setup, sp: &Stager) -> Item {
     let fe = &hw.fe;
     let wd = fe.widths();
-    let Setup { st, divs, cnt_w, guard, cull } = set_up;
+    let Setup { st, div_regs, cnt_w, guard, cull } = set_up;
     frontend_properties(&FrontendShape {
         yw: wd.yw,
         cx: wd.cx,
@@ -26,7 +26,7 @@ pub(super) fn emit(hw: &Hw, set_up: Setup, sp: &Stager) -> Item {
         rw: wd.rw,
         div_clocks: hw.div_clocks(),
         latency: hw.latency(),
-        div_regs: divs.iter().flat_map(|d| ["p", "d", "q"].map(|r| format!("{}_{r}", d.name))).collect(),
+        div_regs,
         calc_stages: (1..=st.stage())
             .map(|j| CalcStage {
                 valid: setup::valid(j),
@@ -71,7 +71,9 @@ pub struct FrontendShape {
     pub div_clocks: u32,
     /// Clocks from a triangle's transfer to its first span (`Hw::latency`): the cover search's depth.
     pub latency: u32,
-    /// The set-up dividers' registers (partial remainder, divisor, quotient of each): cut.
+    /// The set-up dividers' registers (partial remainder, divisor, quotient of each), as Yosys
+    /// names them once the design is flattened (`instance.register`, `*` for a generate loop's
+    /// index): cut.
     pub div_regs: Vec<String>,
     /// CALC's stages after the vertex register (none at level 0), in order.
     pub calc_stages: Vec<CalcStage>,

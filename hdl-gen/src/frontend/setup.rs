@@ -1,18 +1,23 @@
-//! The set-up around CALC: the vertex registers, CALC's stages and their moves, the eight
-//! restoring dividers and the set-up result they complete (`IDLE`, `DIV`, `HOLD`).
+//! The set-up around CALC: the vertex registers, CALC's stages and their moves, the set-up
+//! result (the edges' part is in each `tri_fe_edge`, with its two divisions; dI's and the
+//! reciprocal's dividers are here) and the state machine that completes it (`IDLE`, `DIV`,
+//! `HOLD`).
 
 use super::calc::calc;
-use super::divider::{div_chain, div_iter, div_load, div_regs, Div};
+use super::divider::{Div, DivConns};
+use super::edge;
 use super::hw::Hw;
 use super::stager::Stager;
 use crate::verilog::{assign, comment, lit, net, reg, set, sreg, wire, zext, Item, Stmt};
+use crate::Names;
 use golden::frontend::Widths;
 
-/// What the set-up hands on: CALC (its stage registers, for the properties), the dividers and
-/// their counter's width, and CALC's decisions on the last stage.
+/// What the set-up hands on: CALC (its stage registers, for the properties), the dividers'
+/// registers (hierarchical names after flattening, as a proof cuts them) and their counter's
+/// width, and CALC's decisions on the last stage.
 pub(super) struct Setup {
     pub st: Stager,
-    pub divs: Vec<Div>,
+    pub div_regs: Vec<String>,
     pub cnt_w: u32,
     pub guard: String,
     pub cull: String,
@@ -41,22 +46,36 @@ pub(super) fn counter_width(wd: &Widths) -> u32 {
     32 - wd.rw.leading_zeros()
 }
 
-/// The set-up, from the vertex registers to the divider results (`r_*`) the walker loads.
-pub(super) fn emit(hw: &Hw, body: &mut Vec<Item>) -> Setup {
+/// The set-up, from the vertex registers to the set-up result the walker loads.
+pub(super) fn emit(hw: &Hw, names: &Names, body: &mut Vec<Item>) -> Setup {
     let wd = hw.fe.widths();
     let cnt_w = counter_width(&wd);
     state(hw, cnt_w, body);
     let st = calc(hw);
-    // What the last CALC stage hands on (the dividers' loads, the set-up's result, the decision)
-    // is read before the stage registers are declared, so every register carrying it is among them.
-    let divs = dividers(hw);
-    let load = calc_load(hw, &st, &divs, cnt_w);
+    // What the last CALC stage hands on (the edges' values, the dividers' loads, the set-up's
+    // result, the decision) is read before the stage registers are declared, so every register
+    // carrying it is among them.
+    let edges = edge_inputs(hw, &st);
+    let (ddi, drn) = dividers(hw);
+    let divs = divider_instances(hw, names, &st, &ddi, &drn, cnt_w);
+    let load = calc_load(hw, &st, cnt_w);
     let (guard, cull) = (st.at("guard_ok"), st.at("cull"));
     let v_go = calc_stages(&st, body);
-    divider_regs(hw, &divs, cnt_w, body);
-    control(hw, &divs, cnt_w, load, &v_go, &guard, &cull, body);
+    body.push(comment("The set-up's load (CALC's last clock, the triangle kept) and its dividers' clocks."));
+    body.push(wire("calc_go", 1, format!("!rst && calc && {guard} && !{cull}")));
+    body.push(wire("div_run", 1, "!rst && !calc && st == DIV"));
+    body.extend(edges);
+    results_regs(hw, divs, body);
+    control(hw, cnt_w, load, &v_go, &guard, &cull, body);
     results(hw, body);
-    Setup { st, divs, cnt_w, guard, cull }
+    let mut div_regs = Vec::new();
+    for d in edge::dividers(hw) {
+        div_regs.extend(["p", "d", "q"].map(|r| format!("g_edge*.u_edge.{}.{r}", d.name)));
+    }
+    for d in [&ddi, &drn] {
+        div_regs.extend(["p", "d", "q"].map(|r| format!("{}.{r}", d.name)));
+    }
+    Setup { st, div_regs, cnt_w, guard, cull }
 }
 
 fn state(hw: &Hw, cnt_w: u32, body: &mut Vec<Item>) {
@@ -81,57 +100,56 @@ fn state(hw: &Hw, cnt_w: u32, body: &mut Vec<Item>) {
     body.push(net("take", 1));
 }
 
-/// Per edge its first bound (ei) and its step (es), then dI (ddi) and the reciprocal (drn).
-fn dividers(hw: &Hw) -> Vec<Div> {
-    let Widths { cy: vy_w, aw: area_w, gw: bound_w, dw_edge: ediv_w, rw: recip_w, .. } = hw.fe.widths();
+/// dI's divider (ddi) and the reciprocal's (drn); the edges' are in `tri_fe_edge`.
+fn dividers(hw: &Hw) -> (Div, Div) {
+    let Widths { aw: area_w, rw: recip_w, .. } = hw.fe.widths();
     let iw = hw.fe.cfg.iw();
-    let (pw_init, pw_step) = (bound_w + ediv_w, bound_w + vy_w);
-    (0..3)
-        .flat_map(|k| {
-            [
-                Div { name: ["ei0", "ei1", "ei2"][k], pw: pw_init, qb: bound_w },
-                Div { name: ["es0", "es1", "es2"][k], pw: pw_step, qb: bound_w },
-            ]
-        })
-        .chain([Div { name: "ddi", pw: iw + area_w + 1, qb: iw }, Div { name: "drn", pw: area_w + recip_w + 1, qb: recip_w }])
-        .collect()
+    (Div { name: "u_ddi", pw: iw + area_w + 1, qb: iw }, Div { name: "u_drn", pw: area_w + recip_w + 1, qb: recip_w })
 }
 
-/// CALC's last clock: load the dividers and the set-up result registers.
-fn calc_load(hw: &Hw, st: &Stager, divs: &[Div], cnt_w: u32) -> Vec<Stmt> {
-    let Widths { yw: row_w, cy: vy_w, aw: area_w, gw: bound_w, dw_edge: ediv_w, k: sum_w, rw: recip_w, .. } = hw.fe.widths();
-    let iw = hw.fe.cfg.iw();
-    let (pw_init, pw_step) = (bound_w + ediv_w, bound_w + vy_w);
-    let mut calc_load = vec![set("div_cnt", lit(cnt_w, (recip_w - 1) as u64)), set("st", "DIV")];
-    for k in 0..3 {
-        let ei = &divs[2 * k];
-        let es = &divs[2 * k + 1];
-        let ady = st.at(&format!("ady{k}"));
-        calc_load.extend(div_load(
-            ei,
-            &format!("{}[{}:0]", st.at(&format!("n{k}")), pw_init - 1),
-            &format!("{} << {}", zext(&ady, vy_w, pw_init), bound_w + 7),
-        ));
-        calc_load.extend(div_load(
-            es,
-            &format!("{}[{}:0]", st.at(&format!("sn{k}")), pw_step - 1),
-            &format!("{} << {}", zext(&ady, vy_w, pw_step), bound_w - 1),
-        ));
-        calc_load.push(set(format!("s_act{k}"), st.at(&format!("act{k}"))));
-        calc_load.push(set(format!("s_right{k}"), format!("!{}", st.at(&format!("dyneg{k}")))));
-        calc_load.push(set(format!("s_rs{k}"), st.at(&format!("rsu{k}"))));
-        calc_load.push(set(format!("s_re{k}"), format!("{}[{}:0]", st.at(&format!("re{k}")), row_w - 1)));
-        calc_load.push(set(format!("s_d{k}"), format!("{{{ady}, 8'd0}}")));
+/// CALC's per-edge values as buses of three lanes, edge k in lane k, for the edges' `generate`
+/// loop.
+fn edge_inputs(hw: &Hw, st: &Stager) -> Vec<Item> {
+    let row_w = hw.fe.widths().yw;
+    let mut items = vec![comment("CALC's values for the edges, edge k in lane k.")];
+    for (port, bus, w) in edge::input_buses(hw).inputs {
+        let lane = |k: usize| match port {
+            "n" => format!("{}[{}:0]", st.at(&format!("n{k}")), w - 1),
+            "sn" => format!("{}[{}:0]", st.at(&format!("sn{k}")), w - 1),
+            "ady" => st.at(&format!("ady{k}")),
+            "act" => st.at(&format!("act{k}")),
+            "right" => format!("!{}", st.at(&format!("dyneg{k}"))),
+            "rs" => st.at(&format!("rsu{k}")),
+            "re" => format!("{}[{}:0]", st.at(&format!("re{k}")), row_w - 1),
+            _ => unreachable!("an edge input {port} CALC does not compute"),
+        };
+        let lanes: Vec<String> = (0..3).rev().map(lane).collect();
+        items.push(wire(bus, 3 * w, format!("{{{}}}", lanes.join(", "))));
     }
-    let ddi_pw = iw + area_w + 1;
+    items
+}
+
+/// dI's and the reciprocal's dividers, loaded in CALC's last clock.
+fn divider_instances(hw: &Hw, names: &Names, st: &Stager, ddi: &Div, drn: &Div, cnt_w: u32) -> Vec<Item> {
+    let Widths { aw: area_w, k: sum_w, rw: recip_w, .. } = hw.fe.widths();
+    let iw = hw.fe.cfg.iw();
     let (x2, x2w) = (st.at("x2"), st.width("x2"));
-    let x2_fit = if x2w >= ddi_pw { format!("{x2}[{}:0]", ddi_pw - 1) } else { zext(&x2, x2w, ddi_pw) };
-    calc_load.extend(div_load(&divs[6], &x2_fit, &format!("{} << {}", zext(&st.at("aabs"), area_w, ddi_pw), iw)));
-    calc_load.extend(div_load(
-        &divs[7],
-        &format!("{} << {}", lit(area_w + recip_w + 1, 1), sum_w),
-        &format!("{} << {}", zext(&st.at("an"), area_w, area_w + recip_w + 1), recip_w),
-    ));
+    let x2_fit = if x2w >= ddi.pw { format!("{x2}[{}:0]", ddi.pw - 1) } else { zext(&x2, x2w, ddi.pw) };
+    let ddi_dv = format!("{} << {}", zext(&st.at("aabs"), area_w, ddi.pw), iw);
+    let drn_n = format!("{} << {}", lit(drn.pw, 1), sum_w);
+    let drn_dv = format!("{} << {}", zext(&st.at("an"), area_w, drn.pw), recip_w);
+    let mut items = vec![comment("Its dividers: dI's quotient (ddi) and the reciprocal Rn = 2^K / (2 An) (drn).")];
+    for (d, dividend, divisor) in [(ddi, x2_fit.as_str(), ddi_dv.as_str()), (drn, drn_n.as_str(), drn_dv.as_str())] {
+        let conns = DivConns { cnt: "div_cnt", load: "calc_go", run: "div_run", dividend, divisor };
+        items.extend(d.instance(&names.fe_div, hw.div_bits, cnt_w, &conns, &["q"]));
+    }
+    items
+}
+
+/// CALC's last clock: start the dividers' counter and load the set-up result registers.
+fn calc_load(hw: &Hw, st: &Stager, cnt_w: u32) -> Vec<Stmt> {
+    let recip_w = hw.fe.widths().rw;
+    let mut calc_load = vec![set("div_cnt", lit(cnt_w, (recip_w - 1) as u64)), set("st", "DIV")];
     for (r, v) in [
         ("s_first", "first_u"),
         ("s_last", "last_u"),
@@ -183,30 +201,16 @@ fn calc_stages(st: &Stager, body: &mut Vec<Item>) -> String {
     v_go
 }
 
-fn divider_regs(hw: &Hw, divs: &[Div], cnt_w: u32, body: &mut Vec<Item>) {
-    let Widths { yw: row_w, aw: area_w, dw_edge: ediv_w, k: sum_w, .. } = hw.fe.widths();
-    let bits = hw.div_bits;
-    body.push(comment("Eight restoring dividers, one quotient bit per clock, sharing one counter: per edge its first"));
-    body.push(comment("bound (ei) and its step (es), then dI (ddi) and the reciprocal Rn = 2^K / (2 An) (drn)."));
-    for d in divs {
-        body.extend(div_regs(d));
-    }
-    for d in divs {
-        body.extend(div_chain(d, "div_cnt", cnt_w, bits));
-    }
-    body.push(comment("The set-up result, complete when the dividers are (HOLD)."));
-    for k in 0..3 {
-        body.push(reg(&format!("s_act{k}"), 1));
-        body.push(reg(&format!("s_right{k}"), 1));
-        body.push(reg(&format!("s_rs{k}"), row_w));
-        body.push(reg(&format!("s_re{k}"), row_w));
-        body.push(reg(&format!("s_d{k}"), ediv_w));
-    }
+/// The set-up result's triangle-wide registers, and its dividers.
+fn results_regs(hw: &Hw, divs: Vec<Item>, body: &mut Vec<Item>) {
+    let Widths { yw: row_w, aw: area_w, k: sum_w, .. } = hw.fe.widths();
+    body.push(comment("The set-up result, complete when the dividers are (HOLD): the edges' in g_edge[k].u_edge, and:"));
     for (n, ww) in [("s_first", row_w), ("s_last", row_w), ("s_an", area_w), ("s_tn", sum_w), ("s_gxn", sum_w), ("s_dyn", sum_w)] {
         body.push(reg(n, ww));
     }
     body.push(reg("s_sat", 1));
     body.push(reg("s_dineg", 1));
+    body.extend(divs);
     if super::incremental::on(hw) {
         super::incremental::setup_regs(hw, body);
     }
@@ -214,15 +218,13 @@ fn divider_regs(hw: &Hw, divs: &[Div], cnt_w: u32, body: &mut Vec<Item>) {
 }
 
 /// The set-up's state machine: take a triangle, CALC (drop it, or load the dividers), DIV, HOLD.
-#[allow(clippy::too_many_arguments)]
-fn control(hw: &Hw, divs: &[Div], cnt_w: u32, calc_load: Vec<Stmt>, v_go: &str, guard: &str, cull: &str, body: &mut Vec<Item>) {
+fn control(hw: &Hw, cnt_w: u32, calc_load: Vec<Stmt>, v_go: &str, guard: &str, cull: &str, body: &mut Vec<Item>) {
     let bits = hw.div_bits;
-    let mut div_run: Vec<Stmt> = divs.iter().flat_map(|d| div_iter(d, bits)).collect();
-    div_run.push(Stmt::If(
+    let div_run = vec![Stmt::If(
         format!("div_cnt < {}", lit(cnt_w, bits as u64)),
         vec![set("st", "HOLD")],
         vec![set("div_cnt", format!("div_cnt - {}", lit(cnt_w, bits as u64)))],
-    ));
+    )];
     let mut take_in = vec![set("v_full", "1'b1")];
     for k in 0..3 {
         take_in.push(set(format!("vx{k}"), format!("in_x{k}")));
@@ -249,22 +251,9 @@ fn control(hw: &Hw, divs: &[Div], cnt_w: u32, calc_load: Vec<Stmt>, v_go: &str, 
     body.push(Item::Blank);
 }
 
-/// The dividers' results as the walker loads them.
+/// dI as the walker loads it: the quotient with its sign, or saturated.
 fn results(hw: &Hw, body: &mut Vec<Item>) {
-    let Widths { cy: vy_w, gw: bound_w, dw_edge: ediv_w, .. } = hw.fe.widths();
     let (iw, dw) = (hw.fe.cfg.iw(), hw.fe.cfg.dw());
-
-    // Results of the dividers.
-    body.push(comment("Divider results: bounds and steps (q - B), the remainders, dI with its sign and saturation."));
-    body.push(comment("verilator lint_off UNUSEDSIGNAL"));
-    for k in 0..3 {
-        let flip = |q: &str| if bound_w == 1 { format!("~{q}") } else { format!("{{~{q}[{}], {q}[{}:0]}}", bound_w - 1, bound_w - 2) };
-        body.push(wire(&format!("r_g{k}"), bound_w, flip(&format!("ei{k}_q"))));
-        body.push(wire(&format!("r_rem{k}"), ediv_w, format!("ei{k}_p[{}:0]", ediv_w - 1)));
-        body.push(wire(&format!("r_qs{k}"), bound_w, flip(&format!("es{k}_q"))));
-        body.push(wire(&format!("r_rs256_{k}"), ediv_w, format!("{{es{k}_p[{}:0], 8'd0}}", vy_w - 1)));
-    }
-    body.push(comment("verilator lint_on UNUSEDSIGNAL"));
     let max_pos = format!("{{1'b0, {{{iw}{{1'b1}}}}}}");
     let max_neg = format!("{{1'b1, {}}}", lit(iw, 0));
     body.push(wire(

@@ -3,11 +3,12 @@
 //! registered where the pipeline level asks; every register moves on `adv`, so one stall holds
 //! them all. Then the output register (and, per scanline, the span's dI divider).
 
-use super::divider::{div_chain, div_iter, div_load};
+use super::divider::DivConns;
 use super::hw::Hw;
 use super::stager::Stager;
 use super::walker::scanline_divider;
 use crate::verilog::{comment, lit, reg, set, wire, zext, Item, Stmt};
+use crate::Names;
 use golden::frontend::{DiMode, Widths};
 
 /// The span's first pixel's intensity and, per scanline, its last pixel's, the edge's value
@@ -158,7 +159,7 @@ pub(super) fn path(hw: &Hw, body: &mut Vec<Item>) -> Stager {
 
 /// The output register, loaded from the span path's last stage (per scanline, after the span's
 /// dI divider).
-pub(super) fn output(hw: &Hw, mut sp: Stager, body: &mut Vec<Item>) -> Stager {
+pub(super) fn output(hw: &Hw, names: &Names, mut sp: Stager, body: &mut Vec<Item>) -> Stager {
     let fe = &hw.fe;
     let (xw, iw, dw) = (fe.cfg.xbits, fe.cfg.iw(), fe.cfg.dw());
     let scan = fe.di == DiMode::Scanline;
@@ -179,24 +180,22 @@ pub(super) fn output(hw: &Hw, mut sp: Stager, body: &mut Vec<Item>) -> Stager {
         sp.def("nabs", iw, false, "ilast >= i0 ? ilast - i0 : i0 - ilast");
         sp.def("dm1", xw + 1, false, format!("{olen} - {}", lit(xw + 1, 1)));
         sp.note(Item::Blank);
-        for item in div_chain(&sdv, "sd_cnt", sd_cnt_w, hw.div_bits) {
+        let start_div = format!("!rst && adv && {} && p_div", pv(nsp));
+        let dividend = format!("({} << 1) + {}", zext("nabs", iw, sdv.pw), zext("dm1", xw + 1, sdv.pw));
+        let divisor = format!("{} << {sd_qbits}", zext("dm1", xw + 1, sdv.pw));
+        let conns = DivConns { cnt: "sd_cnt", load: &start_div, run: "!rst && sd_busy", dividend: &dividend, divisor: &divisor };
+        for item in sdv.instance(&names.fe_div, hw.div_bits, sd_cnt_w, &conns, &["q_next"]) {
             sp.note(item);
         }
         sp.def("sd_fin", 1, false, format!("sd_cnt < {}", lit(sd_cnt_w, hw.div_bits as u64)));
-        let q = format!("sdv_q{}", hw.div_bits);
+        let q = sdv.out("q_next");
         sp.def("sd_di", dw, false, format!("sd_neg ? -{} : {}", zext(&q, iw, dw), zext(&q, iw, dw)));
-        let mut start = vec![set("sd_busy", "1'b1"), set("sd_cnt", lit(sd_cnt_w, (sd_qbits - 1) as u64)), set("sd_neg", "ilast < i0")];
-        start.extend(div_load(
-            &sdv,
-            &format!("({} << 1) + {}", zext("nabs", iw, sdv.pw), zext("dm1", xw + 1, sdv.pw)),
-            &format!("{} << {sd_qbits}", zext("dm1", xw + 1, sdv.pw)),
-        ));
-        let mut run = div_iter(&sdv, hw.div_bits);
-        run.push(Stmt::If(
+        let start = vec![set("sd_busy", "1'b1"), set("sd_cnt", lit(sd_cnt_w, (sd_qbits - 1) as u64)), set("sd_neg", "ilast < i0")];
+        let run = vec![Stmt::If(
             "sd_fin".into(),
             vec![set("sd_busy", "1'b0")],
             vec![set("sd_cnt", format!("sd_cnt - {}", lit(sd_cnt_w, hw.div_bits as u64)))],
-        ));
+        )];
         p_scan.push(Item::Always(vec![Stmt::If(
             "rst".into(),
             vec![set("sd_busy", "1'b0")],

@@ -1,0 +1,224 @@
+//! `tri_fe_edge`: one edge of the triangle, instanced three times by a `generate` loop in
+//! `tri_frontend`. From CALC's values for the edge to its bound on the walked row: the set-up
+//! result (its rows, its divisor, and its two divisions, the first bound and the step), then the
+//! walker's integer DDA (one add, compare, subtract a row).
+
+use super::divider::{Div, DivConns};
+use super::hw::Hw;
+use super::setup::counter_width;
+use crate::verilog::{comment, reg, set, sext, sreg, swire, wire, zext, Item, Module, Port, Stmt};
+use crate::Names;
+use golden::frontend::Widths;
+
+/// The widths one edge works in.
+struct EdgeWidths {
+    row_w: u32,
+    vy_w: u32,
+    bound_w: u32,
+    ediv_w: u32,
+    /// The span's ends: a bound and one bit.
+    end_w: u32,
+    /// The dividends of the first bound and of the step.
+    pw_init: u32,
+    pw_step: u32,
+    cnt_w: u32,
+}
+
+impl EdgeWidths {
+    fn new(hw: &Hw) -> EdgeWidths {
+        let wd = hw.fe.widths();
+        let Widths { yw: row_w, cy: vy_w, gw: bound_w, dw_edge: ediv_w, .. } = wd;
+        assert_eq!(ediv_w, vy_w + 8, "an edge's divisor is |dy| in sub-pixels, 8 fraction bits");
+        EdgeWidths {
+            row_w,
+            vy_w,
+            bound_w,
+            ediv_w,
+            end_w: bound_w + 1,
+            pw_init: bound_w + ediv_w,
+            pw_step: bound_w + vy_w,
+            cnt_w: counter_width(&wd),
+        }
+    }
+}
+
+/// The per-edge values CALC hands on and the edges' bounds the walker reads: buses of three lanes,
+/// edge k in lane k (`name[k*w +: w]`).
+pub(super) struct EdgeBuses {
+    /// `(port, bus, lane width)` per input, in port order.
+    pub inputs: Vec<(&'static str, &'static str, u32)>,
+}
+
+/// The buses into the edges: `(port, bus name, lane width)`; the caller declares them.
+pub(super) fn input_buses(hw: &Hw) -> EdgeBuses {
+    let e = EdgeWidths::new(hw);
+    EdgeBuses {
+        inputs: vec![
+            ("n", "e_n", e.pw_init),
+            ("sn", "e_sn", e.pw_step),
+            ("ady", "e_ady", e.vy_w),
+            ("act", "e_act", 1),
+            ("right", "e_right", 1),
+            ("rs", "e_rs", e.row_w),
+            ("re", "e_re", e.row_w),
+        ],
+    }
+}
+
+/// The signed width of an edge's bound on the walked row (`lg`, `ha`).
+pub(super) fn end_width(hw: &Hw) -> u32 {
+    EdgeWidths::new(hw).end_w
+}
+
+/// What the incremental I0 (`--fe-i0 incremental`, `super::incremental`) reads of each edge, as
+/// extra outputs `(port, width, signed, the edge's signal, tri_frontend's name of lane k)`: the
+/// walker's state and the held set-up result. None in the default form.
+pub(super) fn state_outputs(hw: &Hw) -> Vec<(&'static str, u32, bool, String, &'static str)> {
+    if !super::incremental::on(hw) {
+        return Vec::new();
+    }
+    let e = EdgeWidths::new(hw);
+    let flip = |q: &str| if e.bound_w == 1 { format!("~{q}") } else { format!("{{~{q}[{}], {q}[{}:0]}}", e.bound_w - 1, e.bound_w - 2) };
+    vec![
+        ("x_in", 1, false, "in_rows".into(), "in"),
+        ("x_right", 1, false, "w_right".into(), "w_right"),
+        ("x_g", e.end_w, true, "gg".into(), "gg"),
+        ("x_act", 1, false, "w_act".into(), "w_act"),
+        ("x_rs", e.row_w, false, "w_rs".into(), "w_rs"),
+        ("x_qs", e.bound_w, true, "w_qs".into(), "w_qs"),
+        ("x_cy", 1, false, "cy".into(), "cy"),
+        ("x_sact", 1, false, "s_act".into(), "s_act"),
+        ("x_sright", 1, false, "s_right".into(), "s_right"),
+        ("x_srs", e.row_w, false, "s_rs".into(), "s_rs"),
+        ("x_sre", e.row_w, false, "s_re".into(), "s_re"),
+        ("x_rg", e.bound_w, true, flip("ei_q"), "r_g"),
+        ("x_rqs", e.bound_w, true, flip("es_q"), "r_qs"),
+    ]
+}
+
+/// The `generate` loop of the three edges in `tri_frontend`: each lane of the input buses into
+/// its edge, each edge's bounds into `e_lg`, `e_ha`.
+pub(super) fn instances(hw: &Hw, names: &Names, buses: &EdgeBuses) -> Item {
+    let e = EdgeWidths::new(hw);
+    let lane = |bus: &str, w: u32| if w == 1 { format!("{bus}[k]") } else { format!("{bus}[k*{w} +: {w}]") };
+    let mut conns: Vec<(String, String)> = [
+        ("clk", "clk"),
+        ("calc_go", "calc_go"),
+        ("div_run", "div_run"),
+        ("div_cnt", "div_cnt"),
+        ("take", "w_load"),
+        ("step", "w_step"),
+        ("row", "w_row"),
+        ("lo", "lo0"),
+        ("hi", "hi0"),
+    ]
+    .iter()
+    .map(|(p, s)| (p.to_string(), s.to_string()))
+    .collect();
+    conns.extend(buses.inputs.iter().map(|(port, bus, w)| (port.to_string(), lane(bus, *w))));
+    conns.extend([("lg", "e_lg"), ("ha", "e_ha")].map(|(p, bus)| (p.to_string(), lane(bus, e.end_w))));
+    conns.extend(state_outputs(hw).iter().map(|(port, w, ..)| (port.to_string(), lane(&format!("e_{port}"), *w))));
+    Item::ForGenerate {
+        var: "k".into(),
+        count: 3,
+        label: "g_edge".into(),
+        body: vec![Item::Instance { module: names.fe_edge.clone(), name: "u_edge".into(), params: vec![], conns }],
+    }
+}
+
+/// The set-up dividers of one edge: its first bound and its step.
+pub(super) fn dividers(hw: &Hw) -> [Div; 2] {
+    let e = EdgeWidths::new(hw);
+    [Div { name: "u_ei", pw: e.pw_init, qb: e.bound_w }, Div { name: "u_es", pw: e.pw_step, qb: e.bound_w }]
+}
+
+/// `tri_fe_edge`.
+pub(super) fn module(hw: &Hw, names: &Names) -> Module {
+    let e = EdgeWidths::new(hw);
+    let EdgeWidths { row_w, vy_w, bound_w, ediv_w, end_w, pw_init, pw_step, cnt_w } = e;
+    let header = vec![
+        format!("{} — one edge of {}'s triangle (edge k from vertex k+1 to vertex k+2; three instances).", names.fe_edge, names.frontend),
+        "Generated by segshade hdl-gen; do not edit.".into(),
+        String::new(),
+        "Set-up (calc_go, CALC's last clock): the edge's rows rs..re, its side, its divisor D = 256 |dy| (|dy| in sub-pixels), two".into(),
+        format!("divisions on {} ({bound_w} quotient bits, {} a clock, run by the owner's div_cnt):", names.fe_div, hw.div_bits),
+        "the first bound g = floor(n / D) - B and the step qs = floor(sn / |dy|) - B (B = 2^(GW-1)), remainders kept.".into(),
+        "Walker (take: load; step: the next row): on an active row g += qs + carry, the remainder".into(),
+        "rem += rs256 modulo D (one add, compare, subtract); lg/ha is g on the edge's side of the row, else lo/hi.".into(),
+        format!("Widths: bound GW = {bound_w} signed, divisor {ediv_w}, rows {row_w}, bounds out {end_w} signed."),
+    ];
+    let ports = vec![
+        Port::input("clk", 1, "", "rising edge"),
+        Port::input("calc_go", 1, "", "CALC's last clock: take this edge's values, start its divisions"),
+        Port::input("div_run", 1, "", "the set-up's divider clock"),
+        Port::input("div_cnt", cnt_w, "unsigned integer", "the set-up's divider counter"),
+        Port::input("n", pw_init, "unsigned integer", "the first bound's dividend, offset by B D"),
+        Port::input("sn", pw_step, "unsigned integer", "the step's dividend, offset by B D / 256"),
+        Port::input("ady", vy_w, &format!("UQ{}.8", vy_w - 8), "|dy|, pixels"),
+        Port::input("act", 1, "", "the edge bounds some row"),
+        Port::input("right", 1, "", "the interior is on its left: it bounds the span's right end"),
+        Port::input("rs", row_w, "unsigned integer", "first row"),
+        Port::input("re", row_w, "unsigned integer", "last row"),
+        Port::input("take", 1, "", "the walker loads the set-up result"),
+        Port::input("step", 1, "", "the walker moves to the next row"),
+        Port::input("row", row_w, "unsigned integer", "the walked row"),
+        Port::input("lo", end_w, "signed integer", "the screen's left bound (as -x)").signed(),
+        Port::input("hi", end_w, "signed integer", "the screen's right bound").signed(),
+        Port::output("lg", end_w, "signed integer", "a left edge's bound on the row (as -x), else lo").signed(),
+        Port::output("ha", end_w, "signed integer", "a right edge's bound on the row, else hi").signed(),
+    ];
+    let mut ports = ports;
+    for (port, w, signed, _, name) in state_outputs(hw) {
+        let p = Port::output(port, w, if signed { "signed integer" } else { "" }, &format!("for the incremental I0: the edge's {name}"));
+        ports.push(if signed { p.signed() } else { p });
+    }
+    let mut body = vec![comment("Set-up: the edge's rows, side and divisor, held until the walker takes them.")];
+    body.extend([reg("s_act", 1), reg("s_right", 1), reg("s_rs", row_w), reg("s_re", row_w), reg("s_d", ediv_w)]);
+    body.push(Item::Always(vec![Stmt::If(
+        "calc_go".into(),
+        vec![set("s_act", "act"), set("s_right", "right"), set("s_rs", "rs"), set("s_re", "re"), set("s_d", "{ady, 8'd0}")],
+        vec![],
+    )]));
+    body.push(comment("Its divisions: the first bound (ei) and the step (es), q - B = g."));
+    let [ei, es] = dividers(hw);
+    for (d, dividend, shift) in [(&ei, "n", bound_w + 7), (&es, "sn", bound_w - 1)] {
+        let divisor = format!("{} << {shift}", zext("ady", vy_w, d.pw));
+        let conns = DivConns { cnt: "div_cnt", load: "calc_go", run: "div_run", dividend, divisor: &divisor };
+        // The remainder is read in part (its low bits): declared with the unused.
+        body.extend(d.instance(&names.fe_div, hw.div_bits, cnt_w, &conns, &["q"]));
+    }
+    let flip = |q: &str| if bound_w == 1 { format!("~{q}") } else { format!("{{~{q}[{}], {q}[{}:0]}}", bound_w - 1, bound_w - 2) };
+    body.push(Item::Blank);
+    body.push(comment("Walker: the edge's DDA state, loaded from the set-up result."));
+    body.extend([reg("w_act", 1), reg("w_right", 1), reg("w_rs", row_w), reg("w_re", row_w), reg("w_d", ediv_w)]);
+    body.extend([reg("w_rem", ediv_w), reg("w_rs256", ediv_w), sreg("w_g", bound_w), sreg("w_qs", bound_w)]);
+    body.push(wire("in_rows", 1, "w_act && row >= w_rs && row <= w_re"));
+    body.push(swire("gg", end_w, sext("w_g", bound_w, end_w)));
+    // This edge's bound on its side of the row, or the screen's where it bounds none here;
+    // a left edge's bound is -g, kept as g (its smallest is the span's left end).
+    body.push(Item::Assign("lg".into(), "(in_rows && !w_right && gg < lo) ? gg : lo".into()));
+    body.push(Item::Assign("ha".into(), "(in_rows && w_right && gg < hi) ? gg : hi".into()));
+    let d1 = zext("w_d", ediv_w, ediv_w + 1);
+    body.push(wire("rsum", ediv_w + 1, format!("{} + {}", zext("w_rem", ediv_w, ediv_w + 1), zext("w_rs256", ediv_w, ediv_w + 1))));
+    body.push(wire("cy", 1, format!("rsum >= {d1}")));
+    body.push(comment("verilator lint_off UNUSEDSIGNAL"));
+    body.push(wire("rnext", ediv_w + 1, format!("cy ? rsum - {d1} : rsum")));
+    body.push(comment("verilator lint_on UNUSEDSIGNAL"));
+    let load = vec![
+        set("w_act", "s_act"),
+        set("w_right", "s_right"),
+        set("w_rs", "s_rs"),
+        set("w_re", "s_re"),
+        set("w_d", "s_d"),
+        set("w_g", flip("ei_q")),
+        set("w_rem", format!("ei_p[{}:0]", ediv_w - 1)),
+        set("w_qs", flip("es_q")),
+        set("w_rs256", format!("{{es_p[{}:0], 8'd0}}", vy_w - 1)),
+    ];
+    let step = vec![set("w_rem", format!("rnext[{}:0]", ediv_w - 1)), set("w_g", format!("w_g + w_qs + {}", zext("cy", 1, bound_w)))];
+    body.push(Item::Always(vec![Stmt::If("take".into(), load, vec![Stmt::If("step && w_act && row >= w_rs".into(), step, vec![])])]));
+    for (port, _, _, signal, _) in state_outputs(hw) {
+        body.push(Item::Assign(port.into(), signal));
+    }
+    Module { name: names.fe_edge.clone(), header, params: vec![], ports, body }
+}
