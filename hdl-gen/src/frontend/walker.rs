@@ -46,7 +46,13 @@ pub(super) fn emit(hw: &Hw, names: &Names, body: &mut Vec<Item>) {
     body.push(swire("hi0", end_w, slit(end_w, w - 1)));
     body.push(comment("The edges: loaded with the set-up result, stepped a row; each one's bound on the row."));
     body.push(wire("w_load", 1, "!rst && take"));
-    body.push(wire("w_step", 1, "!rst && !take && adv && w_valid && !w_end"));
+    // The incremental I0's walker also waits for its start engine (`ie_wait`, declared below).
+    let step_when = "!rst && !take && adv && w_valid && !w_end";
+    if inc {
+        body.push(net("w_step", 1));
+    } else {
+        body.push(wire("w_step", 1, step_when));
+    }
     body.push(net("e_lg", 3 * end_w));
     body.push(net("e_ha", 3 * end_w));
     let state = edge::state_outputs(hw);
@@ -83,6 +89,7 @@ pub(super) fn emit(hw: &Hw, names: &Names, body: &mut Vec<Item>) {
         body.push(wire("px", 1, format!("w_valid && !room[{end_w}]")));
         super::incremental::select(hw, body);
         body.push(wire("emit", 1, "px && !ie_wait"));
+        body.push(assign("w_step", format!("{step_when} && !ie_wait")));
     } else {
         body.push(wire("emit", 1, format!("w_valid && !room[{end_w}]")));
     }
