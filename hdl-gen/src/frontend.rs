@@ -72,7 +72,7 @@ pub fn module(hw: &Hw, names: &Names) -> Module {
 /// divider (its parameters' defaults those of an edge's first-bound divider).
 pub fn submodules(hw: &Hw, names: &Names) -> Vec<Module> {
     let [ei, _] = edge::dividers(hw);
-    vec![edge::module(hw, names), divider::module(names, &ei, hw.div_bits, setup::counter_width(&hw.fe.widths()))]
+    vec![edge::module(hw, names), divider::module(names, &ei, hw.div_bits, divider::counter_width(&hw.fe.widths()))]
 }
 
 /// The module, and its register stages when it is pipelined ([`stages`]): the set-up, the
@@ -157,39 +157,4 @@ fn header(hw: &Hw, names: &Names) -> Vec<String> {
             if fe.di == DiMode::Scanline { format!(" and the span's dI divider (u_sdv: {})", names.fe_div) } else { String::new() }
         ),
     ]
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// Issue 27's review criterion, kept: the dividers are instances of one module and the edges
-    /// one `generate` loop, at every form (a copy of a divider's step or of an edge fails it).
-    #[test]
-    fn dividers_and_edges_are_instances_not_copies() {
-        for (di, pipeline, bits) in [(DiMode::Triangle, 0, 4), (DiMode::Triangle, 1, 1), (DiMode::Scanline, 0, 2), (DiMode::Scanline, 2, 4)]
-        {
-            let opts = crate::Options {
-                prefix: "x_".into(),
-                fe_di: di,
-                fe_div_bits: Some(bits),
-                pipeline: golden::pipeline::Pipeline::at(pipeline),
-                ..Default::default()
-            };
-            let (hw, names) = (opts.frontend().unwrap(), Names::new("x_", &opts.cfg));
-            let top = module(&hw, &names).render();
-            let what = format!("{di:?}, level {pipeline}, {bits} bits");
-            let scan = di == DiMode::Scanline;
-            assert_eq!(top.matches("x_tri_fe_div #(").count(), if scan { 3 } else { 2 }, "{what}: u_ddi, u_drn (u_sdv)");
-            assert_eq!(top.matches("x_tri_fe_edge u_edge (").count(), 1, "{what}");
-            assert!(top.contains("for (k = 0; k < 3; k = k + 1) begin : g_edge\n"), "{what}");
-            let parts: Vec<String> = submodules(&hw, &names).iter().map(|m| m.render()).collect();
-            assert_eq!(parts[0].matches("x_tri_fe_div #(").count(), 2, "{what}: an edge's first bound and step");
-            assert_eq!(parts[1].matches("for (j = 0; j < BITS; j = j + 1) begin").count(), 1, "{what}: the steps a loop");
-            for text in parts.iter().chain([&top]) {
-                assert!(!text.contains("_p1 ") && !text.contains("_on0 "), "{what}: an unrolled divider step");
-                assert_eq!(text.matches("\nmodule ").count(), 1, "{what}: one module per file");
-            }
-        }
-    }
 }

@@ -3,9 +3,10 @@
 //! or clear goes into a queue that feeds `tri_fb_p<P>` (a clear waits until what came before it
 //! is drawn); a status request answers on `tx`. Faults are counted, never waited on.
 
-use super::{
-    chain_and_port, chain_nets, clear_step, common_ports, reset_items, uart, word_bits, word_fields, DRAW, QUEUE_BITS, QUIET_BITS,
+use super::parts::{
+    chain_and_port, chain_nets, clear_step, common_ports, reset_items, word_bits, word_fields, DRAW, QUEUE_BITS, QUIET_BITS,
 };
+use super::uart;
 use crate::verilog::{assign, comment, lit, net, reg, set, wire, Item, Module, Port, Stmt};
 use crate::Names;
 use golden::frontend::FrontEnd;

@@ -5,6 +5,7 @@
 
 use crate::verilog::{comment, net, set, sized, Item, Kind, Module, Param, Port, Stmt};
 use crate::Names;
+use golden::frontend::Widths;
 
 /// One divider: its instance name, partial remainder (and shifted divisor) bits `pw`, quotient
 /// bits `qb`.
@@ -121,4 +122,9 @@ pub(super) fn module(names: &Names, d: &Div, bits: u32, cnt_w: u32) -> Module {
         )]),
     ];
     Module { name: name.clone(), header, params, ports, body }
+}
+
+/// Clocks' worth of quotient bits the shared counter counts: the reciprocal's RW.
+pub(super) fn counter_width(wd: &Widths) -> u32 {
+    32 - wd.rw.leading_zeros()
 }

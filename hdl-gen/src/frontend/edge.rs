@@ -3,9 +3,9 @@
 //! result (its rows, its divisor, and its two divisions, the first bound and the step), then the
 //! walker's integer DDA (one add, compare, subtract a row).
 
+use super::divider::counter_width;
 use super::divider::{Div, DivConns};
 use super::hw::Hw;
-use super::setup::counter_width;
 use crate::verilog::{comment, reg, set, sext, sreg, swire, wire, zext, Item, Module, Port, Stmt};
 use crate::Names;
 use golden::frontend::Widths;

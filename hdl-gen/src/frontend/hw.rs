@@ -4,6 +4,10 @@
 use crate::verilog::Port;
 use golden::frontend::{DiMode, FrontEnd, I0Form, Widths};
 
+/// The incremental I0's start engine (`super::incremental`): clocks a start takes, and a start at
+/// column 0, which has one step.
+pub const START_CLOCKS: u32 = 10;
+pub const COL0_CLOCKS: u32 = 8;
 /// Quotient bits the set-up's dividers take per clock (`--fe-div-bits`): area against rate.
 pub const DIV_BITS: [u32; 3] = [1, 2, 4];
 pub const DEFAULT_DIV_BITS: u32 = 4;
@@ -59,7 +63,7 @@ impl Hw {
     pub fn start_clocks(&self) -> u32 {
         match self.fe.i0 {
             I0Form::Reciprocal => 0,
-            I0Form::Incremental => super::incremental::START_CLOCKS,
+            I0Form::Incremental => START_CLOCKS,
         }
     }
 

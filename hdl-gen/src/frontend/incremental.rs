@@ -21,8 +21,7 @@ use golden::frontend::{I0Form, Widths};
 /// three reciprocal evaluations (the start, the step without and with the DDA's carry) of two
 /// products each, chained where their operands allow. Column 0 has one step and takes
 /// [`COL0_CLOCKS`]. A walker's start holds the walker these clocks.
-pub const START_CLOCKS: u32 = 10;
-pub const COL0_CLOCKS: u32 = 8;
+pub use super::hw::{COL0_CLOCKS, START_CLOCKS};
 
 pub(super) fn on(hw: &Hw) -> bool {
     hw.fe.i0 == I0Form::Incremental
@@ -96,19 +95,49 @@ pub(super) fn select(hw: &Hw, body: &mut Vec<Item>) {
     body.push(assign("take", "st == HOLD && ie_pv && adv && !ie_wait && (!w_valid || w_end)"));
 }
 
+/// The widths the start engine works in.
+#[derive(Clone, Copy)]
+struct Ew {
+    aw: u32,
+    bound_w: u32,
+    sum_w: u32,
+    recip_w: u32,
+    xw: u32,
+    iw: u32,
+    frac: u32,
+    nx_w: u32,
+    ny_w: u32,
+    a_w: u32,
+    b_w: u32,
+    p_w: u32,
+    e_w: u32,
+    y_w: u32,
+    cmp_w: u32,
+    c_w: u32,
+    end_w: u32,
+}
+
+impl Ew {
+    fn new(hw: &Hw) -> Ew {
+        let Widths { aw, gw: bound_w, k: sum_w, rw: recip_w, .. } = hw.fe.widths();
+        let (xw, iw, frac) = (hw.fe.cfg.xbits, hw.fe.cfg.iw(), hw.fe.cfg.frac);
+        let (nx_w, ny_w) = plane_widths(hw);
+        let (a_w, b_w) = (sum_w, recip_w);
+        // The highest bit read is the quotient estimate's, K + IW.
+        let p_w = sum_w + iw + 1;
+        let e_w = nx_w + bound_w + 1;
+        let y_w = ny_w.max(e_w) + 2;
+        let cmp_w = y_w.max(aw + frac) + 1;
+        let c_w = aw + 2;
+        let end_w = bound_w + 1;
+        Ew { aw, bound_w, sum_w, recip_w, xw, iw, frac, nx_w, ny_w, a_w, b_w, p_w, e_w, y_w, cmp_w, c_w, end_w }
+    }
+}
+
 /// After the walker: the shared engine, and the sources' state stepped with the walker's row.
 pub(super) fn engine(hw: &Hw, body: &mut Vec<Item>) {
-    let Widths { aw, gw: bound_w, k: sum_w, rw: recip_w, .. } = hw.fe.widths();
-    let (xw, iw, frac) = (hw.fe.cfg.xbits, hw.fe.cfg.iw(), hw.fe.cfg.frac);
-    let (nx_w, ny_w) = plane_widths(hw);
-    let (a_w, b_w) = (sum_w, recip_w);
-    // The highest bit read is the quotient estimate's, K + IW.
-    let p_w = sum_w + iw + 1;
-    let e_w = nx_w + bound_w + 1;
-    let y_w = ny_w.max(e_w) + 2;
-    let cmp_w = y_w.max(aw + frac) + 1;
-    let c_w = aw + 2;
-    let end_w = bound_w + 1;
+    let ew = Ew::new(hw);
+    let Ew { aw, bound_w, sum_w, xw, iw, nx_w, a_w, b_w, p_w, e_w, c_w, .. } = ew;
     assert!(
         xw <= b_w && bound_w <= b_w && iw < b_w && nx_w <= a_w && c_w <= a_w && e_w - 1 <= p_w,
         "the engine's operands fit its multiplier"
@@ -138,6 +167,37 @@ pub(super) fn engine(hw: &Hw, body: &mut Vec<Item>) {
         reg("ie_ok0", 1),
         reg("ie_ok1", 1),
     ]);
+    first_row(&ew, body);
+    body.push(comment("The walker's start goes first: it takes the engine from a first-row start, which starts again."));
+    body.push(wire("ie_go", 1, "ie_wait ? (!ie_busy || ie_pre) : (!ie_busy && ie_pneed)"));
+    body.push(wire("ie_tt", 4, format!("ie_go ? {} : ie_t", lit(4, 0))));
+    operands(&ew, body);
+    let prog = program(&ew);
+    let walk = source_steps(&ew, body);
+    let load = first_row_load();
+    let go = vec![
+        set("ie_busy", "1'b1"),
+        set("ie_pre", "!ie_wait"),
+        set("ie_t", lit(4, 1)),
+        set("ie_src", "ie_wait ? ie_sel : ie_psel"),
+        set("ie_p", format!("{} * {}", zext("ie_ma", a_w, p_w), zext("ie_mb", b_w, p_w))),
+    ];
+    let mut busy = vec![set("ie_p", format!("{} * {}", zext("ie_ma", a_w, p_w), zext("ie_mb", b_w, p_w)))];
+    busy.extend(prog);
+    body.push(Item::Always(vec![Stmt::If(
+        "rst".into(),
+        vec![set("ie_busy", "1'b0"), set("ie_t", lit(4, 0)), set("ie_pv", "1'b0")],
+        vec![
+            Stmt::If("ie_go".into(), go, vec![Stmt::If("ie_busy".into(), busy, vec![])]),
+            Stmt::If("take".into(), load, vec![Stmt::If("adv && w_valid && !ie_wait".into(), walk, vec![])]),
+        ],
+    )]));
+    body.push(Item::Blank);
+}
+
+/// The held triangle's first row: its left end and the source giving it.
+fn first_row(ew: &Ew, body: &mut Vec<Item>) {
+    let Ew { bound_w, end_w, .. } = *ew;
     body.push(comment("The held triangle's first row: its left end and the source giving it (none started yet)."));
     for k in 0..3 {
         body.push(wire(&format!("pin{k}"), 1, format!("s_act{k} && s_rs{k} <= s_first && s_first <= s_re{k}")));
@@ -155,9 +215,11 @@ pub(super) fn engine(hw: &Hw, body: &mut Vec<Item>) {
     }
     body.push(wire("ie_psel", 2, "ie_pc0 ? 2'd0 : ie_pc1 ? 2'd1 : ie_pc2 ? 2'd2 : 2'd3"));
     body.push(wire("ie_pneed", 1, "st == HOLD && !ie_pv"));
-    body.push(comment("The walker's start goes first: it takes the engine from a first-row start, which starts again."));
-    body.push(wire("ie_go", 1, "ie_wait ? (!ie_busy || ie_pre) : (!ie_busy && ie_pneed)"));
-    body.push(wire("ie_tt", 4, format!("ie_go ? {} : ie_t", lit(4, 0))));
+}
+
+/// The engine's operands and its arithmetic around the one product.
+fn operands(ew: &Ew, body: &mut Vec<Item>) {
+    let Ew { aw, bound_w, sum_w, recip_w, xw, iw, frac, nx_w, ny_w, a_w, b_w, e_w, y_w, cmp_w, c_w, .. } = *ew;
     body.push(comment("Operands: the set-up's result for a first-row start, the walker's otherwise."));
     body.push(wire("ie_su", 1, "ie_go ? !ie_wait : ie_pre"));
     let x = |name: &str, w: u32, su: &str, wk: &str, signed: bool| {
@@ -247,7 +309,12 @@ pub(super) fn engine(hw: &Hw, body: &mut Vec<Item>) {
     body.push(wire("ie_d0v", 1, "ie_src == 2'd0 ? ie_ok0 : ie_av"));
     body.push(wire("ie_d0q", iw, format!("ie_src == 2'd0 ? {cq} : ie_aq")));
     body.push(wire("ie_d0r", aw + 1, format!("ie_src == 2'd0 ? {cr} : ie_ar")));
+}
 
+/// The engine's program, one step a clock (the go clock is t0).
+fn program(ew: &Ew) -> Vec<Stmt> {
+    let Ew { aw, sum_w, iw, e_w, y_w, cmp_w, .. } = *ew;
+    let (cq, cr) = (format!("ie_cq[{}:0]", iw - 1), format!("ie_cr[{}:0]", aw));
     // The program, one step a clock; the go clock is t0.
     let at = |t: u32, then: Vec<Stmt>| Stmt::If(format!("ie_t == {}", lit(4, t as u64)), then, vec![]);
     let mut prog = vec![
@@ -307,6 +374,12 @@ pub(super) fn engine(hw: &Hw, body: &mut Vec<Item>) {
         vec![],
     ));
 
+    prog
+}
+
+/// The sources stepped with the walker's row; a first row with no pixel drops the held start.
+fn source_steps(ew: &Ew, body: &mut Vec<Item>) -> Vec<Stmt> {
+    let Ew { aw, iw, .. } = *ew;
     // The sources step with the walker's row: edge k's by its DDA's carry this row.
     let mut walk = Vec::new();
     for j in 0..4 {
@@ -339,6 +412,11 @@ pub(super) fn engine(hw: &Hw, body: &mut Vec<Item>) {
     // the triangle, where the reciprocal is not exact) is dropped.
     walk.push(Stmt::If("w_fresh && !px".into(), (0..4).map(|j| set(format!("ie_v{j}"), "1'b0")).collect(), vec![]));
     walk.push(set("w_fresh", "1'b0"));
+    walk
+}
+
+/// The walker's load: the held start into its source.
+fn first_row_load() -> Vec<Stmt> {
     let mut load = vec![set("w_nx", "s_nx"), set("w_ny", "s_ny"), set("w_a", "s_a"), set("w_fresh", "1'b1"), set("ie_pv", "1'b0")];
     for j in 0..4 {
         let mut w = vec![set(format!("ie_v{j}"), "1'b1"), set(format!("ie_q{j}"), "ie_pq"), set(format!("ie_r{j}"), "ie_pr")];
@@ -348,24 +426,7 @@ pub(super) fn engine(hw: &Hw, body: &mut Vec<Item>) {
         }
         load.push(Stmt::If(format!("ie_psrc == {}", lit(2, j as u64)), w, vec![set(format!("ie_v{j}"), "1'b0")]));
     }
-    let go = vec![
-        set("ie_busy", "1'b1"),
-        set("ie_pre", "!ie_wait"),
-        set("ie_t", lit(4, 1)),
-        set("ie_src", "ie_wait ? ie_sel : ie_psel"),
-        set("ie_p", format!("{} * {}", zext("ie_ma", a_w, p_w), zext("ie_mb", b_w, p_w))),
-    ];
-    let mut busy = vec![set("ie_p", format!("{} * {}", zext("ie_ma", a_w, p_w), zext("ie_mb", b_w, p_w)))];
-    busy.extend(prog);
-    body.push(Item::Always(vec![Stmt::If(
-        "rst".into(),
-        vec![set("ie_busy", "1'b0"), set("ie_t", lit(4, 0)), set("ie_pv", "1'b0")],
-        vec![
-            Stmt::If("ie_go".into(), go, vec![Stmt::If("ie_busy".into(), busy, vec![])]),
-            Stmt::If("take".into(), load, vec![Stmt::If("adv && w_valid && !ie_wait".into(), walk, vec![])]),
-        ],
-    )]));
-    body.push(Item::Blank);
+    load
 }
 
 /// The span path of the incremental form: the walker's span (I0 included) carried through the

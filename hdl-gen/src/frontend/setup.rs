@@ -4,6 +4,7 @@
 //! `HOLD`).
 
 use super::calc::calc;
+use super::divider::counter_width;
 use super::divider::{Div, DivConns};
 use super::edge;
 use super::hw::Hw;
@@ -39,11 +40,6 @@ fn mv(j: usize, last: usize) -> String {
     } else {
         format!("c{j}_mv")
     }
-}
-
-/// Clocks' worth of quotient bits the shared counter counts: the reciprocal's RW.
-pub(super) fn counter_width(wd: &Widths) -> u32 {
-    32 - wd.rw.leading_zeros()
 }
 
 /// The set-up, from the vertex registers to the set-up result the walker loads.
