@@ -112,7 +112,7 @@ fn build_model(v: &Verilator, out: &Path, root: &Path, m: &Model) -> Vec<String>
         let (all, _) = verilator::verilate(m, false, &obj, &rtl, &rtl).unwrap_or_else(|e| panic!("{e}"));
         let verilated = start.elapsed().as_secs_f64();
         let mut b = cc_build(v, false, Link::Static);
-        verilator::use_precompiled_header(&mut b, root);
+        verilator::use_precompiled_header(v, &mut b, root);
         b.include(&obj).include(Path::new(env!("CARGO_MANIFEST_DIR")).join("csrc")).out_dir(&obj).file(&all);
         b.compile(&m.tag);
         let total = start.elapsed().as_secs_f64();

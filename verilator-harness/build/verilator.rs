@@ -106,11 +106,15 @@ pub fn cc_build(v: &Verilator, traced: bool, link: Link) -> cc::Build {
 /// itself when it does not, and the code is the same either way (objects compared when this
 /// was written), so the precompiled header is not part of any model's key. It is built in a
 /// private folder renamed into place; when it cannot be built, `b` is left as it was.
-pub fn use_precompiled_header(b: &mut cc::Build, root: &Path) {
+pub fn use_precompiled_header(v: &Verilator, b: &mut cc::Build, root: &Path) {
     const HEADER: &str = "segshade_pch.h";
     let Ok(tool) = b.try_get_compiler() else { return };
     let args: Vec<String> = tool.args().iter().map(|a| a.to_string_lossy().into_owned()).collect();
-    let dir = root.join(format!("pch-{:016x}", hash(&format!("{}\n{}", tool.path().display(), args.join("\n")))));
+    // GCC checks a precompiled header's flags, not whether the header changed since: Verilator's
+    // version and the header's text are part of the folder's name.
+    let text = fs::read_to_string(v.root.join("include/verilated.h")).unwrap_or_default();
+    let key = format!("{}\n{}\n{}\n{text}", v.version, tool.path().display(), args.join("\n"));
+    let dir = root.join(format!("pch-{:016x}", hash(&key)));
     if !dir.join(format!("{HEADER}.gch")).exists() {
         static SERIAL: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
         let n = SERIAL.fetch_add(1, std::sync::atomic::Ordering::Relaxed);

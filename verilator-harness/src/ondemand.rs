@@ -230,7 +230,7 @@ fn build(m: &Model, traced: bool) -> Result<(PathBuf, Outcome), ModelError> {
         runtime.insert(0, pic_runtime(v, &root, &fst, true)?);
     }
     let mut b = compiler(v, traced);
-    verilator::use_precompiled_header(&mut b, &root);
+    verilator::use_precompiled_header(v, &mut b, &root);
     b.include(tmp.join("obj")).include(Path::new(env!("CARGO_MANIFEST_DIR")).join("csrc"));
     let tool = b.try_get_compiler().map_err(|e| ModelError::Compile { tag: m.tag.clone(), dir: tmp.clone(), log: e.to_string() })?;
     // One compile and link: the model's translation unit and a private copy of the runtime, whose
