@@ -231,7 +231,12 @@ fn incremental_spans_of(opts: hdl_gen::Options, n: usize) {
     assert!(!report.ok(), "{}: a wrong expectation went unnoticed", m.tag);
 }
 
+/// Slow tier, as the other comparison forms' chains are (built on request): its model is a
+/// front-end of its own, about 8 s of CPU to build cold, which the five-minute suite cannot
+/// carry for a form that is not the default (docs/regressions.md, stop 27). Run it with
+/// `cargo nextest run -p verilator-harness --run-ignored only -E 'test(/incremental_i0/)'`.
 #[test]
+#[ignore]
 fn incremental_i0_spans_equal_golden_at_640x480() {
     incremental_spans(golden::setup::Screen::default(), 0, 3000);
 }
