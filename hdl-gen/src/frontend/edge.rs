@@ -70,6 +70,15 @@ pub(super) fn end_width(hw: &Hw) -> u32 {
     EdgeWidths::new(hw).end_w
 }
 
+/// A quotient `q` offset by B = 2^(w-1) as the signed `q - B`: its top bit inverted.
+fn offset_to_signed(q: &str, w: u32) -> String {
+    if w == 1 {
+        format!("~{q}")
+    } else {
+        format!("{{~{q}[{}], {q}[{}:0]}}", w - 1, w - 2)
+    }
+}
+
 /// What the incremental I0 (`--fe-i0 incremental`, `super::incremental`) reads of each edge, as
 /// extra outputs `(port, width, signed, the edge's signal, tri_frontend's name of lane k)`: the
 /// walker's state and the held set-up result. None in the default form.
@@ -78,7 +87,7 @@ pub(super) fn state_outputs(hw: &Hw) -> Vec<(&'static str, u32, bool, String, &'
         return Vec::new();
     }
     let e = EdgeWidths::new(hw);
-    let flip = |q: &str| if e.bound_w == 1 { format!("~{q}") } else { format!("{{~{q}[{}], {q}[{}:0]}}", e.bound_w - 1, e.bound_w - 2) };
+    let flip = |q: &str| offset_to_signed(q, e.bound_w);
     vec![
         ("x_in", 1, false, "in_rows".into(), "in"),
         ("x_right", 1, false, "w_right".into(), "w_right"),
@@ -187,7 +196,7 @@ pub(super) fn module(hw: &Hw, names: &Names) -> Module {
         // The remainder is read in part (its low bits): declared with the unused.
         body.extend(d.instance(&names.fe_div, hw.div_bits, cnt_w, &conns, &["q"]));
     }
-    let flip = |q: &str| if bound_w == 1 { format!("~{q}") } else { format!("{{~{q}[{}], {q}[{}:0]}}", bound_w - 1, bound_w - 2) };
+    let flip = |q: &str| offset_to_signed(q, bound_w);
     body.push(Item::Blank);
     body.push(comment("Walker: the edge's DDA state, loaded from the set-up result."));
     body.extend([reg("w_act", 1), reg("w_right", 1), reg("w_rs", row_w), reg("w_re", row_w), reg("w_d", ediv_w)]);
