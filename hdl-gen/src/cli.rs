@@ -5,7 +5,7 @@
 //! `--width`/`--height` are each program's own: `generate`'s default to the configuration's
 //! widest screen up to 640 × 480, the binaries' also bound the random triangles.
 
-use crate::{check_prefix, BfpiArch, Bus, Options};
+use crate::{check_prefix, BfpiArch, Bus, Options, Target};
 use clap::builder::{StringValueParser, TypedValueParser};
 use clap::Args;
 use golden::frontend::{DiMode, I0Form};
@@ -116,7 +116,8 @@ pub struct VariantArgs {
     #[command(flatten)]
     pub brdf: BrdfArgs,
     /// Quotient bits per clock of the front-end's set-up dividers: 1, 2 or 4. More bits,
-    /// fewer set-up clocks per triangle (tiny triangles go faster), longer paths. Default: 4.
+    /// fewer set-up clocks per triangle (tiny triangles go faster), longer paths. Default: 4,
+    /// or the target's choice.
     #[arg(long = "fe-div-bits", value_parser = clap::builder::PossibleValuesParser::new(["1", "2", "4"]).map(|b| b.parse::<u32>().expect("a listed value")))]
     pub fe_div_bits: Option<u32>,
     /// Where the front-end's dI comes from: `triangle` (the constant-increment theorem, once
@@ -129,17 +130,23 @@ pub struct VariantArgs {
     /// source of the span's left end; the reciprocal only at a source's first covered row, on
     /// one shared multiplier, the walker waiting meanwhile). Same spans bit for bit. The
     /// default stays `reciprocal` until the incremental form measures better (docs/design.md,
-    /// issue 27). `incremental` takes `--fe-di triangle` only.
-    #[arg(long = "fe-i0", value_enum, default_value_t = I0Form::Reciprocal)]
-    pub fe_i0: I0Form,
+    /// issue 27). `incremental` takes `--fe-di triangle` only. Default: `reciprocal`, or the
+    /// target's choice.
+    #[arg(long = "fe-i0", value_enum)]
+    pub fe_i0: Option<I0Form>,
     /// Register stages added for clock rate, 0..3 (golden::pipeline): 1 registers the span and
     /// the shader's increments, splits the specular unit's multiplies, and stages the
     /// front-end (CALC in five clocks, its span path in six), 2 also the shader's lane sums, 3 cuts the shader's adders
     /// so no clock has two in a row (same stages as 2). Values and throughput are the same at every
     /// level; latency grows (manifest.json). 0, the default: SPEC's seed structure, smallest
-    /// and shortest (docs/fpga.md compares the levels).
-    #[arg(long, default_value_t = 0, value_parser = clap::value_parser!(u32).range(0..=Pipeline::MAX as i64))]
-    pub pipeline: u32,
+    /// and shortest (docs/fpga.md compares the levels). Or the target's choice.
+    #[arg(long, value_parser = clap::value_parser!(u32).range(0..=Pipeline::MAX as i64))]
+    pub pipeline: Option<u32>,
+    /// The FPGA to generate for: chooses the front-end's form, the pipeline level and the
+    /// dividers' rate that measured best on that device (docs/design.md, "Targets"). Flags given
+    /// with it still override its choices.
+    #[arg(long, value_enum)]
+    pub target: Option<Target>,
     /// Stream interfaces: `native` (SPEC's ports only) or `axis`, which also writes an
     /// AXI4-Stream wrapper `<module>_axis` of the segment shader, the front-end, its chain
     /// and the specular unit, with Vivado interface attributes (docs/axis.md).
@@ -153,21 +160,26 @@ impl VariantArgs {
     pub fn options(&self, p: u32, align: Align, screen: Option<Screen>) -> Result<Options, ArgsError> {
         let config = ConfigArgs { seg: SegArgs { p, align }, format: self.format.clone() };
         let opts = config.options(&self.brdf)?;
-        let pipeline = Pipeline::new(self.pipeline).expect("clap checked the range");
+        // A flag given wins over the target's choice, which wins over the option's default.
+        let choice = self.target.map(Target::choice);
+        let pipeline = self.pipeline.or(choice.map(|c| c.pipeline)).unwrap_or(0);
+        let pipeline = Pipeline::new(pipeline).expect("clap checked the range; the targets' levels exist");
+        let fe_i0 = self.fe_i0.or(choice.map(|c| c.fe_i0)).unwrap_or_default();
         if pipeline.span_stage() && self.bfpi_arch == BfpiArch::Tree {
             return Err(ArgsError::TreeUnpipelined);
         }
-        if self.fe_i0 == I0Form::Incremental && self.fe_di == DiMode::Scanline {
+        if fe_i0 == I0Form::Incremental && self.fe_di == DiMode::Scanline {
             return Err(ArgsError::IncrementalScanline);
         }
         let opts = Options {
             bfpi_arch: self.bfpi_arch,
             screen,
-            fe_div_bits: self.fe_div_bits,
+            fe_div_bits: self.fe_div_bits.or(choice.map(|c| c.fe_div_bits)),
             fe_di: self.fe_di,
-            fe_i0: self.fe_i0,
+            fe_i0,
             pipeline,
             bus: self.bus,
+            target: self.target,
             ..opts
         };
         opts.frontend()?;
@@ -189,5 +201,55 @@ impl ModelArgs {
     /// The options these flags give, on `screen` (`None`: [`Options::default_screen`]).
     pub fn options(&self, screen: Option<Screen>) -> Result<Options, ArgsError> {
         self.variant.options(self.seg.p, self.seg.align, screen)
+    }
+}
+
+/// The argument ids of [`ModelArgs`] (its field names: `p`, `pipeline`, `fe_div_bits`, ...), for
+/// a binary that asks its `ArgMatches` which of them were typed on the command line.
+pub fn model_arg_ids() -> Vec<String> {
+    use clap::Args as _;
+    ModelArgs::augment_args(clap::Command::new("model")).get_arguments().map(|a| a.get_id().to_string()).collect()
+}
+
+/// Those of [`model_arg_ids`] given on the command line (not left to their defaults).
+pub fn given_model_args(m: &clap::ArgMatches) -> Vec<String> {
+    let known: Vec<String> = m.ids().map(|i| i.to_string()).collect();
+    model_arg_ids()
+        .into_iter()
+        .filter(|id| known.contains(id) && m.value_source(id) == Some(clap::parser::ValueSource::CommandLine))
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use clap::Parser;
+
+    #[derive(Parser)]
+    struct Cli {
+        #[command(flatten)]
+        model: ModelArgs,
+    }
+
+    fn options(args: &[&str]) -> Options {
+        let cli = Cli::try_parse_from(std::iter::once("t").chain(args.iter().copied())).expect("the flags parse");
+        cli.model.options(None).expect("a configuration generate accepts")
+    }
+
+    /// A target fills the options it chooses; a flag beside it wins; without it every option is
+    /// its own default (so the comparison below can fail).
+    #[test]
+    fn a_target_chooses_and_a_given_flag_overrides_it() {
+        let plain = options(&[]);
+        assert_eq!((plain.pipeline.level(), plain.fe_div_bits, plain.target), (0, None, None));
+        for t in [Target::Ecp5_25f, Target::Ice40Hx8k, Target::Ice40Up5k] {
+            let c = t.choice();
+            let chosen = options(&["--target", t.name()]);
+            assert_eq!(chosen.target, Some(t));
+            assert_eq!((chosen.pipeline.level(), chosen.fe_div_bits, chosen.fe_i0), (c.pipeline, Some(c.fe_div_bits), c.fe_i0));
+            let over = options(&["--target", t.name(), "--pipeline", "0", "--fe-div-bits", "4", "--fe-i0", "incremental"]);
+            assert_eq!((over.pipeline.level(), over.fe_div_bits, over.fe_i0), (0, Some(4), I0Form::Incremental), "{t}");
+        }
+        assert!(Cli::try_parse_from(["t", "--target", "ecp5-85f"]).is_err());
     }
 }

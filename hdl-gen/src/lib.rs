@@ -14,6 +14,7 @@ pub mod output;
 pub mod rom;
 pub mod segment;
 pub mod specular;
+mod target;
 pub mod tools;
 pub mod verilog;
 pub mod writer;
@@ -23,6 +24,7 @@ pub use bfpi::BfpiArch;
 pub use names::{check_prefix, Names, PrefixError};
 pub use options::{Options, VERSION};
 pub use output::GeneratedFile;
+pub use target::{Choice, Target};
 
 /// Every file of one configuration, in a fixed order. Pure: no clock, no environment.
 pub fn generate(opts: &Options) -> Vec<GeneratedFile> {

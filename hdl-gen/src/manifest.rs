@@ -149,6 +149,9 @@ pub struct Parameters {
     /// `--bus`; only written for `axis`, so the default output stays as it was.
     #[serde(default, skip_serializing_if = "is_native")]
     pub bus: crate::Bus,
+    /// `--target`, when given: the device the other options were chosen for.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub target: Option<crate::Target>,
 }
 
 fn is_native(b: &crate::Bus) -> bool {
@@ -329,6 +332,7 @@ pub fn render(opts: &Options, names: &Names, modules: &[Module], unit: &Specular
             bfpi_arch: (opts.bfpi_arch != BfpiArch::ShiftAdd).then(|| opts.bfpi_arch.name().into()),
             pipeline: opts.pipeline,
             bus: opts.bus,
+            target: opts.target,
         },
         formats: Formats {
             intensity: format!("UQ8.{}", cfg.frac),

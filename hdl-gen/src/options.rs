@@ -30,6 +30,9 @@ pub struct Options {
     pub pipeline: golden::pipeline::Pipeline,
     /// `--bus`: SPEC's ports only, or AXI4-Stream wrappers of the streaming tops as well.
     pub bus: Bus,
+    /// `--target`: the device the options above were chosen for (recorded in the manifest; the
+    /// choice itself is already in the fields).
+    pub target: Option<crate::Target>,
 }
 
 impl Options {

@@ -31,6 +31,12 @@ fn configs() -> Vec<Options> {
         pipeline: golden::pipeline::Pipeline::new(2).unwrap(),
         ..Default::default()
     });
+    // `--target`: recorded with the choices it made.
+    v.push(Options {
+        target: Some(hdl_gen::Target::Ice40Up5k),
+        pipeline: golden::pipeline::Pipeline::new(1).unwrap(),
+        ..Default::default()
+    });
     v
 }
 

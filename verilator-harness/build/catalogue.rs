@@ -222,6 +222,8 @@ pub fn options_key(opts: &hdl_gen::Options) -> String {
     let mut o = opts.clone();
     o.screen = Some(o.screen.unwrap_or_else(|| hdl_gen::Options::default_screen(&o.cfg)));
     o.fe_div_bits = Some(o.fe_div_bits.unwrap_or(hdl_gen::frontend::DEFAULT_DIV_BITS));
+    // A target only names the device its choices (already in the other fields) were made for.
+    o.target = None;
     format!("{o:?}")
 }
 

@@ -15,6 +15,7 @@
 pub mod driver;
 pub mod ffi;
 pub mod frontend;
+pub mod given;
 // build.rs's module tree, which describes, verilates and compiles a model; the library builds
 // the models asked for at run time with it (`ondemand`).
 #[path = "../build/mod.rs"]

@@ -180,6 +180,17 @@ fn cosim_reads_cosim_rtl_dir_when_it_runs() {
         assert!(out.status.success(), "{}: {stdout}{}", rtl.display(), String::from_utf8_lossy(&out.stderr));
         assert!(stdout.contains(&format!("model seg_p{p}_span")) && stdout.contains("5 passed, 0 failed"), "{stdout}");
     }
+    // A model flag typed beside the folder must be what the folder was generated with: given and
+    // equal runs (the negative control), given and different is refused in one line.
+    let out = cosim(package, &dir, &["--p", "2", "--pipeline", "0", "--fe-div-bits", "4", "--triangles", "5", "--seed", "1"]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    for args in [&["--p", "2", "--pipeline", "1"][..], &["--p", "2", "--target", "ice40-up5k"], &["--p", "2", "--frac", "10"]] {
+        let out = cosim(package, &dir, args);
+        let err = String::from_utf8_lossy(&out.stderr);
+        let flag = args[2];
+        assert_eq!(out.status.code(), Some(2), "{args:?}: {err}");
+        assert!(err.starts_with(&format!("error: {flag}: COSIM_RTL_DIR=")) && err.lines().count() == 1, "{args:?}: {err}");
+    }
     assert!(root.join("rtl").is_dir());
     for (rtl, needle) in [(dir.as_path(), "has no such Segment model (it has: seg_p2_span)"), (&dir.join("missing"), "no such folder")] {
         let out = cosim(package, rtl, &["--triangles", "5"]);

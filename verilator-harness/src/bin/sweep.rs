@@ -172,10 +172,14 @@ fn refused(args: &Args) -> Result<(), String> {
 }
 
 fn main() -> ExitCode {
-    let args = Args::parse();
+    let (args, given) = verilator_harness::given::parse::<Args>();
     if let Err(e) = refused(&args) {
         eprintln!("error: {e}");
         return ExitCode::from(2);
+    }
+    // A model flag the COSIM_RTL_DIR folder was not generated with is refused, not ignored.
+    if let Err(code) = verilator_harness::given::refuse(&given, args.variant.options(8, golden::Align::Span, None)) {
+        return code;
     }
     let start = Instant::now();
     let screen = Screen { width: args.width, height: args.height };
