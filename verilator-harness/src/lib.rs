@@ -29,6 +29,7 @@ pub mod soak;
 pub mod specular;
 pub mod stimulus;
 mod tape;
+pub mod targets;
 pub mod traffic;
 pub mod waveform;
 pub mod writer;

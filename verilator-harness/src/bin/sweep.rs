@@ -50,6 +50,10 @@ struct Args {
     // then cached).
     #[command(flatten)]
     variant: VariantArgs,
+    /// Instead: each `--target`'s chain next to the defaults' at p = 4, 8, 16 (triangles per 1000
+    /// clocks, the spans-fed share, triangles a second at the front-end's measured clock).
+    #[arg(long, conflicts_with = "target")]
+    targets: bool,
 }
 
 /// The chains and writers (p > 1) to sweep on `screen`: with the default options the compiled
@@ -195,6 +199,9 @@ fn main() -> ExitCode {
     let mut rng = SeedRng::seed_from_u64(args.seed);
     let workloads: Vec<Vec<Triangle>> =
         CLASSES.iter().map(|&a| (0..args.triangles).map(|_| sized_triangle(&mut rng, &screen, a)).collect()).collect();
+    if args.targets {
+        return targets(&args, screen, &workloads);
+    }
     let (mut chain_models, wr_models) = match on_screen(screen, &args.variant) {
         Ok(models) => models,
         Err(e) => return ondemand::exit("--width/--height", &e),
@@ -298,6 +305,24 @@ fn main() -> ExitCode {
     bar.finish_and_clear();
 
     let md = markdown(&args, screen, failures.is_empty(), &Tables { stats, rows, rtl, chains, writer_rows });
+    eprintln!("sweep: {} models x {} classes in {:.1} s", models.len(), workloads.len(), start.elapsed().as_secs_f64());
+    finish(&args, &md, &failures)
+}
+
+/// `--targets`: the per-target table instead of the sweep's.
+fn targets(args: &Args, screen: Screen, workloads: &[Vec<Triangle>]) -> ExitCode {
+    let mut failures = Vec::new();
+    let names = CLASSES.map(|a| format!("~{a} px"));
+    let names: Vec<&str> = names.iter().map(String::as_str).collect();
+    let md = match verilator_harness::targets::sweep(&args.variant, screen, workloads, &names, args.seed, &mut failures) {
+        Ok(md) => format!("{md}\nMade by `sweep --targets --triangles {} --seed {}`.\n", args.triangles, args.seed),
+        Err(e) => return ondemand::exit("--targets", &e),
+    };
+    finish(args, &md, &failures)
+}
+
+/// Writes the report (to --out, atomically, or to standard output) and says what failed.
+fn finish(args: &Args, md: &str, failures: &[String]) -> ExitCode {
     match &args.out {
         Some(path) => {
             if let Err(e) = hdl_gen::output::write_one(path, md.as_bytes()) {
@@ -307,8 +332,7 @@ fn main() -> ExitCode {
         }
         None => print!("{md}"),
     }
-    eprintln!("sweep: {} models x {} classes in {:.1} s", models.len(), workloads.len(), start.elapsed().as_secs_f64());
-    for f in &failures {
+    for f in failures {
         eprintln!("FAIL {f}");
     }
     if failures.is_empty() {
