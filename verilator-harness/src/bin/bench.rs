@@ -12,11 +12,13 @@
 //!   specular unit, the Verilog build.rs verilated (so the native and cocotb benches simulate
 //!   the very same files) and how long build.rs took to verilate and compile each.
 //!
-//! Stimulus file: a 64-byte header
-//!   `magic "SSBSTIM1", u32 design (0 segment, 1 specular), u32 p, u32 xorshift32 start state,
+//! Stimulus file (format 2): a header of 64 fixed bytes
+//!   `magic "SSBSTIM2", u32 design (0 segment, 1 specular), u32 p, u32 xorshift32 start state,
 //!    u32 valid_thr, u32 ready_thr, u32 spans, u64 outputs, u64 seed, u32 expected record bytes,
-//!    u32 in_di width`, zero padding,
-//! then one 32-byte record per span: `u32 port[5], u32 outputs, u32 triangle, u32 y`, the ports
+//!    u32 in_di width, u32 records_at, u32 model bytes`,
+//! then the model's description ([`StimModel`] as JSON, `model bytes` long), zero-padded to
+//! `records_at` (a multiple of 32), then one 32-byte record per span from `records_at`:
+//! `u32 port[5], u32 outputs, u32 triangle, u32 y`, the ports
 //! being `in_x, in_len, in_i0, in_di, 0` (segment) or `in_c, in_n, in_theta0, in_dtheta, in_len`
 //! (specular), as the port bits. `outputs` is the number of segments (pixels) the span yields.
 //! Expected file: a 24-byte header `magic "SSBEXPT1", u32 design, u32 record bytes, u64 records`,
@@ -24,31 +26,45 @@
 //! u8 pix[p]` (masked lanes 0), zero-padded to a multiple of 4; specular `u16 out_spec,
 //! u8 out_err, u8 out_last`. The traffic is `verilator_harness::traffic`, from the header's state
 //! and thresholds.
+//!
+//! Format 1 (`SSBSTIM1`, before the model was written down) is still read: its bytes 56..64 are
+//! zero, its records start at 64, and it names the default configuration at its P (span
+//! alignment), the only models it could be made for.
 
 use clap::{Parser, Subcommand, ValueEnum};
 use golden::rng::SeedRng;
 use golden::segment::segments;
 use golden::setup::{triangle_spans, Screen};
-use golden::specular::SpecularSpan;
+use golden::specular::{BrdfK, SpecularSpan};
 use golden::{Align, Span};
+use hdl_gen::cli::ModelArgs;
 use hdl_gen::output::{commit, stage, Staged};
 use rand::SeedableRng;
+use serde::{Deserialize, Serialize};
 use std::fs::File;
 use std::io::{BufReader, Read};
 use std::path::PathBuf;
 use std::process::ExitCode;
 use std::time::Instant;
 use verilator_harness::ffi::to_port;
-use verilator_harness::ondemand;
-use verilator_harness::registry::{segment_model, specular_unit, SPECULAR_MODELS};
+use verilator_harness::registry::{segment_model, unit_of, SPECULAR_MODELS};
 use verilator_harness::segment::{Report, SegmentCosim, Stim};
 use verilator_harness::specular::{random_span, SpecularCosim};
 use verilator_harness::stimulus::random_triangle;
 use verilator_harness::traffic::{state_of, Traffic};
 
-const STIM_MAGIC: &[u8; 8] = b"SSBSTIM1";
+/// A stimulus file's magic: these seven bytes, then its format's digit.
+const STIM_MAGIC: &[u8; 7] = b"SSBSTIM";
+/// The format `gen` writes.
+const FORMAT: u8 = b'2';
 const EXPECT_MAGIC: &[u8; 8] = b"SSBEXPT1";
+/// The header's fixed part; format 2's model description follows it.
 const HEADER: usize = 64;
+/// The most bytes a model description may take: `generate`'s flags are a few hundred, so a
+/// larger count is a garbage header, refused before anything is allocated for it.
+const MODEL_LIMIT: u32 = 1 << 16;
+/// Widest and tallest screen of the random triangles (golden::setup::COORD_LIMIT), as cosim's.
+const MAX_SIDE: i64 = golden::setup::COORD_LIMIT as i64;
 
 #[derive(Clone, Copy, PartialEq, Eq, ValueEnum, Debug)]
 enum Design {
@@ -77,9 +93,18 @@ enum Cmd {
     Gen {
         #[arg(long, value_enum)]
         design: Design,
-        /// Segment width (segment shader, span alignment).
-        #[arg(long, default_value_t = 8)]
-        p: u32,
+        // The model: any configuration `generate` accepts, by the same flags (the compiled
+        // catalogue's model when it has it, else built the first time, then cached). The file's
+        // header names it, so `harness` runs the same one.
+        #[command(flatten)]
+        model: ModelArgs,
+        /// Screen width of the random triangles (segment design; 1..=32768, at most what the
+        /// x ports carry). Default: the configuration's, 640 narrowed to 2^XW and 2^F.
+        #[arg(long, value_parser = clap::value_parser!(u32).range(1..=MAX_SIDE))]
+        width: Option<u32>,
+        /// Screen height of the random triangles (segment design; 1..=32768). Default: 480.
+        #[arg(long, value_parser = clap::value_parser!(u32).range(1..=MAX_SIDE))]
+        height: Option<u32>,
         /// Spans to write (1..=4294967295: the header holds the count as a u32). Written as they
         /// are made, so memory does not grow with the count; refused at once when the folder
         /// has not the room the two files take at the least.
@@ -119,16 +144,20 @@ fn main() -> ExitCode {
         return ExitCode::from(2);
     }
     let run = match args.cmd {
-        Cmd::Gen { design, p, spans, seed, traffic, out } => {
+        Cmd::Gen { design, model, width, height, spans, seed, traffic, out } => {
             let traffic = match traffic {
                 TrafficArg::Random => Traffic::RANDOM,
                 TrafficArg::Full => Traffic::FULL,
             };
             // clap bounds the count to the header's u32.
             let count = spans as u32;
+            let run = Run { count, seed, traffic, out: &out };
             match design {
-                Design::Segment => gen_segment(p, count, seed, traffic, &out),
-                Design::Specular => gen_specular(count, seed, traffic, &out),
+                Design::Segment => gen_segment(&model, width, height, &run),
+                Design::Specular if width.or(height).is_some() => {
+                    Err("--width/--height: the specular design draws no triangles (they set the segment design's screen)".into())
+                }
+                Design::Specular => gen_specular(&model, &run),
             }
         }
         Cmd::Harness { stim, limit } => harness(&stim, limit),
@@ -161,6 +190,88 @@ fn info(p: u32) -> ExitCode {
     ExitCode::SUCCESS
 }
 
+/// What a stimulus file needs beyond its fixed fields, written as JSON into its header (format
+/// 2): the writer (`gen`) and the reader (`harness`) share this type.
+#[derive(Serialize, Deserialize, Debug, Clone, PartialEq)]
+#[serde(deny_unknown_fields)]
+struct StimModel {
+    /// `hdl-gen generate`'s flags of the model the file was made for, every one written out
+    /// (`--frac=8`), so that a later change of a default does not change what a file names. Read
+    /// back through the same `hdl_gen::cli::ModelArgs` as the command line: a value `generate`
+    /// refuses is refused with its message, and a user can `generate` the same Verilog.
+    generate: Vec<String>,
+    /// The screen the random triangles were drawn on (segment design; `None`: specular), so the
+    /// file can be made again from its header.
+    screen: Option<[u32; 2]>,
+}
+
+/// `generate`'s flags alone, as clap reads them from a [`StimModel`].
+#[derive(Parser)]
+#[command(name = "model", no_binary_name = true)]
+struct ModelFlags {
+    #[command(flatten)]
+    model: ModelArgs,
+}
+
+/// The name clap gives a choice (`span`, `shift-add`).
+fn choice<E: ValueEnum>(e: &E) -> String {
+    e.to_possible_value().expect("no choice is hidden").get_name().to_string()
+}
+
+impl StimModel {
+    /// The description of `m`, checked to read back as the same configuration, so that a flag
+    /// this list forgot cannot make a file that names another model.
+    fn of(m: &ModelArgs, screen: Option<Screen>) -> Result<StimModel, Bad> {
+        let v = &m.variant;
+        let mut generate = vec![
+            format!("--p={}", m.seg.p),
+            format!("--align={}", choice(&m.seg.align)),
+            format!("--frac={}", v.format.frac),
+            format!("--xbits={}", v.format.xbits),
+            format!("--prefix={}", v.format.prefix),
+            format!("--bfpi-arch={}", choice(&v.bfpi_arch)),
+            format!("--fe-di={}", choice(&v.fe_di)),
+            format!("--fe-i0={}", choice(&v.fe_i0)),
+            format!("--pipeline={}", v.pipeline),
+            format!("--bus={}", choice(&v.bus)),
+        ];
+        generate.extend(v.fe_div_bits.map(|b| format!("--fe-div-bits={b}")));
+        match &v.brdf.brdf_k {
+            None => {}
+            Some(BrdfK::Auto { max_err }) => {
+                generate.push("--brdf-k=auto".into());
+                generate.push(format!("--max-rel-error={}", v.brdf.max_rel_error.unwrap_or(*max_err)));
+            }
+            Some(list) => generate.push(format!("--brdf-k={list}")),
+        }
+        let d = StimModel { generate, screen: screen.map(|s| [s.width, s.height]) };
+        let want = m.options(None).map_err(|e| e.to_string())?;
+        let back = d.options()?;
+        if format!("{back:?}") != format!("{want:?}") {
+            return Err(format!("internal: the header's flags {:?} name another model than the command line's", d.generate));
+        }
+        Ok(d)
+    }
+
+    /// The model of a format-1 file: the default configuration at `p`, span alignment.
+    fn format1(design: u32, p: u32) -> StimModel {
+        match design {
+            0 => StimModel { generate: vec![format!("--p={p}"), "--align=span".into()], screen: Some([640, 480]) },
+            _ => StimModel { generate: Vec::new(), screen: None },
+        }
+    }
+
+    /// `generate`'s options of the model, checked as the command line's are.
+    fn options(&self) -> Result<hdl_gen::Options, Bad> {
+        let flags = ModelFlags::try_parse_from(&self.generate).map_err(|e| {
+            let text = e.to_string();
+            let line = text.lines().next().unwrap_or_default().trim_start_matches("error: ").to_string();
+            format!("the model's flags {:?}: {line}", self.generate)
+        })?;
+        flags.model.options(None).map_err(|e| format!("the model's flags {:?}: {e}", self.generate))
+    }
+}
+
 struct Header {
     design: u32,
     p: u32,
@@ -172,12 +283,22 @@ struct Header {
     seed: u64,
     rec: u32,
     dw: u32,
+    model: StimModel,
+}
+
+/// Where a file's records start, after a model description of `model` bytes.
+fn records_at(model: u32) -> u32 {
+    (HEADER as u32 + model).next_multiple_of(32)
 }
 
 impl Header {
-    fn bytes(&self) -> [u8; HEADER] {
-        let mut h = [0u8; HEADER];
-        h[..8].copy_from_slice(STIM_MAGIC);
+    /// The header in format 2: the fixed part, the model, padding up to the first record.
+    fn bytes(&self) -> Vec<u8> {
+        let model = serde_json::to_vec(&self.model).expect("a StimModel serialises");
+        let model_bytes = u32::try_from(model.len()).ok().filter(|&n| n <= MODEL_LIMIT).expect("a model takes a few hundred bytes");
+        let mut h = vec![0u8; records_at(model_bytes) as usize];
+        h[..7].copy_from_slice(STIM_MAGIC);
+        h[7] = FORMAT;
         let words = [self.design, self.p, self.state, self.valid_thr, self.ready_thr, self.spans];
         for (k, w) in words.iter().enumerate() {
             h[8 + 4 * k..12 + 4 * k].copy_from_slice(&w.to_le_bytes());
@@ -186,29 +307,57 @@ impl Header {
         h[40..48].copy_from_slice(&self.seed.to_le_bytes());
         h[48..52].copy_from_slice(&self.rec.to_le_bytes());
         h[52..56].copy_from_slice(&self.dw.to_le_bytes());
+        h[56..60].copy_from_slice(&records_at(model_bytes).to_le_bytes());
+        h[60..64].copy_from_slice(&model_bytes.to_le_bytes());
+        h[HEADER..HEADER + model.len()].copy_from_slice(&model);
         h
     }
 
-    /// The header of a stimulus file of `len` bytes, every field checked against what `gen`
-    /// writes, so a truncated, foreign or garbage file is refused before anything is read.
-    fn parse(h: &[u8; HEADER], len: u64) -> Result<Header, String> {
-        if &h[..8] != STIM_MAGIC {
-            return Err("not a bench stimulus file (no SSBSTIM1 header)".into());
+    /// The header of a stimulus file of `len` bytes, from its fixed part `h` and, in format 2,
+    /// the model description read from `f`; every field checked against what `gen` writes, so
+    /// a truncated, foreign or garbage file is refused before anything is sized by it. Returns
+    /// the header and where the records start.
+    fn parse(h: &[u8; HEADER], f: &mut impl Read, len: u64) -> Result<(Header, u64), String> {
+        if &h[..7] != STIM_MAGIC {
+            return Err("not a bench stimulus file (no SSBSTIM header)".into());
         }
         let w = |k: usize| u32::from_le_bytes(h[8 + 4 * k..12 + 4 * k].try_into().expect("4 bytes"));
+        let (design, p) = (w(0), w(1));
+        let (start, model) = match h[7] {
+            b'1' => (HEADER as u32, StimModel::format1(design, p)),
+            FORMAT => {
+                let (start, model_bytes) = (w(12), w(13));
+                if model_bytes > MODEL_LIMIT || start != records_at(model_bytes) || start as u64 > len {
+                    return Err(format!("a model description of {model_bytes} bytes and records at byte {start} do not fit"));
+                }
+                let mut text = vec![0u8; model_bytes as usize];
+                f.read_exact(&mut text).map_err(|e| format!("the model description: {e}"))?;
+                let mut pad = vec![0u8; (start - HEADER as u32 - model_bytes) as usize];
+                f.read_exact(&mut pad).map_err(|e| format!("the model description: {e}"))?;
+                let model = serde_json::from_slice(&text).map_err(|e| format!("the model description: {e}"))?;
+                (start, model)
+            }
+            v => {
+                return Err(format!(
+                    "a bench stimulus file of format {}, this bench reads formats 1 and 2: write it again with `bench gen`",
+                    v.escape_ascii()
+                ))
+            }
+        };
         let header = Header {
-            design: w(0),
-            p: w(1),
+            design,
+            p,
             state: w(2),
             valid_thr: w(3),
             ready_thr: w(4),
             spans: w(5),
             outputs: u64::from_le_bytes(h[32..40].try_into().expect("8 bytes")),
             seed: u64::from_le_bytes(h[40..48].try_into().expect("8 bytes")),
-            rec: u32::from_le_bytes(h[48..52].try_into().expect("4 bytes")),
-            dw: u32::from_le_bytes(h[52..56].try_into().expect("4 bytes")),
+            rec: w(10),
+            dw: w(11),
+            model,
         };
-        let want = HEADER as u64 + 32 * header.spans as u64;
+        let want = start as u64 + 32 * header.spans as u64;
         if len != want {
             return Err(format!("the header promises {} spans ({want} bytes), the file has {len} bytes", header.spans));
         }
@@ -223,7 +372,7 @@ impl Header {
         if header.state != state_of(header.seed) {
             return Err("traffic state is not state_of(seed)".into());
         }
-        Ok(header)
+        Ok((header, start as u64))
     }
 }
 
@@ -299,8 +448,13 @@ fn seg_record_bytes(p: u32) -> u32 {
 
 /// The first `count` spans of golden set-up of random triangles from `seed`, each to `f`: made
 /// as they are used, so a pass over them holds no list (gen makes them twice: counting, writing).
-fn segment_spans(cfg: &golden::Config, count: u32, seed: u64, mut f: impl FnMut(Stim) -> Result<(), Bad>) -> Result<(), Bad> {
-    let screen = Screen::default();
+fn segment_spans(
+    cfg: &golden::Config,
+    screen: Screen,
+    count: u32,
+    seed: u64,
+    mut f: impl FnMut(Stim) -> Result<(), Bad>,
+) -> Result<(), Bad> {
     let mut rng = SeedRng::seed_from_u64(seed);
     let (mut made, mut triangle) = (0u32, 0usize);
     while made < count {
@@ -316,16 +470,35 @@ fn segment_spans(cfg: &golden::Config, count: u32, seed: u64, mut f: impl FnMut(
     Ok(())
 }
 
-fn gen_segment(p: u32, count: u32, seed: u64, traffic: Traffic, out: &std::path::Path) -> Result<ExitCode, Bad> {
-    let opts = ondemand::options(p, Align::Span, None).map_err(|e| format!("--p {p}: {e}"))?;
+/// What every `gen` is asked for besides its model.
+struct Run<'a> {
+    count: u32,
+    seed: u64,
+    traffic: Traffic,
+    out: &'a std::path::Path,
+}
+
+/// How a model's error names the configuration (as cosim's do).
+fn model_flags(m: &ModelArgs) -> String {
+    format!("--p {} --align {}", m.seg.p, m.seg.align)
+}
+
+fn gen_segment(model: &ModelArgs, width: Option<u32>, height: Option<u32>, run: &Run) -> Result<ExitCode, Bad> {
+    let Run { count, seed, traffic, out } = *run;
+    let opts = model.options(None).map_err(|e| e.to_string())?;
+    let default = hdl_gen::Options::default_screen(&opts.cfg);
+    let screen = Screen { width: width.unwrap_or(default.width), height: height.unwrap_or(default.height) };
+    screen.check_for(&opts.cfg).map_err(|e| format!("--width/--height: {e}"))?;
+    let stim_model = StimModel::of(model, Some(screen))?;
+    let p = opts.cfg.p;
     let rec = seg_record_bytes(p);
     // Every span yields at least one record. A bad --out is refused before the model is asked
     // for (which may take a build, or not exist in a COSIM_RTL_DIR run).
     check_out(out, count, (HEADER + 24) as u64 + (32 + rec as u64) * count as u64)?;
-    let info = verilator_harness::registry::segment(&opts).map_err(|e| format!("--p {p}: {e}"))?;
+    let info = verilator_harness::registry::segment(&opts).map_err(|e| format!("{}: {e}", model_flags(model)))?;
     let cfg = info.cfg;
     let mut outputs = 0u64;
-    segment_spans(&cfg, count, seed, |s| {
+    segment_spans(&cfg, screen, count, seed, |s| {
         outputs += cfg.segment_count(s.span.x0, s.span.len) as u64;
         Ok(())
     })?;
@@ -340,12 +513,13 @@ fn gen_segment(p: u32, count: u32, seed: u64, traffic: Traffic, out: &std::path:
         seed,
         rec,
         dw: cfg.dw(),
+        model: stim_model,
     };
     let least = (HEADER + 24) as u64 + 32 * count as u64 + rec as u64 * outputs;
     let (mut sf, mut ef) = create_pair(out, &header, least)?;
     let mut r = vec![0u8; rec as usize];
     let mut pixels = 0u64;
-    segment_spans(&cfg, count, seed, |s| {
+    segment_spans(&cfg, screen, count, seed, |s| {
         let Span { x0, len, i0, di } = s.span;
         let n = cfg.segment_count(x0, len);
         sf.put(&stim_record([x0, len, i0, to_port(di as i64, cfg.dw()), 0], n, s.triangle as u32, s.y)).map_err(|e| e.to_string())?;
@@ -370,12 +544,13 @@ fn gen_segment(p: u32, count: u32, seed: u64, traffic: Traffic, out: &std::path:
     Ok(ExitCode::SUCCESS)
 }
 
-fn gen_specular(count: u32, seed: u64, traffic: Traffic, out: &std::path::Path) -> Result<ExitCode, Bad> {
-    let Some(info) = SPECULAR_MODELS.first() else {
-        return Err("this build has no specular unit".into());
-    };
-    let unit = specular_unit();
+fn gen_specular(model: &ModelArgs, run: &Run) -> Result<ExitCode, Bad> {
+    let Run { count, seed, traffic, out } = *run;
+    let opts = model.options(None).map_err(|e| e.to_string())?;
+    let stim_model = StimModel::of(model, None)?;
     check_out(out, count, (HEADER + 24) as u64 + (32 + 4) * count as u64)?;
+    let info = verilator_harness::registry::specular(&opts).map_err(|e| format!("--specular: {e}"))?;
+    let unit = unit_of(info);
     let spans = || {
         let mut rng = SeedRng::seed_from_u64(seed);
         (0..count).map(move |_| random_span(&mut rng, info.cfg.max_len()))
@@ -392,6 +567,7 @@ fn gen_specular(count: u32, seed: u64, traffic: Traffic, out: &std::path::Path) 
         seed,
         rec: 4,
         dw: 32,
+        model: stim_model,
     };
     let least = (HEADER + 24) as u64 + 32 * count as u64 + 4 * outputs;
     let (mut sf, mut ef) = create_pair(out, &header, least)?;
@@ -423,7 +599,8 @@ fn read_stim(path: &std::path::Path, limit: usize) -> Result<(Header, Vec<[u32; 
     let mut f = BufReader::new(file);
     let mut h = [0u8; HEADER];
     f.read_exact(&mut h).map_err(|_| format!("{name}: shorter than the {HEADER}-byte header of a bench stimulus file"))?;
-    let header = Header::parse(&h, meta.len()).map_err(|e| format!("{name}: {e}"))?;
+    // The model description, if any, is read here too: `f` is then at the first record.
+    let (header, _) = Header::parse(&h, &mut f, meta.len()).map_err(|e| format!("{name}: {e}"))?;
     let n = match limit {
         0 => header.spans as usize,
         l => l.min(header.spans as usize),
@@ -464,11 +641,15 @@ fn harness(path: &std::path::Path, limit: usize) -> Result<ExitCode, Bad> {
     let traffic = Traffic { valid: h.valid_thr as f64 / 256.0, ready: h.ready_thr as f64 / 256.0 };
     let mut report = Report::default();
     let rejected = |e: &dyn std::fmt::Display| format!("{}: {e}", path.display());
+    // The model the header names, checked as `gen`'s flags are.
+    let opts = h.model.options().map_err(|e| rejected(&e))?;
     let (tag, (secs, cpu)) = match h.design {
         0 => {
-            let info = ondemand::options(h.p, Align::Span, None)
-                .and_then(|o| verilator_harness::registry::segment(&o))
-                .map_err(|e| format!("{}: the segment shader for p = {}: {e}", path.display(), h.p))?;
+            if h.p != opts.cfg.p {
+                return Err(rejected(&format!("the header's p is {}, its model's --p {}", h.p, opts.cfg.p)));
+            }
+            let info = verilator_harness::registry::segment(&opts)
+                .map_err(|e| rejected(&format!("the segment shader of {:?}: {e}", h.model.generate)))?;
             if h.dw != info.cfg.dw() {
                 return Err(format!("{}: in_di is {} bits in the file, {} in {}", path.display(), h.dw, info.cfg.dw(), info.tag));
             }
@@ -484,12 +665,13 @@ fn harness(path: &std::path::Path, limit: usize) -> Result<ExitCode, Bad> {
             (info.tag, timed(|| sim.stream(&stims, &mut report, |_, _| {})))
         }
         _ => {
-            let info = SPECULAR_MODELS.first().ok_or("no specular unit in this build")?;
+            let info = verilator_harness::registry::specular(&opts)
+                .map_err(|e| rejected(&format!("the specular unit of {:?}: {e}", h.model.generate)))?;
             let spans: Vec<SpecularSpan> = recs
                 .iter()
                 .map(|r| SpecularSpan { c: r[0] as u16, n: r[1] as u16, theta0: r[2] as i32, dtheta: r[3] as i32, len: r[4] })
                 .collect();
-            let mut sim = SpecularCosim::new(info, specular_unit(), h.seed, traffic);
+            let mut sim = SpecularCosim::new(info, unit_of(info), h.seed, traffic);
             let mut result = Ok(());
             let t = timed(|| result = sim.try_stream(&spans, &mut report));
             result.map_err(|e| rejected(&e))?;
