@@ -1,7 +1,7 @@
 """cocotb side of scripts/bench-cosim: the same stimulus, traffic and expected outputs as the
 harness and the native testbench, under Icarus Verilog.
 
-Reads the files written by `bench gen` (layout in verilator-harness/src/bin/bench.rs):
+Reads the files written by `bench gen` (layout in verilator-harness/src/benchfile.rs):
 BENCH_STIM, BENCH_EXPECT; BENCH_SPANS streams only the first N spans (0: all); the result line
 (`RESULT impl=cocotb ...`, as the other two print) goes to BENCH_RESULT.
 

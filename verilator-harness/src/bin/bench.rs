@@ -1,51 +1,31 @@
 //! `bench`: the harness's side of `scripts/bench-cosim`.
 //!
 //! * `bench gen`: writes a stimulus file and an expected-output file (both little-endian
-//!   binary, laid out below) for the segment shader (spans from golden set-up of random
-//!   triangles) or the specular unit (random spans from golden specular set-up). The native
-//!   C++ testbench (`bench/native_tb.cpp`) and the cocotb test (`bench/cocotb/test_bench.py`)
-//!   read the same two files.
+//!   binary, laid out in `verilator_harness::benchfile`) for the segment shader (spans from
+//!   golden set-up of random triangles) or the specular unit (random spans from golden specular
+//!   set-up) of any configuration `generate` accepts, which the stimulus file's header names.
+//!   The native C++ testbench (`bench/native_tb.cpp`) and the cocotb test
+//!   (`bench/cocotb/test_bench.py`) read the same two files.
 //! * `bench harness`: reads a stimulus file and streams it through the harness exactly as users
 //!   run it (`SegmentCosim::stream` / `SpecularCosim::stream`, golden comparison on), timing
 //!   only the streaming loop. Prints one `RESULT` line.
 //! * `bench info`: where this build's models came from: for the segment shader at P and the
 //!   specular unit, the Verilog build.rs verilated (so the native and cocotb benches simulate
 //!   the very same files) and how long build.rs took to verilate and compile each.
-//!
-//! Stimulus file (format 2): a header of 64 fixed bytes
-//!   `magic "SSBSTIM2", u32 design (0 segment, 1 specular), u32 p, u32 xorshift32 start state,
-//!    u32 valid_thr, u32 ready_thr, u32 spans, u64 outputs, u64 seed, u32 expected record bytes,
-//!    u32 in_di width, u32 records_at, u32 model bytes`,
-//! then the model's description ([`StimModel`] as JSON, `model bytes` long), zero-padded to
-//! `records_at` (a multiple of 32), then one 32-byte record per span from `records_at`:
-//! `u32 port[5], u32 outputs, u32 triangle, u32 y`, the ports
-//! being `in_x, in_len, in_i0, in_di, 0` (segment) or `in_c, in_n, in_theta0, in_dtheta, in_len`
-//! (specular), as the port bits. `outputs` is the number of segments (pixels) the span yields.
-//! Expected file: a 24-byte header `magic "SSBEXPT1", u32 design, u32 record bytes, u64 records`,
-//! then one record per output in order: segment `u32 out_x | out_last << 31, u8 mask[ceil(p/8)],
-//! u8 pix[p]` (masked lanes 0), zero-padded to a multiple of 4; specular `u16 out_spec,
-//! u8 out_err, u8 out_last`. The traffic is `verilator_harness::traffic`, from the header's state
-//! and thresholds.
-//!
-//! Format 1 (`SSBSTIM1`, before the model was written down) is still read: its bytes 56..64 are
-//! zero, its records start at 64, and it names the default configuration at its P (span
-//! alignment), the only models it could be made for.
 
 use clap::{Parser, Subcommand, ValueEnum};
 use golden::rng::SeedRng;
 use golden::segment::segments;
 use golden::setup::{triangle_spans, Screen};
-use golden::specular::{BrdfK, SpecularSpan};
+use golden::specular::SpecularSpan;
 use golden::{Align, Span};
 use hdl_gen::cli::ModelArgs;
 use hdl_gen::output::{commit, stage, Staged};
 use rand::SeedableRng;
-use serde::{Deserialize, Serialize};
-use std::fs::File;
-use std::io::{BufReader, Read};
 use std::path::PathBuf;
 use std::process::ExitCode;
 use std::time::Instant;
+use verilator_harness::benchfile::{expect_header, read_stim, seg_record_bytes, stim_record, Header, StimModel, HEADER};
 use verilator_harness::ffi::to_port;
 use verilator_harness::registry::{segment_model, unit_of, SPECULAR_MODELS};
 use verilator_harness::segment::{Report, SegmentCosim, Stim};
@@ -53,16 +33,11 @@ use verilator_harness::specular::{random_span, SpecularCosim};
 use verilator_harness::stimulus::random_triangle;
 use verilator_harness::traffic::{state_of, Traffic};
 
-/// A stimulus file's magic: these seven bytes, then its format's digit.
-const STIM_MAGIC: &[u8; 7] = b"SSBSTIM";
-/// The format `gen` writes.
-const FORMAT: u8 = b'2';
-const EXPECT_MAGIC: &[u8; 8] = b"SSBEXPT1";
-/// The header's fixed part; format 2's model description follows it.
-const HEADER: usize = 64;
-/// The most bytes a model description may take: `generate`'s flags are a few hundred, so a
-/// larger count is a garbage header, refused before anything is allocated for it.
-const MODEL_LIMIT: u32 = 1 << 16;
+/// The header's model, from the command line's flags; an error is a usage error.
+fn header_model(model: &ModelArgs, screen: Option<Screen>) -> Result<StimModel, Bad> {
+    StimModel::of(model, screen).map_err(|e| e.to_string())
+}
+
 /// Widest and tallest screen of the random triangles (golden::setup::COORD_LIMIT), as cosim's.
 const MAX_SIDE: i64 = golden::setup::COORD_LIMIT as i64;
 
@@ -190,192 +165,6 @@ fn info(p: u32) -> ExitCode {
     ExitCode::SUCCESS
 }
 
-/// What a stimulus file needs beyond its fixed fields, written as JSON into its header (format
-/// 2): the writer (`gen`) and the reader (`harness`) share this type.
-#[derive(Serialize, Deserialize, Debug, Clone, PartialEq)]
-#[serde(deny_unknown_fields)]
-struct StimModel {
-    /// `hdl-gen generate`'s flags of the model the file was made for, every one written out
-    /// (`--frac=8`), so that a later change of a default does not change what a file names. Read
-    /// back through the same `hdl_gen::cli::ModelArgs` as the command line: a value `generate`
-    /// refuses is refused with its message, and a user can `generate` the same Verilog.
-    generate: Vec<String>,
-    /// The screen the random triangles were drawn on (segment design; `None`: specular), so the
-    /// file can be made again from its header.
-    screen: Option<[u32; 2]>,
-}
-
-/// `generate`'s flags alone, as clap reads them from a [`StimModel`].
-#[derive(Parser)]
-#[command(name = "model", no_binary_name = true)]
-struct ModelFlags {
-    #[command(flatten)]
-    model: ModelArgs,
-}
-
-/// The name clap gives a choice (`span`, `shift-add`).
-fn choice<E: ValueEnum>(e: &E) -> String {
-    e.to_possible_value().expect("no choice is hidden").get_name().to_string()
-}
-
-impl StimModel {
-    /// The description of `m`, checked to read back as the same configuration, so that a flag
-    /// this list forgot cannot make a file that names another model.
-    fn of(m: &ModelArgs, screen: Option<Screen>) -> Result<StimModel, Bad> {
-        let v = &m.variant;
-        let mut generate = vec![
-            format!("--p={}", m.seg.p),
-            format!("--align={}", choice(&m.seg.align)),
-            format!("--frac={}", v.format.frac),
-            format!("--xbits={}", v.format.xbits),
-            format!("--prefix={}", v.format.prefix),
-            format!("--bfpi-arch={}", choice(&v.bfpi_arch)),
-            format!("--fe-di={}", choice(&v.fe_di)),
-            format!("--fe-i0={}", choice(&v.fe_i0)),
-            format!("--pipeline={}", v.pipeline),
-            format!("--bus={}", choice(&v.bus)),
-        ];
-        generate.extend(v.fe_div_bits.map(|b| format!("--fe-div-bits={b}")));
-        match &v.brdf.brdf_k {
-            None => {}
-            Some(BrdfK::Auto { max_err }) => {
-                generate.push("--brdf-k=auto".into());
-                generate.push(format!("--max-rel-error={}", v.brdf.max_rel_error.unwrap_or(*max_err)));
-            }
-            Some(list) => generate.push(format!("--brdf-k={list}")),
-        }
-        let d = StimModel { generate, screen: screen.map(|s| [s.width, s.height]) };
-        let want = m.options(None).map_err(|e| e.to_string())?;
-        let back = d.options()?;
-        if format!("{back:?}") != format!("{want:?}") {
-            return Err(format!("internal: the header's flags {:?} name another model than the command line's", d.generate));
-        }
-        Ok(d)
-    }
-
-    /// The model of a format-1 file: the default configuration at `p`, span alignment.
-    fn format1(design: u32, p: u32) -> StimModel {
-        match design {
-            0 => StimModel { generate: vec![format!("--p={p}"), "--align=span".into()], screen: Some([640, 480]) },
-            _ => StimModel { generate: Vec::new(), screen: None },
-        }
-    }
-
-    /// `generate`'s options of the model, checked as the command line's are.
-    fn options(&self) -> Result<hdl_gen::Options, Bad> {
-        let flags = ModelFlags::try_parse_from(&self.generate).map_err(|e| {
-            let text = e.to_string();
-            let line = text.lines().next().unwrap_or_default().trim_start_matches("error: ").to_string();
-            format!("the model's flags {:?}: {line}", self.generate)
-        })?;
-        flags.model.options(None).map_err(|e| format!("the model's flags {:?}: {e}", self.generate))
-    }
-}
-
-struct Header {
-    design: u32,
-    p: u32,
-    state: u32,
-    valid_thr: u32,
-    ready_thr: u32,
-    spans: u32,
-    outputs: u64,
-    seed: u64,
-    rec: u32,
-    dw: u32,
-    model: StimModel,
-}
-
-/// Where a file's records start, after a model description of `model` bytes.
-fn records_at(model: u32) -> u32 {
-    (HEADER as u32 + model).next_multiple_of(32)
-}
-
-impl Header {
-    /// The header in format 2: the fixed part, the model, padding up to the first record.
-    fn bytes(&self) -> Vec<u8> {
-        let model = serde_json::to_vec(&self.model).expect("a StimModel serialises");
-        let model_bytes = u32::try_from(model.len()).ok().filter(|&n| n <= MODEL_LIMIT).expect("a model takes a few hundred bytes");
-        let mut h = vec![0u8; records_at(model_bytes) as usize];
-        h[..7].copy_from_slice(STIM_MAGIC);
-        h[7] = FORMAT;
-        let words = [self.design, self.p, self.state, self.valid_thr, self.ready_thr, self.spans];
-        for (k, w) in words.iter().enumerate() {
-            h[8 + 4 * k..12 + 4 * k].copy_from_slice(&w.to_le_bytes());
-        }
-        h[32..40].copy_from_slice(&self.outputs.to_le_bytes());
-        h[40..48].copy_from_slice(&self.seed.to_le_bytes());
-        h[48..52].copy_from_slice(&self.rec.to_le_bytes());
-        h[52..56].copy_from_slice(&self.dw.to_le_bytes());
-        h[56..60].copy_from_slice(&records_at(model_bytes).to_le_bytes());
-        h[60..64].copy_from_slice(&model_bytes.to_le_bytes());
-        h[HEADER..HEADER + model.len()].copy_from_slice(&model);
-        h
-    }
-
-    /// The header of a stimulus file of `len` bytes, from its fixed part `h` and, in format 2,
-    /// the model description read from `f`; every field checked against what `gen` writes, so
-    /// a truncated, foreign or garbage file is refused before anything is sized by it. Returns
-    /// the header and where the records start.
-    fn parse(h: &[u8; HEADER], f: &mut impl Read, len: u64) -> Result<(Header, u64), String> {
-        if &h[..7] != STIM_MAGIC {
-            return Err("not a bench stimulus file (no SSBSTIM header)".into());
-        }
-        let w = |k: usize| u32::from_le_bytes(h[8 + 4 * k..12 + 4 * k].try_into().expect("4 bytes"));
-        let (design, p) = (w(0), w(1));
-        let (start, model) = match h[7] {
-            b'1' => (HEADER as u32, StimModel::format1(design, p)),
-            FORMAT => {
-                let (start, model_bytes) = (w(12), w(13));
-                if model_bytes > MODEL_LIMIT || start != records_at(model_bytes) || start as u64 > len {
-                    return Err(format!("a model description of {model_bytes} bytes and records at byte {start} do not fit"));
-                }
-                let mut text = vec![0u8; model_bytes as usize];
-                f.read_exact(&mut text).map_err(|e| format!("the model description: {e}"))?;
-                let mut pad = vec![0u8; (start - HEADER as u32 - model_bytes) as usize];
-                f.read_exact(&mut pad).map_err(|e| format!("the model description: {e}"))?;
-                let model = serde_json::from_slice(&text).map_err(|e| format!("the model description: {e}"))?;
-                (start, model)
-            }
-            v => {
-                return Err(format!(
-                    "a bench stimulus file of format {}, this bench reads formats 1 and 2: write it again with `bench gen`",
-                    v.escape_ascii()
-                ))
-            }
-        };
-        let header = Header {
-            design,
-            p,
-            state: w(2),
-            valid_thr: w(3),
-            ready_thr: w(4),
-            spans: w(5),
-            outputs: u64::from_le_bytes(h[32..40].try_into().expect("8 bytes")),
-            seed: u64::from_le_bytes(h[40..48].try_into().expect("8 bytes")),
-            rec: w(10),
-            dw: w(11),
-            model,
-        };
-        let want = start as u64 + 32 * header.spans as u64;
-        if len != want {
-            return Err(format!("the header promises {} spans ({want} bytes), the file has {len} bytes", header.spans));
-        }
-        let rec = match header.design {
-            0 => seg_record_bytes(header.p.min(256)),
-            1 => 4,
-            d => return Err(format!("unknown design {d} (0 segment, 1 specular)")),
-        };
-        if header.rec != rec || !(1..=32).contains(&header.dw) || header.valid_thr > 256 || header.ready_thr > 256 {
-            return Err("header fields out of range (record bytes, in_di width or traffic thresholds)".into());
-        }
-        if header.state != state_of(header.seed) {
-            return Err("traffic state is not state_of(seed)".into());
-        }
-        Ok((header, start as u64))
-    }
-}
-
 fn with_ext(prefix: &std::path::Path, ext: &str) -> PathBuf {
     let mut s = prefix.as_os_str().to_owned();
     s.push(ext);
@@ -425,27 +214,6 @@ fn free_bytes(dir: &std::path::Path) -> Option<u64> {
     (rc == 0).then(|| st.f_bavail as u64 * st.f_frsize as u64)
 }
 
-fn stim_record(ports: [u32; 5], outputs: u32, triangle: u32, y: u32) -> [u8; 32] {
-    let mut r = [0u8; 32];
-    for (k, w) in ports.iter().chain(&[outputs, triangle, y]).enumerate() {
-        r[4 * k..4 * k + 4].copy_from_slice(&w.to_le_bytes());
-    }
-    r
-}
-
-fn expect_header(design: u32, rec: u32, records: u64) -> [u8; 24] {
-    let mut h = [0u8; 24];
-    h[..8].copy_from_slice(EXPECT_MAGIC);
-    h[8..12].copy_from_slice(&design.to_le_bytes());
-    h[12..16].copy_from_slice(&rec.to_le_bytes());
-    h[16..24].copy_from_slice(&records.to_le_bytes());
-    h
-}
-
-fn seg_record_bytes(p: u32) -> u32 {
-    (4 + p.div_ceil(8) + p).next_multiple_of(4)
-}
-
 /// The first `count` spans of golden set-up of random triangles from `seed`, each to `f`: made
 /// as they are used, so a pass over them holds no list (gen makes them twice: counting, writing).
 fn segment_spans(
@@ -489,7 +257,7 @@ fn gen_segment(model: &ModelArgs, width: Option<u32>, height: Option<u32>, run: 
     let default = hdl_gen::Options::default_screen(&opts.cfg);
     let screen = Screen { width: width.unwrap_or(default.width), height: height.unwrap_or(default.height) };
     screen.check_for(&opts.cfg).map_err(|e| format!("--width/--height: {e}"))?;
-    let stim_model = StimModel::of(model, Some(screen))?;
+    let stim_model = header_model(model, Some(screen))?;
     let p = opts.cfg.p;
     let rec = seg_record_bytes(p);
     // Every span yields at least one record. A bad --out is refused before the model is asked
@@ -547,7 +315,7 @@ fn gen_segment(model: &ModelArgs, width: Option<u32>, height: Option<u32>, run: 
 fn gen_specular(model: &ModelArgs, run: &Run) -> Result<ExitCode, Bad> {
     let Run { count, seed, traffic, out } = *run;
     let opts = model.options(None).map_err(|e| e.to_string())?;
-    let stim_model = StimModel::of(model, None)?;
+    let stim_model = header_model(model, None)?;
     check_out(out, count, (HEADER + 24) as u64 + (32 + 4) * count as u64)?;
     let info = verilator_harness::registry::specular(&opts).map_err(|e| format!("--specular: {e}"))?;
     let unit = unit_of(info);
@@ -587,33 +355,6 @@ fn gen_specular(model: &ModelArgs, run: &Run) -> Result<ExitCode, Bad> {
     Ok(ExitCode::SUCCESS)
 }
 
-/// The header and the records (at most `limit`, 0: all) of a stimulus file; the file's size
-/// must be what its header says, so nothing is allocated on a garbage count.
-fn read_stim(path: &std::path::Path, limit: usize) -> Result<(Header, Vec<[u32; 8]>), Bad> {
-    let name = path.display();
-    let file = File::open(path).map_err(|e| format!("{name}: {e}"))?;
-    let meta = file.metadata().map_err(|e| format!("{name}: {e}"))?;
-    if !meta.is_file() {
-        return Err(format!("{name}: not a file"));
-    }
-    let mut f = BufReader::new(file);
-    let mut h = [0u8; HEADER];
-    f.read_exact(&mut h).map_err(|_| format!("{name}: shorter than the {HEADER}-byte header of a bench stimulus file"))?;
-    // The model description, if any, is read here too: `f` is then at the first record.
-    let (header, _) = Header::parse(&h, &mut f, meta.len()).map_err(|e| format!("{name}: {e}"))?;
-    let n = match limit {
-        0 => header.spans as usize,
-        l => l.min(header.spans as usize),
-    };
-    let mut recs = Vec::with_capacity(n);
-    let mut r = [0u8; 32];
-    for _ in 0..n {
-        f.read_exact(&mut r).map_err(|e| format!("{name}: {e}"))?;
-        recs.push(std::array::from_fn(|k| u32::from_le_bytes(r[4 * k..4 * k + 4].try_into().expect("4 bytes"))));
-    }
-    Ok((header, recs))
-}
-
 /// The sign-extension of a `width`-bit port value.
 fn from_port(v: u32, width: u32) -> i32 {
     ((v << (32 - width)) as i32) >> (32 - width)
@@ -637,7 +378,7 @@ fn timed(f: impl FnOnce()) -> (f64, f64) {
 }
 
 fn harness(path: &std::path::Path, limit: usize) -> Result<ExitCode, Bad> {
-    let (h, recs) = read_stim(path, limit)?;
+    let (h, recs) = read_stim(path, limit).map_err(|e| e.to_string())?;
     let traffic = Traffic { valid: h.valid_thr as f64 / 256.0, ready: h.ready_thr as f64 / 256.0 };
     let mut report = Report::default();
     let rejected = |e: &dyn std::fmt::Display| format!("{}: {e}", path.display());
