@@ -381,6 +381,9 @@ fn bench_rejects_bad_files_and_flags() {
         (vec!["gen", "--design", "segment", "--spans", "10", "--out", p, "--height", "32769"], "--height".into()),
         (vec!["gen", "--design", "segment", "--spans", "10", "--out", p, "--xbits", "6", "--width", "100"], "--width/--height".into()),
         (vec!["gen", "--design", "specular", "--spans", "10", "--out", p, "--width", "100"], "--width/--height".into()),
+        (vec!["info", "--p", "3"], "--p".into()),
+        (vec!["info", "--pipeline", "-1"], "--pipeline".into()),
+        (vec!["info", "--bfpi-arch", "tree", "--pipeline", "1"], "--pipeline above 0".into()),
     ];
     let before = snapshot(&dir);
     for (args, needle) in &cases {
@@ -467,6 +470,10 @@ fn bench_runs_the_model_generate_options_name() {
         (&["--design", "segment", "--bus", "axis", "--width", "64", "--height", "48"], "seg_p8_span_axis"),
         (&["--design", "specular", "--pipeline", "1"], "spec_pl1"),
     ];
+    // `info` names the Verilog of the configuration's models.
+    let out = run(BENCH, &["info", "--pipeline", "1"]);
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success() && text.contains("MODEL tag=seg_p8_span_pl1 ") && text.contains("MODEL tag=spec_pl1 "), "{text}");
     for (args, tag) in cases {
         let out = run(BENCH, &[&["gen", "--spans", "20", "--out", p], *args].concat());
         let text = String::from_utf8_lossy(&out.stdout);

@@ -9,16 +9,16 @@
 //! * `bench harness`: reads a stimulus file and streams it through the harness exactly as users
 //!   run it (`SegmentCosim::stream` / `SpecularCosim::stream`, golden comparison on), timing
 //!   only the streaming loop. Prints one `RESULT` line.
-//! * `bench info`: where this build's models came from: for the segment shader at P and the
-//!   specular unit, the Verilog build.rs verilated (so the native and cocotb benches simulate
-//!   the very same files) and how long build.rs took to verilate and compile each.
+//! * `bench info`: where a configuration's models come from: for its segment shader and
+//!   specular unit, the Verilog the harness verilated (so the native and cocotb benches simulate
+//!   the very same files) and how long it took to verilate and compile each.
 
 use clap::{Parser, Subcommand, ValueEnum};
 use golden::rng::SeedRng;
 use golden::segment::segments;
 use golden::setup::{triangle_spans, Screen};
 use golden::specular::SpecularSpan;
-use golden::{Align, Span};
+use golden::Span;
 use hdl_gen::cli::ModelArgs;
 use hdl_gen::output::{commit, stage, Staged};
 use rand::SeedableRng;
@@ -27,7 +27,9 @@ use std::process::ExitCode;
 use std::time::Instant;
 use verilator_harness::benchfile::{expect_header, read_stim, seg_record_bytes, stim_record, Header, StimModel, HEADER};
 use verilator_harness::ffi::to_port;
-use verilator_harness::registry::{segment_model, unit_of, SPECULAR_MODELS};
+use verilator_harness::models::Kind;
+use verilator_harness::ondemand;
+use verilator_harness::registry::unit_of;
 use verilator_harness::segment::{Report, SegmentCosim, Stim};
 use verilator_harness::specular::{random_span, SpecularCosim};
 use verilator_harness::stimulus::random_triangle;
@@ -94,9 +96,12 @@ enum Cmd {
         out: PathBuf,
     },
     /// The RTL folder and build time of the models the benchmark uses.
+    // A negative number is a value its flag's range then refuses by name, not an unknown flag.
+    #[command(allow_negative_numbers = true)]
     Info {
-        #[arg(long, default_value_t = 8)]
-        p: u32,
+        // The models: any configuration `generate` accepts, by the same flags.
+        #[command(flatten)]
+        model: ModelArgs,
     },
     /// Stream a stimulus file through the harness with the golden comparison on; time the loop.
     #[command(allow_negative_numbers = true)]
@@ -136,7 +141,7 @@ fn main() -> ExitCode {
             }
         }
         Cmd::Harness { stim, limit } => harness(&stim, limit),
-        Cmd::Info { p } => Ok(info(p)),
+        Cmd::Info { model } => info(&model),
     };
     run.unwrap_or_else(|e| {
         eprintln!("error: {e}");
@@ -144,25 +149,34 @@ fn main() -> ExitCode {
     })
 }
 
-/// `MODEL tag=... top=... rtl=DIR verilate=S compile=S total=S` per model, then the runtime's
-/// `RUNTIME compile=S`: what build.rs recorded when it last built them (`OUT_DIR/obj/*/build.time`).
-fn info(p: u32) -> ExitCode {
+/// `MODEL tag=... top=... rtl=DIR verilate=S compile=S total=S` for the segment shader and the
+/// specular unit of the configuration, then the runtime's `RUNTIME compile=S`: the Verilog each
+/// model was verilated from (build.rs's for the catalogue's models, the cache entry's for one
+/// built at run time, which this builds first, or the `COSIM_RTL_DIR` folder), so the native and
+/// cocotb benches simulate the very same files, and how long its build took.
+fn info(model: &ModelArgs) -> Result<ExitCode, Bad> {
+    let opts = model.options(None).map_err(|e| e.to_string())?;
     let out = PathBuf::from(env!("OUT_DIR"));
-    let times = |tag: &str| -> String {
-        let text = std::fs::read_to_string(out.join("obj").join(tag).join("build.time")).unwrap_or_default();
+    let times = |record: &std::path::Path| -> String {
+        let text = std::fs::read_to_string(record.join("build.time")).unwrap_or_default();
         text.lines().filter_map(|l| l.split_once(' ')).map(|(k, v)| format!(" {k}={v}")).collect()
     };
-    let Some(seg) = segment_model(p, Align::Span) else {
-        eprintln!("error: no segment shader model for p = {p}");
-        return ExitCode::from(2);
-    };
-    let mut models = vec![(seg.tag, seg.top)];
-    models.extend(SPECULAR_MODELS.first().map(|m| (m.tag, m.top)));
-    for (tag, top) in models {
-        println!("MODEL tag={tag} top={top} rtl={}{}", out.join("rtl").join(tag).display(), times(tag));
+    let seg = verilator_harness::registry::segment(&opts).map_err(|e| format!("{}: {e}", model_flags(model)))?;
+    let spec = verilator_harness::registry::specular(&opts).map_err(|e| format!("--specular: {e}"))?;
+    for (tag, top, kind) in [(seg.tag, seg.top, Kind::Segment), (spec.tag, spec.top, Kind::Specular)] {
+        let compiled = out.join("rtl").join(tag);
+        let (rtl, record) = match verilator_harness::registry::rtl_dir() {
+            Some(dir) => (dir.to_path_buf(), PathBuf::new()),
+            None if compiled.is_dir() => (compiled, out.join("obj").join(tag)),
+            None => {
+                let entry = ondemand::describe(&opts, kind).and_then(|m| ondemand::cache_entry(&m)).map_err(|e| format!("{tag}: {e}"))?;
+                (entry.join("rtl"), entry)
+            }
+        };
+        println!("MODEL tag={tag} top={top} rtl={}{}", rtl.display(), times(&record));
     }
-    println!("RUNTIME{}", times("runtime"));
-    ExitCode::SUCCESS
+    println!("RUNTIME{}", times(&out.join("obj").join("runtime")));
+    Ok(ExitCode::SUCCESS)
 }
 
 fn with_ext(prefix: &std::path::Path, ext: &str) -> PathBuf {
