@@ -428,7 +428,8 @@ fn directed_triangles_take_an_out_of_range_step() {
         let steps = fe.i0_steps(&st);
         let out = (0..3).filter(|&k| {
             let x = 512 * st.plane.ny - 512 * st.plane.nx * st.edges[k].qs as i128;
-            let outside = x.div_euclid(2 * st.plane.a).unsigned_abs() >= 1 << iw;
+            let q = x.div_euclid(2 * st.plane.a);
+            let outside = !(-(1i128 << iw)..1i128 << iw).contains(&q);
             assert_eq!(steps.edge[k][0].is_none(), outside, "{t:?}: edge {k}'s step is None exactly when out of range");
             outside && !st.edges[k].right
         });
