@@ -35,11 +35,6 @@ use verilator_harness::specular::{random_span, SpecularCosim};
 use verilator_harness::stimulus::random_triangle;
 use verilator_harness::traffic::{state_of, Traffic};
 
-/// The header's model, from the command line's flags; an error is a usage error.
-fn header_model(model: &ModelArgs, screen: Option<Screen>) -> Result<StimModel, Bad> {
-    StimModel::of(model, screen).map_err(|e| e.to_string())
-}
-
 /// Widest and tallest screen of the random triangles (golden::setup::COORD_LIMIT), as cosim's.
 const MAX_SIDE: i64 = golden::setup::COORD_LIMIT as i64;
 
@@ -263,6 +258,11 @@ struct Run<'a> {
 /// How a model's error names the configuration (as cosim's do).
 fn model_flags(m: &ModelArgs) -> String {
     format!("--p {} --align {}", m.seg.p, m.seg.align)
+}
+
+/// The header's model, from the command line's flags; an error is a usage error.
+fn header_model(model: &ModelArgs, screen: Option<Screen>) -> Result<StimModel, Bad> {
+    StimModel::of(model, screen).map_err(|e| e.to_string())
 }
 
 fn gen_segment(model: &ModelArgs, width: Option<u32>, height: Option<u32>, run: &Run) -> Result<ExitCode, Bad> {
