@@ -161,12 +161,16 @@ int main(int argc, char** argv) {
     }
     const std::vector<uint8_t> stim_file = slurp(argv[1]);
     const std::vector<uint8_t> expect_file = slurp(argv[2]);
-    if (stim_file.size() < 64 || std::memcmp(stim_file.data(), "SSBSTIM1", 8) != 0 || expect_file.size() < 24 ||
+    // Formats 1 and 2 (bench.rs): format 2 puts its model's description between the fixed
+    // 64 bytes and the records, and says where the records start.
+    const bool format2 = stim_file.size() >= 64 && std::memcmp(stim_file.data(), "SSBSTIM2", 8) == 0;
+    if (stim_file.size() < 64 || (!format2 && std::memcmp(stim_file.data(), "SSBSTIM1", 8) != 0) || expect_file.size() < 24 ||
         std::memcmp(expect_file.data(), "SSBEXPT1", 8) != 0) {
         std::fprintf(stderr, "native_tb: not bench stimulus/expected files\n");
         return 2;
     }
     const uint8_t* h = stim_file.data();
+    const size_t records_at = format2 ? le32(h + 56) : 64;
     const uint32_t design = le32(h + 8), p = le32(h + 12);
     Traffic traffic{le32(h + 16), le32(h + 20), le32(h + 24)};
     size_t spans = le32(h + 28);
@@ -176,8 +180,12 @@ int main(int argc, char** argv) {
         return 2;
     }
     if (argc > 3 && std::atol(argv[3]) > 0 && size_t(std::atol(argv[3])) < spans) spans = std::atol(argv[3]);
+    if (stim_file.size() < records_at + spans * sizeof(Stim)) {
+        std::fprintf(stderr, "native_tb: stimulus file too short\n");
+        return 2;
+    }
     std::vector<Stim> stims(spans);
-    std::memcpy(stims.data(), h + 64, spans * sizeof(Stim));
+    std::memcpy(stims.data(), h + records_at, spans * sizeof(Stim));
     uint64_t total = 0;
     for (const Stim& s : stims) total += s.outputs;
     const uint8_t* expect = expect_file.data() + 24;

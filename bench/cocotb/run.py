@@ -15,7 +15,7 @@ import warnings
 from pathlib import Path
 
 warnings.filterwarnings("ignore", message="Python runners")
-from cocotb.runner import get_runner  # noqa: E402
+from cocotb.runner import get_results, get_runner  # noqa: E402
 
 HERE = Path(__file__).resolve().parent
 
@@ -49,7 +49,12 @@ def main():
         stamp.write_text(key.hexdigest())
     else:
         sys.path.insert(0, str(HERE))
-        runner.test(
+        # The simulation runs in the build folder: the files' paths are made absolute first, so
+        # paths relative to where this was called from work.
+        for k in ("BENCH_STIM", "BENCH_EXPECT", "BENCH_RESULT"):
+            if k in os.environ:
+                os.environ[k] = str(Path(os.environ[k]).resolve())
+        results = runner.test(
             hdl_toplevel=args.top,
             hdl_toplevel_lang="verilog",
             test_module="test_bench",
@@ -57,6 +62,10 @@ def main():
             test_dir=str(args.build_dir),
             extra_env={"PYTHONPATH": str(HERE) + os.pathsep + os.environ.get("PYTHONPATH", "")},
         )
+        # The runner returns normally when the test fails; a failed bench is a failed command.
+        _, failed = get_results(results)
+        if failed:
+            sys.exit(f"cocotb: {failed} test(s) failed (see {args.build_dir}/results.xml)")
 
 
 if __name__ == "__main__":

@@ -1,7 +1,7 @@
 """cocotb side of scripts/bench-cosim: the same stimulus, traffic and expected outputs as the
 harness and the native testbench, under Icarus Verilog.
 
-Reads the files written by `bench gen` (layout in verilator-harness/src/bin/bench.rs):
+Reads the files written by `bench gen` (layout in verilator-harness/src/benchfile.rs):
 BENCH_STIM, BENCH_EXPECT; BENCH_SPANS streams only the first N spans (0: all); the result line
 (`RESULT impl=cocotb ...`, as the other two print) goes to BENCH_RESULT.
 
@@ -46,13 +46,15 @@ def read_files():
         stim = f.read()
     with open(os.environ["BENCH_EXPECT"], "rb") as f:
         expect = f.read()
-    assert stim[:8] == b"SSBSTIM1" and expect[:8] == b"SSBEXPT1", "not bench files"
+    assert stim[:8] in (b"SSBSTIM1", b"SSBSTIM2") and expect[:8] == b"SSBEXPT1", "not bench files"
     design, p, state, valid_thr, ready_thr, spans = struct.unpack_from("<6I", stim, 8)
+    # Format 2 puts its model's description before the records and says where they start.
+    (records_at,) = struct.unpack_from("<I", stim, 56) if stim[:8] == b"SSBSTIM2" else (64,)
     (record,) = struct.unpack_from("<I", expect, 12)
     limit = int(os.environ.get("BENCH_SPANS", "0"))
     if 0 < limit < spans:
         spans = limit
-    recs = [struct.unpack_from("<8I", stim, 64 + 32 * k) for k in range(spans)]
+    recs = [struct.unpack_from("<8I", stim, records_at + 32 * k) for k in range(spans)]
     return design, p, Traffic(state, valid_thr, ready_thr), recs, expect[24:], record
 
 

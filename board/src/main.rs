@@ -111,11 +111,22 @@ fn main() -> ExitCode {
     }
 }
 
+/// Refuses an output file `out` that cannot be written or is `input` (by any name): checked
+/// before the work, so a bad path is a usage error and never destroys the input.
+fn check_out(flag: &str, out: &std::path::Path, input: &std::path::Path) -> Result<(), ExitCode> {
+    hdl_gen::output::check_writable(out)
+        .and_then(|()| hdl_gen::output::check_not_input(out, &[input]))
+        .map_err(|e| usage(format!("{flag}: {e}")))
+}
+
 fn mesh_file(args: &MeshArgs) -> ExitCode {
     let name = args.obj.display().to_string();
-    let text = match std::fs::read_to_string(&args.obj) {
+    if let Err(code) = check_out("--out", &args.out, &args.obj) {
+        return code;
+    }
+    let text = match hdl_gen::input::read_text(&args.obj) {
         Ok(t) => t,
-        Err(e) => return usage(format!("--obj {name}: {e}")),
+        Err(e) => return usage(format!("--obj {e}")),
     };
     let (out, faces, front) = match segshade_board::mesh::painter_triangles(&text, &name, frame::WIDTH as f64, frame::HEIGHT as f64) {
         Ok(r) => r,
@@ -131,9 +142,19 @@ fn mesh_file(args: &MeshArgs) -> ExitCode {
 
 fn send_file(args: &SendArgs) -> ExitCode {
     let what = args.file.display().to_string();
+    // A port that is a folder, a file in no folder, or the file itself (by any name) is bad
+    // input. A device or pipe (/dev/stdout) is opened as it is, not checked as a file to replace.
+    let device = std::fs::metadata(&args.port).is_ok_and(|m| !m.is_file() && !m.is_dir());
+    if device {
+        if let Err(e) = hdl_gen::output::check_not_input(&args.port, &[&args.file]) {
+            return usage(format!("--port: {e}"));
+        }
+    } else if let Err(code) = check_out("--port", &args.port, &args.file) {
+        return code;
+    }
     let sent = (|| {
         uart::divider(args.baud, DRAW_HZ)?;
-        let text = std::fs::read_to_string(&args.file).map_err(|e| send::SendError::File { what: what.clone(), error: e.to_string() })?;
+        let text = hdl_gen::input::read_text(&args.file).map_err(|e| send::SendError::Input(e.to_string()))?;
         let bytes = send::packets(&text, &what)?;
         let status = send::send(&args.port, args.baud, &bytes, args.status)?;
         Ok::<_, send::SendError>((bytes.len(), status))
@@ -164,12 +185,23 @@ fn send_file(args: &SendArgs) -> ExitCode {
 }
 
 fn board(args: &Args) -> ExitCode {
+    if args.out.exists() && !args.out.is_dir() {
+        return usage(format!("--out {}: not a folder (the board writes rtl/, sim/ and its frame into it)", args.out.display()));
+    }
     let text = match &args.triangles {
         None => DEFAULT_TRIANGLES.to_string(),
-        Some(f) => match std::fs::read_to_string(f) {
-            Ok(t) => t,
-            Err(e) => return usage(format!("--triangles {}: {e}", f.display())),
-        },
+        Some(f) => {
+            // The files the run replaces in --out: none may be the triangle file.
+            for name in ["tmds.bin", "frame.png", "expected.png"] {
+                if let Err(e) = hdl_gen::output::check_not_input(&args.out.join(name), &[f]) {
+                    return usage(format!("--out: {e}"));
+                }
+            }
+            match hdl_gen::input::read_text(f) {
+                Ok(t) => t,
+                Err(e) => return usage(format!("--triangles {e}")),
+            }
+        }
     };
     let what = args.triangles.as_ref().map_or(DEFAULT_NAME.into(), |f| f.display().to_string());
     let tris = match golden::setup::parse_triangles(&text) {

@@ -16,6 +16,9 @@ pub enum SendError {
     Baud(#[from] uart::WireError),
     #[error("{what}: {error}")]
     File { what: String, error: String },
+    /// The file could not be read as text (`hdl_gen::input`'s message, which names it).
+    #[error("{0}")]
+    Input(String),
     #[error("{what}: triangle {triangle} does not fit the board's front-end (a vertex too far off the 320x240 screen)")]
     Ports { what: String, triangle: usize },
     #[error("--port {port}: {error}")]

@@ -203,3 +203,97 @@ fn uart_rtl_is_lint_clean_and_latch_free() {
     let err = latches(&dir.path().join("bad"), &ours).unwrap_err();
     assert!(err.contains("planted"), "{err}");
 }
+
+/// Every file listing of `dir` with its bytes (under 1 MiB): equal listings, nothing written.
+fn listing(dir: &Path) -> Vec<(PathBuf, Vec<u8>)> {
+    let mut v: Vec<_> = std::fs::read_dir(dir)
+        .unwrap()
+        .flatten()
+        .map(|e| {
+            let p = e.path();
+            let small = p.is_file() && p.metadata().unwrap().len() < 1 << 20;
+            let bytes = if small { std::fs::read(&p).unwrap() } else { Vec::new() };
+            (p, bytes)
+        })
+        .collect();
+    v.sort();
+    v
+}
+
+/// Hostile input to each subcommand: input files missing, folders, empty, not text, 1 GB (sparse:
+/// read no further than 64 MiB) or with a line over 4096 bytes; outputs that are folders, in no
+/// folder, a file where a folder goes, or the input itself (by name or link). Each is one `error:`
+/// line, exit status 2, and nothing written; the good files of the same table still run (the
+/// negative control: the refusals are not a broken binary).
+#[test]
+fn every_subcommand_refuses_hostile_files_and_outputs() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path();
+    let put = |name: &str, body: &[u8]| {
+        let p = dir.join(name);
+        std::fs::write(&p, body).unwrap();
+        p.to_str().unwrap().to_string()
+    };
+    let good = put("good.txt", b"1 1 10  5 1 20  1 5 30\n");
+    let obj = put("tri.obj", b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+    let binary = put("binary.txt", &[0xff, 0xfe, 0x00, 0x41]);
+    let mut long = b"1 1 10  5 1 20  1 5 30\n#".to_vec();
+    long.extend(std::iter::repeat_n(b'x', 5000));
+    let long = put("long.txt", &long);
+    let huge = dir.join("huge.txt");
+    std::fs::File::create(&huge).unwrap().set_len(1 << 30).unwrap();
+    let huge = huge.to_str().unwrap().to_string();
+    let alias = dir.join("alias.txt");
+    std::os::unix::fs::symlink(&good, &alias).unwrap();
+    let alias = alias.to_str().unwrap().to_string();
+    let folder = dir.join("folder");
+    std::fs::create_dir(&folder).unwrap();
+    let folder = folder.to_str().unwrap().to_string();
+    let missing = dir.join("missing.txt").to_str().unwrap().to_string();
+    let nowhere = dir.join("no/such/out.txt").to_str().unwrap().to_string();
+    let out = dir.join("out").to_str().unwrap().to_string();
+    let fresh = dir.join("fresh.txt").to_str().unwrap().to_string();
+    let cases: Vec<(Vec<&str>, &str)> = vec![
+        (vec!["ulx3s-85f", "--rtl-only", "--triangles", &missing, "--out", &out], "missing.txt"),
+        (vec!["ulx3s-85f", "--rtl-only", "--triangles", &folder, "--out", &out], "is a folder"),
+        (vec!["ulx3s-85f", "--rtl-only", "--triangles", &binary, "--out", &out], "not UTF-8"),
+        (vec!["ulx3s-85f", "--rtl-only", "--triangles", &huge, "--out", &out], "larger than 64 MiB"),
+        (vec!["ulx3s-85f", "--rtl-only", "--triangles", &long, "--out", &out], "line 2 is longer than 4096 bytes"),
+        (vec!["ulx3s-85f", "--rtl-only", "--triangles", &good, "--out", &good], "not a folder"),
+        (vec!["ulx3s-85f", "--rtl-only", "--triangles", &good, "--out", "/dev/null"], "not a folder"),
+        (vec!["ulx3s-85f", "--rtl-only", "--triangles", &good, "--out", ""], "--out"),
+        (vec!["ulx3s-85f", "--rtl-only", "--p", "3", "--out", &out], "--p 3"),
+        (vec!["send", "--port", &fresh, &missing], "missing.txt"),
+        (vec!["send", "--port", &fresh, &folder], "is a folder"),
+        (vec!["send", "--port", &fresh, &huge], "larger than 64 MiB"),
+        (vec!["send", "--port", &fresh, &binary], "not UTF-8"),
+        (vec!["send", "--port", &fresh, "/dev/null"], "no triangles"),
+        (vec!["send", "--port", &good, &good], "is the input file"),
+        (vec!["send", "--port", &alias, &good], "is the input file"),
+        (vec!["send", "--port", &folder, &good], "--port"),
+        (vec!["send", "--port", &nowhere, &good], "--port"),
+        (vec!["send", "--port", "", &good], "--port"),
+        (vec!["mesh", "--obj", &missing, "--out", &fresh], "missing.txt"),
+        (vec!["mesh", "--obj", &folder, "--out", &fresh], "is a folder"),
+        (vec!["mesh", "--obj", &huge, "--out", &fresh], "larger than 64 MiB"),
+        (vec!["mesh", "--obj", "/dev/null", "--out", &fresh], "no faces"),
+        (vec!["mesh", "--obj", &obj, "--out", &obj], "is the input file"),
+        (vec!["mesh", "--obj", &obj, "--out", &folder], "--out"),
+        (vec!["mesh", "--obj", &obj, "--out", &nowhere], "--out"),
+    ];
+    let before = listing(dir);
+    for (args, needle) in &cases {
+        let run = std::process::Command::new(env!("CARGO_BIN_EXE_board")).args(args).output().unwrap();
+        let err = String::from_utf8_lossy(&run.stderr);
+        assert_eq!(run.status.code(), Some(2), "{args:?}: {err}");
+        assert_eq!(err.lines().filter(|l| l.starts_with("error")).count(), 1, "{args:?}: one message: {err}");
+        assert!(err.starts_with("error: ") && err.contains(needle), "{args:?}: should name '{needle}': {err}");
+        assert!(run.stdout.is_empty() && listing(dir) == before, "{args:?}: wrote something");
+    }
+    assert!(!Path::new(&out).exists());
+    // The control: the same files and folders, used rightly, run.
+    for args in [vec!["send", "--port", &fresh, &alias], vec!["mesh", "--obj", &obj, "--out", &fresh]] {
+        let run = std::process::Command::new(env!("CARGO_BIN_EXE_board")).args(&args).output().unwrap();
+        assert!(run.status.success(), "{args:?}: {}", String::from_utf8_lossy(&run.stderr));
+    }
+}

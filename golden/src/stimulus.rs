@@ -191,6 +191,28 @@ pub fn random_fixed_triangles(rng: &mut impl Rng, fe: &FrontEnd, n: usize) -> Ve
         .collect()
 }
 
+/// Directed triangles for the incremental I0's range check (`--fe-i0 incremental`), on the
+/// default configuration and the 640 × 480 screen: in each, a left edge's step without its DDA's
+/// carry has a quotient outside `[-2^IW, 2^IW)` ([`FrontEnd::i0_steps`] gives it as `None`), the
+/// walk takes that step on a row where the edge gave the span's left end, and the edge gives a
+/// left end again later, so a correct front-end starts the edge again where one that took the
+/// step walks on with a quotient its divider cannot form. Each is a tall sliver whose spans reach
+/// column 0. Random triangles are rarely so (466 in 1.87 million of golden's kinds, half of them
+/// moved across column 0), which left a planted fault in that check caught only on some seeds
+/// (docs/design.md).
+///
+/// Column 0's own step cannot do it: a source that gives the left end on two rows has in-range
+/// intensities there, so its per-row step is in range (docs/design.md). Found by a search over
+/// golden's random triangles of every kind (`frontend::tests`' generator, seed 2727), the three
+/// that restart the most; `frontend::tests` asserts each still has the property.
+pub fn out_of_range_step_triangles() -> [FixedTriangle; 3] {
+    [
+        FixedTriangle { x: [4595, 4526, -3263], y: [102160, 102160, -47888], i: [360480, 694283, 1004974] },
+        FixedTriangle { x: [-4632, -7663, 20367], y: [42770, 23641, 195719], i: [266626, 744275, 425793] },
+        FixedTriangle { x: [107344, 107402, -163840], y: [105067, 105067, -116322], i: [963032, 262379, 502379] },
+    ]
+}
+
 /// A mesh of triangles sharing edges: a jittered grid over the screen, each cell cut on a
 /// random diagonal, vertices sometimes exactly on pixel centres.
 pub fn fixed_mesh(rng: &mut impl Rng, fe: &FrontEnd, cols: i64, rows: i64) -> Vec<FixedTriangle> {

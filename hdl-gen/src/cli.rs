@@ -211,8 +211,10 @@ pub fn model_arg_ids() -> Vec<String> {
     ModelArgs::augment_args(clap::Command::new("model")).get_arguments().map(|a| a.get_id().to_string()).collect()
 }
 
-/// Those of [`model_arg_ids`] given on the command line (not left to their defaults).
+/// Those of [`model_arg_ids`] given on the command line (not left to their defaults), in the
+/// subcommand's arguments when there is one (`bench gen`).
 pub fn given_model_args(m: &clap::ArgMatches) -> Vec<String> {
+    let m = m.subcommand().map_or(m, |(_, sub)| sub);
     let known: Vec<String> = m.ids().map(|i| i.to_string()).collect();
     model_arg_ids()
         .into_iter()

@@ -7,6 +7,7 @@ pub mod board;
 pub mod cli;
 pub mod formal;
 pub mod frontend;
+pub mod input;
 pub mod manifest;
 mod names;
 mod options;

@@ -120,6 +120,9 @@ fn synth_and_check_rtl_dir_show_the_generators_message() {
         (&["--p 3"], &["configuration '--p 3'", "power of two"]),
         (&["--p 8", "--p 8 --bus axi"], &["configuration '--p 8 --bus axi'", "axi"]),
         (&["--bogus"], &["configuration '--bogus'", "--bogus"]),
+        // A configuration's own --out would write elsewhere; a glob is not this folder's files.
+        (&["--p 8 --out /tmp/segshade-check-rtl-dir-out"], &["configuration '--p 8 --out", "cannot be used multiple times"]),
+        (&["--prefix *"], &["configuration '--prefix *'", "--prefix"]),
     ];
     for (args, needles) in cases {
         assert_refused("check-rtl-dir", args, needles, &dir);
@@ -134,6 +137,7 @@ fn other_scripts_refuse_bad_arguments() {
     let file = dir.join("a-file");
     std::fs::write(&file, "keep").unwrap();
     let f = file.to_str().unwrap();
+    let d = dir.to_str().unwrap();
     let cases: &[(&str, &[&str], &[&str])] = &[
         ("bench-cosim", &["--runs", "abc"], &["--runs takes a positive number, not 'abc'"]),
         ("bench-cosim", &["--runs"], &["--runs needs a value"]),
@@ -147,6 +151,17 @@ fn other_scripts_refuse_bad_arguments() {
         ("icarus-tests", &["--vectors"], &["--vectors needs a value"]),
         ("check-fusesoc", &["--p 3"], &["configuration '--p 3'", "power of two"]),
         ("board", &["ulx3s-85f", "--source", "uart", "--out"], &["--out needs a folder"]),
+        // The FPGA flow works in --out's folder: without one it would clear fpga/ where it runs.
+        ("board", &["ulx3s-85f", "--bitstream"], &["--bitstream needs --out DIR"]),
+        ("board", &["ulx3s-85f", "--bitstream", "--out="], &["--bitstream needs --out DIR"]),
+        ("board", &["send", "--bitstream", "--port", f, f], &["--bitstream goes with ulx3s-85f"]),
+        // Checked before anything is installed or built (python starts in about 0.2 s each).
+        ("lint-all", &["--jobs", "0"], &["--jobs", "positive number, not '0'"]),
+        ("lint-all", &["--jobs", "abc"], &["--jobs", "positive number, not 'abc'"]),
+        ("lint-all", &["--only", "("], &["--only '('", "not a valid regular expression"]),
+        ("lint-all", &["--only", "NOMATCH"], &["--only 'NOMATCH' matches no configuration"]),
+        ("lint-all", &["--keep", f], &["is not a folder"]),
+        ("lint-all", &["--keep", d], &["holds other files"]),
     ];
     for (name, args, needles) in cases {
         assert_refused(name, args, needles, &dir);

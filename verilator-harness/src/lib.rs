@@ -12,6 +12,7 @@
 //! with the native and cocotb benches of `scripts/bench-cosim`); [`waveform`] writes FST files of
 //! failures (COSIM_TRACE) and of whole runs (`--trace`).
 
+pub mod benchfile;
 pub mod driver;
 pub mod ffi;
 pub mod frontend;

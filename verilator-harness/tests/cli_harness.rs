@@ -364,6 +364,30 @@ fn bench_rejects_bad_files_and_flags() {
         (vec!["gen", "--design", "specular", "--spans", "10", "--out", &folder_prefix], "a path prefix, not a folder".into()),
         (vec!["gen", "--design", "segment", "--spans", "10", "--traffic", "bursty", "--out", p], "--traffic".into()),
         (vec!["frobnicate"], "frobnicate".into()),
+        // generate's options (hdl_gen::cli), each refused as generate refuses it.
+        (vec!["gen", "--design", "segment", "--spans", "10", "--out", p, "--p", "3"], "--p".into()),
+        (vec!["gen", "--design", "segment", "--spans", "10", "--out", p, "--align", "diagonal"], "--align".into()),
+        (vec!["gen", "--design", "segment", "--spans", "10", "--out", p, "--frac", "3"], "--frac".into()),
+        (vec!["gen", "--design", "segment", "--spans", "10", "--out", p, "--xbits", "17"], "--xbits".into()),
+        (vec!["gen", "--design", "segment", "--spans", "10", "--out", p, "--pipeline", "4"], "--pipeline".into()),
+        (vec!["gen", "--design", "segment", "--spans", "10", "--out", p, "--bus", "pci"], "--bus".into()),
+        (vec!["gen", "--design", "segment", "--spans", "10", "--out", p, "--fe-div-bits", "3"], "--fe-div-bits".into()),
+        (vec!["gen", "--design", "segment", "--spans", "10", "--out", p, "--fe-i0", "cubic"], "--fe-i0".into()),
+        (
+            vec!["gen", "--design", "segment", "--spans", "10", "--out", p, "--bfpi-arch", "tree", "--pipeline", "1"],
+            "--pipeline above 0".into(),
+        ),
+        (vec!["gen", "--design", "specular", "--spans", "10", "--out", p, "--brdf-k", "0"], "--brdf-k".into()),
+        (vec!["gen", "--design", "specular", "--spans", "10", "--out", p, "--max-rel-error", "1%"], "--brdf-k".into()),
+        (vec!["gen", "--design", "specular", "--spans", "10", "--out", p, "--prefix", "9lives"], "--prefix".into()),
+        // The random triangles' screen: within the coordinates and the x ports, and only for spans.
+        (vec!["gen", "--design", "segment", "--spans", "10", "--out", p, "--width", "0"], "--width".into()),
+        (vec!["gen", "--design", "segment", "--spans", "10", "--out", p, "--height", "32769"], "--height".into()),
+        (vec!["gen", "--design", "segment", "--spans", "10", "--out", p, "--xbits", "6", "--width", "100"], "--width/--height".into()),
+        (vec!["gen", "--design", "specular", "--spans", "10", "--out", p, "--width", "100"], "--width/--height".into()),
+        (vec!["info", "--p", "3"], "--p".into()),
+        (vec!["info", "--pipeline", "-1"], "--pipeline".into()),
+        (vec!["info", "--bfpi-arch", "tree", "--pipeline", "1"], "--pipeline above 0".into()),
     ];
     let before = snapshot(&dir);
     for (args, needle) in &cases {
@@ -392,8 +416,75 @@ fn bench_rejects_bad_files_and_flags() {
     let cut = file("cut.stim", &bytes[..bytes.len() - 5]);
     assert_rejected(BENCH, &["harness", &cut], "the header promises 20 spans");
     // A span no port can carry in an otherwise good file.
+    let at = u32::from_le_bytes(bytes[56..60].try_into().unwrap()) as usize;
     let mut bad = bytes.clone();
-    bad[64 + 4..64 + 8].copy_from_slice(&u32::MAX.to_le_bytes());
+    bad[at + 4..at + 8].copy_from_slice(&u32::MAX.to_le_bytes());
     let bad = file("badspan.stim", &bad);
     assert_rejected(BENCH, &["harness", &bad], "span 0: span length 4294967295 exceeds");
+
+    // The header's model description (format 2): a value generate refuses, a field it does not
+    // know, a P the fixed fields contradict, a length that does not fit, an unknown format.
+    // An edit of the same length, so the fixed fields stay true.
+    let edited = |name: &str, from: &str, to: &str| {
+        let text = String::from_utf8_lossy(&bytes[64..at]).into_owned();
+        assert!(text.contains(from) && from.len() == to.len(), "{from} not in {text}");
+        let mut b = bytes.clone();
+        b[64..at].copy_from_slice(text.replacen(from, to, 1).as_bytes());
+        file(name, &b)
+    };
+    let cases = [
+        (edited("xb99.stim", "--xbits=12", "--xbits=99"), "--xbits"),
+        (edited("field.stim", "\"screen\"", "\"screan\""), "unknown field `screan`"),
+        (edited("p4.stim", "--p=8", "--p=4"), "the header's p is 8, its model's --p 4"),
+    ];
+    for (f, needle) in &cases {
+        assert_rejected(BENCH, &["harness", f], needle);
+    }
+    let mut long = bytes.clone();
+    long[60..64].copy_from_slice(&(1u32 << 20).to_le_bytes());
+    assert_rejected(BENCH, &["harness", &file("long.stim", &long)], "a model description of 1048576 bytes");
+    let mut v9 = bytes.clone();
+    v9[7] = b'9';
+    assert_rejected(BENCH, &["harness", &file("v9.stim", &v9)], "format 9, this bench reads formats 1 and 2");
+    // Format 1 (no model description) still reads, as the default configuration at its P.
+    let mut v1 = bytes[..56].to_vec();
+    v1[7] = b'1';
+    v1.extend([0u8; 8]);
+    v1.extend(&bytes[at..]);
+    let out = run(BENCH, &["harness", &file("v1.stim", &v1)]);
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success() && text.contains("model=seg_p8_span ") && text.contains("spans=20"), "{text}");
+}
+
+/// The negative control of `bench`'s rows for generate's options: valid, they reach the model
+/// (named by the file's header, which `harness` builds again). Each configuration is in the
+/// compiled catalogue, so nothing is built; a flag parsed and then dropped would run another model.
+#[test]
+fn bench_runs_the_model_generate_options_name() {
+    if verilator_harness::registry::rtl_dir().is_some() {
+        eprintln!("cli_harness: bench with generate's options: skipped under COSIM_RTL_DIR (the folder's models are the run's)");
+        return;
+    }
+    let dir = scratch("bench-options");
+    let prefix = dir.join("s");
+    let p = prefix.to_str().unwrap();
+    let cases: &[(&[&str], &str)] = &[
+        (&["--design", "segment", "--pipeline", "1"], "seg_p8_span_pl1"),
+        (&["--design", "segment", "--align", "screen", "--pipeline", "2"], "seg_p8_screen_pl2"),
+        (&["--design", "segment", "--bus", "axis", "--width", "64", "--height", "48"], "seg_p8_span_axis"),
+        (&["--design", "specular", "--pipeline", "1"], "spec_pl1"),
+    ];
+    // `info` names the Verilog of the configuration's models.
+    let out = run(BENCH, &["info", "--pipeline", "1"]);
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success() && text.contains("MODEL tag=seg_p8_span_pl1 ") && text.contains("MODEL tag=spec_pl1 "), "{text}");
+    for (args, tag) in cases {
+        let out = run(BENCH, &[&["gen", "--spans", "20", "--out", p], *args].concat());
+        let text = String::from_utf8_lossy(&out.stdout);
+        assert!(out.status.success() && text.contains(&format!("({tag})")), "{args:?}: {text}{}", String::from_utf8_lossy(&out.stderr));
+        let out = run(BENCH, &["harness", &format!("{p}.stim")]);
+        let text = String::from_utf8_lossy(&out.stdout);
+        assert!(out.status.success() && text.contains(&format!("model={tag} ")) && text.contains("mismatches=0"), "{args:?}: {text}");
+    }
+    let _ = std::fs::remove_dir_all(&dir);
 }

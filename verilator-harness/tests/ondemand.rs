@@ -191,6 +191,14 @@ fn cosim_reads_cosim_rtl_dir_when_it_runs() {
         assert_eq!(out.status.code(), Some(2), "{args:?}: {err}");
         assert!(err.starts_with(&format!("error: {flag}: COSIM_RTL_DIR=")) && err.lines().count() == 1, "{args:?}: {err}");
     }
+    // bench's subcommands take the same flags and the same rule.
+    let out = Command::new(env!("CARGO_BIN_EXE_bench"))
+        .env("COSIM_RTL_DIR", &dir)
+        .args(["info", "--p", "2", "--pipeline", "1"])
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.code() == Some(2) && err.starts_with("error: --pipeline: COSIM_RTL_DIR="), "bench info: {err}");
     assert!(root.join("rtl").is_dir());
     for (rtl, needle) in [(dir.as_path(), "has no such Segment model (it has: seg_p2_span)"), (&dir.join("missing"), "no such folder")] {
         let out = cosim(package, rtl, &["--triangles", "5"]);

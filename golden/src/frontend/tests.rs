@@ -1,6 +1,6 @@
 //! The front-end against the host set-up, the exact plane and itself (orders, windings, screens).
 
-use super::incremental::{Cost, Steps};
+use super::incremental::{Cost, Step, Steps};
 use super::*;
 use crate::setup::Vertex;
 use crate::Align;
@@ -393,4 +393,55 @@ fn the_plan_names_its_i0_form() {
     let text = serde_json::to_string(&inc).unwrap();
     assert!(text.contains("\"i0\":\"incremental\""), "{text}");
     assert_eq!(serde_json::from_str::<FrontEnd>(&text).unwrap(), inc);
+}
+
+/// The walk of `t` restarts a source after a step out of `[-2^IW, 2^IW)` (column 0's, or an
+/// edge's without its carry) that a front-end ignoring the range would have taken: the window
+/// where a fault in that range check shows. Returns (starts, starts with those steps taken
+/// modulo 2^IW) when it does.
+fn restarts_after_out_of_range_step(fe: &FrontEnd, t: &FixedTriangle) -> Option<(u64, u64)> {
+    let st = fe.setup(t).1?;
+    let (a2, iw) = (2 * st.plane.a, fe.cfg.iw());
+    let taken = |x: i128| Some(Step { q: (x.div_euclid(a2) as u32) & mask(iw) as u32, rn: (x.rem_euclid(a2) as u128) << st.s });
+    let steps = fe.i0_steps(&st);
+    let mut forced = steps;
+    forced.col0 = forced.col0.or(taken(512 * st.plane.ny));
+    // The steps without the DDA's carry, whose range check is the one `ie_ok0` makes in the RTL.
+    for (k, e) in st.edges.iter().enumerate() {
+        forced.edge[k][0] = forced.edge[k][0].or(taken(512 * st.plane.ny - 512 * st.plane.nx * e.qs as i128));
+    }
+    let starts = fe.walk_incremental(&st, |_, _| {}).starts;
+    let forced_starts = fe.walk_with_steps(&st, &forced, |_, _| {}).starts;
+    (forced_starts < starts).then_some((starts, forced_starts))
+}
+
+/// The directed triangles of [`crate::stimulus::out_of_range_step_triangles`] keep the property
+/// the co-simulation's planted fault "a step out of range taken" needs (a left edge's step
+/// without its carry out of range, taken, the edge then used again), reach column 0 and walk to
+/// today's spans; a plain triangle has not the property (the check's negative control).
+#[test]
+fn directed_triangles_take_an_out_of_range_step() {
+    let fe = FrontEnd::new(Config::default(), Screen::default()).unwrap().with_i0(I0Form::Incremental);
+    let iw = fe.cfg.iw();
+    for t in crate::stimulus::out_of_range_step_triangles() {
+        let st = fe.setup(&t).1.unwrap_or_else(|| panic!("{t:?} is not walked"));
+        let steps = fe.i0_steps(&st);
+        let out = (0..3).filter(|&k| {
+            let x = 512 * st.plane.ny - 512 * st.plane.nx * st.edges[k].qs as i128;
+            let q = x.div_euclid(2 * st.plane.a);
+            let outside = !(-(1i128 << iw)..1i128 << iw).contains(&q);
+            assert_eq!(steps.edge[k][0].is_none(), outside, "{t:?}: edge {k}'s step is None exactly when out of range");
+            outside && !st.edges[k].right
+        });
+        assert!(out.count() > 0, "{t:?}: no left edge's step without carry is out of range");
+        let (starts, forced) = restarts_after_out_of_range_step(&fe, &t).unwrap_or_else(|| panic!("{t:?}: no restart after such a step"));
+        let (mut old, mut new) = (Vec::new(), Vec::new());
+        fe.walk(&st, |y, s| old.push((y, s)));
+        fe.walk_incremental(&st, |y, s| new.push((y, s)));
+        assert_eq!(new, old, "{t:?}");
+        assert!(new.iter().any(|(_, s)| s.x0 == 0), "{t:?}: no span reaches column 0");
+        eprintln!("{t:?}: {} spans, {starts} starts ({forced} with the out-of-range steps taken)", new.len());
+    }
+    let plain = FixedTriangle { x: [2560, 25600, 5120], y: [2560, 7680, 25600], i: [0, 500_000, 1_000_000] };
+    assert!(fe.setup(&plain).1.is_some() && restarts_after_out_of_range_step(&fe, &plain).is_none());
 }

@@ -1,54 +1,42 @@
 //! `bench`: the harness's side of `scripts/bench-cosim`.
 //!
 //! * `bench gen`: writes a stimulus file and an expected-output file (both little-endian
-//!   binary, laid out below) for the segment shader (spans from golden set-up of random
-//!   triangles) or the specular unit (random spans from golden specular set-up). The native
-//!   C++ testbench (`bench/native_tb.cpp`) and the cocotb test (`bench/cocotb/test_bench.py`)
-//!   read the same two files.
+//!   binary, laid out in `verilator_harness::benchfile`) for the segment shader (spans from
+//!   golden set-up of random triangles) or the specular unit (random spans from golden specular
+//!   set-up) of any configuration `generate` accepts, which the stimulus file's header names.
+//!   The native C++ testbench (`bench/native_tb.cpp`) and the cocotb test
+//!   (`bench/cocotb/test_bench.py`) read the same two files.
 //! * `bench harness`: reads a stimulus file and streams it through the harness exactly as users
 //!   run it (`SegmentCosim::stream` / `SpecularCosim::stream`, golden comparison on), timing
 //!   only the streaming loop. Prints one `RESULT` line.
-//! * `bench info`: where this build's models came from: for the segment shader at P and the
-//!   specular unit, the Verilog build.rs verilated (so the native and cocotb benches simulate
-//!   the very same files) and how long build.rs took to verilate and compile each.
-//!
-//! Stimulus file: a 64-byte header
-//!   `magic "SSBSTIM1", u32 design (0 segment, 1 specular), u32 p, u32 xorshift32 start state,
-//!    u32 valid_thr, u32 ready_thr, u32 spans, u64 outputs, u64 seed, u32 expected record bytes,
-//!    u32 in_di width`, zero padding,
-//! then one 32-byte record per span: `u32 port[5], u32 outputs, u32 triangle, u32 y`, the ports
-//! being `in_x, in_len, in_i0, in_di, 0` (segment) or `in_c, in_n, in_theta0, in_dtheta, in_len`
-//! (specular), as the port bits. `outputs` is the number of segments (pixels) the span yields.
-//! Expected file: a 24-byte header `magic "SSBEXPT1", u32 design, u32 record bytes, u64 records`,
-//! then one record per output in order: segment `u32 out_x | out_last << 31, u8 mask[ceil(p/8)],
-//! u8 pix[p]` (masked lanes 0), zero-padded to a multiple of 4; specular `u16 out_spec,
-//! u8 out_err, u8 out_last`. The traffic is `verilator_harness::traffic`, from the header's state
-//! and thresholds.
+//! * `bench info`: where a configuration's models come from: for its segment shader and
+//!   specular unit, the Verilog the harness verilated (so the native and cocotb benches simulate
+//!   the very same files) and how long it took to verilate and compile each.
 
 use clap::{Parser, Subcommand, ValueEnum};
 use golden::rng::SeedRng;
 use golden::segment::segments;
 use golden::setup::{triangle_spans, Screen};
 use golden::specular::SpecularSpan;
-use golden::{Align, Span};
+use golden::Span;
+use hdl_gen::cli::ModelArgs;
 use hdl_gen::output::{commit, stage, Staged};
 use rand::SeedableRng;
-use std::fs::File;
-use std::io::{BufReader, Read};
 use std::path::PathBuf;
 use std::process::ExitCode;
 use std::time::Instant;
+use verilator_harness::benchfile::{expect_header, read_stim, seg_record_bytes, stim_record, Header, StimModel, HEADER};
 use verilator_harness::ffi::to_port;
+use verilator_harness::models::Kind;
 use verilator_harness::ondemand;
-use verilator_harness::registry::{segment_model, specular_unit, SPECULAR_MODELS};
+use verilator_harness::registry::unit_of;
 use verilator_harness::segment::{Report, SegmentCosim, Stim};
 use verilator_harness::specular::{random_span, SpecularCosim};
 use verilator_harness::stimulus::random_triangle;
 use verilator_harness::traffic::{state_of, Traffic};
 
-const STIM_MAGIC: &[u8; 8] = b"SSBSTIM1";
-const EXPECT_MAGIC: &[u8; 8] = b"SSBEXPT1";
-const HEADER: usize = 64;
+/// Widest and tallest screen of the random triangles (golden::setup::COORD_LIMIT), as cosim's.
+const MAX_SIDE: i64 = golden::setup::COORD_LIMIT as i64;
 
 #[derive(Clone, Copy, PartialEq, Eq, ValueEnum, Debug)]
 enum Design {
@@ -77,9 +65,18 @@ enum Cmd {
     Gen {
         #[arg(long, value_enum)]
         design: Design,
-        /// Segment width (segment shader, span alignment).
-        #[arg(long, default_value_t = 8)]
-        p: u32,
+        // The model: any configuration `generate` accepts, by the same flags (the compiled
+        // catalogue's model when it has it, else built the first time, then cached). The file's
+        // header names it, so `harness` runs the same one.
+        #[command(flatten)]
+        model: ModelArgs,
+        /// Screen width of the random triangles (segment design; 1..=32768, at most what the
+        /// x ports carry). Default: the configuration's, 640 narrowed to 2^XW and 2^F.
+        #[arg(long, value_parser = clap::value_parser!(u32).range(1..=MAX_SIDE))]
+        width: Option<u32>,
+        /// Screen height of the random triangles (segment design; 1..=32768). Default: 480.
+        #[arg(long, value_parser = clap::value_parser!(u32).range(1..=MAX_SIDE))]
+        height: Option<u32>,
         /// Spans to write (1..=4294967295: the header holds the count as a u32). Written as they
         /// are made, so memory does not grow with the count; refused at once when the folder
         /// has not the room the two files take at the least.
@@ -94,9 +91,12 @@ enum Cmd {
         out: PathBuf,
     },
     /// The RTL folder and build time of the models the benchmark uses.
+    // A negative number is a value its flag's range then refuses by name, not an unknown flag.
+    #[command(allow_negative_numbers = true)]
     Info {
-        #[arg(long, default_value_t = 8)]
-        p: u32,
+        // The models: any configuration `generate` accepts, by the same flags.
+        #[command(flatten)]
+        model: ModelArgs,
     },
     /// Stream a stimulus file through the harness with the golden comparison on; time the loop.
     #[command(allow_negative_numbers = true)]
@@ -112,27 +112,37 @@ enum Cmd {
 type Bad = String;
 
 fn main() -> ExitCode {
-    let args = Args::parse();
+    let (args, given) = verilator_harness::given::parse::<Args>();
     // A COSIM_RTL_DIR that describes no models is a usage error, said before anything runs.
     if let Err(e) = verilator_harness::registry::check_folder() {
         eprintln!("error: {e}");
         return ExitCode::from(2);
     }
+    // A model flag the COSIM_RTL_DIR folder was not generated with is refused, not ignored.
+    if let Cmd::Gen { model, .. } | Cmd::Info { model } = &args.cmd {
+        if let Err(code) = verilator_harness::given::refuse(&given, model.options(None)) {
+            return code;
+        }
+    }
     let run = match args.cmd {
-        Cmd::Gen { design, p, spans, seed, traffic, out } => {
+        Cmd::Gen { design, model, width, height, spans, seed, traffic, out } => {
             let traffic = match traffic {
                 TrafficArg::Random => Traffic::RANDOM,
                 TrafficArg::Full => Traffic::FULL,
             };
             // clap bounds the count to the header's u32.
             let count = spans as u32;
+            let run = Run { count, seed, traffic, out: &out };
             match design {
-                Design::Segment => gen_segment(p, count, seed, traffic, &out),
-                Design::Specular => gen_specular(count, seed, traffic, &out),
+                Design::Segment => gen_segment(&model, width, height, &run),
+                Design::Specular if width.or(height).is_some() => {
+                    Err("--width/--height: the specular design draws no triangles (they set the segment design's screen)".into())
+                }
+                Design::Specular => gen_specular(&model, &run),
             }
         }
         Cmd::Harness { stim, limit } => harness(&stim, limit),
-        Cmd::Info { p } => Ok(info(p)),
+        Cmd::Info { model } => info(&model),
     };
     run.unwrap_or_else(|e| {
         eprintln!("error: {e}");
@@ -140,91 +150,34 @@ fn main() -> ExitCode {
     })
 }
 
-/// `MODEL tag=... top=... rtl=DIR verilate=S compile=S total=S` per model, then the runtime's
-/// `RUNTIME compile=S`: what build.rs recorded when it last built them (`OUT_DIR/obj/*/build.time`).
-fn info(p: u32) -> ExitCode {
+/// `MODEL tag=... top=... rtl=DIR verilate=S compile=S total=S` for the segment shader and the
+/// specular unit of the configuration, then the runtime's `RUNTIME compile=S`: the Verilog each
+/// model was verilated from (build.rs's for the catalogue's models, the cache entry's for one
+/// built at run time, which this builds first, or the `COSIM_RTL_DIR` folder), so the native and
+/// cocotb benches simulate the very same files, and how long its build took.
+fn info(model: &ModelArgs) -> Result<ExitCode, Bad> {
+    let opts = model.options(None).map_err(|e| e.to_string())?;
     let out = PathBuf::from(env!("OUT_DIR"));
-    let times = |tag: &str| -> String {
-        let text = std::fs::read_to_string(out.join("obj").join(tag).join("build.time")).unwrap_or_default();
+    let times = |record: &std::path::Path| -> String {
+        let text = std::fs::read_to_string(record.join("build.time")).unwrap_or_default();
         text.lines().filter_map(|l| l.split_once(' ')).map(|(k, v)| format!(" {k}={v}")).collect()
     };
-    let Some(seg) = segment_model(p, Align::Span) else {
-        eprintln!("error: no segment shader model for p = {p}");
-        return ExitCode::from(2);
-    };
-    let mut models = vec![(seg.tag, seg.top)];
-    models.extend(SPECULAR_MODELS.first().map(|m| (m.tag, m.top)));
-    for (tag, top) in models {
-        println!("MODEL tag={tag} top={top} rtl={}{}", out.join("rtl").join(tag).display(), times(tag));
-    }
-    println!("RUNTIME{}", times("runtime"));
-    ExitCode::SUCCESS
-}
-
-struct Header {
-    design: u32,
-    p: u32,
-    state: u32,
-    valid_thr: u32,
-    ready_thr: u32,
-    spans: u32,
-    outputs: u64,
-    seed: u64,
-    rec: u32,
-    dw: u32,
-}
-
-impl Header {
-    fn bytes(&self) -> [u8; HEADER] {
-        let mut h = [0u8; HEADER];
-        h[..8].copy_from_slice(STIM_MAGIC);
-        let words = [self.design, self.p, self.state, self.valid_thr, self.ready_thr, self.spans];
-        for (k, w) in words.iter().enumerate() {
-            h[8 + 4 * k..12 + 4 * k].copy_from_slice(&w.to_le_bytes());
-        }
-        h[32..40].copy_from_slice(&self.outputs.to_le_bytes());
-        h[40..48].copy_from_slice(&self.seed.to_le_bytes());
-        h[48..52].copy_from_slice(&self.rec.to_le_bytes());
-        h[52..56].copy_from_slice(&self.dw.to_le_bytes());
-        h
-    }
-
-    /// The header of a stimulus file of `len` bytes, every field checked against what `gen`
-    /// writes, so a truncated, foreign or garbage file is refused before anything is read.
-    fn parse(h: &[u8; HEADER], len: u64) -> Result<Header, String> {
-        if &h[..8] != STIM_MAGIC {
-            return Err("not a bench stimulus file (no SSBSTIM1 header)".into());
-        }
-        let w = |k: usize| u32::from_le_bytes(h[8 + 4 * k..12 + 4 * k].try_into().expect("4 bytes"));
-        let header = Header {
-            design: w(0),
-            p: w(1),
-            state: w(2),
-            valid_thr: w(3),
-            ready_thr: w(4),
-            spans: w(5),
-            outputs: u64::from_le_bytes(h[32..40].try_into().expect("8 bytes")),
-            seed: u64::from_le_bytes(h[40..48].try_into().expect("8 bytes")),
-            rec: u32::from_le_bytes(h[48..52].try_into().expect("4 bytes")),
-            dw: u32::from_le_bytes(h[52..56].try_into().expect("4 bytes")),
+    let seg = verilator_harness::registry::segment(&opts).map_err(|e| format!("{}: {e}", model_flags(model)))?;
+    let spec = verilator_harness::registry::specular(&opts).map_err(|e| format!("--specular: {e}"))?;
+    for (tag, top, kind) in [(seg.tag, seg.top, Kind::Segment), (spec.tag, spec.top, Kind::Specular)] {
+        let compiled = out.join("rtl").join(tag);
+        let (rtl, record) = match verilator_harness::registry::rtl_dir() {
+            Some(dir) => (dir.to_path_buf(), PathBuf::new()),
+            None if compiled.is_dir() => (compiled, out.join("obj").join(tag)),
+            None => {
+                let entry = ondemand::describe(&opts, kind).and_then(|m| ondemand::cache_entry(&m)).map_err(|e| format!("{tag}: {e}"))?;
+                (entry.join("rtl"), entry)
+            }
         };
-        let want = HEADER as u64 + 32 * header.spans as u64;
-        if len != want {
-            return Err(format!("the header promises {} spans ({want} bytes), the file has {len} bytes", header.spans));
-        }
-        let rec = match header.design {
-            0 => seg_record_bytes(header.p.min(256)),
-            1 => 4,
-            d => return Err(format!("unknown design {d} (0 segment, 1 specular)")),
-        };
-        if header.rec != rec || !(1..=32).contains(&header.dw) || header.valid_thr > 256 || header.ready_thr > 256 {
-            return Err("header fields out of range (record bytes, in_di width or traffic thresholds)".into());
-        }
-        if header.state != state_of(header.seed) {
-            return Err("traffic state is not state_of(seed)".into());
-        }
-        Ok(header)
+        println!("MODEL tag={tag} top={top} rtl={}{}", rtl.display(), times(&record));
     }
+    println!("RUNTIME{}", times(&out.join("obj").join("runtime")));
+    Ok(ExitCode::SUCCESS)
 }
 
 fn with_ext(prefix: &std::path::Path, ext: &str) -> PathBuf {
@@ -276,31 +229,15 @@ fn free_bytes(dir: &std::path::Path) -> Option<u64> {
     (rc == 0).then(|| st.f_bavail as u64 * st.f_frsize as u64)
 }
 
-fn stim_record(ports: [u32; 5], outputs: u32, triangle: u32, y: u32) -> [u8; 32] {
-    let mut r = [0u8; 32];
-    for (k, w) in ports.iter().chain(&[outputs, triangle, y]).enumerate() {
-        r[4 * k..4 * k + 4].copy_from_slice(&w.to_le_bytes());
-    }
-    r
-}
-
-fn expect_header(design: u32, rec: u32, records: u64) -> [u8; 24] {
-    let mut h = [0u8; 24];
-    h[..8].copy_from_slice(EXPECT_MAGIC);
-    h[8..12].copy_from_slice(&design.to_le_bytes());
-    h[12..16].copy_from_slice(&rec.to_le_bytes());
-    h[16..24].copy_from_slice(&records.to_le_bytes());
-    h
-}
-
-fn seg_record_bytes(p: u32) -> u32 {
-    (4 + p.div_ceil(8) + p).next_multiple_of(4)
-}
-
 /// The first `count` spans of golden set-up of random triangles from `seed`, each to `f`: made
 /// as they are used, so a pass over them holds no list (gen makes them twice: counting, writing).
-fn segment_spans(cfg: &golden::Config, count: u32, seed: u64, mut f: impl FnMut(Stim) -> Result<(), Bad>) -> Result<(), Bad> {
-    let screen = Screen::default();
+fn segment_spans(
+    cfg: &golden::Config,
+    screen: Screen,
+    count: u32,
+    seed: u64,
+    mut f: impl FnMut(Stim) -> Result<(), Bad>,
+) -> Result<(), Bad> {
     let mut rng = SeedRng::seed_from_u64(seed);
     let (mut made, mut triangle) = (0u32, 0usize);
     while made < count {
@@ -316,16 +253,40 @@ fn segment_spans(cfg: &golden::Config, count: u32, seed: u64, mut f: impl FnMut(
     Ok(())
 }
 
-fn gen_segment(p: u32, count: u32, seed: u64, traffic: Traffic, out: &std::path::Path) -> Result<ExitCode, Bad> {
-    let opts = ondemand::options(p, Align::Span, None).map_err(|e| format!("--p {p}: {e}"))?;
+/// What every `gen` is asked for besides its model.
+struct Run<'a> {
+    count: u32,
+    seed: u64,
+    traffic: Traffic,
+    out: &'a std::path::Path,
+}
+
+/// How a model's error names the configuration (as cosim's do).
+fn model_flags(m: &ModelArgs) -> String {
+    format!("--p {} --align {}", m.seg.p, m.seg.align)
+}
+
+/// The header's model, from the command line's flags; an error is a usage error.
+fn header_model(model: &ModelArgs, screen: Option<Screen>) -> Result<StimModel, Bad> {
+    StimModel::of(model, screen).map_err(|e| e.to_string())
+}
+
+fn gen_segment(model: &ModelArgs, width: Option<u32>, height: Option<u32>, run: &Run) -> Result<ExitCode, Bad> {
+    let Run { count, seed, traffic, out } = *run;
+    let opts = model.options(None).map_err(|e| e.to_string())?;
+    let default = hdl_gen::Options::default_screen(&opts.cfg);
+    let screen = Screen { width: width.unwrap_or(default.width), height: height.unwrap_or(default.height) };
+    screen.check_for(&opts.cfg).map_err(|e| format!("--width/--height: {e}"))?;
+    let stim_model = header_model(model, Some(screen))?;
+    let p = opts.cfg.p;
     let rec = seg_record_bytes(p);
     // Every span yields at least one record. A bad --out is refused before the model is asked
     // for (which may take a build, or not exist in a COSIM_RTL_DIR run).
     check_out(out, count, (HEADER + 24) as u64 + (32 + rec as u64) * count as u64)?;
-    let info = verilator_harness::registry::segment(&opts).map_err(|e| format!("--p {p}: {e}"))?;
+    let info = verilator_harness::registry::segment(&opts).map_err(|e| format!("{}: {e}", model_flags(model)))?;
     let cfg = info.cfg;
     let mut outputs = 0u64;
-    segment_spans(&cfg, count, seed, |s| {
+    segment_spans(&cfg, screen, count, seed, |s| {
         outputs += cfg.segment_count(s.span.x0, s.span.len) as u64;
         Ok(())
     })?;
@@ -340,12 +301,13 @@ fn gen_segment(p: u32, count: u32, seed: u64, traffic: Traffic, out: &std::path:
         seed,
         rec,
         dw: cfg.dw(),
+        model: stim_model,
     };
     let least = (HEADER + 24) as u64 + 32 * count as u64 + rec as u64 * outputs;
     let (mut sf, mut ef) = create_pair(out, &header, least)?;
     let mut r = vec![0u8; rec as usize];
     let mut pixels = 0u64;
-    segment_spans(&cfg, count, seed, |s| {
+    segment_spans(&cfg, screen, count, seed, |s| {
         let Span { x0, len, i0, di } = s.span;
         let n = cfg.segment_count(x0, len);
         sf.put(&stim_record([x0, len, i0, to_port(di as i64, cfg.dw()), 0], n, s.triangle as u32, s.y)).map_err(|e| e.to_string())?;
@@ -370,12 +332,13 @@ fn gen_segment(p: u32, count: u32, seed: u64, traffic: Traffic, out: &std::path:
     Ok(ExitCode::SUCCESS)
 }
 
-fn gen_specular(count: u32, seed: u64, traffic: Traffic, out: &std::path::Path) -> Result<ExitCode, Bad> {
-    let Some(info) = SPECULAR_MODELS.first() else {
-        return Err("this build has no specular unit".into());
-    };
-    let unit = specular_unit();
+fn gen_specular(model: &ModelArgs, run: &Run) -> Result<ExitCode, Bad> {
+    let Run { count, seed, traffic, out } = *run;
+    let opts = model.options(None).map_err(|e| e.to_string())?;
+    let stim_model = header_model(model, None)?;
     check_out(out, count, (HEADER + 24) as u64 + (32 + 4) * count as u64)?;
+    let info = verilator_harness::registry::specular(&opts).map_err(|e| format!("--specular: {e}"))?;
+    let unit = unit_of(info);
     let spans = || {
         let mut rng = SeedRng::seed_from_u64(seed);
         (0..count).map(move |_| random_span(&mut rng, info.cfg.max_len()))
@@ -392,6 +355,7 @@ fn gen_specular(count: u32, seed: u64, traffic: Traffic, out: &std::path::Path) 
         seed,
         rec: 4,
         dw: 32,
+        model: stim_model,
     };
     let least = (HEADER + 24) as u64 + 32 * count as u64 + 4 * outputs;
     let (mut sf, mut ef) = create_pair(out, &header, least)?;
@@ -409,32 +373,6 @@ fn gen_specular(count: u32, seed: u64, traffic: Traffic, out: &std::path::Path) 
     commit(vec![sf, ef]).map_err(|e| e.to_string())?;
     println!("wrote {count} spans, {outputs} pixels ({})", info.tag);
     Ok(ExitCode::SUCCESS)
-}
-
-/// The header and the records (at most `limit`, 0: all) of a stimulus file; the file's size
-/// must be what its header says, so nothing is allocated on a garbage count.
-fn read_stim(path: &std::path::Path, limit: usize) -> Result<(Header, Vec<[u32; 8]>), Bad> {
-    let name = path.display();
-    let file = File::open(path).map_err(|e| format!("{name}: {e}"))?;
-    let meta = file.metadata().map_err(|e| format!("{name}: {e}"))?;
-    if !meta.is_file() {
-        return Err(format!("{name}: not a file"));
-    }
-    let mut f = BufReader::new(file);
-    let mut h = [0u8; HEADER];
-    f.read_exact(&mut h).map_err(|_| format!("{name}: shorter than the {HEADER}-byte header of a bench stimulus file"))?;
-    let header = Header::parse(&h, meta.len()).map_err(|e| format!("{name}: {e}"))?;
-    let n = match limit {
-        0 => header.spans as usize,
-        l => l.min(header.spans as usize),
-    };
-    let mut recs = Vec::with_capacity(n);
-    let mut r = [0u8; 32];
-    for _ in 0..n {
-        f.read_exact(&mut r).map_err(|e| format!("{name}: {e}"))?;
-        recs.push(std::array::from_fn(|k| u32::from_le_bytes(r[4 * k..4 * k + 4].try_into().expect("4 bytes"))));
-    }
-    Ok((header, recs))
 }
 
 /// The sign-extension of a `width`-bit port value.
@@ -460,15 +398,19 @@ fn timed(f: impl FnOnce()) -> (f64, f64) {
 }
 
 fn harness(path: &std::path::Path, limit: usize) -> Result<ExitCode, Bad> {
-    let (h, recs) = read_stim(path, limit)?;
+    let (h, recs) = read_stim(path, limit).map_err(|e| e.to_string())?;
     let traffic = Traffic { valid: h.valid_thr as f64 / 256.0, ready: h.ready_thr as f64 / 256.0 };
     let mut report = Report::default();
     let rejected = |e: &dyn std::fmt::Display| format!("{}: {e}", path.display());
+    // The model the header names, checked as `gen`'s flags are.
+    let opts = h.model.options().map_err(|e| rejected(&e))?;
     let (tag, (secs, cpu)) = match h.design {
         0 => {
-            let info = ondemand::options(h.p, Align::Span, None)
-                .and_then(|o| verilator_harness::registry::segment(&o))
-                .map_err(|e| format!("{}: the segment shader for p = {}: {e}", path.display(), h.p))?;
+            if h.p != opts.cfg.p {
+                return Err(rejected(&format!("the header's p is {}, its model's --p {}", h.p, opts.cfg.p)));
+            }
+            let info = verilator_harness::registry::segment(&opts)
+                .map_err(|e| rejected(&format!("the segment shader of {:?}: {e}", h.model.generate)))?;
             if h.dw != info.cfg.dw() {
                 return Err(format!("{}: in_di is {} bits in the file, {} in {}", path.display(), h.dw, info.cfg.dw(), info.tag));
             }
@@ -484,12 +426,13 @@ fn harness(path: &std::path::Path, limit: usize) -> Result<ExitCode, Bad> {
             (info.tag, timed(|| sim.stream(&stims, &mut report, |_, _| {})))
         }
         _ => {
-            let info = SPECULAR_MODELS.first().ok_or("no specular unit in this build")?;
+            let info = verilator_harness::registry::specular(&opts)
+                .map_err(|e| rejected(&format!("the specular unit of {:?}: {e}", h.model.generate)))?;
             let spans: Vec<SpecularSpan> = recs
                 .iter()
                 .map(|r| SpecularSpan { c: r[0] as u16, n: r[1] as u16, theta0: r[2] as i32, dtheta: r[3] as i32, len: r[4] })
                 .collect();
-            let mut sim = SpecularCosim::new(info, specular_unit(), h.seed, traffic);
+            let mut sim = SpecularCosim::new(info, unit_of(info), h.seed, traffic);
             let mut result = Ok(());
             let t = timed(|| result = sim.try_stream(&spans, &mut report));
             result.map_err(|e| rejected(&e))?;

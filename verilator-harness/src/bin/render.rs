@@ -82,31 +82,10 @@ struct Args {
 /// error, or gigabytes of buffers first).
 const MAX_SIDE: i64 = golden::setup::COORD_LIMIT as i64;
 
-/// Largest input file (--triangles, --obj): read no further than this. A SPEC §5 line takes
-/// about 60 bytes, so this is about a million triangles, each of them simulated clock by clock;
-/// a file larger than that is a mistake more often than a render.
-const MAX_INPUT_BYTES: u64 = 64 << 20;
-/// Longest line of an input file: a triangle takes nine numbers, an OBJ face a vertex list.
-const MAX_LINE_BYTES: usize = 4096;
-
-/// The text of an input file, refused when it is no file, larger than [`MAX_INPUT_BYTES`], not
-/// UTF-8, or has a line longer than [`MAX_LINE_BYTES`]. Reads at most one byte past the limit.
+/// The text of an input file (`hdl_gen::input`: refused when it is a folder, over 64 MiB, not
+/// UTF-8 or with a line over 4096 bytes).
 fn read_input(file: &Path) -> Result<String, String> {
-    use std::io::Read;
-    let name = file.display();
-    if file.is_dir() {
-        return Err(format!("{name}: is a folder"));
-    }
-    let mut bytes = Vec::new();
-    std::fs::File::open(file).and_then(|f| f.take(MAX_INPUT_BYTES + 1).read_to_end(&mut bytes)).map_err(|e| format!("{name}: {e}"))?;
-    if bytes.len() as u64 > MAX_INPUT_BYTES {
-        return Err(format!("{name}: larger than {} MiB, the most an input file may hold", MAX_INPUT_BYTES >> 20));
-    }
-    let text = String::from_utf8(bytes).map_err(|_| format!("{name}: not UTF-8 text"))?;
-    if let Some(n) = text.lines().position(|l| l.len() > MAX_LINE_BYTES) {
-        return Err(format!("{name}: line {} is longer than {MAX_LINE_BYTES} bytes", n + 1));
-    }
-    Ok(text)
+    hdl_gen::input::read_text(file).map_err(|e| e.to_string())
 }
 
 /// What can be checked before any model is chosen: every output writable and none of them the
