@@ -61,24 +61,72 @@ fn configs() -> Vec<(Config, &'static str, BfpiArch, Pipeline)> {
     v
 }
 
+/// `verilator --version` and `iverilog -V`'s first line: part of every cache key.
+fn tools() -> &'static str {
+    static TOOLS: std::sync::OnceLock<String> = std::sync::OnceLock::new();
+    TOOLS.get_or_init(|| {
+        let version = |tool: &str, arg: &str| {
+            Command::new(tool).arg(arg).output().map(|o| String::from_utf8_lossy(&o.stdout).into_owned()).unwrap_or_default()
+        };
+        format!("{}{}", version("verilator", "--version"), version("iverilog", "-V").lines().next().unwrap_or(""))
+    })
+}
+
 /// What decides a configuration's lint result: its generated files, what is linted of them,
 /// the tools' versions and this test's own source. A hash, so the cache is only a cache: a
 /// change of any of these is a miss.
 fn cache_key(files: &[hdl_gen::GeneratedFile], what: &str, fe_first: bool, chain: bool) -> String {
     use std::hash::{Hash, Hasher};
-    static TOOLS: std::sync::OnceLock<String> = std::sync::OnceLock::new();
-    let tools = TOOLS.get_or_init(|| {
-        let version = |tool: &str, arg: &str| {
-            Command::new(tool).arg(arg).output().map(|o| String::from_utf8_lossy(&o.stdout).into_owned()).unwrap_or_default()
-        };
-        format!("{}{}", version("verilator", "--version"), version("iverilog", "-V").lines().next().unwrap_or(""))
-    });
     let mut h = std::collections::hash_map::DefaultHasher::new();
-    (include_str!("lint.rs"), tools, what, fe_first, chain).hash(&mut h);
+    (include_str!("lint.rs"), tools(), what, fe_first, chain).hash(&mut h);
     for f in files {
         (&f.name, &f.contents).hash(&mut h);
     }
     format!("{:016x}", h.finish())
+}
+
+/// A Verilog file of a configuration: its path and its text.
+type Source = (String, String);
+
+/// The files the lint of `top` reads: `top`'s own (one module per file, SPEC §3, so a file's stem
+/// is its module) and, transitively, those of the modules it names (a name in a comment only adds
+/// a file). The rest of the configuration's files are not in `top`'s hierarchy.
+fn reads<'a>(sources: &'a [Source], top: &str) -> Vec<&'a Source> {
+    let stem = |s: &Source| Path::new(&s.0).file_stem().and_then(|f| f.to_str()).unwrap_or_default().to_string();
+    let mut out: Vec<&Source> = sources.iter().filter(|s| stem(s) == top).collect();
+    assert_eq!(out.len(), 1, "one file holds {top}");
+    let mut n = 0;
+    while n < out.len() {
+        let names: std::collections::HashSet<&str> = out[n].1.split(|c: char| !(c.is_ascii_alphanumeric() || c == '_')).collect();
+        for s in sources {
+            if names.contains(stem(s).as_str()) && !out.iter().any(|o| o.0 == s.0) {
+                out.push(s);
+            }
+        }
+        n += 1;
+    }
+    out
+}
+
+/// Lints the hierarchy under `top` from the files it reads, unless the same top over the same
+/// texts was linted clean before (with the same tools and this test). Across configurations most
+/// files differ, but not all: the specular unit and its ROMs are the same at every P, the BFPI
+/// in both alignments, so the sweep lints each of those once, not once per configuration.
+fn lint_top(sources: &[Source], top: &str) {
+    use std::hash::{Hash, Hasher};
+    let read = reads(sources, top);
+    let mut texts: Vec<(&str, &str)> =
+        read.iter().map(|s| (Path::new(&s.0).file_name().and_then(|f| f.to_str()).unwrap_or_default(), s.1.as_str())).collect();
+    texts.sort();
+    let mut h = std::collections::hash_map::DefaultHasher::new();
+    (include_str!("lint.rs"), tools(), top, &texts).hash(&mut h);
+    let marker = Path::new(env!("CARGO_TARGET_TMPDIR")).join("lint-cache").join(format!("top-{:016x}", h.finish()));
+    if marker.exists() {
+        return;
+    }
+    lint(&read.iter().map(|s| s.0.clone()).collect::<Vec<_>>(), top);
+    std::fs::create_dir_all(marker.parent().unwrap()).unwrap();
+    std::fs::write(&marker, top).unwrap();
 }
 
 /// Verilator's lint of the hierarchy under `top`: whether it is clean, and what it printed.
@@ -108,14 +156,17 @@ fn a_warning_inside_a_wrapped_module_fails_its_wrapper_lint() {
     let end = file.contents.rfind("endmodule").unwrap();
     file.contents.insert_str(end, "wire lint_control_probe;\n");
     output::write_all(&dir, &files).unwrap();
-    let mut sources: Vec<String> =
-        files.iter().filter(|f| f.name.ends_with(".v")).map(|f| dir.join(&f.name).display().to_string()).collect();
+    let mut sources: Vec<Source> =
+        files.iter().filter(|f| f.name.ends_with(".v")).map(|f| (dir.join(&f.name).display().to_string(), f.contents.clone())).collect();
     let manifest = &files.iter().find(|f| f.name == "manifest.json").unwrap().contents;
     let w = wrapper::module(&module, &wrapper::ports_from_manifest(manifest, &module).unwrap(), wrapper::Outputs::Registered).unwrap();
     let wfile = dir.join(format!("{}.v", w.name));
     std::fs::write(&wfile, w.render()).unwrap();
-    sources.push(wfile.display().to_string());
-    let (clean, text) = lint_text(&sources, &w.name);
+    sources.push((wfile.display().to_string(), w.render()));
+    // The files the sweep's lint of this wrapper reads (`reads`): the planted module among them.
+    let read: Vec<String> = reads(&sources, &w.name).iter().map(|s| s.0.clone()).collect();
+    assert!(read.iter().any(|f| f.ends_with(&format!("/{module}.v"))), "{read:?}");
+    let (clean, text) = lint_text(&read, &w.name);
     let _ = std::fs::remove_dir_all(&dir);
     assert!(!clean && text.contains("lint_control_probe"), "the planted unused signal passed {}'s lint:\n{text}", w.name);
 }
@@ -252,6 +303,7 @@ fn lint_one(
         let path = |name: &str| dir.join(name).display().to_string();
         let sources: Vec<String> = files.iter().filter(|f| f.name.ends_with(".v")).map(|f| path(&f.name)).collect();
         assert!(sources.len() >= 2, "{what}: {sources:?}");
+        let texts: Vec<Source> = files.iter().filter(|f| f.name.ends_with(".v")).map(|f| (path(&f.name), f.contents.clone())).collect();
         let manifest = &files.iter().find(|f| f.name == "manifest.json").unwrap().contents;
         // The clocked modules the manifest lists are linted below inside their synthesis wrappers,
         // which lint them whole (Verilator lints the hierarchy under the top): linting them as tops
@@ -268,7 +320,7 @@ fn lint_one(
         for f in files.iter().filter(|f| f.name.ends_with(".v")) {
             let module = f.name.trim_end_matches(".v");
             if !skip(module) && !wrapped.iter().any(|(m, _)| m == module) {
-                lint(&sources, module);
+                lint_top(&texts, module);
             }
         }
         let mut with_wrappers = sources.clone();
@@ -279,10 +331,11 @@ fn lint_one(
         for (module, ports) in wrapped {
             let w = wrapper::module(&module, &ports, outputs).unwrap();
             let file = path(&format!("{}.v", w.name));
-            std::fs::write(&file, w.render()).unwrap();
-            let mut srcs = sources.clone();
-            srcs.push(file.clone());
-            lint(&srcs, &w.name);
+            let text = w.render();
+            std::fs::write(&file, &text).unwrap();
+            let mut srcs = texts.clone();
+            srcs.push((file.clone(), text));
+            lint_top(&srcs, &w.name);
             with_wrappers.push(file);
         }
         let mut ivl = vec!["-g2005".to_string(), "-Wall".into(), "-o".into(), path("a.out")];

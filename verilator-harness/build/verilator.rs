@@ -155,6 +155,24 @@ pub fn key(v: &Verilator, m: &Model, traced: bool, link: Link) -> String {
     key
 }
 
+/// The cache entry of Verilator's runtime, the files `globals` the models' makefiles ask for:
+/// its key, its folder under `root` and the archive in it. One entry for the crate's models
+/// (build.rs) and the shared objects built at run time (`crate::ondemand`) alike, compiled
+/// position-independent ([`Link::Shared`]'s set-up), so that it is compiled once. `traced`: the
+/// FST writer's files, with `VM_TRACE` on.
+pub fn runtime_entry(v: &Verilator, root: &Path, globals: &[String], traced: bool) -> (String, PathBuf, PathBuf) {
+    let mut key = format!("{}\n{}\n{}\n", v.version, Link::Shared.layout(), globals.join(" "));
+    if traced {
+        key.push_str(TRACE_LAYOUT);
+    }
+    let dir = cache_dir(root, if traced { "fst-runtime-pic" } else { "runtime-pic" }, &key);
+    let lib = dir.join(format!("lib{RUNTIME_PIC}.a"));
+    (key, dir, lib)
+}
+
+/// The runtime archive's name (`lib<name>.a`, [`runtime_entry`]).
+pub const RUNTIME_PIC: &str = "verilated_rt_pic";
+
 /// The folder of a build with this key under `root`: `<tag>-<hash of the key>`.
 pub fn cache_dir(root: &Path, tag: &str, key: &str) -> PathBuf {
     root.join(format!("{tag}-{:016x}", hash(key)))

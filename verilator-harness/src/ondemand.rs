@@ -125,18 +125,10 @@ fn publish(tmp: &Path, dir: &Path, product: &Path) -> Result<(), ModelError> {
 
 /// Verilator's runtime (the files `globals` lists), compiled position-independent once for
 /// every shared object: a static archive each links a private copy of. `traced`: the traced
-/// twins' (with the FST writer, `VM_TRACE` on).
+/// twins' (with the FST writer, `VM_TRACE` on). The untraced one is usually there already:
+/// build.rs compiles the same entry for the crate's models.
 fn pic_runtime(v: &Verilator, root: &Path, globals: &[String], traced: bool) -> Result<PathBuf, ModelError> {
-    let mut key = format!("{}\n{}\n{}\n", v.version, Link::Shared.layout(), globals.join(" "));
-    let tag = match traced {
-        false => "runtime-pic",
-        true => {
-            key.push_str(TRACE_LAYOUT);
-            "fst-runtime-pic"
-        }
-    };
-    let dir = verilator::cache_dir(root, tag, &key);
-    let lib = dir.join("libverilated_rt_pic.a");
+    let (key, dir, lib) = verilator::runtime_entry(v, root, globals, traced);
     if lib.exists() {
         return Ok(lib);
     }
@@ -144,7 +136,7 @@ fn pic_runtime(v: &Verilator, root: &Path, globals: &[String], traced: bool) -> 
     if lib.exists() {
         return Ok(lib);
     }
-    let tmp = temp_dir(root, tag)?;
+    let tmp = temp_dir(root, if traced { "fst-runtime-pic" } else { "runtime-pic" })?;
     if traced {
         verilator::require_zlib(compiler(v, true), &tmp).map_err(ModelError::Config)?;
     }
@@ -153,7 +145,7 @@ fn pic_runtime(v: &Verilator, root: &Path, globals: &[String], traced: bool) -> 
     for g in globals {
         b.file(v.root.join("include").join(format!("{g}.cpp")));
     }
-    b.try_compile("verilated_rt_pic").map_err(|e| ModelError::Compile {
+    b.try_compile(verilator::RUNTIME_PIC).map_err(|e| ModelError::Compile {
         tag: "Verilator's runtime".into(),
         dir: tmp.clone(),
         log: e.to_string(),
