@@ -145,6 +145,9 @@ pub struct FrontEnd {
     pub di: DiMode,
     #[serde(default, skip_serializing_if = "I0Form::is_default")]
     pub i0: I0Form,
+    /// How the set-up is built (issue 27): the spans do not depend on it, its clocks do.
+    #[serde(default, skip_serializing_if = "engine::SetupForm::is_default")]
+    pub setup: engine::SetupForm,
 }
 
 /// Every width of the front-end, derived once from the configuration: the generator declares
@@ -331,7 +334,7 @@ impl FrontEnd {
         if screen.height == 0 || screen.height > 1 << 16 {
             return Err(FrontEndError::Height { height: screen.height });
         }
-        Ok(FrontEnd { cfg, screen, di: DiMode::Triangle, i0: I0Form::Reciprocal })
+        Ok(FrontEnd { cfg, screen, di: DiMode::Triangle, i0: I0Form::Reciprocal, setup: engine::SetupForm::Parallel })
     }
 
     /// The same front-end with `dI` from `di`.
@@ -342,6 +345,16 @@ impl FrontEnd {
     /// The same front-end with `I0` formed by `i0`.
     pub fn with_i0(self, i0: I0Form) -> FrontEnd {
         FrontEnd { i0, ..self }
+    }
+
+    /// The same front-end with its set-up built as `setup` says.
+    pub fn with_setup(self, setup: engine::SetupForm) -> FrontEnd {
+        FrontEnd { setup, ..self }
+    }
+
+    /// The set-up engine's schedule, for a form with one (`None`: the parallel set-up).
+    pub fn engine(&self) -> Option<Result<engine::schedule::Schedule, engine::schedule::EngineError>> {
+        self.setup.plan().map(|p| p.schedule(self))
     }
 
     pub fn widths(&self) -> Widths {

@@ -8,6 +8,7 @@
 use crate::{check_prefix, BfpiArch, Bus, Options};
 use clap::builder::{StringValueParser, TypedValueParser};
 use clap::Args;
+use golden::frontend::engine::SetupForm;
 use golden::frontend::{DiMode, I0Form};
 use golden::pipeline::Pipeline;
 use golden::setup::Screen;
@@ -28,6 +29,8 @@ pub enum ArgsError {
     TreeUnpipelined,
     #[error("--fe-i0 incremental takes --fe-di triangle: the per-scanline dI needs the reciprocal's I0 at every span's last pixel")]
     IncrementalScanline,
+    #[error("--fe-setup {0} takes --fe-di triangle and --fe-i0 reciprocal: its engine computes the per-triangle set-up only")]
+    EngineForm(&'static str),
     #[error("--width/--height: {0}")]
     Screen(#[from] golden::frontend::FrontEndError),
 }
@@ -132,6 +135,13 @@ pub struct VariantArgs {
     /// issue 27). `incremental` takes `--fe-di triangle` only.
     #[arg(long = "fe-i0", value_enum, default_value_t = I0Form::Reciprocal)]
     pub fe_i0: I0Form,
+    /// How the front-end sets a triangle up: `parallel` (CALC's products in one clock and
+    /// eight dividers, the default) or the shared set-up engine on a device's plan, `ecp5-25f`,
+    /// `ice40-up5k` or `ice40-hx8k` (golden's `Plan`: a few shared multipliers and dividers
+    /// sequenced over several clocks a triangle, behind a set-up result queue; docs/design.md).
+    /// Same spans bit for bit. The engine forms take `--fe-di triangle --fe-i0 reciprocal`.
+    #[arg(long = "fe-setup", value_enum, default_value_t = SetupForm::Parallel)]
+    pub fe_setup: SetupForm,
     /// Register stages added for clock rate, 0..3 (golden::pipeline): 1 registers the span and
     /// the shader's increments, splits the specular unit's multiplies, and stages the
     /// front-end (CALC in five clocks, its span path in six), 2 also the shader's lane sums, 3 cuts the shader's adders
@@ -160,12 +170,16 @@ impl VariantArgs {
         if self.fe_i0 == I0Form::Incremental && self.fe_di == DiMode::Scanline {
             return Err(ArgsError::IncrementalScanline);
         }
+        if self.fe_setup != SetupForm::Parallel && (self.fe_i0 != I0Form::Reciprocal || self.fe_di != DiMode::Triangle) {
+            return Err(ArgsError::EngineForm(self.fe_setup.name()));
+        }
         let opts = Options {
             bfpi_arch: self.bfpi_arch,
             screen,
             fe_div_bits: self.fe_div_bits,
             fe_di: self.fe_di,
             fe_i0: self.fe_i0,
+            fe_setup: self.fe_setup,
             pipeline,
             bus: self.bus,
             ..opts

@@ -35,7 +35,7 @@ mod stager;
 mod walker;
 
 pub use chain::top_module;
-pub use hw::{ports, span_ports, Hw, DEFAULT_DIV_BITS, DIV_BITS};
+pub use hw::{ports, span_ports, Hw, DEFAULT_DIV_BITS, DIV_BITS, QUEUE_DEPTH};
 use stager::Stager;
 
 use crate::verilog::Module;

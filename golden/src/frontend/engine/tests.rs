@@ -271,3 +271,33 @@ fn engine_listing() {
     let s = Plan::ECP5_25F.schedule(&fe640()).unwrap();
     println!("II {} latency {}\n{}", s.ii, s.latency, s.listing());
 }
+
+/// The binding the RTL runs is periodic: every plan the generator offers, at three screens.
+#[test]
+fn the_binding_is_periodic() {
+    use crate::frontend::engine::SetupForm;
+    for screen in [Screen::default(), Screen { width: 37, height: 23 }, Screen { width: 4096, height: 4096 }] {
+        let fe = FrontEnd::new(Default::default(), screen).unwrap();
+        for form in SetupForm::ALL {
+            let Some(plan) = form.plan() else { continue };
+            let s = plan.schedule(&fe).unwrap();
+            let r = s.epochs().unwrap_or_else(|| panic!("{form:?} at {screen:?}: no period in {:?}", s.binding));
+            eprintln!("{form:?} {}x{}: II {} latency {} epochs {r}", screen.width, screen.height, s.ii, s.latency);
+            assert_eq!(s.verify_binding(), Ok(r));
+            // Negative control: a binding broken in one triangle has no period.
+            let mut bad = s.clone();
+            let o = bad.binding.iter().position(|b| !b.is_empty()).unwrap();
+            let last = bad.binding[o].len() - 1;
+            bad.binding[o][last] = bad.binding[o][last] + 1;
+            assert_eq!(bad.epochs(), None);
+            // And one that puts two operations on one unit at once is refused.
+            let mut bad = s.clone();
+            let o = bad.binding.iter().position(|b| !b.is_empty()).unwrap();
+            let same = |k: usize| k != o && bad.slots[k].class == bad.slots[o].class && bad.slots[k].start == bad.slots[o].start;
+            if let Some(p) = (0..bad.binding.len()).find(|&k| same(k)) {
+                bad.binding[p] = bad.binding[o].clone();
+                assert!(bad.verify_binding().is_err());
+            }
+        }
+    }
+}
