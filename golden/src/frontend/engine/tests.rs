@@ -288,7 +288,7 @@ fn the_binding_is_periodic() {
             let mut bad = s.clone();
             let o = bad.binding.iter().position(|b| !b.is_empty()).unwrap();
             let last = bad.binding[o].len() - 1;
-            bad.binding[o][last] = bad.binding[o][last] + 1;
+            bad.binding[o][last] += 1;
             assert_eq!(bad.epochs(), None);
             // And one that puts two operations on one unit at once is refused.
             let mut bad = s.clone();
