@@ -375,3 +375,67 @@ fn incremental_i0_planted_faults_are_caught() {
         assert!(!report.ok(), "planted fault not caught: {what}");
     }
 }
+
+/// The shared set-up engine (`--fe-setup`, issue 27) on `screen`: asked of `ondemand` (built
+/// once, then cached), or `None` when this build hands out a folder's models.
+fn engine(screen: golden::setup::Screen, form: golden::frontend::engine::SetupForm) -> Option<hdl_gen::Options> {
+    if verilator_harness::registry::rtl_dir().is_some() {
+        eprintln!("set-up engine: skipped: COSIM_RTL_DIR provides the models");
+        return None;
+    }
+    let cfg = golden::Config::new(8, golden::Config::default().frac, golden::Config::default().xbits, golden::Align::Span).unwrap();
+    Some(hdl_gen::Options { cfg, screen: Some(screen), fe_setup: form, ..Default::default() })
+}
+
+/// Spans of every kind of triangle under random gaps and backpressure, then under resets, bit
+/// for bit golden's; every triangle costs the engine's II clocks at full rate; a wrong
+/// expectation is caught.
+fn engine_spans_of(opts: hdl_gen::Options, n: usize) {
+    let m = verilator_harness::registry::frontend(&opts).unwrap_or_else(|e| panic!("{e}"));
+    let seed = verilator_harness::seed("frontend engine");
+    let fe = frontend(m);
+    let hw = opts.frontend().unwrap();
+    assert_eq!(fe.with_setup(opts.fe_setup), hw.fe, "the model's front-end is the plan's");
+    assert_eq!(hw.latency(), m.latency, "the manifest's latency is the engine's");
+    let tris = random_triangles(&mut SeedRng::seed_from_u64(seed), &fe, n);
+    let exp = Expected::new(fe, &tris);
+    let report = verilator_harness::frontend::run_frontend_against(m, seed, &tris, &exp);
+    eprintln!(
+        "{}: {} triangles, {} spans out, {} guard drops, {} clocks",
+        m.tag, report.triangles, report.segments, report.pulses, report.cycles
+    );
+    assert_clean(m.tag, seed, &report);
+    assert_eq!(report.segments, exp.spans.len() as u64);
+    assert_eq!(report.pulses, exp.guard_drops());
+    let report = run_frontend(m, seed ^ 5, Traffic::RANDOM, Stress::HARSH, &tris);
+    assert_clean(m.tag, seed, &report);
+    assert!(report.resets > 0, "{}: no reset in {} triangles", m.tag, tris.len());
+    // The set-up rate: one-row triangles and zero-area ones each take II clocks at full rate.
+    let (per, _) = hw.setup_clocks();
+    let row = FixedTriangle { x: [2560, 7680, 2560], y: [2600, 2600, 2800], i: [100 << 12; 3] };
+    let flat = FixedTriangle { x: [2560, 5120, 7680], y: [2560, 5120, 7680], i: [0; 3] };
+    for tri in [row, flat] {
+        let k = 200u64;
+        let report = run_frontend(m, 1, Traffic::FULL, Stress::NONE, &vec![tri; k as usize]);
+        assert_clean(m.tag, 1, &report);
+        let slack = 2 * hw.latency() as u64 + m.screen.height as u64 + 8;
+        assert!(
+            report.cycles >= k * per as u64 && report.cycles <= k * per as u64 + slack,
+            "{}: {k} triangles took {} clocks; II is {per}",
+            m.tag,
+            report.cycles
+        );
+    }
+    // Negative control: one I0 off by one in the expectation is caught.
+    let mut bad = tris.clone();
+    let k = exp.stims.iter().position(|s| s.count > 0).unwrap();
+    bad[k].i[0] ^= 1 << 10;
+    let report = verilator_harness::frontend::run_frontend_against(m, seed, &tris, &Expected::new(fe, &bad));
+    assert!(!report.ok(), "{}: a wrong expectation went unnoticed", m.tag);
+}
+
+#[test]
+fn engine_spans_equal_golden_on_a_small_screen() {
+    let Some(opts) = engine(golden::setup::Screen { width: 37, height: 23 }, golden::frontend::engine::SetupForm::Ecp5_25f) else { return };
+    engine_spans_of(opts, 3000);
+}
