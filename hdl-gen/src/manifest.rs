@@ -304,6 +304,11 @@ pub fn render(opts: &Options, names: &Names, modules: &[Module], unit: &Specular
             (Role::FrontendPart, 1, "BITS quotient bits a clock; the quotient after ceil(QB / BITS) run clocks")
         } else if name == &names.fe_edge {
             (Role::FrontendPart, 1, "one row per clock")
+        } else if name == &names.fe_engine {
+            let s = fe.as_ref().and_then(|hw| hw.engine()).expect("the engine form writes the engine");
+            (Role::FrontendPart, s.latency + 1, "one triangle every frontend.engine.ii clocks")
+        } else if name == &names.fe_queue {
+            (Role::FrontendPart, 1, "one entry in and one out per clock")
         } else if name == &names.top {
             (Role::TriangleShader, fe_latency + seg_latency, "one segment per clock")
         } else if name == &names.writer {

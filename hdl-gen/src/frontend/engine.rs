@@ -264,6 +264,7 @@ pub(super) fn setup(hw: &Hw, names: &Names, body: &mut Vec<Item>) {
     body.push(crate::verilog::net("take", 1));
     body.push(crate::verilog::wire("q_push", 1, "res_v && res_guard && !res_cull"));
     body.push(Item::Assign("en".into(), "!(q_push && q_full)".into()));
+    body.push(crate::verilog::wire("q_in", 1, "q_push && !q_full"));
     let mut conns: Vec<(String, String)> =
         ["clk", "rst", "en", "in_valid", "in_ready"].iter().map(|p| (p.to_string(), p.to_string())).collect();
     for k in 0..3 {
@@ -276,7 +277,7 @@ pub(super) fn setup(hw: &Hw, names: &Names, body: &mut Vec<Item>) {
     let qc = [
         ("clk", "clk"),
         ("rst", "rst"),
-        ("push", "q_push"),
+        ("push", "q_in"),
         ("din", "res"),
         ("pop", "take"),
         ("dout", "q_head"),
