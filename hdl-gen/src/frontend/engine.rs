@@ -205,8 +205,9 @@ pub(super) fn module(hw: &Hw, names: &Names) -> Module {
     caps.extend(units::dividers(&v, &seq, &mut body));
     for c in caps {
         let w = v.op(c.op).w;
-        let items: Vec<(String, String)> = c.from.iter().enumerate().map(|(e, f)| (seq.when(c.t, e as u32), f.clone())).collect();
-        let val = if items.iter().all(|(_, f)| *f == items[0].1) { items[0].1.clone() } else { and_or(&items, w) };
+        // The register loads at its phase; the epoch only picks the unit.
+        let items: Vec<(String, String)> = c.from.iter().map(|(es, f)| (seq.when_any(c.t, es), f.clone())).collect();
+        let val = if items.len() == 1 { items[0].1.clone() } else { and_or(&items, w) };
         loads[(c.t % s.ii) as usize].extend(shift(&v, c.op, val));
     }
     body.push(comment("Every value register's load at its phase (the copies shift with it)."));

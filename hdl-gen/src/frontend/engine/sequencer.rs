@@ -23,14 +23,32 @@ impl Seq {
         }
     }
 
-    /// Schedule clock `t` of the triangle of epoch `e` is this clock.
-    pub fn when(&self, t: u32, e: u32) -> String {
+    /// Schedule clock `t` of a triangle of one of the epochs `es` is this clock: the phase alone
+    /// when `es` are all of them (an operation that keeps its unit).
+    pub fn when_any(&self, t: u32, es: &[u32]) -> String {
         let p = self.phase(t % self.ii);
-        if self.epochs == 1 {
-            p
-        } else {
-            format!("({p} && {})", bit("ep", self.epochs, (e + t / self.ii) % self.epochs))
+        if es.len() as u32 >= self.epochs {
+            return p;
         }
+        let eps: Vec<String> = es.iter().map(|e| bit("ep", self.epochs, (e + t / self.ii) % self.epochs)).collect();
+        if eps.len() == 1 {
+            format!("({p} && {})", eps[0])
+        } else {
+            format!("({p} && ({}))", eps.join(" || "))
+        }
+    }
+
+    /// The units an operation runs on, each with the epochs of the triangles it runs there.
+    pub fn units_of(&self, s: &golden::frontend::engine::schedule::Schedule, o: usize) -> Vec<(u32, Vec<u32>)> {
+        let mut v: Vec<(u32, Vec<u32>)> = Vec::new();
+        for e in 0..self.epochs {
+            let u = s.unit_of(o, e).expect("an operation bound to a unit");
+            match v.iter_mut().find(|(x, _)| *x == u) {
+                Some((_, es)) => es.push(e),
+                None => v.push((u, vec![e])),
+            }
+        }
+        v
     }
 
     /// The entry: the last phase, a triangle (or a bubble) moves from the vertex registers into

@@ -52,8 +52,8 @@ pub(super) struct Capture {
     pub op: usize,
     /// Schedule clock of the load (the value is ready the clock after).
     pub t: u32,
-    /// Per epoch, the unit output's expression.
-    pub from: Vec<String>,
+    /// The unit outputs' expressions, each with the epochs it serves.
+    pub from: Vec<(Vec<u32>, String)>,
 }
 
 /// A chunk of `bits` of value `v` starting at chunk `i`, as a `bits + 1`-bit signed lane.
@@ -93,11 +93,11 @@ pub(super) fn multipliers(v: &Values, seq: &Seq, body: &mut Vec<Item>) -> Vec<Ca
                 assert_eq!(pairs.len() as u32, s.slots[o].busy, "{}: golden's passes", v.op(o).name);
                 let st = s.slots[o].start;
                 let mut from = Vec::new();
-                for e in 0..seq.epochs {
-                    let u = s.unit_of(o, e).expect("a bound product") as usize;
+                for (u, es) in seq.units_of(s, o) {
+                    let u = u as usize;
                     for (k, &(i, j)) in pairs.iter().enumerate() {
                         let t = st + k as u32;
-                        let c = seq.when(t, e);
+                        let c = seq.when_any(t, &es);
                         src[u][0].push((c.clone(), chunk(&v.at(a, t), i, bits, i + 1 == ca, sg(a))));
                         src[u][1].push((c.clone(), chunk(&v.at(b, t), j, bits, j + 1 == cb, sg(b))));
                         if k == 0 {
@@ -106,7 +106,7 @@ pub(super) fn multipliers(v: &Values, seq: &Seq, body: &mut Vec<Item>) -> Vec<Ca
                         src[u][3].push((c, format!("{}", (i + j) * bits)));
                         wmax = wmax.max((i + j) * bits);
                     }
-                    from.push(format!("mu_acc[{}:{}]", u as u32 * acc_w + v.op(o).w - 1, u as u32 * acc_w));
+                    from.push((es, format!("mu_acc[{}:{}]", u as u32 * acc_w + v.op(o).w - 1, u as u32 * acc_w)));
                 }
                 caps.push(Capture { op: o, t: s.slots[o].ready - 1, from });
             }
@@ -121,11 +121,11 @@ pub(super) fn multipliers(v: &Values, seq: &Seq, body: &mut Vec<Item>) -> Vec<Ca
                 assert_eq!(p, s.slots[o].busy, "{}: golden's passes", v.op(o).name);
                 let st = s.slots[o].start;
                 let mut from = Vec::new();
-                for e in 0..seq.epochs {
-                    let u = s.unit_of(o, e).expect("a bound product") as usize;
+                for (u, es) in seq.units_of(s, o) {
+                    let u = u as usize;
                     for k in 0..p {
                         let t = st + k;
-                        let c = seq.when(t, e);
+                        let c = seq.when_any(t, &es);
                         src[u][0].push((c.clone(), v.at(wide, t).ext(acc_w)));
                         src[u][1].push((c.clone(), chunk(&v.at(narrow, t), k, bits, k + 1 == p, sg(narrow))));
                         if k == 0 {
@@ -134,7 +134,7 @@ pub(super) fn multipliers(v: &Values, seq: &Seq, body: &mut Vec<Item>) -> Vec<Ca
                         src[u][3].push((c, format!("{}", k * bits)));
                         wmax = wmax.max(k * bits);
                     }
-                    from.push(format!("mu_acc[{}:{}]", u as u32 * acc_w + v.op(o).w - 1, u as u32 * acc_w));
+                    from.push((es, format!("mu_acc[{}:{}]", u as u32 * acc_w + v.op(o).w - 1, u as u32 * acc_w)));
                 }
                 caps.push(Capture { op: o, t: s.slots[o].ready - 1, from });
             }
@@ -233,17 +233,17 @@ pub(super) fn dividers(v: &Values, seq: &Seq, body: &mut Vec<Item>) -> Vec<Captu
         let lo = if qm > qp { format!("{{{}, {}'d0}}", nn.bits(0, qp), qm - qp) } else { nn.bits(0, qp) };
         let t = st + s.slots[o].busy - 1;
         let (mut fq, mut fr) = (Vec::new(), Vec::new());
-        for e in 0..seq.epochs {
-            let u = s.unit_of(o, e).expect("a bound division") as usize;
-            let c = seq.when(st, e);
+        for (u, es) in seq.units_of(s, o) {
+            let u = u as usize;
+            let c = seq.when_any(st, &es);
             src[u][0].push((c.clone(), "1'b1".into()));
             src[u][1].push((c.clone(), dd.ext(wd)));
             src[u][2].push((c.clone(), nn.bits(qp, wd)));
             src[u][3].push((c, lo.clone()));
             let u = u as u32;
-            fq.push(format!("du_q[{}:{}]", u * qm + qb - 1, u * qm));
+            fq.push((es.clone(), format!("du_q[{}:{}]", u * qm + qb - 1, u * qm)));
             if let Some(ro) = rem_of(o) {
-                fr.push(format!("du_r[{}:{}]", u * wd + v.op(ro).w - 1, u * wd));
+                fr.push((es.clone(), format!("du_r[{}:{}]", u * wd + v.op(ro).w - 1, u * wd)));
             }
         }
         caps.push(Capture { op: o, t, from: fq });
