@@ -493,14 +493,14 @@ fn engine_planted_faults_are_caught() {
         .lines()
         .find(|l| l.trim_start().starts_with("wire [") && l.contains(" t") && l.contains("_1 "))
         .expect("a logic operation reading a second copy");
-    let weight_line = engine.lines().find(|l| l.contains("assign mu_sh[") && l.contains("'d36")).expect("a pass at weight 2^36");
+    let weight_line = engine.lines().find(|l| l.contains("assign mu_sh[") && l.contains("'d2)")).expect("a pass at chunk weight 2");
     let epoch_line = engine
         .lines()
         .find(|l| l.contains("<= (") && l.contains("du_q[") && l.contains("(ep[2] || ep[5])"))
         .expect("a quotient captured by epoch");
     let faults = [
         (copy_line.to_string(), copy_line.replacen("_1 ", "_0 ", 1), "an operand's copy off by one period"),
-        (weight_line.to_string(), weight_line.replacen("'d36", "'d35", 1), "a tile pass at the wrong weight"),
+        (weight_line.to_string(), weight_line.replacen("'d2)", "'d1)", 1), "a tile pass at the wrong weight"),
         (epoch_line.to_string(), epoch_line.replacen("(ep[2] || ep[5])", "(ep[3] || ep[0])", 1), "a quotient from another epoch's divider"),
     ];
     for (k, (from, to, what)) in faults.into_iter().enumerate() {

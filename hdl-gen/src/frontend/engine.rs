@@ -90,7 +90,7 @@ pub(super) fn queue(hw: &Hw, names: &Names) -> Module {
 fn plan_text(s: &Schedule) -> String {
     let p = &s.plan;
     let mul = match p.mul {
-        MulUnit::Tile { bits } => format!("{} multiplier tiles of {bits} x {bits}", p.mults),
+        MulUnit::Tile { bits } => format!("{} multiplier tiles of {} x {} signed ({bits}-bit chunks)", p.mults, bits + 1, bits + 1),
         MulUnit::ShiftAdd { bits } => format!("{} shift-add multipliers of {bits} bit(s) a clock", p.mults),
     };
     let form = match p.div_form {

@@ -94,6 +94,26 @@ fn engine_equals_setup() {
     }
 }
 
+/// The named plans the RTL runs (`SetupForm`), as they schedule, equal `setup` on 500 random
+/// triangles at 640x480 and at 37x23, the co-simulation's screens (about 0.3 s).
+#[test]
+fn the_named_plans_equal_setup() {
+    let seed = test_seed("the_named_plans_equal_setup");
+    let mut rng = SeedRng::seed_from_u64(seed);
+    for screen in [Screen::default(), Screen { width: 37, height: 23 }] {
+        let fe = FrontEnd::new(Config::default(), screen).unwrap();
+        let tris = random_fixed_triangles(&mut rng, &fe, 500);
+        for form in SetupForm::ALL {
+            let Some(p) = form.plan() else { continue };
+            let s = p.schedule(&fe).unwrap();
+            s.verify().unwrap();
+            if let Some(m) = first_mismatch(&fe, &s, &tris) {
+                panic!("{form:?} on {screen:?}: {m}");
+            }
+        }
+    }
+}
+
 /// 10^6 random triangles of every kind at 640x480, and as many on the small and the widest
 /// screen, through every plan of `plans()`: `cargo test --release -p golden --lib
 /// engine_equals_setup_on -- --ignored` (time in docs/design.md).

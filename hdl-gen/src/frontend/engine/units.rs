@@ -103,8 +103,8 @@ pub(super) fn multipliers(v: &Values, seq: &Seq, body: &mut Vec<Item>) -> Vec<Ca
                         if k == 0 {
                             src[u][2].push((c.clone(), "1'b1".into()));
                         }
-                        src[u][3].push((c, format!("{}", (i + j) * bits)));
-                        wmax = wmax.max((i + j) * bits);
+                        src[u][3].push((c, format!("{}", i + j)));
+                        wmax = wmax.max(i + j);
                     }
                     from.push((es, format!("mu_acc[{}:{}]", u as u32 * acc_w + v.op(o).w - 1, u as u32 * acc_w)));
                 }
@@ -168,7 +168,22 @@ pub(super) fn multipliers(v: &Values, seq: &Seq, body: &mut Vec<Item>) -> Vec<Ca
             g.extend([sreg("pr", pw), reg("f2", 1), reg("s2", sh_w), reg("acc", acc_w)]);
             let pe = if acc_w > pw { crate::verilog::sext("pr", pw, acc_w) } else { format!("pr[{}:0]", acc_w - 1) };
             g.push(wire("pe", acc_w, pe));
-            g.push(wire("accn", acc_w, format!("(f2 ? {acc_w}'d0 : acc) + (pe << s2)")));
+            // The pair's weight 2^(bits (i + j)): a multiplexer over the few weights the unit
+            // uses, not a barrel shifter over every shift its lane could encode.
+            let mut ps = format!("{acc_w}'d0");
+            for x in (0..=sh_max).rev() {
+                let sh = x * bits;
+                let v = if sh == 0 {
+                    "pe".to_string()
+                } else if sh >= acc_w {
+                    format!("{acc_w}'d0")
+                } else {
+                    format!("{{pe[{}:0], {sh}'d0}}", acc_w - sh - 1)
+                };
+                ps = if x == sh_max { v } else { format!("(s2 == {sh_w}'d{x}) ? {v} : {ps}") };
+            }
+            g.push(wire("ps", acc_w, ps));
+            g.push(wire("accn", acc_w, format!("(f2 ? {acc_w}'d0 : acc) + ps")));
             g.push(Item::Always(vec![Stmt::If(
                 "en".into(),
                 vec![
