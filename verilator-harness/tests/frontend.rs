@@ -493,10 +493,13 @@ fn engine_planted_faults_are_caught() {
         .lines()
         .find(|l| l.trim_start().starts_with("wire [") && l.contains(" t") && l.contains("_1 "))
         .expect("a logic operation reading a second copy");
-    let weight_line = engine.lines().find(|l| l.contains("assign mu_sh[") && l.contains("'d2)")).expect("a pass at chunk weight 2");
+    let weight_line = engine
+        .lines()
+        .find(|l| l.trim_start().starts_with("assign m") && l.contains("_sh[") && l.contains("'d2)"))
+        .expect("a pass at chunk weight 2");
     let epoch_line = engine
         .lines()
-        .find(|l| l.contains("<= (") && l.contains("du_q[") && l.contains("(ep[2] || ep[5])"))
+        .find(|l| l.contains("<= (") && l.contains("_q[") && l.contains("(ep[2] || ep[5])"))
         .expect("a quotient captured by epoch");
     let faults = [
         (copy_line.to_string(), copy_line.replacen("_1 ", "_0 ", 1), "an operand's copy off by one period"),
