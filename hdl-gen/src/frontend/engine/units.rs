@@ -105,6 +105,10 @@ fn lane_bits(bus: &str, li: u32, lw: u32, w: u32) -> String {
     }
 }
 
+/// A product's operands (for shift-add the wide one first) and its passes: chunk of a, chunk
+/// of b, weight index, whether each chunk is its operand's top one.
+type Passes = (golden::frontend::engine::V, golden::frontend::engine::V, Vec<(u32, u32, u32, bool, bool)>);
+
 /// The multipliers: their lanes' multiplexers, a generate loop per width, and what each
 /// product's value register captures.
 pub(super) fn multipliers(v: &Values, seq: &Seq, body: &mut Vec<Item>) -> Vec<Capture> {
@@ -119,7 +123,7 @@ pub(super) fn multipliers(v: &Values, seq: &Seq, body: &mut Vec<Item>) -> Vec<Ca
     let sg = |x: golden::frontend::engine::V| v.op(x.0 as usize).signed;
     // Each product's passes: (pass index, chunk of a, chunk of b, weight index) and its operands
     // in order (for shift-add, the wide one first).
-    let passes = |o: usize| -> (golden::frontend::engine::V, golden::frontend::engine::V, Vec<(u32, u32, u32, bool, bool)>) {
+    let passes = |o: usize| -> Passes {
         let Kind::Mul(a, b) = v.op(o).kind else { unreachable!() };
         match plan.mul {
             MulUnit::Tile { bits } => {
