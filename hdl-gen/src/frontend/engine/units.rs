@@ -4,8 +4,9 @@
 //!
 //! - **Tile** (`MulUnit::Tile`): one pass multiplies a chunk of each operand (the top chunk of
 //!   a signed operand signed, the others unsigned: `bits + 1`-bit signed lanes), registered;
-//!   the product, registered; the accumulator adds it at the pair's weight (`2^(bits (i + j))`,
-//!   modulo its width), cleared on a product's first pass. Golden's `MUL_PIPE` = 2: the value
+//!   the product, registered; the accumulator adds it, cleared on a product's first pass and
+//!   shifted one chunk up when the pair's weight drops (the passes run heaviest first: Horner),
+//!   modulo its width. Golden's `MUL_PIPE` = 2: the value
 //!   is ready two clocks after the last pass.
 //! - **Shift-add** (`MulUnit::ShiftAdd`): a pass multiplies the wider operand by `bits` bits of
 //!   the narrower one, shifted to their weight, registered; the accumulator adds it. Ready one
@@ -128,11 +129,15 @@ pub(super) fn multipliers(v: &Values, seq: &Seq, body: &mut Vec<Item>) -> Vec<Ca
         match plan.mul {
             MulUnit::Tile { bits } => {
                 let (ca, cb) = (w(a).div_ceil(bits), w(b).div_ceil(bits));
-                let p: Vec<_> = (0..ca)
+                // Heaviest pair first (golden fixes the passes' clocks, not their order): the
+                // accumulator then shifts one chunk up when the weight drops (Horner), instead
+                // of a multiplexer placing each product at its weight.
+                let mut p: Vec<_> = (0..ca)
                     .flat_map(|i| (0..cb).map(move |j| (i, j)))
                     .filter(|&(i, j)| (i + j) * bits < v.op(o).w)
                     .map(|(i, j)| (i, j, i + j, i + 1 == ca, j + 1 == cb))
                     .collect();
+                p.sort_by_key(|x| std::cmp::Reverse(x.2));
                 (a, b, p)
             }
             MulUnit::ShiftAdd { bits } => {
@@ -146,7 +151,8 @@ pub(super) fn multipliers(v: &Values, seq: &Seq, body: &mut Vec<Item>) -> Vec<Ca
     for &o in &ops {
         let (_, _, p) = passes(o);
         assert_eq!(p.len() as u32, s.slots[o].busy, "{}: golden's passes", v.op(o).name);
-        let wmax = p.iter().map(|x| x.2).max().unwrap_or(0);
+        // A tile's lane says only "shift down a weight"; a shift-add unit's, the pass's shift.
+        let wmax = if matches!(plan.mul, MulUnit::Tile { .. }) { 1 } else { p.iter().map(|x| x.2).max().unwrap_or(0) };
         for (u, _) in seq.units_of(s, o) {
             let k = keys[u as usize].get_or_insert(vec![1, 0]);
             k[0] = k[0].max(v.op(o).w);
@@ -177,7 +183,11 @@ pub(super) fn multipliers(v: &Values, seq: &Seq, body: &mut Vec<Item>) -> Vec<Ca
                 if k == 0 {
                     src[u][2].push((c.clone(), "1'b1".into()));
                 }
-                src[u][3].push((c, format!("{x}")));
+                let drop = k > 0 && x < p[k - 1].2;
+                match plan.mul {
+                    MulUnit::Tile { .. } => src[u][3].push((c, if drop { "1" } else { "0" }.into())),
+                    MulUnit::ShiftAdd { .. } => src[u][3].push((c, format!("{x}"))),
+                }
             }
             from.push((es, lane_bits(&format!("m{gi}_acc"), li, acc_w, v.op(o).w)));
         }
@@ -212,7 +222,11 @@ pub(super) fn multipliers(v: &Values, seq: &Seq, body: &mut Vec<Item>) -> Vec<Ca
             body.push(Item::Assign(lane_bits(&bus("f"), li, 1, 1), or(&firsts)));
             let sh: Vec<(String, String)> =
                 sr[3].iter().filter(|(_, x)| x != "0").map(|(c, x)| (c.clone(), format!("{sh_w}'d{x}"))).collect();
-            body.push(Item::Assign(lane_bits(&bus("sh"), li, sh_w, sh_w), and_or_zero(&sh, sh_w)));
+            let sh = match plan.mul {
+                MulUnit::Tile { .. } => or(&sh.iter().map(|(c, _)| c.clone()).collect::<Vec<_>>()),
+                MulUnit::ShiftAdd { .. } => and_or_zero(&sh, sh_w),
+            };
+            body.push(Item::Assign(lane_bits(&bus("sh"), li, sh_w, sh_w), sh));
         }
         let k = format!("m{gi}k");
         let lane = |x: &str, lw: u32| if lw == 1 { format!("{}[{k}]", bus(x)) } else { format!("{}[{k}*{lw} +: {lw}]", bus(x)) };
@@ -220,26 +234,14 @@ pub(super) fn multipliers(v: &Values, seq: &Seq, body: &mut Vec<Item>) -> Vec<Ca
         match plan.mul {
             MulUnit::Tile { bits } => {
                 let pw = 2 * bits + 2;
-                g.extend([sreg("ra", bits + 1), sreg("rb", bits + 1), reg("f1", 1), reg("s1", sh_w)]);
-                g.extend([sreg("pr", pw), reg("f2", 1), reg("s2", sh_w), reg("acc", acc_w)]);
+                g.extend([sreg("ra", bits + 1), sreg("rb", bits + 1), reg("f1", 1), reg("s1", 1)]);
+                g.extend([sreg("pr", pw), reg("f2", 1), reg("s2", 1), reg("acc", acc_w)]);
                 let pe = if acc_w > pw { crate::verilog::sext("pr", pw, acc_w) } else { format!("pr[{}:0]", acc_w - 1) };
                 g.push(wire("pe", acc_w, pe));
-                // The pair's weight 2^(bits (i + j)): a multiplexer over the few weights the
-                // unit uses, not a barrel shifter over every shift its lane could encode.
-                let mut ps = format!("{acc_w}'d0");
-                for x in (0..=sh_max).rev() {
-                    let sh = x * bits;
-                    let val = if sh == 0 {
-                        "pe".to_string()
-                    } else if sh >= acc_w {
-                        format!("{acc_w}'d0")
-                    } else {
-                        format!("{{pe[{}:0], {sh}'d0}}", acc_w - sh - 1)
-                    };
-                    ps = if x == sh_max { val } else { format!("(s2 == {sh_w}'d{x}) ? {val} : {ps}") };
-                }
-                g.push(wire("ps", acc_w, ps));
-                g.push(wire("accn", acc_w, format!("(f2 ? {acc_w}'d0 : acc) + ps")));
+                // Cleared on a product's first pass, shifted a chunk up when the weight drops.
+                let up = if acc_w > bits { format!("{{acc[{}:0], {bits}'d0}}", acc_w - bits - 1) } else { format!("{acc_w}'d0") };
+                g.push(wire("held", acc_w, format!("f2 ? {acc_w}'d0 : s2 ? {up} : acc")));
+                g.push(wire("accn", acc_w, "held + pe"));
                 g.push(Item::Always(vec![Stmt::If(
                     "en".into(),
                     vec![
