@@ -25,17 +25,6 @@ use golden::frontend::engine::{Kind, MulUnit};
 /// `(condition, value)` pairs as one AND-OR multiplexer of `w` bits; a lone source needs none
 /// (its unit's value is a don't-care on its other clocks).
 fn and_or(items: &[(String, String)], w: u32) -> String {
-    // A source selected at several clocks (a chunk read by several passes) is one term.
-    let mut merged: Vec<(Vec<String>, String)> = Vec::new();
-    for (c, v) in items {
-        match merged.iter_mut().find(|(_, x)| x == v) {
-            Some((cs, _)) => cs.push(c.clone()),
-            None => merged.push((vec![c.clone()], v.clone())),
-        }
-    }
-    let merged: Vec<(String, String)> =
-        merged.into_iter().map(|(cs, v)| (if cs.len() == 1 { cs[0].clone() } else { format!("({})", cs.join(" || ")) }, v)).collect();
-    let items = merged.as_slice();
     match items {
         [] => format!("{w}'d0"),
         [(_, v)] => v.clone(),
