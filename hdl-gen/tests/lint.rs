@@ -353,7 +353,13 @@ fn lint_engine(form: golden::frontend::engine::SetupForm) {
             sources.join(" "),
             names.frontend
         );
-        run("yosys", &["-q".to_string(), "-p".into(), script]);
+        run("yosys", &["-q".to_string(), "-p".into(), script.clone()]);
+        // Negative control: a latch planted in the engine is found.
+        let engine = dir.join(format!("{}.v", names.fe_engine));
+        let text = std::fs::read_to_string(&engine).unwrap();
+        std::fs::write(&engine, text.replacen("endmodule", "reg probe;\n  always @(*) if (en) probe = rst;\nendmodule", 1)).unwrap();
+        let (ok, _) = tool_output("yosys", &["-q".to_string(), "-p".into(), script]);
+        assert!(!ok, "{form:?}: a latch planted in the engine went unnoticed");
         let _ = std::fs::remove_dir_all(&dir);
     }
 }
