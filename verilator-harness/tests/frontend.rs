@@ -410,10 +410,12 @@ fn engine_spans_of(opts: hdl_gen::Options, n: usize) {
     let report = run_frontend(m, seed ^ 5, Traffic::RANDOM, Stress::HARSH, &tris);
     assert_clean(m.tag, seed, &report);
     assert!(report.resets > 0, "{}: no reset in {} triangles", m.tag, tris.len());
-    // The set-up rate: one-row triangles and zero-area ones each take II clocks at full rate.
+    // The set-up rate: one-row triangles and zero-area ones each take II clocks at full rate
+    // (both in the top-left pixels, so they fit every screen's ports).
     let (per, _) = hw.setup_clocks();
-    let row = FixedTriangle { x: [2560, 7680, 2560], y: [2600, 2600, 2800], i: [100 << 12; 3] };
-    let flat = FixedTriangle { x: [2560, 5120, 7680], y: [2560, 5120, 7680], i: [0; 3] };
+    let row = FixedTriangle { x: [64, 448, 64], y: [40, 40, 216], i: [100 << fe.cfg.frac; 3] };
+    let flat = FixedTriangle { x: [64, 128, 192], y: [64, 128, 192], i: [0; 3] };
+    assert_eq!(fe.setup(&row).0, Outcome::Walked, "the rate's one-row triangle is walked");
     for tri in [row, flat] {
         let k = 200u64;
         let report = run_frontend(m, 1, Traffic::FULL, Stress::NONE, &vec![tri; k as usize]);
@@ -555,4 +557,18 @@ fn engine_throughput_against_the_parallel_set_up() {
             );
         }
     }
+}
+
+/// The slow tier: the widest formats (F = 20, XW = 16: II 14, the binding repeating every 12
+/// triangles) and the smallest (F = 4, XW = 4 on 16x8: II 8), the ECP5 plan.
+#[test]
+#[ignore]
+fn engine_spans_equal_golden_at_other_formats() {
+    let form = golden::frontend::engine::SetupForm::Ecp5_25f;
+    let Some(opts) = engine(golden::setup::Screen::default(), form) else { return };
+    let wide = golden::Config::new(8, 20, 16, golden::Align::Span).unwrap();
+    engine_spans_of(hdl_gen::Options { cfg: wide, ..opts.clone() }, 3000);
+    let small = golden::Config::new(8, 4, 4, golden::Align::Span).unwrap();
+    let screen = Some(golden::setup::Screen { width: 16, height: 8 });
+    engine_spans_of(hdl_gen::Options { cfg: small, screen, ..opts }, 3000);
 }

@@ -113,6 +113,14 @@ fn class(k: &Kind) -> Class {
     }
 }
 
+fn gcd(a: u32, b: u32) -> u32 {
+    if b == 0 {
+        a
+    } else {
+        gcd(b, a % b)
+    }
+}
+
 /// The chunk pairs a product takes on a tile of `bits`: `(i, j)`, low chunks first, those
 /// wholly above the kept bits left out.
 fn pairs(wa: u32, wb: u32, keep: u32, bits: u32) -> Vec<(u32, u32)> {
@@ -262,9 +270,9 @@ impl Schedule {
     /// keeps a steady-state triangle's binding in the slots.
     fn bind(&mut self) {
         let span = ceil(self.latency + 1, self.ii) as usize;
-        // The binding is kept over 4 span steady triangles, which end a span before the
+        // The binding is kept over 8 span steady triangles, which end a span before the
         // unrolled stretch does: the last triangles see fewer contenders and bind otherwise.
-        let tris = 8 * span + 4;
+        let tris = 12 * span + 4;
         let steady = 2 * span + 2;
         for c in [Class::Mul, Class::Div] {
             let mut iv: Vec<(u32, usize, usize)> = Vec::new();
@@ -327,7 +335,7 @@ impl Schedule {
         if j == steady {
             self.slots[o].unit = Some(u as u32);
         }
-        if (steady..steady + 4 * span).contains(&j) {
+        if (steady..steady + 8 * span).contains(&j) {
             if j < steady + span {
                 self.rotation.push((o, u as u32));
             }
@@ -498,15 +506,28 @@ impl Schedule {
     }
 
     /// The binding's period in triangles: the smallest `R` for which every operation on a unit
-    /// runs on the same unit as `R` triangles before, over the steady stretch [`Schedule::bind`]
-    /// unrolls (`None` if it has none there). An operation no busier than II keeps one unit
+    /// runs on the same unit as `R` triangles before (the least common multiple of each
+    /// operation's own period over the steady stretch [`Schedule::bind`] unrolls; `None` if one
+    /// has none there). An operation no busier than II keeps one unit
     /// (`R = 1`); one busier alternates. The RTL selects a unit's operands by phase and by the
     /// triangle's number modulo `R` (its epoch).
     pub fn epochs(&self) -> Option<u32> {
-        let len = self.binding.iter().map(Vec::len).max().unwrap_or(0);
-        (1..=len.max(1) / 2)
-            .map(|r| r as u32)
-            .find(|&r| self.binding.iter().all(|b| b.iter().enumerate().all(|(i, &u)| u == b[i % r as usize] && u != u32::MAX)))
+        let mut r = 1u32;
+        for o in 0..self.binding.len() {
+            if !self.binding[o].is_empty() {
+                let p = self.period(o)?;
+                r = r / gcd(r, p) * p;
+            }
+        }
+        Some(r)
+    }
+
+    /// Operation `o`'s own period: the smallest `p` with every triangle on the unit of the one
+    /// `p` before, seen at least twice over the stretch. [`Schedule::epochs`] is their least
+    /// common multiple.
+    fn period(&self, o: usize) -> Option<u32> {
+        let b = &self.binding[o];
+        (1..=b.len() / 2).find(|&p| b.iter().enumerate().all(|(i, &u)| u == b[i % p] && u != u32::MAX)).map(|p| p as u32)
     }
 
     /// Checks the periodic binding ([`Schedule::epochs`]) from the first triangle on: no unit
@@ -536,7 +557,8 @@ impl Schedule {
     /// The unit operation `o` runs on for a triangle of epoch `e` (its number modulo
     /// [`Schedule::epochs`]).
     pub fn unit_of(&self, o: usize, e: u32) -> Option<u32> {
-        self.binding[o].get(e as usize).copied()
+        let p = self.period(o)?;
+        self.binding[o].get((e % p) as usize).copied()
     }
 
     /// The unit operations in start order: `clock unit name (busy)`, for documents and reviews.

@@ -296,8 +296,17 @@ fn engine_listing() {
 #[test]
 fn the_binding_is_periodic() {
     use crate::frontend::engine::SetupForm;
-    for screen in [Screen::default(), Screen { width: 37, height: 23 }, Screen { width: 4096, height: 4096 }] {
-        let fe = FrontEnd::new(Default::default(), screen).unwrap();
+    let wide = Config::new(8, 20, 16, Align::Span).unwrap();
+    let small = Config::new(8, 4, 4, Align::Span).unwrap();
+    let cases = [
+        (Config::default(), Screen::default()),
+        (Config::default(), Screen { width: 37, height: 23 }),
+        (Config::default(), Screen { width: 4096, height: 4096 }),
+        (wide, Screen::default()),
+        (small, Screen { width: 16, height: 8 }),
+    ];
+    for (cfg, screen) in cases {
+        let fe = FrontEnd::new(cfg, screen).unwrap();
         for form in SetupForm::ALL {
             let Some(plan) = form.plan() else { continue };
             let s = plan.schedule(&fe).unwrap();

@@ -235,7 +235,15 @@ pub(super) fn multipliers(v: &Values, seq: &Seq, body: &mut Vec<Item>) -> Vec<Ca
             MulUnit::Tile { bits } => {
                 let pw = 2 * bits + 2;
                 g.extend([sreg("ra", bits + 1), sreg("rb", bits + 1), reg("f1", 1), reg("s1", 1)]);
-                g.extend([sreg("pr", pw), reg("f2", 1), reg("s2", 1), reg("acc", acc_w)]);
+                if acc_w < pw {
+                    // The accumulator keeps the product's low bits only.
+                    g.push(comment("verilator lint_off UNUSEDSIGNAL"));
+                    g.push(sreg("pr", pw));
+                    g.push(comment("verilator lint_on UNUSEDSIGNAL"));
+                } else {
+                    g.push(sreg("pr", pw));
+                }
+                g.extend([reg("f2", 1), reg("s2", 1), reg("acc", acc_w)]);
                 let pe = if acc_w > pw { crate::verilog::sext("pr", pw, acc_w) } else { format!("pr[{}:0]", acc_w - 1) };
                 g.push(wire("pe", acc_w, pe));
                 // Cleared on a product's first pass, shifted a chunk up when the weight drops.
