@@ -74,7 +74,7 @@ pub fn module(hw: &Hw, names: &Names) -> Module {
 pub fn submodules(hw: &Hw, names: &Names) -> Vec<Module> {
     if engine::on(hw) {
         // The engine made the divisions: no divider module, the engine and its queue instead.
-        return vec![edge::module(hw, names), engine::module(hw, names), engine::queue(hw, names)];
+        return vec![edge::module(hw, names), engine::module(hw, names), engine::result_queue(hw, names)];
     }
     let [ei, _] = edge::dividers(hw);
     vec![edge::module(hw, names), divider::module(names, &ei, hw.div_bits, divider::counter_width(&hw.fe.widths()))]

@@ -126,33 +126,9 @@ impl Plan {
     };
 }
 
-/// How `tri_frontend` sets a triangle up (`generate --fe-setup`): today's one-clock CALC and
-/// eight parallel dividers, or the shared engine on one of the named plans. The spans are the
-/// same bit for bit in every form; the hardware, its set-up rate and its latency differ.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
-#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
-#[serde(rename_all = "kebab-case")]
-pub enum SetupForm {
-    /// CALC (every product in one clock) and eight dividers in parallel.
-    #[default]
-    Parallel,
-    /// [`Plan::ECP5_25F`].
-    #[cfg_attr(feature = "clap", value(name = "ecp5-25f"))]
-    #[serde(rename = "ecp5-25f")]
-    Ecp5_25f,
-    /// [`Plan::ICE40_UP5K`].
-    #[cfg_attr(feature = "clap", value(name = "ice40-up5k"))]
-    #[serde(rename = "ice40-up5k")]
-    Ice40Up5k,
-    /// [`Plan::ICE40_HX8K`].
-    #[cfg_attr(feature = "clap", value(name = "ice40-hx8k"))]
-    #[serde(rename = "ice40-hx8k")]
-    Ice40Hx8k,
-}
+pub use super::SetupForm;
 
 impl SetupForm {
-    pub const ALL: [SetupForm; 4] = [SetupForm::Parallel, SetupForm::Ecp5_25f, SetupForm::Ice40Up5k, SetupForm::Ice40Hx8k];
-
     /// The engine's plan; `None` for the parallel set-up.
     pub fn plan(self) -> Option<Plan> {
         match self {
@@ -161,20 +137,6 @@ impl SetupForm {
             SetupForm::Ice40Up5k => Some(Plan::ICE40_UP5K),
             SetupForm::Ice40Hx8k => Some(Plan::ICE40_HX8K),
         }
-    }
-
-    pub fn name(self) -> &'static str {
-        match self {
-            SetupForm::Parallel => "parallel",
-            SetupForm::Ecp5_25f => "ecp5-25f",
-            SetupForm::Ice40Up5k => "ice40-up5k",
-            SetupForm::Ice40Hx8k => "ice40-hx8k",
-        }
-    }
-
-    /// Whether this is the default (serialised plans leave it out, so theirs stay as they were).
-    pub fn is_default(&self) -> bool {
-        *self == SetupForm::default()
     }
 }
 

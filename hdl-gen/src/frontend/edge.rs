@@ -52,7 +52,7 @@ pub(super) struct EdgeBuses {
 /// The buses into the edges: `(port, bus name, lane width)`; the caller declares them.
 pub(super) fn input_buses(hw: &Hw) -> EdgeBuses {
     let e = EdgeWidths::new(hw);
-    if super::engine::on(hw) {
+    if hw.engine_form() {
         // The shared engine's result: the edge's set-up complete, divisions made.
         return EdgeBuses {
             inputs: vec![
@@ -126,7 +126,7 @@ pub(super) fn state_outputs(hw: &Hw) -> Vec<(&'static str, u32, bool, String, &'
 pub(super) fn instances(hw: &Hw, names: &Names, buses: &EdgeBuses) -> Item {
     let e = EdgeWidths::new(hw);
     let lane = |bus: &str, w: u32| if w == 1 { format!("{bus}[k]") } else { format!("{bus}[k*{w} +: {w}]") };
-    let engine = super::engine::on(hw);
+    let engine = hw.engine_form();
     let mut conns: Vec<(String, String)> = [
         ("clk", "clk"),
         ("calc_go", "calc_go"),
@@ -161,7 +161,7 @@ pub(super) fn dividers(hw: &Hw) -> [Div; 2] {
 
 /// `tri_fe_edge`.
 pub(super) fn module(hw: &Hw, names: &Names) -> Module {
-    if super::engine::on(hw) {
+    if hw.engine_form() {
         return module_engine(hw, names);
     }
     let e = EdgeWidths::new(hw);

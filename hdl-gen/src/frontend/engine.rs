@@ -28,11 +28,11 @@ use golden::frontend::Widths;
 use sequencer::Seq;
 use values::Values;
 
-pub(super) use queue::module as queue_module;
+use queue::module as queue_module;
 
 /// Whether this front-end's set-up is the shared engine.
 pub(super) fn on(hw: &Hw) -> bool {
-    hw.fe.setup.plan().is_some()
+    hw.engine_form()
 }
 
 /// One field of the set-up result the walker reads: its name, the program's value and its
@@ -82,7 +82,7 @@ pub(super) fn entry_bits(hw: &Hw, s: &Schedule) -> u32 {
 }
 
 /// The set-up result queue module of this configuration.
-pub(super) fn queue(hw: &Hw, names: &Names) -> Module {
+pub(super) fn result_queue(hw: &Hw, names: &Names) -> Module {
     let s = hw.engine().expect("the engine form");
     queue_module(names, entry_bits(hw, &s), super::QUEUE_DEPTH)
 }

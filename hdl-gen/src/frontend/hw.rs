@@ -28,6 +28,11 @@ pub struct Hw {
 pub const QUEUE_DEPTH: u32 = 2;
 
 impl Hw {
+    /// Whether the set-up is the shared engine (`--fe-setup` not `parallel`).
+    pub fn engine_form(&self) -> bool {
+        self.fe.setup.plan().is_some()
+    }
+
     /// The shared set-up engine's schedule (golden's, the one the RTL runs), `None` for the
     /// parallel set-up.
     pub fn engine(&self) -> Option<golden::frontend::engine::schedule::Schedule> {

@@ -128,6 +128,13 @@ fn pairs(wa: u32, wb: u32, keep: u32, bits: u32) -> Vec<(u32, u32)> {
     (0..ca).flat_map(|i| (0..cb).map(move |j| (i, j))).filter(|&(i, j)| (i + j) * bits < keep).collect()
 }
 
+impl FrontEnd {
+    /// The set-up engine's schedule, for a form with one (`None`: the parallel set-up).
+    pub fn engine(&self) -> Option<Result<Schedule, EngineError>> {
+        self.setup.plan().map(|p| p.schedule(self))
+    }
+}
+
 impl Plan {
     fn check(&self) -> Result<(), EngineError> {
         let r = |what, value, max| if (1..=max).contains(&value) { Ok(()) } else { Err(EngineError::Range { what, value, max }) };

@@ -6,7 +6,7 @@ use crate::verilog::{comment, set, sized, wire, Item, Kind, Module, Param, Port,
 use crate::Names;
 
 /// The queue module, its parameters' defaults `w` bits and `depth` entries.
-pub(in crate::frontend) fn module(names: &Names, w: u32, depth: u32) -> Module {
+pub(crate) fn module(names: &Names, w: u32, depth: u32) -> Module {
     assert!(depth >= 2, "a set-up result queue of {depth} entries (2 or more, so set-up overlaps the walk)");
     let pw = 32 - (depth - 1).leading_zeros();
     let header = vec![

@@ -230,61 +230,68 @@ pub(super) fn multipliers(v: &Values, seq: &Seq, body: &mut Vec<Item>) -> Vec<Ca
         }
         let k = format!("m{gi}k");
         let lane = |x: &str, lw: u32| if lw == 1 { format!("{}[{k}]", bus(x)) } else { format!("{}[{k}*{lw} +: {lw}]", bus(x)) };
-        let mut g = Vec::new();
-        match plan.mul {
-            MulUnit::Tile { bits } => {
-                let pw = 2 * bits + 2;
-                g.extend([sreg("ra", bits + 1), sreg("rb", bits + 1), reg("f1", 1), reg("s1", 1)]);
-                if acc_w < pw {
-                    // The accumulator keeps the product's low bits only.
-                    g.push(comment("verilator lint_off UNUSEDSIGNAL"));
-                    g.push(sreg("pr", pw));
-                    g.push(comment("verilator lint_on UNUSEDSIGNAL"));
-                } else {
-                    g.push(sreg("pr", pw));
-                }
-                g.extend([reg("f2", 1), reg("s2", 1), reg("acc", acc_w)]);
-                let pe = if acc_w > pw { crate::verilog::sext("pr", pw, acc_w) } else { format!("pr[{}:0]", acc_w - 1) };
-                g.push(wire("pe", acc_w, pe));
-                // Cleared on a product's first pass, shifted a chunk up when the weight drops.
-                let up = if acc_w > bits { format!("{{acc[{}:0], {bits}'d0}}", acc_w - bits - 1) } else { format!("{acc_w}'d0") };
-                g.push(wire("held", acc_w, format!("f2 ? {acc_w}'d0 : s2 ? {up} : acc")));
-                g.push(wire("accn", acc_w, "held + pe"));
-                g.push(Item::Always(vec![Stmt::If(
-                    "en".into(),
-                    vec![
-                        set("ra", lane("a", lane_a)),
-                        set("rb", lane("b", lane_b)),
-                        set("f1", lane("f", 1)),
-                        set("s1", lane("sh", sh_w)),
-                        set("pr", "ra * rb"),
-                        set("f2", "f1"),
-                        set("s2", "s1"),
-                        set("acc", "accn"),
-                    ],
-                    vec![],
-                )]));
-            }
-            MulUnit::ShiftAdd { bits } => {
-                g.extend([reg("pp", acc_w), reg("f2", 1), reg("acc", acc_w)]);
-                g.push(wire("wa", acc_w, lane("a", lane_a)));
-                g.push(crate::verilog::swire("cb", bits + 1, lane("b", lane_b)));
-                let prod = if bits == 1 { format!("cb[1] ? -wa : (cb[0] ? wa : {acc_w}'d0)") } else { "$signed(wa) * cb".to_string() };
-                g.push(wire("pw", acc_w, prod));
-                g.push(wire("accn", acc_w, format!("(f2 ? {acc_w}'d0 : acc) + pp")));
-                let shift = if bits == 1 { lane("sh", sh_w) } else { format!("({} * {bits})", lane("sh", sh_w)) };
-                g.push(Item::Always(vec![Stmt::If(
-                    "en".into(),
-                    vec![set("pp", format!("pw << {shift}")), set("f2", lane("f", 1)), set("acc", "accn")],
-                    vec![],
-                )]));
-            }
-        }
+        let mut g = multiplier(plan.mul, acc_w, (lane_a, lane_b, sh_w), &lane);
         g.push(Item::Assign(lane("acc", acc_w), "accn".into()));
         body.push(Item::ForGenerate { var: k.clone(), count: n, label: format!("g_mul{gi}"), body: g });
     }
     body.push(Item::Blank);
     caps
+}
+
+/// One multiplier unit's datapath (the body of its group's generate loop): `lane` names its
+/// slice of the group's buses.
+fn multiplier(mul: MulUnit, acc_w: u32, (lane_a, lane_b, sh_w): (u32, u32, u32), lane: &dyn Fn(&str, u32) -> String) -> Vec<Item> {
+    let mut g = Vec::new();
+    match mul {
+        MulUnit::Tile { bits } => {
+            let pw = 2 * bits + 2;
+            g.extend([sreg("ra", bits + 1), sreg("rb", bits + 1), reg("f1", 1), reg("s1", 1)]);
+            if acc_w < pw {
+                // The accumulator keeps the product's low bits only.
+                g.push(comment("verilator lint_off UNUSEDSIGNAL"));
+                g.push(sreg("pr", pw));
+                g.push(comment("verilator lint_on UNUSEDSIGNAL"));
+            } else {
+                g.push(sreg("pr", pw));
+            }
+            g.extend([reg("f2", 1), reg("s2", 1), reg("acc", acc_w)]);
+            let pe = if acc_w > pw { crate::verilog::sext("pr", pw, acc_w) } else { format!("pr[{}:0]", acc_w - 1) };
+            g.push(wire("pe", acc_w, pe));
+            // Cleared on a product's first pass, shifted a chunk up when the weight drops.
+            let up = if acc_w > bits { format!("{{acc[{}:0], {bits}'d0}}", acc_w - bits - 1) } else { format!("{acc_w}'d0") };
+            g.push(wire("held", acc_w, format!("f2 ? {acc_w}'d0 : s2 ? {up} : acc")));
+            g.push(wire("accn", acc_w, "held + pe"));
+            g.push(Item::Always(vec![Stmt::If(
+                "en".into(),
+                vec![
+                    set("ra", lane("a", lane_a)),
+                    set("rb", lane("b", lane_b)),
+                    set("f1", lane("f", 1)),
+                    set("s1", lane("sh", sh_w)),
+                    set("pr", "ra * rb"),
+                    set("f2", "f1"),
+                    set("s2", "s1"),
+                    set("acc", "accn"),
+                ],
+                vec![],
+            )]));
+        }
+        MulUnit::ShiftAdd { bits } => {
+            g.extend([reg("pp", acc_w), reg("f2", 1), reg("acc", acc_w)]);
+            g.push(wire("wa", acc_w, lane("a", lane_a)));
+            g.push(crate::verilog::swire("cb", bits + 1, lane("b", lane_b)));
+            let prod = if bits == 1 { format!("cb[1] ? -wa : (cb[0] ? wa : {acc_w}'d0)") } else { "$signed(wa) * cb".to_string() };
+            g.push(wire("pw", acc_w, prod));
+            g.push(wire("accn", acc_w, format!("(f2 ? {acc_w}'d0 : acc) + pp")));
+            let shift = if bits == 1 { lane("sh", sh_w) } else { format!("({} * {bits})", lane("sh", sh_w)) };
+            g.push(Item::Always(vec![Stmt::If(
+                "en".into(),
+                vec![set("pp", format!("pw << {shift}")), set("f2", lane("f", 1)), set("acc", "accn")],
+                vec![],
+            )]));
+        }
+    }
+    g
 }
 
 /// `and_or` over sources of which the zero ones were left out (the lane is zero on the others).
