@@ -200,21 +200,15 @@ impl<'a> Values<'a> {
             Kind::Or(a, b) => (format!("(|{}) || (|{})", x(a).ext(self.op(a.0 as usize).w), x(b).ext(self.op(b.0 as usize).w)), 1),
             Kind::Sel(c, a, b) => (format!("(|{}) ? {} : {}", x(c).ext(self.op(c.0 as usize).w), x(a).ext(op.w), x(b).ext(op.w)), op.w),
             Kind::ShlBy(a, s) => (format!("{} << {}", x(a).ext(op.w), x(s).ext(self.op(s.0 as usize).w)), op.w),
-            Kind::Lzc(a, n) => (lzc(&x(a), 0, n, op.w), op.w),
+            Kind::Lzc(a, n) => {
+                let v = x(a);
+                let mut e = format!("{}'d{n}", op.w);
+                for i in 0..n {
+                    e = format!("{} ? {}'d{} : ({e})", v.bits(i, 1), op.w, n - 1 - i);
+                }
+                (e, op.w)
+            }
             _ => unreachable!("{} is not logic", op.name),
         }
     }
-}
-
-/// The leading zeros of bits `lo .. lo + len` of `v` as a `w`-bit expression, halving: the top
-/// half's count if it has a one, else its width plus the bottom half's. Log depth: a chain of
-/// selects over every bit was the engine's critical path on the ECP5 (docs/fpga.md).
-fn lzc(v: &Src, lo: u32, len: u32, w: u32) -> String {
-    if len == 1 {
-        return format!("({} ? {w}'d0 : {w}'d1)", v.bits(lo, 1));
-    }
-    let top = len / 2;
-    let bottom = len - top;
-    let zero = format!("{} == {top}'d0", v.bits(lo + bottom, top));
-    format!("(({zero}) ? {w}'d{top} + {} : {})", lzc(v, lo, bottom, w), lzc(v, lo + bottom, top, w))
 }
