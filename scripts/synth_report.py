@@ -50,9 +50,12 @@ def level(tag):
 def block_form(r):
     """The block and form columns of a row: 'shift-add+pl2/p8' reads P = 8, shift-add, --pipeline 2."""
     if r["label"].startswith("frontend"):
-        # 'frontend+pl1+div2': --pipeline 1 --fe-div-bits 2
+        # 'frontend+pl1+div2': --pipeline 1 --fe-div-bits 2; '+ecp5-25f': --fe-setup ecp5-25f
         tags = r["label"].split("+")[1:]
-        form = [level("+" + t) if t.startswith("pl") else f"--fe-div-bits {t[3:]}" for t in tags]
+        form = [
+            level("+" + t) if t.startswith("pl") else f"--fe-div-bits {t[3:]}" if t.startswith("div") else f"--fe-setup {t}"
+            for t in tags
+        ]
         return r["top"], ", ".join(form) or "—"
     if r["label"].startswith("specular"):
         return r["top"], level(r["label"][len("specular"):]) or "—"

@@ -135,6 +135,48 @@ impl I0Form {
     }
 }
 
+/// How `tri_frontend` sets a triangle up (`generate --fe-setup`): today's one-clock CALC and
+/// eight parallel dividers, or the shared engine on one of the named plans. The spans are the
+/// same bit for bit in every form; the hardware, its set-up rate and its latency differ.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
+#[serde(rename_all = "kebab-case")]
+pub enum SetupForm {
+    /// CALC (every product in one clock) and eight dividers in parallel.
+    #[default]
+    Parallel,
+    /// The engine on `Plan::ECP5_25F` (the `engine` module).
+    #[cfg_attr(feature = "clap", value(name = "ecp5-25f"))]
+    #[serde(rename = "ecp5-25f")]
+    Ecp5_25f,
+    /// The engine on `Plan::ICE40_UP5K`.
+    #[cfg_attr(feature = "clap", value(name = "ice40-up5k"))]
+    #[serde(rename = "ice40-up5k")]
+    Ice40Up5k,
+    /// The engine on `Plan::ICE40_HX8K`.
+    #[cfg_attr(feature = "clap", value(name = "ice40-hx8k"))]
+    #[serde(rename = "ice40-hx8k")]
+    Ice40Hx8k,
+}
+
+impl SetupForm {
+    pub const ALL: [SetupForm; 4] = [SetupForm::Parallel, SetupForm::Ecp5_25f, SetupForm::Ice40Up5k, SetupForm::Ice40Hx8k];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            SetupForm::Parallel => "parallel",
+            SetupForm::Ecp5_25f => "ecp5-25f",
+            SetupForm::Ice40Up5k => "ice40-up5k",
+            SetupForm::Ice40Hx8k => "ice40-hx8k",
+        }
+    }
+
+    /// Whether this is the default (serialised plans leave it out, so theirs stay as they were).
+    pub fn is_default(&self) -> bool {
+        *self == SetupForm::default()
+    }
+}
+
 /// A front-end configuration: the shader's formats, the screen it draws on, where `dI` comes
 /// from and how `I0` is formed.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
@@ -145,6 +187,9 @@ pub struct FrontEnd {
     pub di: DiMode,
     #[serde(default, skip_serializing_if = "I0Form::is_default")]
     pub i0: I0Form,
+    /// How the set-up is built (issue 27): the spans do not depend on it, its clocks do.
+    #[serde(default, skip_serializing_if = "SetupForm::is_default")]
+    pub setup: SetupForm,
 }
 
 /// Every width of the front-end, derived once from the configuration: the generator declares
@@ -331,7 +376,7 @@ impl FrontEnd {
         if screen.height == 0 || screen.height > 1 << 16 {
             return Err(FrontEndError::Height { height: screen.height });
         }
-        Ok(FrontEnd { cfg, screen, di: DiMode::Triangle, i0: I0Form::Reciprocal })
+        Ok(FrontEnd { cfg, screen, di: DiMode::Triangle, i0: I0Form::Reciprocal, setup: SetupForm::Parallel })
     }
 
     /// The same front-end with `dI` from `di`.
@@ -342,6 +387,11 @@ impl FrontEnd {
     /// The same front-end with `I0` formed by `i0`.
     pub fn with_i0(self, i0: I0Form) -> FrontEnd {
         FrontEnd { i0, ..self }
+    }
+
+    /// The same front-end with its set-up built as `setup` says.
+    pub fn with_setup(self, setup: SetupForm) -> FrontEnd {
+        FrontEnd { setup, ..self }
     }
 
     pub fn widths(&self) -> Widths {

@@ -8,6 +8,7 @@
 use crate::{check_prefix, BfpiArch, Bus, Options, Target};
 use clap::builder::{StringValueParser, TypedValueParser};
 use clap::Args;
+use golden::frontend::engine::SetupForm;
 use golden::frontend::{DiMode, I0Form};
 use golden::pipeline::Pipeline;
 use golden::setup::Screen;
@@ -28,6 +29,8 @@ pub enum ArgsError {
     TreeUnpipelined,
     #[error("--fe-i0 incremental takes --fe-di triangle: the per-scanline dI needs the reciprocal's I0 at every span's last pixel")]
     IncrementalScanline,
+    #[error("--fe-setup {0} takes --fe-di triangle and --fe-i0 reciprocal: its engine computes the per-triangle set-up only")]
+    EngineForm(&'static str),
     #[error("--width/--height: {0}")]
     Screen(#[from] golden::frontend::FrontEndError),
 }
@@ -134,6 +137,14 @@ pub struct VariantArgs {
     /// target's choice.
     #[arg(long = "fe-i0", value_enum)]
     pub fe_i0: Option<I0Form>,
+    /// How the front-end sets a triangle up: `parallel` (CALC's products in one clock and
+    /// eight dividers, the default) or the shared set-up engine on a device's plan, `ecp5-25f`,
+    /// `ice40-up5k` or `ice40-hx8k` (golden's `Plan`: a few shared multipliers and dividers
+    /// sequenced over several clocks a triangle, behind a set-up result queue; docs/design.md).
+    /// Same spans bit for bit. The engine forms take `--fe-di triangle --fe-i0 reciprocal`.
+    /// Default: `parallel`, or the target's choice.
+    #[arg(long = "fe-setup", value_enum)]
+    pub fe_setup: Option<SetupForm>,
     /// Register stages added for clock rate, 0..3 (golden::pipeline): 1 registers the span and
     /// the shader's increments, splits the specular unit's multiplies, and stages the
     /// front-end (CALC in five clocks, its span path in six), 2 also the shader's lane sums, 3 cuts the shader's adders
@@ -165,18 +176,23 @@ impl VariantArgs {
         let pipeline = self.pipeline.or(choice.map(|c| c.pipeline)).unwrap_or(0);
         let pipeline = Pipeline::new(pipeline).expect("clap checked the range; the targets' levels exist");
         let fe_i0 = self.fe_i0.or(choice.map(|c| c.fe_i0)).unwrap_or_default();
+        let fe_setup = self.fe_setup.or(choice.map(|c| c.fe_setup)).unwrap_or_default();
         if pipeline.span_stage() && self.bfpi_arch == BfpiArch::Tree {
             return Err(ArgsError::TreeUnpipelined);
         }
         if fe_i0 == I0Form::Incremental && self.fe_di == DiMode::Scanline {
             return Err(ArgsError::IncrementalScanline);
         }
+        if fe_setup != SetupForm::Parallel && (fe_i0 != I0Form::Reciprocal || self.fe_di != DiMode::Triangle) {
+            return Err(ArgsError::EngineForm(fe_setup.name()));
+        }
         let opts = Options {
             bfpi_arch: self.bfpi_arch,
             screen,
-            fe_div_bits: self.fe_div_bits.or(choice.map(|c| c.fe_div_bits)),
+            fe_div_bits: self.fe_div_bits.or(choice.and_then(|c| c.fe_div_bits)),
             fe_di: self.fe_di,
             fe_i0,
+            fe_setup,
             pipeline,
             bus: self.bus,
             target: self.target,
@@ -243,14 +259,32 @@ mod tests {
     #[test]
     fn a_target_chooses_and_a_given_flag_overrides_it() {
         let plain = options(&[]);
-        assert_eq!((plain.pipeline.level(), plain.fe_div_bits, plain.target), (0, None, None));
+        assert_eq!((plain.pipeline.level(), plain.fe_div_bits, plain.target, plain.fe_setup), (0, None, None, SetupForm::Parallel));
         for t in [Target::Ecp5_25f, Target::Ice40Hx8k, Target::Ice40Up5k] {
             let c = t.choice();
             let chosen = options(&["--target", t.name()]);
             assert_eq!(chosen.target, Some(t));
-            assert_eq!((chosen.pipeline.level(), chosen.fe_div_bits, chosen.fe_i0), (c.pipeline, Some(c.fe_div_bits), c.fe_i0));
-            let over = options(&["--target", t.name(), "--pipeline", "0", "--fe-div-bits", "4", "--fe-i0", "incremental"]);
-            assert_eq!((over.pipeline.level(), over.fe_div_bits, over.fe_i0), (0, Some(4), I0Form::Incremental), "{t}");
+            assert_eq!(
+                (chosen.pipeline.level(), chosen.fe_div_bits, chosen.fe_i0, chosen.fe_setup),
+                (c.pipeline, c.fe_div_bits, c.fe_i0, c.fe_setup)
+            );
+            let over = options(&[
+                "--target",
+                t.name(),
+                "--pipeline",
+                "0",
+                "--fe-setup",
+                "parallel",
+                "--fe-div-bits",
+                "4",
+                "--fe-i0",
+                "incremental",
+            ]);
+            assert_eq!(
+                (over.pipeline.level(), over.fe_div_bits, over.fe_i0, over.fe_setup),
+                (0, Some(4), I0Form::Incremental, SetupForm::Parallel),
+                "{t}"
+            );
         }
         assert!(Cli::try_parse_from(["t", "--target", "ecp5-85f"]).is_err());
     }

@@ -91,6 +91,12 @@ pub struct Frontend {
     /// Incremental I0 only: clocks of a start on the shared engine (`Hw::start_clocks`).
     #[serde(default, skip_serializing_if = "is_zero")]
     pub start_clocks: u32,
+    /// How the set-up is built (`--fe-setup`); left out for the default, `parallel`.
+    #[serde(default, skip_serializing_if = "golden::frontend::engine::SetupForm::is_default")]
+    pub setup: golden::frontend::engine::SetupForm,
+    /// The shared set-up engine's plan and schedule (`--fe-setup` not `parallel`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub engine: Option<Engine>,
     /// Per-scanline dI only: clocks the span divider runs for a span of two pixels or more.
     pub span_div_clocks: u32,
     /// Clocks from a triangle's transfer to its first span when the walker is idle.
@@ -100,6 +106,21 @@ pub struct Frontend {
     pub setup_clocks_dropped: u32,
     /// Walker clocks per triangle: one per row from its first to its last covered row.
     pub walker: String,
+}
+
+/// The shared set-up engine: golden's plan, and its schedule's clocks.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Engine {
+    pub module: String,
+    pub plan: golden::frontend::engine::Plan,
+    /// Clocks between two triangles entering the engine: the sustained set-up rate.
+    pub ii: u32,
+    /// Clocks from a triangle's entry to its set-up result at the queue.
+    pub latency: u32,
+    /// Triangles after which the units' binding repeats (an operation busier than II
+    /// alternates between units).
+    pub epochs: u32,
+    pub queue_depth: u32,
 }
 
 /// The specular unit's configuration: k-set, n ranges, tables, ROM geometry, pipeline.
@@ -286,6 +307,11 @@ pub fn render(opts: &Options, names: &Names, modules: &[Module], unit: &Specular
             (Role::FrontendPart, 1, "BITS quotient bits a clock; the quotient after ceil(QB / BITS) run clocks")
         } else if name == &names.fe_edge {
             (Role::FrontendPart, 1, "one row per clock")
+        } else if name == &names.fe_engine {
+            let s = fe.as_ref().and_then(|hw| hw.engine()).expect("the engine form writes the engine");
+            (Role::FrontendPart, s.latency + 1, "one triangle every frontend.engine.ii clocks")
+        } else if name == &names.fe_queue {
+            (Role::FrontendPart, 1, "one entry in and one out per clock")
         } else if name == &names.top {
             (Role::TriangleShader, fe_latency + seg_latency, "one segment per clock")
         } else if name == &names.writer {
@@ -373,6 +399,15 @@ pub fn render(opts: &Options, names: &Names, modules: &[Module], unit: &Specular
             di: hw.fe.di,
             i0: hw.fe.i0,
             start_clocks: hw.start_clocks(),
+            setup: hw.fe.setup,
+            engine: hw.engine().map(|s| Engine {
+                module: names.fe_engine.clone(),
+                plan: s.plan,
+                ii: s.ii,
+                latency: s.latency,
+                epochs: s.epochs().expect("a periodic binding (golden's tests)"),
+                queue_depth: crate::frontend::QUEUE_DEPTH,
+            }),
             span_div_clocks: hw.span_div_clocks(),
             latency: hw.latency(),
             setup_clocks_walked: hw.setup_clocks().0,

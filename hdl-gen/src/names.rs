@@ -14,6 +14,9 @@ pub struct Names {
     /// division and the per-scanline dI's) and one edge (its set-up result and its walker step).
     pub fe_div: String,
     pub fe_edge: String,
+    /// The shared set-up engine (`--fe-setup` not `parallel`) and its result queue.
+    pub fe_engine: String,
+    pub fe_queue: String,
     pub top: String,
     /// SPEC §7's segment writer, and the chain from triangles to memory.
     pub writer: String,
@@ -29,6 +32,8 @@ impl Names {
             frontend: format!("{prefix}tri_frontend"),
             fe_div: format!("{prefix}tri_fe_div"),
             fe_edge: format!("{prefix}tri_fe_edge"),
+            fe_engine: format!("{prefix}tri_fe_engine"),
+            fe_queue: format!("{prefix}tri_fe_queue"),
             top: format!("{prefix}tri_shader_p{}", cfg.p),
             writer: format!("{prefix}fb_writer_p{}", cfg.p),
             fb_top: format!("{prefix}tri_fb_p{}", cfg.p),

@@ -26,6 +26,9 @@ pub struct Options {
     /// How the front-end forms each span's `I0` (`--fe-i0`); the default is today's reciprocal
     /// a row.
     pub fe_i0: golden::frontend::I0Form,
+    /// How the front-end sets a triangle up (`--fe-setup`); the default is today's parallel CALC
+    /// and dividers.
+    pub fe_setup: golden::frontend::engine::SetupForm,
     /// Register stages added for clock rate (`--pipeline`); level 0 is SPEC's seed structure.
     pub pipeline: golden::pipeline::Pipeline,
     /// `--bus`: SPEC's ports only, or AXI4-Stream wrappers of the streaming tops as well.
@@ -46,7 +49,8 @@ impl Options {
     pub fn frontend(&self) -> Result<frontend::Hw, golden::frontend::FrontEndError> {
         let fe = golden::frontend::FrontEnd::new(self.cfg, self.screen.unwrap_or_else(|| Options::default_screen(&self.cfg)))?
             .with_di(self.fe_di)
-            .with_i0(self.fe_i0);
+            .with_i0(self.fe_i0)
+            .with_setup(self.fe_setup);
         Ok(frontend::Hw { fe, div_bits: self.fe_div_bits.unwrap_or(frontend::DEFAULT_DIV_BITS), pipeline: self.pipeline })
     }
 

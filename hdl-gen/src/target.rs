@@ -4,7 +4,7 @@
 //! other option keeps its own default. The choices are the measured best for each device
 //! (docs/design.md, "Targets"; figures in docs/fpga.md), so they change when a measurement does.
 
-use golden::frontend::I0Form;
+use golden::frontend::{I0Form, SetupForm};
 use serde::{Deserialize, Serialize};
 
 /// A device family and size the generated chain is meant to fit.
@@ -24,31 +24,35 @@ pub enum Target {
     Ice40Up5k,
 }
 
-/// The options a target chooses; `None` fields stay at the option's own default.
+/// The options a target chooses.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Choice {
     /// `--pipeline`.
     pub pipeline: u32,
-    /// `--fe-div-bits`.
-    pub fe_div_bits: u32,
+    /// `--fe-div-bits` (the parallel set-up's dividers; `None`: the option's default).
+    pub fe_div_bits: Option<u32>,
     /// `--fe-i0`.
     pub fe_i0: I0Form,
+    /// `--fe-setup`.
+    pub fe_setup: SetupForm,
 }
 
 impl Target {
-    /// What this target chooses, from the measured `tri_frontend` on an ECP5-85F (docs/fpga.md;
-    /// docs/design.md, "Targets"): `--pipeline 1` on every device (the set-up's CALC in five
-    /// clocks: 18.2 MHz at level 0, 47-48 MHz at level 1); on the ECP5 two quotient bits a clock
-    /// (47.5 MHz, 13 set-up clocks a triangle: about the rows a ~100 px triangle walks, so the
-    /// most such triangles a second of the measured forms, at 9,134 LUT4), on the iCE40s one
-    /// (4,916 LUT4, the smallest, at 24 clocks); the reciprocal `I0` everywhere (the
-    /// incremental form is larger on one shared multiplier).
+    /// What this target chooses, from the measured `tri_frontend` (docs/fpga.md; docs/design.md,
+    /// "Targets"): the shared set-up engine on the device's own plan, which is smaller than the
+    /// parallel set-up on every device measured (ECP5, `--pipeline 1`: 7,110 LUT4 and 29
+    /// MULT18X18D at 48.8 MHz against 9,134 LUT4 and 83 at 47.5 MHz for the parallel form's best;
+    /// iCE40: 16,413 SB_LUT4 against 38,337 without DSPs, 19 SB_MAC16 against 81 with them) and
+    /// sets a triangle up in fewer clocks than the parallel form at the same clock (12 against
+    /// 13); `--pipeline 1` (the span path in stages: the parallel form's 18.2 MHz at level 0
+    /// became 47-48 MHz); the reciprocal `I0`, which the engine forms take.
     pub fn choice(self) -> Choice {
-        let fe_div_bits = match self {
-            Target::Ecp5_25f => 2,
-            Target::Ice40Hx8k | Target::Ice40Up5k => 1,
+        let fe_setup = match self {
+            Target::Ecp5_25f => SetupForm::Ecp5_25f,
+            Target::Ice40Hx8k => SetupForm::Ice40Hx8k,
+            Target::Ice40Up5k => SetupForm::Ice40Up5k,
         };
-        Choice { pipeline: 1, fe_div_bits, fe_i0: I0Form::Reciprocal }
+        Choice { pipeline: 1, fe_div_bits: None, fe_i0: I0Form::Reciprocal, fe_setup }
     }
 
     /// The name `--target` takes.

@@ -75,6 +75,9 @@ fn generate_bad_flags() {
         (&["generate", "--out", d, "--bogus"], "--bogus"),
         (&["generate", "--out", d, "--fe-i0", "lazy"], "--fe-i0"),
         (&["generate", "--out", d, "--fe-i0", "incremental", "--fe-di", "scanline"], "--fe-i0 incremental takes --fe-di triangle"),
+        (&["generate", "--out", d, "--fe-setup", "ecp5-85f"], "--fe-setup"),
+        (&["generate", "--out", d, "--fe-setup", "ecp5-25f", "--fe-i0", "incremental"], "--fe-setup ecp5-25f takes --fe-di triangle"),
+        (&["generate", "--out", d, "--fe-setup", "ice40-hx8k", "--fe-di", "scanline"], "--fe-setup ice40-hx8k takes --fe-di triangle"),
     ];
     for (args, needle) in cases {
         assert_rejected(args, needle, &dir);

@@ -64,6 +64,11 @@ fn prove_refuses_bad_arguments() {
     let out = hdl_gen(&["generate", "--p", "1", "--out", spaced.to_str().unwrap()]);
     assert!(out.status.success());
     let (e, s) = (empty.to_str().unwrap(), spaced.to_str().unwrap());
+    // The shared set-up engine's front-end has no properties yet: its folder is refused.
+    let engine = dir.join("engine");
+    let out =
+        hdl_gen(&["generate", "--p", "1", "--width", "37", "--height", "23", "--fe-setup", "ecp5-25f", "--out", engine.to_str().unwrap()]);
+    assert!(out.status.success());
     let missing = dir.join("missing");
     let cases: &[(&[&str], &[&str])] = &[
         (&["--depth", "abc"], &["--depth 'abc'"]),
@@ -75,6 +80,7 @@ fn prove_refuses_bad_arguments() {
         (&["--rtl", ""], &["--rtl needs a value"]),
         (&["--rtl", missing.to_str().unwrap()], &["is not a folder"]),
         (&["--rtl", e], &["holds no Verilog module with properties"]),
+        (&["--rtl", engine.to_str().unwrap()], &["its front-end is the shared set-up engine (--fe-setup)"]),
         (&["--rtl", s, "--only", "("], &["--only '('", "not a valid regular expression"]),
         (&["--rtl", s, "--skip", "[a"], &["--skip '[a'"]),
         (&["--only"], &["--only needs a value"]),

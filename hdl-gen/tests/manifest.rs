@@ -21,6 +21,14 @@ fn configs() -> Vec<Options> {
         let pipeline = golden::pipeline::Pipeline::new(level).unwrap();
         v.push(Options { cfg: Config { p: 8, align: Align::Screen, ..Config::default() }, pipeline, ..Default::default() });
     }
+    // `--fe-setup`: the set-up engine and its queue are listed with their ports, and the
+    // engine's fields are documented.
+    v.push(Options {
+        cfg: Config { p: 8, ..Config::default() },
+        screen: Some(golden::setup::Screen { width: 37, height: 23 }),
+        fe_setup: golden::frontend::engine::SetupForm::Ecp5_25f,
+        ..Default::default()
+    });
     // `--bus axis`: the wrappers are listed with their ports like every module, and the `axis`
     // section's fields are documented.
     v.push(Options { cfg: Config { p: 8, ..Config::default() }, bus: Bus::Axis, ..Default::default() });

@@ -18,7 +18,12 @@ pub fn decided(id: &str, m: &Manifest) -> Result<Option<String>, String> {
         format!("{v:?}")
     }
     let fe = |f: &dyn Fn(&hdl_gen::manifest::Frontend) -> String| m.frontend.as_ref().map_or("(no front-end)".to_string(), f);
-    let (pipeline, div_bits, i0) = (m.parameters.pipeline.to_string(), fe(&|f| f.div_bits.to_string()), fe(&|f| f.i0.name().to_string()));
+    let (pipeline, div_bits, i0, setup) = (
+        m.parameters.pipeline.to_string(),
+        fe(&|f| f.div_bits.to_string()),
+        fe(&|f| f.i0.name().to_string()),
+        fe(&|f| f.setup.name().to_string()),
+    );
     let v = match id {
         "p" | "align" => return Ok(None),
         "frac" => m.parameters.frac.to_string(),
@@ -30,9 +35,10 @@ pub fn decided(id: &str, m: &Manifest) -> Result<Option<String>, String> {
         "fe_div_bits" => div_bits,
         "fe_di" => fe(&|f| f.di.name().to_string()),
         "fe_i0" => i0,
+        "fe_setup" => setup,
         // A target decides what it chooses: a folder generated with the same choices by flags
         // is the same circuit.
-        "target" => format!("--pipeline {pipeline} --fe-div-bits {div_bits} --fe-i0 {i0}"),
+        "target" => format!("--pipeline {pipeline} --fe-div-bits {div_bits} --fe-i0 {i0} --fe-setup {setup}"),
         "brdf_k" | "max_rel_error" => {
             let g = &m.specular.geometry;
             format!("k {:?}, n ranges {}, tables {}", g.ks, text(&g.k_ranges), text(&g.tables))
@@ -109,7 +115,10 @@ mod tests {
         }
         let pl1 = manifest(&hdl_gen::Options { pipeline: golden::pipeline::Pipeline::new(1).unwrap(), ..Default::default() });
         let div1 = manifest(&hdl_gen::Options { fe_div_bits: Some(1), ..Default::default() });
-        for (id, other) in [("pipeline", &pl1), ("target", &pl1), ("fe_div_bits", &div1), ("target", &div1)] {
+        let engine = manifest(&hdl_gen::Options { fe_setup: golden::frontend::SetupForm::Ice40Up5k, ..Default::default() });
+        let cases =
+            [("pipeline", &pl1), ("target", &pl1), ("fe_div_bits", &div1), ("target", &div1), ("fe_setup", &engine), ("target", &engine)];
+        for (id, other) in cases {
             assert_ne!(decided(id, &m), decided(id, other), "{id}");
         }
         assert!(decided("no_such_flag", &m).is_err());

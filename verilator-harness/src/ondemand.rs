@@ -464,6 +464,9 @@ pub fn tag_suffix(opts: &hdl_gen::Options) -> String {
     if opts.fe_i0 != golden::frontend::I0Form::Reciprocal {
         s += "_inc";
     }
+    if !opts.fe_setup.is_default() {
+        s += &format!("_{}", opts.fe_setup.name().replace('-', ""));
+    }
     if opts.bfpi_arch != hdl_gen::BfpiArch::ShiftAdd {
         s += &format!("_{:?}", opts.bfpi_arch).to_lowercase();
     }

@@ -382,3 +382,200 @@ fn incremental_i0_planted_faults_are_caught() {
         assert!(!report.ok(), "planted fault not caught: {what}");
     }
 }
+
+/// The shared set-up engine (`--fe-setup`, issue 27) on `screen`: asked of `ondemand` (built
+/// once, then cached), or `None` when this build hands out a folder's models.
+fn engine(screen: golden::setup::Screen, form: golden::frontend::engine::SetupForm) -> Option<hdl_gen::Options> {
+    if verilator_harness::registry::rtl_dir().is_some() {
+        eprintln!("set-up engine: skipped: COSIM_RTL_DIR provides the models");
+        return None;
+    }
+    let cfg = golden::Config::new(8, golden::Config::default().frac, golden::Config::default().xbits, golden::Align::Span).unwrap();
+    Some(hdl_gen::Options { cfg, screen: Some(screen), fe_setup: form, ..Default::default() })
+}
+
+/// Spans of every kind of triangle under random gaps and backpressure, then under resets, bit
+/// for bit golden's; every triangle costs the engine's II clocks at full rate; a wrong
+/// expectation is caught.
+fn engine_spans_of(opts: hdl_gen::Options, n: usize) {
+    let m = verilator_harness::registry::frontend(&opts).unwrap_or_else(|e| panic!("{e}"));
+    let seed = verilator_harness::seed("frontend engine");
+    let fe = frontend(m);
+    let hw = opts.frontend().unwrap();
+    assert_eq!(fe.with_setup(opts.fe_setup), hw.fe, "the model's front-end is the plan's");
+    assert_eq!(hw.latency(), m.latency, "the manifest's latency is the engine's");
+    let tris = random_triangles(&mut SeedRng::seed_from_u64(seed), &fe, n);
+    let exp = Expected::new(fe, &tris);
+    let report = verilator_harness::frontend::run_frontend_against(m, seed, &tris, &exp);
+    eprintln!(
+        "{}: {} triangles, {} spans out, {} guard drops, {} clocks",
+        m.tag, report.triangles, report.segments, report.pulses, report.cycles
+    );
+    assert_clean(m.tag, seed, &report);
+    assert_eq!(report.segments, exp.spans.len() as u64);
+    assert_eq!(report.pulses, exp.guard_drops());
+    let report = run_frontend(m, seed ^ 5, Traffic::RANDOM, Stress::HARSH, &tris);
+    assert_clean(m.tag, seed, &report);
+    assert!(report.resets > 0, "{}: no reset in {} triangles", m.tag, tris.len());
+    // The set-up rate: one-row triangles and zero-area ones each take II clocks at full rate
+    // (both in the top-left pixels, so they fit every screen's ports).
+    let (per, _) = hw.setup_clocks();
+    let row = FixedTriangle { x: [64, 448, 64], y: [40, 40, 216], i: [100 << fe.cfg.frac; 3] };
+    let flat = FixedTriangle { x: [64, 128, 192], y: [64, 128, 192], i: [0; 3] };
+    assert_eq!(fe.setup(&row).0, Outcome::Walked, "the rate's one-row triangle is walked");
+    for tri in [row, flat] {
+        let k = 200u64;
+        let report = run_frontend(m, 1, Traffic::FULL, Stress::NONE, &vec![tri; k as usize]);
+        assert_clean(m.tag, 1, &report);
+        let slack = 2 * hw.latency() as u64 + m.screen.height as u64 + 8;
+        assert!(
+            report.cycles >= k * per as u64 && report.cycles <= k * per as u64 + slack,
+            "{}: {k} triangles took {} clocks; II is {per}",
+            m.tag,
+            report.cycles
+        );
+    }
+    // Negative control: one I0 off by one in the expectation is caught.
+    let mut bad = tris.clone();
+    let k = exp.stims.iter().position(|s| s.count > 0).unwrap();
+    bad[k].i[0] ^= 1 << 10;
+    let report = verilator_harness::frontend::run_frontend_against(m, seed, &tris, &Expected::new(fe, &bad));
+    assert!(!report.ok(), "{}: a wrong expectation went unnoticed", m.tag);
+}
+
+#[test]
+fn engine_spans_equal_golden_on_a_small_screen() {
+    let Some(opts) = engine(golden::setup::Screen { width: 37, height: 23 }, golden::frontend::engine::SetupForm::Ecp5_25f) else { return };
+    engine_spans_of(opts, 3000);
+}
+
+/// The slow tier (`--ignored`): the ECP5 plan at 640x480, the iCE40 plans at 37x23 (II = 120 and
+/// 270 clocks a triangle: 3,000 triangles are about a million clocks each); each builds a model
+/// on first use. `cargo nextest run -p verilator-harness --run-ignored only -E 'test(/engine_/)'`.
+#[test]
+#[ignore]
+fn engine_spans_equal_golden_at_640x480_and_on_the_ice40_plans() {
+    use golden::frontend::engine::SetupForm;
+    let small = golden::setup::Screen { width: 37, height: 23 };
+    for (screen, form) in
+        [(golden::setup::Screen::default(), SetupForm::Ecp5_25f), (small, SetupForm::Ice40Up5k), (small, SetupForm::Ice40Hx8k)]
+    {
+        let Some(opts) = engine(screen, form) else { return };
+        engine_spans_of(opts, 3000);
+    }
+}
+
+/// The shared-edge mesh through `tri_fb_p8` with the engine's front-end: every pixel of the
+/// screen written exactly once, at 37x23 and 640x480. Slow tier (a chain model each).
+#[test]
+#[ignore]
+fn engine_mesh_lands_in_memory_once_per_pixel() {
+    for screen in [golden::setup::Screen { width: 37, height: 23 }, golden::setup::Screen::default()] {
+        let Some(opts) = engine(screen, golden::frontend::engine::SetupForm::Ecp5_25f) else { return };
+        let m = verilator_harness::registry::tri_writer(&opts).unwrap_or_else(|e| panic!("{e}"));
+        let seed = verilator_harness::seed("tri_fb engine mesh");
+        let tris: Vec<FixedTriangle> = mesh(&mut SeedRng::seed_from_u64(seed), &m.frontend(), 13, 9);
+        let run = verilator_harness::writer::run_fb(m, seed, Traffic::RANDOM, &tris);
+        assert_clean(m.tag, seed, &run.report);
+        let writes = run.mem.screen_writes();
+        assert!(writes.iter().all(|&n| n == 1), "{}: every pixel of the screen written exactly once", m.tag);
+    }
+}
+
+/// Negative controls of the engine's co-simulation: a fault planted in the generated engine
+/// (each a model built on first use, 37x23) is caught on the triangles the clean model passes:
+/// one logic operation reading its operand's copy of the next triangle (a copy off by one
+/// period), a tile's passes added at the wrong weights (its accumulator never shifted), a division's quotient taken from the
+/// divider of another epoch (a binding rotated). Slow tier.
+#[test]
+#[ignore]
+fn engine_planted_faults_are_caught() {
+    use verilator_harness::ffi::{FeOut, TriIn};
+    let Some(opts) = engine(golden::setup::Screen { width: 37, height: 23 }, golden::frontend::engine::SetupForm::Ecp5_25f) else { return };
+    let base = verilator_harness::ondemand::describe(&opts, verilator_harness::models::Kind::Frontend).unwrap_or_else(|e| panic!("{e}"));
+    let seed = verilator_harness::seed("frontend engine faults");
+    let fe = opts.frontend().unwrap().fe;
+    let tris = random_triangles(&mut SeedRng::seed_from_u64(seed), &fe, 3000);
+    let engine = &base.sources.iter().find(|(n, _)| n == "tri_fe_engine.v").expect("the engine's file").1;
+    // The faults, found in the generated text (its names depend on the program's order).
+    let copy_line = engine
+        .lines()
+        .find(|l| l.trim_start().starts_with("wire [") && l.contains(" t") && l.contains("_1 "))
+        .expect("a logic operation reading a second copy");
+    let weight_line =
+        engine.lines().find(|l| l.trim_start().starts_with("assign m") && l.contains("_sh[")).expect("a tile's weight shifts");
+    let epoch_line = engine
+        .lines()
+        .find(|l| l.contains("<= (") && l.contains("_q[") && l.contains("(ep[2] || ep[5])"))
+        .expect("a quotient captured by epoch");
+    let faults = [
+        (copy_line.to_string(), copy_line.replacen("_1 ", "_0 ", 1), "an operand's copy off by one period"),
+        (
+            weight_line.to_string(),
+            format!("{}= 1'b0;", weight_line.split_once('=').unwrap().0),
+            "a tile's passes at the wrong weights (no shift)",
+        ),
+        (epoch_line.to_string(), epoch_line.replacen("(ep[2] || ep[5])", "(ep[3] || ep[0])", 1), "a quotient from another epoch's divider"),
+    ];
+    for (k, (from, to, what)) in faults.into_iter().enumerate() {
+        assert_ne!(from, to, "{what}: the fault does not apply");
+        let mut m = base.clone();
+        let file = m.sources.iter_mut().find(|(n, _)| n == "tri_fe_engine.v").expect("the engine's file");
+        file.1 = file.1.replacen(&from, &to, 1);
+        m.tag = format!("{}_fault{k}", base.tag);
+        let info = verilator_harness::ondemand::load::<TriIn, FeOut>(&m).unwrap_or_else(|e| panic!("{e}"));
+        let report = run_frontend(info, seed, Traffic::RANDOM, Stress::NONE, &tris);
+        eprintln!("{what}: {} mismatches", report.mismatch_count);
+        assert!(!report.ok(), "planted fault not caught: {what}");
+    }
+}
+
+/// The set-up engine's rate: ~10, ~100 and ~1000 px triangles through `tri_shader_p<P>` at full
+/// rate, p = 8 and 16 at 640x480, the ECP5 plan against the parallel set-up; busy clocks as
+/// `sweep` counts them, every segment checked. A measurement (docs/design.md, "The shared
+/// set-up engine in RTL"); it fails only on a mismatch. Slow tier (two chains a P).
+#[test]
+#[ignore]
+fn engine_throughput_against_the_parallel_set_up() {
+    use verilator_harness::frontend::drain_clocks;
+    let screen = golden::setup::Screen::default();
+    for p in [8, 16] {
+        let Some(mut opts) = engine(screen, golden::frontend::engine::SetupForm::Ecp5_25f) else { return };
+        opts.cfg = golden::Config::new(p, opts.cfg.frac, opts.cfg.xbits, golden::Align::Span).unwrap();
+        let eng = verilator_harness::registry::tri_shader(&opts).unwrap_or_else(|e| panic!("{e}"));
+        let par = verilator_harness::registry::tri_shader(&hdl_gen::Options { fe_setup: Default::default(), ..opts.clone() })
+            .unwrap_or_else(|e| panic!("{e}"));
+        for area in [10.0, 100.0, 1000.0] {
+            let mut rng = SeedRng::seed_from_u64(1);
+            let tris: Vec<FixedTriangle> =
+                (0..2000).map(|_| FixedTriangle::from_triangle(&sized(&mut rng, screen, area), opts.cfg.frac)).collect();
+            let busy = |m| {
+                let run = run_chain(m, 1, Traffic::FULL, &tris);
+                assert_clean(m.tag, 1, &run.report);
+                (run.report.cycles - drain_clocks(m.latency, &m.frontend()), run.report.pixels, run.report.segments)
+            };
+            let ((ce, px, segs), (cp, _, _)) = (busy(eng), busy(par));
+            eprintln!(
+                "p = {p}, ~{area} px: engine {ce} clocks ({:.2} px/clock, {:.1} triangles/1000 clocks, {:.1} clocks a triangle), parallel {cp}: {:+.1} %; {segs} segments",
+                px as f64 / ce as f64,
+                1000.0 * tris.len() as f64 / ce as f64,
+                ce as f64 / tris.len() as f64,
+                100.0 * (ce as f64 / cp as f64 - 1.0)
+            );
+        }
+    }
+}
+
+/// The slow tier: the widest formats (F = 20, XW = 16: II 14, the binding repeating every 12
+/// triangles) and the smallest (F = 4, XW = 4 on 16x8: II 8), the ECP5 plan.
+#[test]
+#[ignore]
+fn engine_spans_equal_golden_at_other_formats() {
+    let form = golden::frontend::engine::SetupForm::Ecp5_25f;
+    let Some(opts) = engine(golden::setup::Screen::default(), form) else { return };
+    let wide = golden::Config::new(8, 20, 16, golden::Align::Span).unwrap();
+    engine_spans_of(hdl_gen::Options { cfg: wide, ..opts.clone() }, 3000);
+    let small = golden::Config::new(8, 4, 4, golden::Align::Span).unwrap();
+    let screen = Some(golden::setup::Screen { width: 16, height: 8 });
+    engine_spans_of(hdl_gen::Options { cfg: small, screen, ..opts }, 3000);
+}

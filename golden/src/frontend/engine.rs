@@ -39,7 +39,8 @@ use serde::{Deserialize, Serialize};
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum MulUnit {
-    /// One hard multiplier of `bits` x `bits` (ECP5 MULT18X18D: 18; iCE40 SB_MAC16: 16). A
+    /// One hard multiplier of `bits` x `bits` (ECP5 MULT18X18D: 18; iCE40 SB_MAC16: 16), or, as
+    /// the RTL infers it, of `bits + 1`-bit signed operands (17 and 15: [`Plan::TILE18_RTL`]). A
     /// wider product is cut into `bits`-wide chunks of each operand and takes one pass a chunk
     /// pair, accumulated at the pair's weight; passes wholly above the bits the product keeps
     /// are skipped. The sign is handled per chunk (ECP5's SIGNEDA/B are inputs) or as
@@ -82,24 +83,31 @@ pub struct Plan {
 }
 
 impl Plan {
-    /// ECP5 MULT18X18D tiles.
+    /// ECP5 MULT18X18D tiles, 18-bit chunks (the sign per chunk, as the tile's SIGNEDA/B
+    /// inputs can take it): the estimates' grid.
     pub const TILE18: MulUnit = MulUnit::Tile { bits: 18 };
+    /// The same tiles as the RTL infers them: 17-bit chunks, each an 18-bit signed operand of
+    /// fixed signedness (a lower chunk zero-extended, the top one sign-extended), so synthesis
+    /// maps a pass onto one MULT18X18D. At 640x480 the set-up's products take as many passes
+    /// as with 18-bit chunks (75), and the schedule the same II and latency.
+    pub const TILE18_RTL: MulUnit = MulUnit::Tile { bits: 17 };
 
     /// docs/design.md's recommendation for the ECP5-25F: 12 clocks a triangle on 12 MULT18X18D
     /// and twelve 1-bit dividers, the incremental steps left to the walker's start evaluator.
     pub const ECP5_25F: Plan = Plan {
         mults: 12,
-        mul: Plan::TILE18,
+        mul: Plan::TILE18_RTL,
         dividers: 12,
         div_bits: 1,
         div_form: DivForm::ShiftRemainder,
         reciprocal: true,
         i0_steps: false,
     };
-    /// For the iCE40 UP5K: 2 of its SB_MAC16 and one 1-bit divider, the smallest engine.
+    /// For the iCE40 UP5K: 2 of its SB_MAC16 and one 1-bit divider, the smallest engine. 15-bit
+    /// chunks, 16-bit signed operands (as [`Plan::TILE18_RTL`]): 120 clocks a triangle either way.
     pub const ICE40_UP5K: Plan = Plan {
         mults: 2,
-        mul: MulUnit::Tile { bits: 16 },
+        mul: MulUnit::Tile { bits: 15 },
         dividers: 1,
         div_bits: 1,
         div_form: DivForm::ShiftRemainder,
@@ -116,6 +124,20 @@ impl Plan {
         reciprocal: false,
         i0_steps: false,
     };
+}
+
+pub use super::SetupForm;
+
+impl SetupForm {
+    /// The engine's plan; `None` for the parallel set-up.
+    pub fn plan(self) -> Option<Plan> {
+        match self {
+            SetupForm::Parallel => None,
+            SetupForm::Ecp5_25f => Some(Plan::ECP5_25F),
+            SetupForm::Ice40Up5k => Some(Plan::ICE40_UP5K),
+            SetupForm::Ice40Hx8k => Some(Plan::ICE40_HX8K),
+        }
+    }
 }
 
 /// A value of the program: the result of the operation with this index.

@@ -52,6 +52,22 @@ pub(super) struct EdgeBuses {
 /// The buses into the edges: `(port, bus name, lane width)`; the caller declares them.
 pub(super) fn input_buses(hw: &Hw) -> EdgeBuses {
     let e = EdgeWidths::new(hw);
+    if hw.engine_form() {
+        // The shared engine's result: the edge's set-up complete, divisions made.
+        return EdgeBuses {
+            inputs: vec![
+                ("act", "e_act", 1),
+                ("right", "e_right", 1),
+                ("rs", "e_rs", e.row_w),
+                ("re", "e_re", e.row_w),
+                ("d", "e_d", e.ediv_w),
+                ("g", "e_g", e.bound_w),
+                ("rem", "e_rem", e.ediv_w),
+                ("qs", "e_qs", e.bound_w),
+                ("rs256", "e_rs256", e.ediv_w),
+            ],
+        };
+    }
     EdgeBuses {
         inputs: vec![
             ("n", "e_n", e.pw_init),
@@ -110,6 +126,7 @@ pub(super) fn state_outputs(hw: &Hw) -> Vec<(&'static str, u32, bool, String, &'
 pub(super) fn instances(hw: &Hw, names: &Names, buses: &EdgeBuses) -> Item {
     let e = EdgeWidths::new(hw);
     let lane = |bus: &str, w: u32| if w == 1 { format!("{bus}[k]") } else { format!("{bus}[k*{w} +: {w}]") };
+    let engine = hw.engine_form();
     let mut conns: Vec<(String, String)> = [
         ("clk", "clk"),
         ("calc_go", "calc_go"),
@@ -122,6 +139,7 @@ pub(super) fn instances(hw: &Hw, names: &Names, buses: &EdgeBuses) -> Item {
         ("hi", "hi0"),
     ]
     .iter()
+    .filter(|(p, _)| !engine || !["calc_go", "div_run", "div_cnt"].contains(p))
     .map(|(p, s)| (p.to_string(), s.to_string()))
     .collect();
     conns.extend(buses.inputs.iter().map(|(port, bus, w)| (port.to_string(), lane(bus, *w))));
@@ -143,6 +161,9 @@ pub(super) fn dividers(hw: &Hw) -> [Div; 2] {
 
 /// `tri_fe_edge`.
 pub(super) fn module(hw: &Hw, names: &Names) -> Module {
+    if hw.engine_form() {
+        return module_engine(hw, names);
+    }
     let e = EdgeWidths::new(hw);
     let EdgeWidths { row_w, vy_w, bound_w, ediv_w, end_w, pw_init, pw_step, cnt_w } = e;
     let header = vec![
@@ -197,8 +218,29 @@ pub(super) fn module(hw: &Hw, names: &Names) -> Module {
         body.extend(d.instance(&names.fe_div, hw.div_bits, cnt_w, &conns, &["q"]));
     }
     let flip = |q: &str| offset_to_signed(q, bound_w);
-    body.push(Item::Blank);
-    body.push(comment("Walker: the edge's DDA state, loaded from the set-up result."));
+    body.extend(dda(&e));
+    let load = vec![
+        set("w_act", "s_act"),
+        set("w_right", "s_right"),
+        set("w_rs", "s_rs"),
+        set("w_re", "s_re"),
+        set("w_d", "s_d"),
+        set("w_g", flip("ei_q")),
+        set("w_rem", format!("ei_p[{}:0]", ediv_w - 1)),
+        set("w_qs", flip("es_q")),
+        set("w_rs256", format!("{{es_p[{}:0], 8'd0}}", vy_w - 1)),
+    ];
+    body.push(walk(&e, load));
+    for (port, _, _, signal, _) in state_outputs(hw) {
+        body.push(Item::Assign(port.into(), signal));
+    }
+    Module { name: names.fe_edge.clone(), header, params: vec![], ports, body }
+}
+
+/// The walker's DDA of an edge: its state, its bound on the row, its step.
+fn dda(e: &EdgeWidths) -> Vec<Item> {
+    let EdgeWidths { row_w, bound_w, ediv_w, end_w, .. } = *e;
+    let mut body = vec![Item::Blank, comment("Walker: the edge's DDA state, loaded from the set-up result.")];
     body.extend([reg("w_act", 1), reg("w_right", 1), reg("w_rs", row_w), reg("w_re", row_w), reg("w_d", ediv_w)]);
     body.extend([reg("w_rem", ediv_w), reg("w_rs256", ediv_w), sreg("w_g", bound_w), sreg("w_qs", bound_w)]);
     body.push(wire("in_rows", 1, "w_act && row >= w_rs && row <= w_re"));
@@ -213,21 +255,47 @@ pub(super) fn module(hw: &Hw, names: &Names) -> Module {
     body.push(comment("verilator lint_off UNUSEDSIGNAL"));
     body.push(wire("rnext", ediv_w + 1, format!("cy ? rsum - {d1} : rsum")));
     body.push(comment("verilator lint_on UNUSEDSIGNAL"));
-    let load = vec![
-        set("w_act", "s_act"),
-        set("w_right", "s_right"),
-        set("w_rs", "s_rs"),
-        set("w_re", "s_re"),
-        set("w_d", "s_d"),
-        set("w_g", flip("ei_q")),
-        set("w_rem", format!("ei_p[{}:0]", ediv_w - 1)),
-        set("w_qs", flip("es_q")),
-        set("w_rs256", format!("{{es_p[{}:0], 8'd0}}", vy_w - 1)),
-    ];
+    body
+}
+
+/// The DDA's always block: `load` on take, else a step on an active row.
+fn walk(e: &EdgeWidths, load: Vec<Stmt>) -> Item {
+    let EdgeWidths { bound_w, ediv_w, .. } = *e;
     let step = vec![set("w_rem", format!("rnext[{}:0]", ediv_w - 1)), set("w_g", format!("w_g + w_qs + {}", zext("cy", 1, bound_w)))];
-    body.push(Item::Always(vec![Stmt::If("take".into(), load, vec![Stmt::If("step && w_act && row >= w_rs".into(), step, vec![])])]));
-    for (port, _, _, signal, _) in state_outputs(hw) {
-        body.push(Item::Assign(port.into(), signal));
+    Item::Always(vec![Stmt::If("take".into(), load, vec![Stmt::If("step && w_act && row >= w_rs".into(), step, vec![])])])
+}
+
+/// `tri_fe_edge` behind the shared set-up engine: the set-up result arrives complete (the
+/// engine made the divisions), so the edge is its DDA only.
+fn module_engine(hw: &Hw, names: &Names) -> Module {
+    let e = EdgeWidths::new(hw);
+    let EdgeWidths { row_w, bound_w, ediv_w, end_w, .. } = e;
+    let header = vec![
+        format!("{} — one edge of {}'s triangle (edge k from vertex k+1 to vertex k+2; three instances).", names.fe_edge, names.frontend),
+        "Generated by segshade hdl-gen; do not edit.".into(),
+        String::new(),
+        format!("Its set-up result comes from the shared set-up engine ({}) through the queue: rows rs..re, side,", names.fe_engine),
+        "divisor D = 256 |dy|, first bound g with its remainder, step qs with rs256 = 256 (its remainder).".into(),
+        "Walker (take: load; step: the next row): on an active row g += qs + carry, the remainder".into(),
+        "rem += rs256 modulo D (one add, compare, subtract); lg/ha is g on the edge's side of the row, else lo/hi.".into(),
+        format!("Widths: bound GW = {bound_w} signed, divisor {ediv_w}, rows {row_w}, bounds out {end_w} signed."),
+    ];
+    let mut ports = vec![Port::input("clk", 1, "", "rising edge")];
+    for (port, _, w) in input_buses(hw).inputs {
+        let p = Port::input(port, w, "", &format!("the set-up result's {port}"));
+        ports.push(if port == "g" || port == "qs" { p.signed() } else { p });
     }
+    ports.extend([
+        Port::input("take", 1, "", "the walker loads the set-up result"),
+        Port::input("step", 1, "", "the walker moves to the next row"),
+        Port::input("row", row_w, "unsigned integer", "the walked row"),
+        Port::input("lo", end_w, "signed integer", "the screen's left bound (as -x)").signed(),
+        Port::input("hi", end_w, "signed integer", "the screen's right bound").signed(),
+        Port::output("lg", end_w, "signed integer", "a left edge's bound on the row (as -x), else lo").signed(),
+        Port::output("ha", end_w, "signed integer", "a right edge's bound on the row, else hi").signed(),
+    ]);
+    let mut body = dda(&e);
+    let load = ["act", "right", "rs", "re", "d", "g", "rem", "qs", "rs256"].map(|p| set(format!("w_{p}"), p)).to_vec();
+    body.push(walk(&e, load));
     Module { name: names.fe_edge.clone(), header, params: vec![], ports, body }
 }

@@ -22,7 +22,23 @@ pub struct Hw {
     pub pipeline: golden::pipeline::Pipeline,
 }
 
+/// Entries of the set-up result queue behind the shared engine (`--fe-setup` not `parallel`):
+/// two, so the next triangle's set-up waits behind the one being walked without freezing the
+/// engine.
+pub const QUEUE_DEPTH: u32 = 2;
+
 impl Hw {
+    /// Whether the set-up is the shared engine (`--fe-setup` not `parallel`).
+    pub fn engine_form(&self) -> bool {
+        self.fe.setup.plan().is_some()
+    }
+
+    /// The shared set-up engine's schedule (golden's, the one the RTL runs), `None` for the
+    /// parallel set-up.
+    pub fn engine(&self) -> Option<golden::frontend::engine::schedule::Schedule> {
+        self.fe.engine().map(|s| s.expect("the named plans schedule (golden's tests)"))
+    }
+
     /// Clocks the dividers run: the reciprocal's RW quotient bits, `div_bits` a clock.
     pub fn div_clocks(&self) -> u32 {
         self.fe.widths().rw.div_ceil(self.div_bits)
@@ -51,7 +67,14 @@ impl Hw {
     /// Clocks from a triangle's transfer to the first span's `out_valid` when the walker is
     /// idle: CALC, the dividers, the hand-off, the walker's clock, the span path's stages (and,
     /// per scanline, the span's division when it has two pixels or more).
+    ///
+    /// With the shared engine: up to II - 1 clocks waiting for the engine's entry slot, the
+    /// entry clock, the schedule's latency, the queue, the walker's load and the span path: the
+    /// figure is the worst case of the slot's wait.
     pub fn latency(&self) -> u32 {
+        if let Some(s) = self.engine() {
+            return s.ii + s.latency + 3 + self.i0_stages();
+        }
         self.calc_clocks() + self.div_clocks() + 2 + self.i0_stages() + self.span_div_clocks() + self.start_clocks()
     }
 
@@ -77,7 +100,11 @@ impl Hw {
     /// dividers, then the hand-off clock, which is also the next triangle's last CALC clock),
     /// and per triangle dropped in set-up (its last CALC clock). CALC's earlier stages overlap
     /// the triangle ahead's division, so neither depends on the pipeline level.
+    /// With the shared engine every triangle takes one entry slot, II clocks, walked or dropped.
     pub fn setup_clocks(&self) -> (u32, u32) {
+        if let Some(s) = self.engine() {
+            return (s.ii, s.ii);
+        }
         (self.div_clocks() + 1 + self.start_clocks(), 1)
     }
 }

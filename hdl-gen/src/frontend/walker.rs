@@ -38,7 +38,10 @@ pub(super) fn emit(hw: &Hw, names: &Names, body: &mut Vec<Item>) {
     }
     body.push(wire("w_end", 1, "w_row == w_last"));
     let inc = super::incremental::on(hw);
-    if !inc {
+    let engine = hw.engine_form();
+    if engine {
+        body.push(assign("take", "q_ne && adv && (!w_valid || w_end)"));
+    } else if !inc {
         body.push(assign("take", "st == HOLD && adv && (!w_valid || w_end)"));
     }
     let end_w = edge::end_width(hw);
@@ -98,7 +101,7 @@ pub(super) fn emit(hw: &Hw, names: &Names, body: &mut Vec<Item>) {
     load.extend([
         set("w_di", "r_di"),
         set("w_an", "s_an"),
-        set("w_rn", "drn_q"),
+        set("w_rn", if engine { "r_rn" } else { "drn_q" }),
         set("w_tn", "s_tn"),
         set("w_gxn", "s_gxn"),
         set("w_dyn", "s_dyn"),

@@ -91,6 +91,9 @@ pub struct Schedule {
     pub cost: Cost,
     /// Every (operation, unit) of a stretch of steady-state triangles.
     pub rotation: Vec<(usize, u32)>,
+    /// Per operation on a unit, the unit it runs on for each triangle of a stretch of
+    /// steady-state triangles, in entry order (empty for the others).
+    pub binding: Vec<Vec<u32>>,
 }
 
 /// What feeds a unit's port: (value, chunk) pairs, or a product's chunk weights.
@@ -110,11 +113,26 @@ fn class(k: &Kind) -> Class {
     }
 }
 
+fn gcd(a: u32, b: u32) -> u32 {
+    if b == 0 {
+        a
+    } else {
+        gcd(b, a % b)
+    }
+}
+
 /// The chunk pairs a product takes on a tile of `bits`: `(i, j)`, low chunks first, those
 /// wholly above the kept bits left out.
 fn pairs(wa: u32, wb: u32, keep: u32, bits: u32) -> Vec<(u32, u32)> {
     let (ca, cb) = (ceil(wa, bits), ceil(wb, bits));
     (0..ca).flat_map(|i| (0..cb).map(move |j| (i, j))).filter(|&(i, j)| (i + j) * bits < keep).collect()
+}
+
+impl FrontEnd {
+    /// The set-up engine's schedule, for a form with one (`None`: the parallel set-up).
+    pub fn engine(&self) -> Option<Result<Schedule, EngineError>> {
+        self.setup.plan().map(|p| p.schedule(self))
+    }
 }
 
 impl Plan {
@@ -159,7 +177,17 @@ impl Schedule {
         let ready: Vec<u32> = (0..n).map(|o| start[o] + timing[o].2).collect();
         let latency = prog.out.all().iter().map(|v| ready[v.0 as usize]).max().unwrap_or(0);
         let slots = (0..n).map(|o| Slot { class: timing[o].0, unit: None, start: start[o], busy: timing[o].1, ready: ready[o] }).collect();
-        let mut s = Schedule { plan, prog, ii, latency, slots, copies: vec![1; n], cost: Cost::default(), rotation: Vec::new() };
+        let mut s = Schedule {
+            plan,
+            prog,
+            ii,
+            latency,
+            slots,
+            copies: vec![1; n],
+            cost: Cost::default(),
+            rotation: Vec::new(),
+            binding: vec![Vec::new(); n],
+        };
         s.copies = s.copies_needed();
         s.bind();
         s.cost = s.cost();
@@ -249,7 +277,9 @@ impl Schedule {
     /// keeps a steady-state triangle's binding in the slots.
     fn bind(&mut self) {
         let span = ceil(self.latency + 1, self.ii) as usize;
-        let tris = 4 * span + 4;
+        // The binding is kept over 8 span steady triangles, which end a span before the
+        // unrolled stretch does: the last triangles see fewer contenders and bind otherwise.
+        let tris = 12 * span + 4;
         let steady = 2 * span + 2;
         for c in [Class::Mul, Class::Div] {
             let mut iv: Vec<(u32, usize, usize)> = Vec::new();
@@ -312,8 +342,15 @@ impl Schedule {
         if j == steady {
             self.slots[o].unit = Some(u as u32);
         }
-        if (steady..steady + span).contains(&j) {
-            self.rotation.push((o, u as u32));
+        if (steady..steady + 8 * span).contains(&j) {
+            if j < steady + span {
+                self.rotation.push((o, u as u32));
+            }
+            let b = &mut self.binding[o];
+            if b.len() <= j - steady {
+                b.resize(j - steady + 1, u32::MAX);
+            }
+            b[j - steady] = u as u32;
         }
     }
 
@@ -473,6 +510,62 @@ impl Schedule {
             out.push(self.prog.out.extract(t, |v| fetch(&hist, v.0 as usize, at, j).0));
         }
         out
+    }
+
+    /// The binding's period in triangles: the smallest `R` for which every operation on a unit
+    /// runs on the same unit as `R` triangles before (the least common multiple of each
+    /// operation's own period over the steady stretch [`Schedule::bind`] unrolls; `None` if one
+    /// has none there). An operation no busier than II keeps one unit
+    /// (`R = 1`); one busier alternates. The RTL selects a unit's operands by phase and by the
+    /// triangle's number modulo `R` (its epoch).
+    pub fn epochs(&self) -> Option<u32> {
+        let mut r = 1u32;
+        for o in 0..self.binding.len() {
+            if !self.binding[o].is_empty() {
+                let p = self.period(o)?;
+                r = r / gcd(r, p) * p;
+            }
+        }
+        Some(r)
+    }
+
+    /// Operation `o`'s own period: the smallest `p` with every triangle on the unit of the one
+    /// `p` before, seen at least twice over the stretch. [`Schedule::epochs`] is their least
+    /// common multiple.
+    fn period(&self, o: usize) -> Option<u32> {
+        let b = &self.binding[o];
+        (1..=b.len() / 2).find(|&p| b.iter().enumerate().all(|(i, &u)| u == b[i % p] && u != u32::MAX)).map(|p| p as u32)
+    }
+
+    /// Checks the periodic binding ([`Schedule::epochs`]) from the first triangle on: no unit
+    /// runs two operations in one clock. The RTL binds by epoch from reset.
+    pub fn verify_binding(&self) -> Result<u32, String> {
+        let r = self.epochs().ok_or("the binding has no period")?;
+        let span = ceil(self.latency + 1, self.ii);
+        for c in [Class::Mul, Class::Div] {
+            let mut iv: Vec<(u32, u32, u32, usize)> = Vec::new();
+            for j in 0..r * (span + 2) {
+                for (o, s) in self.slots.iter().enumerate().filter(|(_, s)| s.class == c) {
+                    let u = self.unit_of(o, j % r).ok_or("an operation on no unit")?;
+                    iv.push((u, j * self.ii + s.start, j * self.ii + s.start + s.busy, o));
+                }
+            }
+            iv.sort();
+            for w in iv.windows(2) {
+                if w[0].0 == w[1].0 && w[1].1 < w[0].2 {
+                    let name = |o: usize| &self.prog.ops[o].name;
+                    return Err(format!("{:?} unit {}: {} and {} overlap at clock {}", c, w[0].0, name(w[0].3), name(w[1].3), w[1].1));
+                }
+            }
+        }
+        Ok(r)
+    }
+
+    /// The unit operation `o` runs on for a triangle of epoch `e` (its number modulo
+    /// [`Schedule::epochs`]).
+    pub fn unit_of(&self, o: usize, e: u32) -> Option<u32> {
+        let p = self.period(o)?;
+        self.binding[o].get((e % p) as usize).copied()
     }
 
     /// The unit operations in start order: `clock unit name (busy)`, for documents and reviews.

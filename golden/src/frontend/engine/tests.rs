@@ -94,6 +94,26 @@ fn engine_equals_setup() {
     }
 }
 
+/// The named plans the RTL runs (`SetupForm`), as they schedule, equal `setup` on 500 random
+/// triangles at 640x480 and at 37x23, the co-simulation's screens (about 0.3 s).
+#[test]
+fn the_named_plans_equal_setup() {
+    let seed = test_seed("the_named_plans_equal_setup");
+    let mut rng = SeedRng::seed_from_u64(seed);
+    for screen in [Screen::default(), Screen { width: 37, height: 23 }] {
+        let fe = FrontEnd::new(Config::default(), screen).unwrap();
+        let tris = random_fixed_triangles(&mut rng, &fe, 500);
+        for form in SetupForm::ALL {
+            let Some(p) = form.plan() else { continue };
+            let s = p.schedule(&fe).unwrap();
+            s.verify().unwrap();
+            if let Some(m) = first_mismatch(&fe, &s, &tris) {
+                panic!("{form:?} on {screen:?}: {m}");
+            }
+        }
+    }
+}
+
 /// 10^6 random triangles of every kind at 640x480, and as many on the small and the widest
 /// screen, through every plan of `plans()`: `cargo test --release -p golden --lib
 /// engine_equals_setup_on -- --ignored` (time in docs/design.md).
@@ -270,4 +290,43 @@ fn the_recommended_plans() {
 fn engine_listing() {
     let s = Plan::ECP5_25F.schedule(&fe640()).unwrap();
     println!("II {} latency {}\n{}", s.ii, s.latency, s.listing());
+}
+
+/// The binding the RTL runs is periodic: every plan the generator offers, at three screens.
+#[test]
+fn the_binding_is_periodic() {
+    use crate::frontend::engine::SetupForm;
+    let wide = Config::new(8, 20, 16, Align::Span).unwrap();
+    let small = Config::new(8, 4, 4, Align::Span).unwrap();
+    let cases = [
+        (Config::default(), Screen::default()),
+        (Config::default(), Screen { width: 37, height: 23 }),
+        (Config::default(), Screen { width: 4096, height: 4096 }),
+        (wide, Screen::default()),
+        (small, Screen { width: 16, height: 8 }),
+    ];
+    for (cfg, screen) in cases {
+        let fe = FrontEnd::new(cfg, screen).unwrap();
+        for form in SetupForm::ALL {
+            let Some(plan) = form.plan() else { continue };
+            let s = plan.schedule(&fe).unwrap();
+            let r = s.epochs().unwrap_or_else(|| panic!("{form:?} at {screen:?}: no period in {:?}", s.binding));
+            eprintln!("{form:?} {}x{}: II {} latency {} epochs {r}", screen.width, screen.height, s.ii, s.latency);
+            assert_eq!(s.verify_binding(), Ok(r));
+            // Negative control: a binding broken in one triangle has no period.
+            let mut bad = s.clone();
+            let o = bad.binding.iter().position(|b| !b.is_empty()).unwrap();
+            let last = bad.binding[o].len() - 1;
+            bad.binding[o][last] += 1;
+            assert_eq!(bad.epochs(), None);
+            // And one that puts two operations on one unit at once is refused.
+            let mut bad = s.clone();
+            let o = bad.binding.iter().position(|b| !b.is_empty()).unwrap();
+            let same = |k: usize| k != o && bad.slots[k].class == bad.slots[o].class && bad.slots[k].start == bad.slots[o].start;
+            if let Some(p) = (0..bad.binding.len()).find(|&k| same(k)) {
+                bad.binding[p] = bad.binding[o].clone();
+                assert!(bad.verify_binding().is_err());
+            }
+        }
+    }
 }
