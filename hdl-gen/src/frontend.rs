@@ -96,6 +96,7 @@ fn build(hw: &Hw, names: &Names) -> (Module, Vec<golden::pipeline::PipeStage>) {
         let sp = span::path(hw, &mut body);
         let sp = span::output(hw, names, sp, &mut body);
         let stages = if hw.calc_clocks() > 1 { stage_list(&sp, "span", &golden::pipeline::I0_STAGES) } else { Vec::new() };
+        body.push(properties::emit_engine(hw, &sp));
         let module = Module {
             name: names.frontend.clone(),
             header: header(hw, names),

@@ -64,7 +64,7 @@ fn prove_refuses_bad_arguments() {
     let out = hdl_gen(&["generate", "--p", "1", "--out", spaced.to_str().unwrap()]);
     assert!(out.status.success());
     let (e, s) = (empty.to_str().unwrap(), spaced.to_str().unwrap());
-    // The shared set-up engine's front-end has no properties yet: its folder is refused.
+    // The shared set-up engine's front-end: its folder is taken (it has properties of its own).
     let engine = dir.join("engine");
     let out =
         hdl_gen(&["generate", "--p", "1", "--width", "37", "--height", "23", "--fe-setup", "ecp5-25f", "--out", engine.to_str().unwrap()]);
@@ -80,7 +80,6 @@ fn prove_refuses_bad_arguments() {
         (&["--rtl", ""], &["--rtl needs a value"]),
         (&["--rtl", missing.to_str().unwrap()], &["is not a folder"]),
         (&["--rtl", e], &["holds no Verilog module with properties"]),
-        (&["--rtl", engine.to_str().unwrap()], &["its front-end is the shared set-up engine (--fe-setup)"]),
         (&["--rtl", s, "--only", "("], &["--only '('", "not a valid regular expression"]),
         (&["--rtl", s, "--skip", "[a"], &["--skip '[a'"]),
         (&["--only"], &["--only needs a value"]),
@@ -96,6 +95,7 @@ fn prove_refuses_bad_arguments() {
     let yosys = Command::new("yosys-smtbmc").arg("-h").output().is_ok();
     if venv.exists() && yosys {
         assert_refused("prove", &["--rtl", s, "--only", "NOMATCH"], &["--only 'NOMATCH' matches no proof"], &dir);
+        assert_refused("prove", &["--rtl", engine.to_str().unwrap(), "--only", "NOMATCH"], &["--only 'NOMATCH' matches no proof"], &dir);
         assert_refused("prove", &["--self-test", "--only", "NOMATCH"], &["--only 'NOMATCH' matches no planted fault"], &dir);
     } else {
         eprintln!("cli_scripts: skipped: prove --only NOMATCH needs yosys and target/formal-venv (scripts/test installs them)");

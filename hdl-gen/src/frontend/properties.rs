@@ -7,13 +7,55 @@ use super::setup::{self, Setup};
 use super::span;
 use super::stager::Stager;
 use crate::formal::{assert, covers, past_flags, reset_and_stability, slit, when, CUT_TAG, OUT};
-use crate::verilog::{comment, lit, reg, set, sext, wire, zext, Item, Stmt};
+use crate::verilog::{bit, comment, lit, net, reg, set, sext, wire, zext, Item, Stmt};
 
 pub(super) fn emit(hw: &Hw, set_up: Setup, sp: &Stager) -> Item {
     let fe = &hw.fe;
-    let wd = fe.widths();
     let Setup { st, div_regs, cnt_w, guard, cull } = set_up;
-    frontend_properties(&FrontendShape {
+    let mut shape = shape(
+        hw,
+        sp,
+        SetupShape::Parallel(ParallelSetup {
+            cnt_w,
+            bits: hw.div_bits,
+            rw: fe.widths().rw,
+            div_clocks: hw.div_clocks(),
+            div_regs,
+            calc_stages: (1..=st.stage())
+                .map(|j| CalcStage {
+                    valid: setup::valid(j),
+                    guard: st.held("guard_ok", j).expect("the guard-band check reaches the last stage"),
+                    ymin: st.held("ymin", j),
+                    ymax: st.held("ymax", j),
+                    first_s: st.held("first_s", j),
+                    last_s: st.held("last_s", j),
+                    cull: st.held("cull", j),
+                    last_alt: ["last_s0", "last_s1"].iter().filter_map(|n| st.held(n, j)).collect(),
+                })
+                .collect(),
+            guard,
+            cull,
+        }),
+    );
+    shape.starts = super::incremental::on(hw).then_some(super::incremental::START_CLOCKS);
+    frontend_properties(&shape)
+}
+
+/// The engine form's properties (`--fe-setup` a plan): the same walker and span path, behind
+/// the shared engine and its result queue.
+pub(super) fn emit_engine(hw: &Hw, sp: &Stager) -> Item {
+    let s = hw.engine().expect("the engine form");
+    let epochs = s.verify_binding().unwrap_or_else(|e| panic!("golden's binding: {e}"));
+    let engine =
+        EngineShape { ii: s.ii, latency: s.latency, epochs, depth: super::QUEUE_DEPTH, entry_w: super::engine::entry_bits(hw, &s) };
+    frontend_properties(&shape(hw, sp, SetupShape::Engine(engine)))
+}
+
+/// What both forms share: widths, screen, the span path's stages.
+fn shape(hw: &Hw, sp: &Stager, setup: SetupShape) -> FrontendShape {
+    let fe = &hw.fe;
+    let wd = fe.widths();
+    FrontendShape {
         yw: wd.yw,
         cx: wd.cx,
         cy: wd.cy,
@@ -21,37 +63,19 @@ pub(super) fn emit(hw: &Hw, set_up: Setup, sp: &Stager) -> Item {
         dw: fe.cfg.dw(),
         width: fe.screen.width as u64,
         height: fe.screen.height as u64,
-        cnt_w,
-        bits: hw.div_bits,
-        rw: wd.rw,
-        div_clocks: hw.div_clocks(),
         latency: hw.latency(),
-        div_regs,
-        calc_stages: (1..=st.stage())
-            .map(|j| CalcStage {
-                valid: setup::valid(j),
-                guard: st.held("guard_ok", j).expect("the guard-band check reaches the last stage"),
-                ymin: st.held("ymin", j),
-                ymax: st.held("ymax", j),
-                first_s: st.held("first_s", j),
-                last_s: st.held("last_s", j),
-                cull: st.held("cull", j),
-                last_alt: ["last_s0", "last_s1"].iter().filter_map(|n| st.held(n, j)).collect(),
-            })
-            .collect(),
-        guard,
-        cull,
+        setup,
         span_stages: (1..=sp.stage())
             .map(|j| {
                 let held = |n: &str| sp.held(n, j).expect("a span's fields reach the output");
                 SpanStage { valid: span::valid(j), y: held("y"), x: held("x"), len: held("len"), di: held("di") }
             })
             .collect(),
-        starts: super::incremental::on(hw).then_some(super::incremental::START_CLOCKS),
-    })
+        starts: None,
+    }
 }
 
-/// What the front-end's proof needs from its generator: widths, screen, divider clocks.
+/// What the front-end's proof needs from its generator: widths, screen, its set-up's shape.
 pub struct FrontendShape {
     /// Row bits (`out_y`), vertex x and y bits.
     pub yw: u32,
@@ -63,14 +87,35 @@ pub struct FrontendShape {
     /// Screen width and height, pixels.
     pub width: u64,
     pub height: u64,
+    /// Clocks from a triangle's transfer to its first span (`Hw::latency`): the cover search's depth.
+    pub latency: u32,
+    /// The set-up in front of the walker.
+    pub setup: SetupShape,
+    /// The span path's register stages between the walker and the output, in order.
+    pub span_stages: Vec<SpanStage>,
+    /// The incremental I0 (`--fe-i0 incremental`): its start engine's clocks. The walker then
+    /// waits while a source starts (`ie_wait`, a data decision taken as given, like a row's
+    /// coverage) and the held triangle is taken once its first row is started (`ie_pv`); the
+    /// engine's own properties bound both waits.
+    pub starts: Option<u32>,
+}
+
+/// The set-up the reference follows in front of the walker.
+pub enum SetupShape {
+    /// CALC (in one clock or in stages), the dividers and the DIV/HOLD state machine.
+    Parallel(ParallelSetup),
+    /// The shared engine (`--fe-setup` a plan) and its result queue.
+    Engine(EngineShape),
+}
+
+/// The parallel set-up's shape.
+pub struct ParallelSetup {
     /// The dividers' counter width, quotient bits per clock, the reciprocal's quotient bits,
     /// and the clocks they run (`Hw::div_clocks`).
     pub cnt_w: u32,
     pub bits: u32,
     pub rw: u32,
     pub div_clocks: u32,
-    /// Clocks from a triangle's transfer to its first span (`Hw::latency`): the cover search's depth.
-    pub latency: u32,
     /// The set-up dividers' registers (partial remainder, divisor, quotient of each), as Yosys
     /// names them once the design is flattened (`instance.register`, `*` for a generate loop's
     /// index): cut.
@@ -80,13 +125,18 @@ pub struct FrontendShape {
     /// The names under which the last CALC stage holds the guard-band check and the cull.
     pub guard: String,
     pub cull: String,
-    /// The span path's register stages between the walker and the output, in order.
-    pub span_stages: Vec<SpanStage>,
-    /// The incremental I0 (`--fe-i0 incremental`): its start engine's clocks. The walker then
-    /// waits while a source starts (`ie_wait`, a data decision taken as given, like a row's
-    /// coverage) and the held triangle is taken once its first row is started (`ie_pv`); the
-    /// engine's own properties bound both waits.
-    pub starts: Option<u32>,
+}
+
+/// The shared engine's shape (golden's schedule and the queue behind it).
+pub struct EngineShape {
+    /// Clocks between entries (II), the schedule's latency from the entry to the result, and
+    /// the binding's period in triangles (the epoch ring's length).
+    pub ii: u32,
+    pub latency: u32,
+    pub epochs: u32,
+    /// The queue's entries and an entry's bits.
+    pub depth: u32,
+    pub entry_w: u32,
 }
 
 /// A register stage of the front-end's span path: where it holds a span's valid, row, columns
@@ -145,37 +195,52 @@ pub struct CalcStage {
 /// through their restoring steps (66 bits wide at 640x480) is more than twice as slow.
 pub fn frontend_properties(s: &FrontendShape) -> Item {
     // No `*` below: the proof cuts every multiplier, the properties' own too.
-    assert!(s.bits.is_power_of_two(), "divider bits per clock: {}", s.bits);
     let r = Reference {
         s,
         // The span path's stages: the reference's f_<i>v, f_<i>y, f_<i>n for i = 1..=nsp.
         nsp: s.span_stages.len(),
-        // CALC's stages: 0 is the vertex register, 1.. the pipelined set-up's (none at level 0).
-        last: s.calc_stages.len(),
         // Reference counters: wide enough for the stages they count through, modulo 2^cw.
         cw: 4,
-        nw: 32 - s.div_clocks.leading_zeros(),
     };
     let mut b = r.declarations();
     b.push(r.update());
     b.extend(r.at_the_ports());
     b.extend(r.linking());
-    b.extend(covers(
-        s.latency + 3,
-        &[("Span taken: a triangle walked.", "out_valid && out_ready"), ("Guard band drop: a triangle outside it.", "err")],
-    ));
+    match &s.setup {
+        SetupShape::Parallel(_) => b.extend(covers(
+            s.latency + 3,
+            &[("Span taken: a triangle walked.", "out_valid && out_ready"), ("Guard band drop: a triangle outside it.", "err")],
+        )),
+        // A triangle's first span is the schedule's latency away (39 to 318 clocks) and its entry
+        // up to II (8 to 314): a cover search costs about a second a clock, so the covers are the
+        // port's and, where II is short (the ECP5 plan), the entry's.
+        SetupShape::Engine(e) => {
+            let mut c = vec![("Triangle taken at the port.", "in_valid && in_ready")];
+            if e.ii + 2 <= ENTRY_COVER_DEPTH {
+                c.push(("A triangle enters the schedule.", "f_enter && f_vf"));
+            }
+            b.extend(covers(if c.len() > 1 { e.ii + 2 } else { 4 }, &c));
+        }
+    }
     Item::Formal(b)
 }
+
+/// The deepest cover search for the engine's entry (II + 2 clocks).
+const ENTRY_COVER_DEPTH: u32 = 16;
 
 /// The reference model's shape: the stages it follows and its counters' widths.
 #[derive(Clone, Copy)]
 struct Reference<'a> {
     s: &'a FrontendShape,
     nsp: usize,
-    last: usize,
     cw: u32,
-    /// The divider-clock counter's width.
-    nw: u32,
+}
+
+/// The parallel set-up's reference: its shape, CALC's last stage (0: the vertex register) and
+/// the divider-clock counter's width.
+fn parallel(p: &ParallelSetup) -> (usize, u32) {
+    assert!(p.bits.is_power_of_two(), "divider bits per clock: {}", p.bits);
+    (p.calc_stages.len(), 32 - p.div_clocks.leading_zeros())
 }
 
 /// The reference's CALC stage j's valid bit (0: the vertex register).
@@ -206,6 +271,10 @@ fn f_mv(j: usize, last: usize) -> String {
 fn one(w: u32) -> String {
     lit(w, 1)
 }
+/// Bits to hold `n` (at least 1).
+fn bits_for(n: u32) -> u32 {
+    (32 - n.leading_zeros()).max(1)
+}
 /// A valid span (`v`) is on the screen with at least one pixel.
 fn on_screen(v: &str, x: &str, len: &str, xw: u32, width: u64) -> Stmt {
     let wlim = lit(xw + 2, width);
@@ -218,24 +287,158 @@ fn on_screen(v: &str, x: &str, len: &str, xw: u32, width: u64) -> Stmt {
     )
 }
 
+/// The engine's and the queue's registers the properties read, by the names Yosys gives them
+/// once the design is flattened (`instance.register`; `mem[k]`, the queue's entry k, once
+/// `memory_map` has run): `scripts/prove` drives each formal-only wire from its register
+/// (`connect -set`), since Yosys reads no hierarchical reference.
+fn engine_probes(e: &EngineShape) -> Vec<(String, String, u32)> {
+    let pw = bits_for(e.depth - 1);
+    let mut v = vec![("f_e_vfull".to_string(), "u_engine.v_full".to_string(), 1), ("f_e_vld".into(), "u_engine.vld".into(), e.periods())];
+    if e.ii > 1 {
+        v.push(("f_e_ph".into(), "u_engine.ph".into(), e.ii));
+    }
+    if e.epochs > 1 {
+        v.push(("f_e_ep".into(), "u_engine.ep".into(), e.epochs));
+    }
+    v.extend([
+        ("f_q_cnt".into(), "u_queue.cnt".into(), pw + 1),
+        ("f_q_rd".into(), "u_queue.rd".into(), pw),
+        ("f_q_wr".into(), "u_queue.wr".into(), pw),
+    ]);
+    v.extend((0..e.depth).map(|k| (format!("f_q_mem{k}"), format!("u_queue.mem[{k}]"), e.entry_w)));
+    v
+}
+
+impl EngineShape {
+    /// The valid bits of the periods in flight (the sequencer's `vld`).
+    fn periods(&self) -> u32 {
+        self.latency / self.ii + 1
+    }
+    /// The phase counter's width.
+    fn phw(&self) -> u32 {
+        bits_for(self.ii - 1)
+    }
+    /// The queue's count width (holds `depth`).
+    fn qw(&self) -> u32 {
+        bits_for(self.depth)
+    }
+}
+
 impl Reference<'_> {
     /// The reference's registers and the wires it reads.
     fn declarations(&self) -> Vec<Item> {
-        let FrontendShape { yw, cx, cy, dw, width, height, ref div_regs, ref cull, .. } = *self.s;
-        let Reference { nsp, last, cw, nw, .. } = *self;
-        let f_mv = |j: usize| f_mv(j, last);
-        let mut b = vec![
-            comment(format!("{CUT_TAG}cutpoint t:$mul {}", div_regs.iter().map(|r| format!("w:{r}")).collect::<Vec<_>>().join(" "))),
-            comment("(the multipliers: area, edges, plane, I0; and the set-up dividers' registers, free every clock:"),
-            comment("only the coverage decision, taken as given, depends on them; values are left to co-simulation)"),
-        ];
+        let FrontendShape { yw, cy, dw, .. } = *self.s;
+        let Reference { nsp, cw, .. } = *self;
+        let mut b = match &self.s.setup {
+            SetupShape::Parallel(p) => vec![
+                comment(format!("{CUT_TAG}cutpoint t:$mul {}", p.div_regs.iter().map(|r| format!("w:{r}")).collect::<Vec<_>>().join(" "))),
+                comment("(the multipliers: area, edges, plane, I0; and the set-up dividers' registers, free every clock:"),
+                comment("only the coverage decision, taken as given, depends on them; values are left to co-simulation)"),
+            ],
+            SetupShape::Engine(e) => {
+                let mut b = vec![
+                    comment(format!("{CUT_TAG}cutpoint t:$mul")),
+                    comment("(the multipliers, the engine's tiles and the span path's: the values are left to co-simulation)"),
+                    comment("The engine's and the queue's registers, each driven by scripts/prove from the flattened design:"),
+                ];
+                for (w, r, n) in engine_probes(e) {
+                    b.push(comment(format!("{CUT_TAG}connect -set {w} {r}")));
+                    b.push(net(&w, n));
+                }
+                b
+            }
+        };
         b.extend(past_flags());
         b.extend(reset_and_stability("span", OUT, &["out_y", "out_x", "out_len", "out_i0", "out_di"]));
         b.push(comment("Reset: no error pulse out of reset either."));
         b.push(Item::Always(vec![when("f_past && $past(rst)", vec![assert("!err")])]));
+        match &self.s.setup {
+            SetupShape::Parallel(p) => b.extend(self.parallel_declarations(p)),
+            SetupShape::Engine(e) => b.extend(self.engine_declarations(e)),
+        }
+        let parallel_form = matches!(self.s.setup, SetupShape::Parallel(_));
+        b.push(comment(if parallel_form {
+            "The walker: the triangle being walked, its row and last row, its extent."
+        } else {
+            "The walker: the triangle being walked, its row and last row."
+        }));
+        b.extend([reg("f_wv", 1), reg("f_wrow", yw), reg("f_wlast", yw)]);
+        if parallel_form {
+            b.push(Item::Reg { name: "f_wymin".into(), width: cy, signed: true });
+            b.push(Item::Reg { name: "f_wymax".into(), width: cy, signed: true });
+        }
+        b.push(comment("The spans: the walker's row in the I0 stages and the output (valid, row)."));
+        for i in 1..=nsp {
+            b.extend([reg(&format!("f_{i}v"), 1), reg(&format!("f_{i}y"), yw)]);
+        }
+        b.extend([reg("f_ov", 1), reg("f_oy", yw)]);
+        b.push(comment("Each span's tag: its triangle's first (the walker has emitted none of it yet: f_wnew)."));
+        b.push(reg("f_wnew", 1));
+        for i in 1..=nsp {
+            b.push(reg(&format!("f_{i}n"), 1));
+        }
+        b.push(reg("f_on", 1));
+        b.push(comment("The dI of the last span offered, and whether the output register could load (f_free):"));
+        b.push(comment("a span on the output is new when it is valid and f_free."));
+        b.extend([reg("f_pdi", dw), reg("f_free", 1)]);
+        b.push(Item::Always(vec![set("f_free", "rst || !out_valid || out_ready"), when("out_valid", vec![set("f_pdi", "out_di")])]));
+        b.push(comment("The error pulse owed, and counts: triangles accepted, flagged (at the port), culled,"));
+        b.push(comment("walked; spans the walker produced (covered rows) and spans taken at the port."));
+        b.extend([reg("f_errp", 1), reg("f_nacc", cw), reg("f_nerr", cw), reg("f_ncull", cw), reg("f_nwalk", cw)]);
+        b.extend([reg("f_nrow", cw), reg("f_nout", cw)]);
 
-        b.push(comment("The reference. The input stage: the triangle waiting for the set-up, whether its"));
-        b.push(comment("vertices lie in SPEC §6's guard band (decided here from the ports), its vertical extent."));
+        b.push(wire("f_adv", 1, "!out_valid || out_ready"));
+        b.push(wire("f_wend", 1, "f_wrow == f_wlast"));
+        let take = match (&self.s.setup, self.s.starts) {
+            (SetupShape::Engine(e), _) => format!("f_qn != {} && f_adv && (!f_wv || f_wend)", lit(e.qw(), 0)),
+            (_, Some(_)) => "f_sb && f_sh && ie_pv && f_adv && !ie_wait && (!f_wv || f_wend)".into(),
+            (_, None) => "f_sb && f_sh && f_adv && (!f_wv || f_wend)".into(),
+        };
+        b.push(wire("f_take", 1, take));
+        match &self.s.setup {
+            SetupShape::Parallel(p) => {
+                let (last, _) = parallel(p);
+                b.push(wire("f_calc", 1, format!("{} && (!f_sb || f_take)", f_v(last))));
+                for j in (0..last).rev() {
+                    b.push(wire(&f_mv(j, last), 1, format!("{} && (!{} || {})", f_v(j), f_v(j + 1), f_mv(j + 1, last))));
+                }
+                b.push(wire("f_rdy", 1, format!("!f_vf || {}", f_mv(0, last))));
+            }
+            SetupShape::Engine(e) => {
+                let q = e.latency / e.ii;
+                let (phw, qw) = (e.phw(), e.qw());
+                b.push(comment("A result is due at the schedule's latency: period q = latency / II, phase latency mod II."));
+                b.push(wire("f_due", 1, format!("{} && f_ph == {}", bit("f_vld", e.periods(), q), lit(phw, (e.latency % e.ii) as u64))));
+                b.push(comment("The design's data decisions, taken as given: the result's guard-band check and cull."));
+                b.push(wire("f_push", 1, "f_due && res_guard && !res_cull"));
+                b.push(wire("f_full", 1, format!("f_qn == {}", lit(qw, e.depth as u64))));
+                b.push(comment("The engine freezes exactly while a result for the queue is due and the queue is full."));
+                b.push(wire("f_en", 1, "!(f_push && f_full)"));
+                b.push(wire("f_qin", 1, "f_push && !f_full"));
+                b.push(wire("f_enter", 1, format!("f_en && f_ph == {}", lit(phw, (e.ii - 1) as u64))));
+                b.push(wire("f_rdy", 1, "!f_vf || f_enter"));
+            }
+        }
+        b.push(wire("f_acc", 1, "in_valid && f_rdy"));
+        if let SetupShape::Parallel(p) = &self.s.setup {
+            b.push(comment("The design's data decisions, taken as given: culled, and a walked row's covered pixels."));
+            b.push(wire("f_cull", 1, p.cull.as_str()));
+        } else {
+            b.push(comment("The design's data decisions, taken as given: a walked row's covered pixels."));
+        }
+        b.push(wire("f_cover", 1, "lo3 <= hi3"));
+        b
+    }
+
+    /// The parallel set-up's reference registers: the input stage with its guard-band decision
+    /// and extent, CALC's stages, the dividers.
+    fn parallel_declarations(&self, p: &ParallelSetup) -> Vec<Item> {
+        let FrontendShape { cx, cy, width, height, .. } = *self.s;
+        let (last, nw) = parallel(p);
+        let mut b = vec![
+            comment("The reference. The input stage: the triangle waiting for the set-up, whether its"),
+            comment("vertices lie in SPEC §6's guard band (decided here from the ports), its vertical extent."),
+        ];
         b.extend([reg("f_vf", 1), reg("f_vg", 1), Item::Reg { name: "f_vymin".into(), width: cy, signed: true }]);
         b.push(Item::Reg { name: "f_vymax".into(), width: cy, signed: true });
         let (gxl, gxh) = (-(width as i64) * 256, 2 * width as i64 * 256);
@@ -279,58 +482,26 @@ impl Reference<'_> {
         b.extend([reg("f_sb", 1), reg("f_sh", 1), reg("f_sn", nw)]);
         b.push(Item::Reg { name: "f_symin".into(), width: cy, signed: true });
         b.push(Item::Reg { name: "f_symax".into(), width: cy, signed: true });
-        b.push(comment("The walker: the triangle being walked, its row and last row, its extent."));
-        b.extend([reg("f_wv", 1), reg("f_wrow", yw), reg("f_wlast", yw)]);
-        b.push(Item::Reg { name: "f_wymin".into(), width: cy, signed: true });
-        b.push(Item::Reg { name: "f_wymax".into(), width: cy, signed: true });
-        b.push(comment("The spans: the walker's row in the I0 stages and the output (valid, row)."));
-        for i in 1..=nsp {
-            b.extend([reg(&format!("f_{i}v"), 1), reg(&format!("f_{i}y"), yw)]);
-        }
-        b.extend([reg("f_ov", 1), reg("f_oy", yw)]);
-        b.push(comment("Each span's tag: its triangle's first (the walker has emitted none of it yet: f_wnew)."));
-        b.push(reg("f_wnew", 1));
-        for i in 1..=nsp {
-            b.push(reg(&format!("f_{i}n"), 1));
-        }
-        b.push(reg("f_on", 1));
-        b.push(comment("The dI of the last span offered, and whether the output register could load (f_free):"));
-        b.push(comment("a span on the output is new when it is valid and f_free."));
-        b.extend([reg("f_pdi", dw), reg("f_free", 1)]);
-        b.push(Item::Always(vec![set("f_free", "rst || !out_valid || out_ready"), when("out_valid", vec![set("f_pdi", "out_di")])]));
-        b.push(comment("The error pulse owed, and counts: triangles accepted, flagged (at the port), culled,"));
-        b.push(comment("walked; spans the walker produced (covered rows) and spans taken at the port."));
-        b.extend([reg("f_errp", 1), reg("f_nacc", cw), reg("f_nerr", cw), reg("f_ncull", cw), reg("f_nwalk", cw)]);
-        b.extend([reg("f_nrow", cw), reg("f_nout", cw)]);
-
-        b.push(wire("f_adv", 1, "!out_valid || out_ready"));
-        b.push(wire("f_wend", 1, "f_wrow == f_wlast"));
-        b.push(wire(
-            "f_take",
-            1,
-            if self.s.starts.is_some() {
-                "f_sb && f_sh && ie_pv && f_adv && !ie_wait && (!f_wv || f_wend)"
-            } else {
-                "f_sb && f_sh && f_adv && (!f_wv || f_wend)"
-            },
-        ));
-        b.push(wire("f_calc", 1, format!("{} && (!f_sb || f_take)", f_v(last))));
-        for j in (0..last).rev() {
-            b.push(wire(&f_mv(j), 1, format!("{} && (!{} || {})", f_v(j), f_v(j + 1), f_mv(j + 1))));
-        }
-        b.push(wire("f_rdy", 1, format!("!f_vf || {}", f_mv(0))));
-        b.push(wire("f_acc", 1, "in_valid && f_rdy"));
-        b.push(comment("The design's data decisions, taken as given: culled, and a walked row's covered pixels."));
-        b.push(wire("f_cull", 1, cull.as_str()));
-        b.push(wire("f_cover", 1, "lo3 <= hi3"));
         b
     }
 
-    /// The reference's clock: input, CALC's stages, set-up, walker, spans and the counts.
+    /// The engine's reference registers: the vertex register, the phase and the valid bits of
+    /// the periods in flight, and the queue (its count and entries, in order).
+    fn engine_declarations(&self, e: &EngineShape) -> Vec<Item> {
+        let mut b = vec![
+            comment("The reference. The vertex register, the engine's phase (0 .. II - 1) and the valid bits of the"),
+            comment("periods in flight (a triangle or a bubble enters at the last phase), the queue: its count and"),
+            comment("its entries, the head first, each as the engine offered it (the result's bits, taken as given)."),
+        ];
+        b.extend([reg("f_vf", 1), reg("f_ph", e.phw()), reg("f_vld", e.periods()), reg("f_qn", e.qw())]);
+        b.extend((0..e.depth).map(|i| reg(&format!("f_q{i}"), e.entry_w)));
+        b
+    }
+
+    /// The reference's clock: input, set-up, walker, spans and the counts.
     fn update(&self) -> Item {
-        let FrontendShape { yw, div_clocks, .. } = *self.s;
-        let Reference { nsp, last, cw, nw, .. } = *self;
-        let f_mv = |j: usize| f_mv(j, last);
+        let FrontendShape { yw, .. } = *self.s;
+        let Reference { nsp, cw, .. } = *self;
         let inc1 = |n: &str| set(n, format!("{n} + {}", one(cw)));
         // The walker moves when the output is free (and, with starts, no source is starting).
         let (wgo, row) = match self.s.starts {
@@ -338,10 +509,76 @@ impl Reference<'_> {
             None => ("f_adv", "f_wv && f_cover"),
         };
         let inc = |n: &str, c: &str| when(c, vec![inc1(n)]);
+        let mut load = vec![set("f_wv", "1'b1"), set("f_wrow", "s_first"), set("f_wlast", "s_last")];
+        if let SetupShape::Parallel(_) = self.s.setup {
+            load.extend([set("f_wymin", "f_symin"), set("f_wymax", "f_symax")]);
+        }
+        load.extend([set("f_wnew", "1'b1"), inc1("f_nwalk")]);
+        let walker = Stmt::If(
+            "f_take".into(),
+            load,
+            vec![
+                when(format!("f_adv && {row}"), vec![set("f_wnew", "1'b0")]),
+                when(
+                    format!("{wgo} && f_wv"),
+                    vec![Stmt::If("f_wend".into(), vec![set("f_wv", "1'b0")], vec![set("f_wrow", format!("f_wrow + {}", one(yw)))])],
+                ),
+            ],
+        );
+        let spans = when(
+            "f_adv",
+            vec![set("f_1v", row), set("f_1y", "f_wrow"), set("f_1n", "f_wnew")]
+                .into_iter()
+                .chain((2..=nsp).flat_map(|i| ["v", "y", "n"].map(|f| set(format!("f_{i}{f}"), format!("f_{}{f}", i - 1)))))
+                .chain(["v", "y", "n"].map(|f| set(format!("f_o{f}"), format!("f_{nsp}{f}"))))
+                .collect(),
+        );
+        let (reset, front) = match &self.s.setup {
+            SetupShape::Parallel(p) => self.parallel_update(p),
+            SetupShape::Engine(e) => self.engine_update(e),
+        };
+        let zero = lit(cw, 0);
+        Item::Always(vec![Stmt::If(
+            "rst".into(),
+            reset
+                .into_iter()
+                .chain([set("f_wv", "1'b0")])
+                .chain((1..=nsp).map(|i| set(format!("f_{i}v"), "1'b0")))
+                .chain([
+                    set("f_ov", "1'b0"),
+                    set("f_errp", "1'b0"),
+                    set("f_nacc", zero.clone()),
+                    set("f_nerr", zero.clone()),
+                    set("f_ncull", zero.clone()),
+                    set("f_nwalk", zero.clone()),
+                    set("f_nrow", zero.clone()),
+                    set("f_nout", zero.clone()),
+                ])
+                .collect(),
+            vec![
+                set("f_errp", "1'b0"),
+                inc("f_nacc", "f_acc"),
+                inc("f_nerr", "err"),
+                inc("f_nrow", &format!("f_adv && {row}")),
+                inc("f_nout", "out_valid && out_ready"),
+            ]
+            .into_iter()
+            .chain(front)
+            .chain([walker, spans])
+            .collect(),
+        )])
+    }
+
+    /// The parallel set-up's clock: (its reset, its update).
+    fn parallel_update(&self, p: &ParallelSetup) -> (Vec<Stmt>, Vec<Stmt>) {
+        let (last, nw) = parallel(p);
+        let cw = self.cw;
+        let f_mv = |j: usize| f_mv(j, last);
+        let inc1 = |n: &str| set(n, format!("{n} + {}", one(cw)));
         let calc_go = vec![
             set("f_sb", "1'b1"),
             set("f_sh", "1'b0"),
-            set("f_sn", lit(nw, (div_clocks - 1) as u64)),
+            set("f_sn", lit(nw, (p.div_clocks - 1) as u64)),
             set("f_symin", f_held(last, "ymin")),
             set("f_symax", f_held(last, "ymax")),
         ];
@@ -365,90 +602,65 @@ impl Reference<'_> {
                 )],
             )],
         );
-        let walker = Stmt::If(
-            "f_take".into(),
-            vec![
-                set("f_wv", "1'b1"),
-                set("f_wrow", "s_first"),
-                set("f_wlast", "s_last"),
-                set("f_wymin", "f_symin"),
-                set("f_wymax", "f_symax"),
-                set("f_wnew", "1'b1"),
-                inc1("f_nwalk"),
-            ],
-            vec![
-                when(format!("f_adv && {row}"), vec![set("f_wnew", "1'b0")]),
-                when(
-                    format!("{wgo} && f_wv"),
-                    vec![Stmt::If("f_wend".into(), vec![set("f_wv", "1'b0")], vec![set("f_wrow", format!("f_wrow + {}", one(yw)))])],
-                ),
-            ],
-        );
-        let spans = when(
-            "f_adv",
-            vec![set("f_1v", row), set("f_1y", "f_wrow"), set("f_1n", "f_wnew")]
-                .into_iter()
-                .chain((2..=nsp).flat_map(|i| ["v", "y", "n"].map(|f| set(format!("f_{i}{f}"), format!("f_{}{f}", i - 1)))))
-                .chain(["v", "y", "n"].map(|f| set(format!("f_o{f}"), format!("f_{nsp}{f}"))))
-                .collect(),
-        );
         let input = Stmt::If(
             "f_acc".into(),
             vec![set("f_vf", "1'b1"), set("f_vg", "f_band"), set("f_vymin", "f_iymin"), set("f_vymax", "f_iymax")],
             vec![when(f_mv(0), vec![set("f_vf", "1'b0")])],
         );
-        let stages: Vec<Stmt> = (1..=last)
-            .map(|j| {
-                Stmt::If(
-                    f_mv(j - 1),
-                    vec![
-                        set(f_v(j), "1'b1"),
-                        set(f_held(j, "g"), f_held(j - 1, "g")),
-                        set(f_held(j, "ymin"), f_held(j - 1, "ymin")),
-                        set(f_held(j, "ymax"), f_held(j - 1, "ymax")),
-                    ],
-                    vec![when(f_mv(j), vec![set(f_v(j), "1'b0")])],
-                )
-            })
-            .collect();
-        let zero = lit(cw, 0);
-        Item::Always(vec![Stmt::If(
-            "rst".into(),
-            vec![set("f_vf", "1'b0")]
-                .into_iter()
-                .chain((1..=last).map(|j| set(f_v(j), "1'b0")))
-                .chain([set("f_sb", "1'b0"), set("f_wv", "1'b0")])
-                .chain((1..=nsp).map(|i| set(format!("f_{i}v"), "1'b0")))
-                .chain([
-                    set("f_ov", "1'b0"),
-                    set("f_errp", "1'b0"),
-                    set("f_nacc", zero.clone()),
-                    set("f_nerr", zero.clone()),
-                    set("f_ncull", zero.clone()),
-                    set("f_nwalk", zero.clone()),
-                    set("f_nrow", zero.clone()),
-                    set("f_nout", zero.clone()),
-                ])
-                .collect(),
-            vec![
-                set("f_errp", "1'b0"),
-                inc("f_nacc", "f_acc"),
-                inc("f_nerr", "err"),
-                inc("f_nrow", &format!("f_adv && {row}")),
-                inc("f_nout", "out_valid && out_ready"),
-                input,
-            ]
-            .into_iter()
-            .chain(stages)
-            .chain([setup, walker, spans])
-            .collect(),
-        )])
+        let stages = (1..=last).map(|j| {
+            Stmt::If(
+                f_mv(j - 1),
+                vec![
+                    set(f_v(j), "1'b1"),
+                    set(f_held(j, "g"), f_held(j - 1, "g")),
+                    set(f_held(j, "ymin"), f_held(j - 1, "ymin")),
+                    set(f_held(j, "ymax"), f_held(j - 1, "ymax")),
+                ],
+                vec![when(f_mv(j), vec![set(f_v(j), "1'b0")])],
+            )
+        });
+        let reset = [set("f_vf", "1'b0")].into_iter().chain((1..=last).map(|j| set(f_v(j), "1'b0"))).chain([set("f_sb", "1'b0")]).collect();
+        (reset, [input].into_iter().chain(stages).chain([setup]).collect())
+    }
+
+    /// The engine's clock: (its reset, its update). The phase and the valid bits move only while
+    /// the engine is not frozen; the queue shifts its head out on the walker's take and writes a
+    /// result behind the entries that stay.
+    fn engine_update(&self, e: &EngineShape) -> (Vec<Stmt>, Vec<Stmt>) {
+        let (phw, qw, n) = (e.phw(), e.qw(), e.periods());
+        let inc1 = |x: &str| set(x, format!("{x} + {}", one(self.cw)));
+        let last = lit(phw, (e.ii - 1) as u64);
+        let shift_in = if n == 1 { "f_vf".to_string() } else { format!("{{f_vld[{}:0], f_vf}}", n - 2) };
+        let mut st = vec![
+            set("f_errp", "f_due && !res_guard"),
+            when("f_due && f_en && res_guard && res_cull", vec![inc1("f_ncull")]),
+            Stmt::If("f_acc".into(), vec![set("f_vf", "1'b1")], vec![when("f_enter", vec![set("f_vf", "1'b0")])]),
+            when(
+                "f_en",
+                vec![Stmt::If(
+                    format!("f_ph == {last}"),
+                    vec![set("f_ph", lit(phw, 0)), set("f_vld", shift_in)],
+                    vec![set("f_ph", format!("f_ph + {}", one(phw)))],
+                )],
+            ),
+            when("f_take", (1..e.depth).map(|i| set(format!("f_q{}", i - 1), format!("f_q{i}"))).collect()),
+        ];
+        // The slot the pushed result lands in: behind the entries that stay.
+        for i in 0..e.depth {
+            st.push(when(
+                format!("f_qin && f_qn - {} == {}", zext("f_take", 1, qw), lit(qw, i as u64)),
+                vec![set(format!("f_q{i}"), "res")],
+            ));
+        }
+        st.push(set("f_qn", format!("f_qn + {} - {}", zext("f_qin", 1, qw), zext("f_take", 1, qw))));
+        let reset = vec![set("f_vf", "1'b0"), set("f_ph", lit(phw, 0)), set("f_vld", lit(n, 0)), set("f_qn", lit(qw, 0))];
+        (reset, st)
     }
 
     /// At the ports: the reference's stream, the rate, and nothing lost or invented.
     fn at_the_ports(&self) -> Vec<Item> {
-        let FrontendShape { yw, xw, width, ref calc_stages, ref guard, ref cull, .. } = *self.s;
-        let Reference { nsp, last, cw, .. } = *self;
+        let FrontendShape { yw, xw, width, .. } = *self.s;
+        let Reference { nsp, cw, .. } = *self;
 
         let mut b = vec![
             comment("The front-end is the reference at its ports: it takes a triangle exactly when the"),
@@ -469,46 +681,70 @@ impl Reference<'_> {
         b.push(Item::Comb(vec![when("f_past", ports)]));
         b.push(comment("Rate (SPEC §6), in the design's terms: the walker takes a row every clock the output is"));
         b.push(comment("free; a set-up result waiting when the walker is on its last row follows it with no"));
-        b.push(comment("bubble (set-up overlapped with the walk); a dropped or culled triangle costs its CALC clock."));
+        b.push(comment(match self.s.setup {
+            SetupShape::Parallel(_) => "bubble (set-up overlapped with the walk); a dropped or culled triangle costs its CALC clock.",
+            SetupShape::Engine(_) => "bubble (set-up overlapped with the walk).",
+        }));
         let (go, held) = if self.s.starts.is_some() { (" && !ie_wait", " && ie_pv") } else { ("", "") };
-        b.push(Item::Always(vec![when(
-            "f_past && !$past(rst)",
-            vec![
-                when(
-                    format!("$past(w_valid && adv && !w_end{go})"),
-                    vec![assert("w_valid"), assert(format!("w_row == $past(w_row) + {}", one(yw)))],
-                ),
-                when(
-                    format!("$past(w_valid && adv && w_end && st == HOLD{held}{go})"),
-                    vec![assert("w_valid"), assert("w_row == $past(s_first)")],
-                ),
-                // The triangle behind a dropped one moves up in the same clock: into the last CALC
-                // stage, or (CALC in one clock) straight into it from the port.
-                when(
-                    format!("$past(calc && (!{guard} || {cull}))"),
-                    vec![match last {
-                        0 => assert("in_ready"),
-                        1 => assert(format!("!$past(v_full) || {}", calc_stages[0].valid)),
-                        _ => assert(format!("!$past({}) || {}", calc_stages[last - 2].valid, calc_stages[last - 1].valid)),
-                    }],
-                ),
-            ],
-        )]));
+        let waiting = match self.s.setup {
+            SetupShape::Parallel(_) => "st == HOLD",
+            SetupShape::Engine(_) => "q_ne",
+        };
+        let mut rate = vec![
+            when(
+                format!("$past(w_valid && adv && !w_end{go})"),
+                vec![assert("w_valid"), assert(format!("w_row == $past(w_row) + {}", one(yw)))],
+            ),
+            when(
+                format!("$past(w_valid && adv && w_end && {waiting}{held}{go})"),
+                vec![assert("w_valid"), assert("w_row == $past(s_first)")],
+            ),
+        ];
+        if let SetupShape::Parallel(p) = &self.s.setup {
+            let last = p.calc_stages.len();
+            // A dropped or culled triangle costs its CALC clock: the triangle behind it moves up
+            // in the same clock, into the last CALC stage, or (CALC in one clock) straight into
+            // it from the port.
+            rate.push(when(
+                format!("$past(calc && (!{} || {}))", p.guard, p.cull),
+                vec![match last {
+                    0 => assert("in_ready"),
+                    1 => assert(format!("!$past(v_full) || {}", p.calc_stages[0].valid)),
+                    _ => assert(format!("!$past({}) || {}", p.calc_stages[last - 2].valid, p.calc_stages[last - 1].valid)),
+                }],
+            ));
+        }
+        b.push(Item::Always(vec![when("f_past && !$past(rst)", rate)]));
         if let Some(clocks) = self.s.starts {
             b.extend(starts(clocks));
         }
+        let in_flight = match &self.s.setup {
+            SetupShape::Parallel(p) => {
+                let last = p.calc_stages.len();
+                format!(" + {}", zext("f_sb", 1, cw)) + &(1..=last).map(|j| format!(" + {}", zext(&f_v(j), 1, cw))).collect::<String>()
+            }
+            SetupShape::Engine(e) => {
+                b.extend(self.engine_ports(e));
+                // A period's triangle is in flight until its result is taken: every period before
+                // the result's, and the result's up to its phase.
+                let q = e.latency / e.ii;
+                let n = e.periods();
+                let mut s = format!(" + {}", zext("f_qn", e.qw(), cw));
+                s += &(0..q).map(|j| format!(" + {}", zext(&bit("f_vld", n, j), 1, cw))).collect::<String>();
+                s + &format!(
+                    " + {}",
+                    zext(&format!("({} && f_ph <= {})", bit("f_vld", n, q), lit(e.phw(), (e.latency % e.ii) as u64)), 1, cw)
+                )
+            }
+        };
         b.push(comment("Nothing lost or invented: every accepted triangle was flagged, culled or walked, or is"));
-        b.push(comment("still waiting or in set-up (counts modulo 16)."));
+        b.push(comment(match self.s.setup {
+            SetupShape::Parallel(_) => "still waiting or in set-up (counts modulo 16).",
+            SetupShape::Engine(_) => "still waiting, in the engine or in the queue (counts modulo 16).",
+        }));
         b.push(Item::Comb(vec![when(
             "f_past",
-            vec![assert(
-                format!(
-                    "f_nacc == f_nerr + {} + f_ncull + f_nwalk + {} + {}",
-                    zext("err", 1, cw),
-                    zext("f_vf", 1, cw),
-                    zext("f_sb", 1, cw)
-                ) + &(1..=last).map(|j| format!(" + {}", zext(&f_v(j), 1, cw))).collect::<String>(),
-            )],
+            vec![assert(format!("f_nacc == f_nerr + {} + f_ncull + f_nwalk + {}{in_flight}", zext("err", 1, cw), zext("f_vf", 1, cw),))],
         )]));
         b.push(comment("Every span the walker produced is offered once: taken at the port, or still in a stage."));
         b.push(Item::Comb(vec![when(
@@ -522,14 +758,82 @@ impl Reference<'_> {
         b
     }
 
+    /// The engine and its queue at their boundary with the front-end: results due when the
+    /// reference says, the freeze, the queue's writes and reads, its order.
+    fn engine_ports(&self, e: &EngineShape) -> Vec<Item> {
+        let depth = lit(e.qw(), e.depth as u64);
+        let mut b = vec![comment("The engine: a result is due exactly at its schedule's latency after its entry plus the clocks")];
+        b.push(comment("frozen; the engine freezes exactly while that result finds the queue full."));
+        b.push(Item::Comb(vec![when("f_past", vec![assert("res_v == f_due"), assert("en == f_en")])]));
+        b.push(comment("The queue: never written when full, never read when empty, written exactly when a result"));
+        b.push(comment("for it is due and it has room, read exactly when the walker takes; its head is the oldest"));
+        b.push(comment("entry not yet taken (entries leave in the order they came, none lost or repeated)."));
+        b.push(Item::Comb(vec![when(
+            "f_past",
+            vec![
+                assert("!(q_in && q_full)"),
+                assert("!(take && !q_ne)"),
+                assert(format!("f_q_cnt <= {}", lit(e.qw(), e.depth as u64))),
+                assert("q_in == f_qin"),
+                assert("take == f_take"),
+                assert(format!("q_ne == (f_qn != {})", lit(e.qw(), 0))),
+                assert(format!("q_full == (f_qn == {depth})")),
+                when(format!("f_qn != {}", lit(e.qw(), 0)), vec![assert("q_head == f_q0")]),
+            ],
+        )]));
+        b.push(comment("The freeze: while en is low the phase ring, the valid bits of the periods in flight and"));
+        b.push(comment("the epoch ring hold, and the queue is not written."));
+        let mut hold = vec![assert("f_e_vld == $past(f_e_vld)")];
+        if e.ii > 1 {
+            hold.push(assert("f_e_ph == $past(f_e_ph)"));
+        }
+        if e.epochs > 1 {
+            hold.push(assert("f_e_ep == $past(f_e_ep)"));
+        }
+        b.push(Item::Comb(vec![when("f_past && !en", vec![assert("!q_in")])]));
+        b.push(Item::Always(vec![when("f_past && !$past(rst) && !$past(en)", hold)]));
+        b
+    }
+
     /// Linking invariants: every stage's registers are the reference's.
     fn linking(&self) -> Vec<Item> {
-        let FrontendShape { yw, cy, xw, width, height, cnt_w, bits, rw, div_clocks, ref calc_stages, ref span_stages, .. } = *self.s;
-        let Reference { nsp, nw, .. } = *self;
+        let FrontendShape { xw, width, ref span_stages, .. } = *self.s;
+        let Reference { nsp, .. } = *self;
 
         let mut b = Vec::new();
         b.push(comment("Linking invariants: every stage's registers are the reference's; a row's centre"));
         b.push(comment("(256 r + 128 sub-pixels) lies within its triangle's vertical extent and on the screen."));
+        let mut link = match &self.s.setup {
+            SetupShape::Parallel(p) => self.parallel_links(p),
+            SetupShape::Engine(e) => self.engine_links(e),
+        };
+        for (i, sp) in span_stages.iter().enumerate().map(|(k, sp)| (k + 1, sp)) {
+            link.push(assert(format!("{} == f_{i}v", sp.valid)));
+            link.push(when(format!("f_{i}v"), vec![assert(format!("{} == f_{i}y", sp.y))]));
+        }
+        link.push(Stmt::Comment("A span that is not its triangle's first has the dI of the span ahead of it.".into()));
+        link.push(when("f_ov && !f_free", vec![assert("out_di == f_pdi")]));
+        // The dI ahead of stage i (i = nsp + 1: the output's): the nearest valid stage's, else the
+        // output's or the last span offered.
+        let ahead = |i: usize| {
+            (i..=nsp).rev().fold("f_ov ? out_di : f_pdi".to_string(), |acc, k| format!("f_{k}v ? {} : {acc}", span_stages[k - 1].di))
+        };
+        for (i, sp) in span_stages.iter().enumerate().map(|(k, sp)| (k + 1, sp)).rev() {
+            link.push(when(format!("f_{i}v && !f_{i}n"), vec![assert(format!("{} == ({})", sp.di, ahead(i + 1)))]));
+        }
+        link.push(when("f_wv && !f_wnew", vec![assert(format!("w_di == ({})", ahead(1)))]));
+        for sp in span_stages {
+            link.push(on_screen(&sp.valid, &sp.x, &sp.len, xw, width));
+        }
+        b.push(Item::Comb(vec![when("f_past", link)]));
+        b
+    }
+
+    /// The parallel set-up's and the walker's links.
+    fn parallel_links(&self, p: &ParallelSetup) -> Vec<Stmt> {
+        let FrontendShape { yw, cy, height, .. } = *self.s;
+        let ParallelSetup { cnt_w, bits, rw, div_clocks, ref calc_stages, .. } = *p;
+        let (_, nw) = parallel(p);
         let centre = |r: &str| format!("$signed({{2'b00, {r}, 8'd128}})");
         let within = |r: &str, lo: &str, hi: &str| vec![assert(format!("{} >= {lo}", centre(r))), assert(format!("{} <= {hi}", centre(r)))];
         let hmax = lit(yw, height - 1);
@@ -582,26 +886,40 @@ impl Reference<'_> {
             assert("w_valid == f_wv"),
             when("f_wv", wk),
         ]);
-        for (i, sp) in span_stages.iter().enumerate().map(|(k, sp)| (k + 1, sp)) {
-            link.push(assert(format!("{} == f_{i}v", sp.valid)));
-            link.push(when(format!("f_{i}v"), vec![assert(format!("{} == f_{i}y", sp.y))]));
+        link
+    }
+
+    /// The engine's, the queue's and the walker's links. The rows the walker loads are the
+    /// engine's data (taken as given: where they lie is co-simulated), so its links are its
+    /// registers only.
+    fn engine_links(&self, e: &EngineShape) -> Vec<Stmt> {
+        let (phw, qw, pw) = (e.phw(), e.qw(), bits_for(e.depth - 1));
+        let mut link =
+            vec![assert("f_e_vfull == f_vf"), assert("f_e_vld == f_vld"), assert(format!("f_ph <= {}", lit(phw, (e.ii - 1) as u64)))];
+        if e.ii > 1 {
+            link.push(assert(format!("f_e_ph == {} << f_ph", lit(e.ii, 1))));
         }
-        link.push(Stmt::Comment("A span that is not its triangle's first has the dI of the span ahead of it.".into()));
-        link.push(when("f_ov && !f_free", vec![assert("out_di == f_pdi")]));
-        // The dI ahead of stage i (i = nsp + 1: the output's): the nearest valid stage's, else the
-        // output's or the last span offered.
-        let ahead = |i: usize| {
-            (i..=nsp).rev().fold("f_ov ? out_di : f_pdi".to_string(), |acc, k| format!("f_{k}v ? {} : {acc}", span_stages[k - 1].di))
-        };
-        for (i, sp) in span_stages.iter().enumerate().map(|(k, sp)| (k + 1, sp)).rev() {
-            link.push(when(format!("f_{i}v && !f_{i}n"), vec![assert(format!("{} == ({})", sp.di, ahead(i + 1)))]));
+        if e.epochs > 1 {
+            link.push(assert(format!("f_e_ep != {} && (f_e_ep & (f_e_ep - {})) == {}", lit(e.epochs, 0), one(e.epochs), lit(e.epochs, 0))));
         }
-        link.push(when("f_wv && !f_wnew", vec![assert(format!("w_di == ({})", ahead(1)))]));
-        for sp in span_stages {
-            link.push(on_screen(&sp.valid, &sp.x, &sp.len, xw, width));
+        // The queue's pointers: the tail is the count past the head, modulo the depth; entry i
+        // from the head is its memory word (rd + i) mod depth.
+        let rd = "{1'b0, f_q_rd}";
+        let wrap = |x: String, k: u32| format!("({x} == {} || {x} == {})", lit(pw + 1, k as u64), lit(pw + 1, (k + e.depth) as u64));
+        link.extend([
+            assert(format!("f_q_cnt == {}", zext("f_qn", qw, pw + 1))),
+            assert(format!("{rd} + f_q_cnt == {{1'b0, f_q_wr}} || {rd} + f_q_cnt == {{1'b0, f_q_wr}} + {}", lit(pw + 1, e.depth as u64))),
+        ]);
+        for i in 0..e.depth {
+            for k in 0..e.depth {
+                link.push(when(
+                    format!("f_qn > {} && {}", lit(qw, i as u64), wrap(format!("{rd} + {}", lit(pw + 1, i as u64)), k)),
+                    vec![assert(format!("f_q_mem{k} == f_q{i}"))],
+                ));
+            }
         }
-        b.push(Item::Comb(vec![when("f_past", link)]));
-        b
+        link.extend([assert("w_valid == f_wv"), when("f_wv", vec![assert("w_row == f_wrow"), assert("w_last == f_wlast")])]);
+        link
     }
 }
 
