@@ -566,8 +566,8 @@ fn engine_throughput_against_the_parallel_set_up() {
     }
 }
 
-/// The slow tier: the widest formats (F = 20, XW = 16: II 14, the binding repeating every 12
-/// triangles) and the smallest (F = 4, XW = 4 on 16x8: II 8), the ECP5 plan.
+/// The slow tier: the widest formats (F = 20, XW = 16: II 15 on the plan's 8 tiles, the binding
+/// repeating every 12 triangles) and the smallest (F = 4, XW = 4 on 16x8: II 8), the ECP5 plan.
 #[test]
 #[ignore]
 fn engine_spans_equal_golden_at_other_formats() {

@@ -92,10 +92,13 @@ impl Plan {
     /// as with 18-bit chunks (75), and the schedule the same II and latency.
     pub const TILE18_RTL: MulUnit = MulUnit::Tile { bits: 17 };
 
-    /// docs/design.md's recommendation for the ECP5-25F: 12 clocks a triangle on 12 MULT18X18D
+    /// docs/design.md's recommendation for the ECP5-25F: 12 clocks a triangle on 8 MULT18X18D
     /// and twelve 1-bit dividers, the incremental steps left to the walker's start evaluator.
+    /// 8 tiles, not 12: the dividers set II = 12 (120 divider clocks on 12), and 8 tiles are the
+    /// fewest the scheduler keeps at 12 (7 give 13), so the front-end with the span path's 17
+    /// per-row products has 25 MULT18X18D, within the LFE5U-25F's 28.
     pub const ECP5_25F: Plan = Plan {
-        mults: 12,
+        mults: 8,
         mul: Plan::TILE18_RTL,
         dividers: 12,
         div_bits: 1,
