@@ -2,6 +2,9 @@
 //! its state, handed to the property writer. The scanline comparison option's divider adds a
 //! stall of its own and is left to co-simulation.
 
+mod engine;
+mod parallel;
+
 use super::hw::Hw;
 use super::setup::{self, Setup};
 use super::span;
@@ -236,13 +239,6 @@ struct Reference<'a> {
     cw: u32,
 }
 
-/// The parallel set-up's reference: its shape, CALC's last stage (0: the vertex register) and
-/// the divider-clock counter's width.
-fn parallel(p: &ParallelSetup) -> (usize, u32) {
-    assert!(p.bits.is_power_of_two(), "divider bits per clock: {}", p.bits);
-    (p.calc_stages.len(), 32 - p.div_clocks.leading_zeros())
-}
-
 /// The reference's CALC stage j's valid bit (0: the vertex register).
 fn f_v(j: usize) -> String {
     if j == 0 {
@@ -287,43 +283,6 @@ fn on_screen(v: &str, x: &str, len: &str, xw: u32, width: u64) -> Stmt {
     )
 }
 
-/// The engine's and the queue's registers the properties read, by the names Yosys gives them
-/// once the design is flattened (`instance.register`; `mem[k]`, the queue's entry k, once
-/// `memory_map` has run): `scripts/prove` drives each formal-only wire from its register
-/// (`connect -set`), since Yosys reads no hierarchical reference.
-fn engine_probes(e: &EngineShape) -> Vec<(String, String, u32)> {
-    let pw = bits_for(e.depth - 1);
-    let mut v = vec![("f_e_vfull".to_string(), "u_engine.v_full".to_string(), 1), ("f_e_vld".into(), "u_engine.vld".into(), e.periods())];
-    if e.ii > 1 {
-        v.push(("f_e_ph".into(), "u_engine.ph".into(), e.ii));
-    }
-    if e.epochs > 1 {
-        v.push(("f_e_ep".into(), "u_engine.ep".into(), e.epochs));
-    }
-    v.extend([
-        ("f_q_cnt".into(), "u_queue.cnt".into(), pw + 1),
-        ("f_q_rd".into(), "u_queue.rd".into(), pw),
-        ("f_q_wr".into(), "u_queue.wr".into(), pw),
-    ]);
-    v.extend((0..e.depth).map(|k| (format!("f_q_mem{k}"), format!("u_queue.mem[{k}]"), e.entry_w)));
-    v
-}
-
-impl EngineShape {
-    /// The valid bits of the periods in flight (the sequencer's `vld`).
-    fn periods(&self) -> u32 {
-        self.latency / self.ii + 1
-    }
-    /// The phase counter's width.
-    fn phw(&self) -> u32 {
-        bits_for(self.ii - 1)
-    }
-    /// The queue's count width (holds `depth`).
-    fn qw(&self) -> u32 {
-        bits_for(self.depth)
-    }
-}
-
 impl Reference<'_> {
     /// The reference's registers and the wires it reads.
     fn declarations(&self) -> Vec<Item> {
@@ -341,7 +300,7 @@ impl Reference<'_> {
                     comment("(the multipliers, the engine's tiles and the span path's: the values are left to co-simulation)"),
                     comment("The engine's and the queue's registers, each driven by scripts/prove from the flattened design:"),
                 ];
-                for (w, r, n) in engine_probes(e) {
+                for (w, r, n) in engine::engine_probes(e) {
                     b.push(comment(format!("{CUT_TAG}connect -set {w} {r}")));
                     b.push(net(&w, n));
                 }
@@ -397,7 +356,7 @@ impl Reference<'_> {
         b.push(wire("f_take", 1, take));
         match &self.s.setup {
             SetupShape::Parallel(p) => {
-                let (last, _) = parallel(p);
+                let (last, _) = parallel::parallel(p);
                 b.push(wire("f_calc", 1, format!("{} && (!f_sb || f_take)", f_v(last))));
                 for j in (0..last).rev() {
                     b.push(wire(&f_mv(j, last), 1, format!("{} && (!{} || {})", f_v(j), f_v(j + 1), f_mv(j + 1, last))));
@@ -427,74 +386,6 @@ impl Reference<'_> {
             b.push(comment("The design's data decisions, taken as given: a walked row's covered pixels."));
         }
         b.push(wire("f_cover", 1, "lo3 <= hi3"));
-        b
-    }
-
-    /// The parallel set-up's reference registers: the input stage with its guard-band decision
-    /// and extent, CALC's stages, the dividers.
-    fn parallel_declarations(&self, p: &ParallelSetup) -> Vec<Item> {
-        let FrontendShape { cx, cy, width, height, .. } = *self.s;
-        let (last, nw) = parallel(p);
-        let mut b = vec![
-            comment("The reference. The input stage: the triangle waiting for the set-up, whether its"),
-            comment("vertices lie in SPEC §6's guard band (decided here from the ports), its vertical extent."),
-        ];
-        b.extend([reg("f_vf", 1), reg("f_vg", 1), Item::Reg { name: "f_vymin".into(), width: cy, signed: true }]);
-        b.push(Item::Reg { name: "f_vymax".into(), width: cy, signed: true });
-        let (gxl, gxh) = (-(width as i64) * 256, 2 * width as i64 * 256);
-        let (gyl, gyh) = (-(height as i64) * 256, 2 * height as i64 * 256);
-        let mut band = Vec::new();
-        for k in 0..3 {
-            b.push(Item::Wire {
-                name: format!("f_ix{k}"),
-                width: cx + 2,
-                signed: true,
-                value: Some(sext(&format!("in_x{k}"), cx, cx + 2)),
-            });
-            b.push(Item::Wire {
-                name: format!("f_iy{k}"),
-                width: cy + 2,
-                signed: true,
-                value: Some(sext(&format!("in_y{k}"), cy, cy + 2)),
-            });
-            band.push(format!(
-                "f_ix{k} >= {} && f_ix{k} < {} && f_iy{k} >= {} && f_iy{k} < {}",
-                slit(cx + 2, gxl),
-                slit(cx + 2, gxh),
-                slit(cy + 2, gyl),
-                slit(cy + 2, gyh)
-            ));
-        }
-        b.push(wire("f_band", 1, band.join(" && ")));
-        let min3 = |op: &str| format!("((in_y0 {op} in_y1) ? ((in_y0 {op} in_y2) ? in_y0 : in_y2) : ((in_y1 {op} in_y2) ? in_y1 : in_y2))");
-        b.push(Item::Wire { name: "f_iymin".into(), width: cy, signed: true, value: Some(min3("<")) });
-        b.push(Item::Wire { name: "f_iymax".into(), width: cy, signed: true, value: Some(min3(">")) });
-
-        for j in 1..=last {
-            if j == 1 {
-                b.push(comment("CALC's stages: each triangle's guard-band check and vertical extent, as the vertex register's."));
-            }
-            b.extend([reg(&f_v(j), 1), reg(&f_held(j, "g"), 1)]);
-            b.push(Item::Reg { name: f_held(j, "ymin"), width: cy, signed: true });
-            b.push(Item::Reg { name: f_held(j, "ymax"), width: cy, signed: true });
-        }
-        b.push(comment("The set-up: busy (dividing, f_sn + 1 clocks left, or holding its result: f_sh), its extent."));
-        b.extend([reg("f_sb", 1), reg("f_sh", 1), reg("f_sn", nw)]);
-        b.push(Item::Reg { name: "f_symin".into(), width: cy, signed: true });
-        b.push(Item::Reg { name: "f_symax".into(), width: cy, signed: true });
-        b
-    }
-
-    /// The engine's reference registers: the vertex register, the phase and the valid bits of
-    /// the periods in flight, and the queue (its count and entries, in order).
-    fn engine_declarations(&self, e: &EngineShape) -> Vec<Item> {
-        let mut b = vec![
-            comment("The reference. The vertex register, the engine's phase (0 .. II - 1) and the valid bits of the"),
-            comment("periods in flight (a triangle or a bubble enters at the last phase), the queue: its count and"),
-            comment("its entries, the head first, each as the engine offered it (the result's bits, taken as given)."),
-        ];
-        b.extend([reg("f_vf", 1), reg("f_ph", e.phw()), reg("f_vld", e.periods()), reg("f_qn", e.qw())]);
-        b.extend((0..e.depth).map(|i| reg(&format!("f_q{i}"), e.entry_w)));
         b
     }
 
@@ -567,94 +458,6 @@ impl Reference<'_> {
             .chain([walker, spans])
             .collect(),
         )])
-    }
-
-    /// The parallel set-up's clock: (its reset, its update).
-    fn parallel_update(&self, p: &ParallelSetup) -> (Vec<Stmt>, Vec<Stmt>) {
-        let (last, nw) = parallel(p);
-        let cw = self.cw;
-        let f_mv = |j: usize| f_mv(j, last);
-        let inc1 = |n: &str| set(n, format!("{n} + {}", one(cw)));
-        let calc_go = vec![
-            set("f_sb", "1'b1"),
-            set("f_sh", "1'b0"),
-            set("f_sn", lit(nw, (p.div_clocks - 1) as u64)),
-            set("f_symin", f_held(last, "ymin")),
-            set("f_symax", f_held(last, "ymax")),
-        ];
-        let setup = Stmt::If(
-            "f_calc".into(),
-            vec![Stmt::If(
-                format!("!{}", f_held(last, "g")),
-                vec![set("f_errp", "1'b1"), set("f_sb", "1'b0")],
-                vec![Stmt::If("f_cull".into(), vec![set("f_sb", "1'b0"), inc1("f_ncull")], calc_go)],
-            )],
-            vec![Stmt::If(
-                "f_take".into(),
-                vec![set("f_sb", "1'b0")],
-                vec![when(
-                    "f_sb && !f_sh",
-                    vec![Stmt::If(
-                        format!("f_sn == {}", lit(nw, 0)),
-                        vec![set("f_sh", "1'b1")],
-                        vec![set("f_sn", format!("f_sn - {}", one(nw)))],
-                    )],
-                )],
-            )],
-        );
-        let input = Stmt::If(
-            "f_acc".into(),
-            vec![set("f_vf", "1'b1"), set("f_vg", "f_band"), set("f_vymin", "f_iymin"), set("f_vymax", "f_iymax")],
-            vec![when(f_mv(0), vec![set("f_vf", "1'b0")])],
-        );
-        let stages = (1..=last).map(|j| {
-            Stmt::If(
-                f_mv(j - 1),
-                vec![
-                    set(f_v(j), "1'b1"),
-                    set(f_held(j, "g"), f_held(j - 1, "g")),
-                    set(f_held(j, "ymin"), f_held(j - 1, "ymin")),
-                    set(f_held(j, "ymax"), f_held(j - 1, "ymax")),
-                ],
-                vec![when(f_mv(j), vec![set(f_v(j), "1'b0")])],
-            )
-        });
-        let reset = [set("f_vf", "1'b0")].into_iter().chain((1..=last).map(|j| set(f_v(j), "1'b0"))).chain([set("f_sb", "1'b0")]).collect();
-        (reset, [input].into_iter().chain(stages).chain([setup]).collect())
-    }
-
-    /// The engine's clock: (its reset, its update). The phase and the valid bits move only while
-    /// the engine is not frozen; the queue shifts its head out on the walker's take and writes a
-    /// result behind the entries that stay.
-    fn engine_update(&self, e: &EngineShape) -> (Vec<Stmt>, Vec<Stmt>) {
-        let (phw, qw, n) = (e.phw(), e.qw(), e.periods());
-        let inc1 = |x: &str| set(x, format!("{x} + {}", one(self.cw)));
-        let last = lit(phw, (e.ii - 1) as u64);
-        let shift_in = if n == 1 { "f_vf".to_string() } else { format!("{{f_vld[{}:0], f_vf}}", n - 2) };
-        let mut st = vec![
-            set("f_errp", "f_due && !res_guard"),
-            when("f_due && f_en && res_guard && res_cull", vec![inc1("f_ncull")]),
-            Stmt::If("f_acc".into(), vec![set("f_vf", "1'b1")], vec![when("f_enter", vec![set("f_vf", "1'b0")])]),
-            when(
-                "f_en",
-                vec![Stmt::If(
-                    format!("f_ph == {last}"),
-                    vec![set("f_ph", lit(phw, 0)), set("f_vld", shift_in)],
-                    vec![set("f_ph", format!("f_ph + {}", one(phw)))],
-                )],
-            ),
-            when("f_take", (1..e.depth).map(|i| set(format!("f_q{}", i - 1), format!("f_q{i}"))).collect()),
-        ];
-        // The slot the pushed result lands in: behind the entries that stay.
-        for i in 0..e.depth {
-            st.push(when(
-                format!("f_qin && f_qn - {} == {}", zext("f_take", 1, qw), lit(qw, i as u64)),
-                vec![set(format!("f_q{i}"), "res")],
-            ));
-        }
-        st.push(set("f_qn", format!("f_qn + {} - {}", zext("f_qin", 1, qw), zext("f_take", 1, qw))));
-        let reset = vec![set("f_vf", "1'b0"), set("f_ph", lit(phw, 0)), set("f_vld", lit(n, 0)), set("f_qn", lit(qw, 0))];
-        (reset, st)
     }
 
     /// At the ports: the reference's stream, the rate, and nothing lost or invented.
@@ -758,43 +561,6 @@ impl Reference<'_> {
         b
     }
 
-    /// The engine and its queue at their boundary with the front-end: results due when the
-    /// reference says, the freeze, the queue's writes and reads, its order.
-    fn engine_ports(&self, e: &EngineShape) -> Vec<Item> {
-        let depth = lit(e.qw(), e.depth as u64);
-        let mut b = vec![comment("The engine: a result is due exactly at its schedule's latency after its entry plus the clocks")];
-        b.push(comment("frozen; the engine freezes exactly while that result finds the queue full."));
-        b.push(Item::Comb(vec![when("f_past", vec![assert("res_v == f_due"), assert("en == f_en")])]));
-        b.push(comment("The queue: never written when full, never read when empty, written exactly when a result"));
-        b.push(comment("for it is due and it has room, read exactly when the walker takes; its head is the oldest"));
-        b.push(comment("entry not yet taken (entries leave in the order they came, none lost or repeated)."));
-        b.push(Item::Comb(vec![when(
-            "f_past",
-            vec![
-                assert("!(q_in && q_full)"),
-                assert("!(take && !q_ne)"),
-                assert(format!("f_q_cnt <= {}", lit(e.qw(), e.depth as u64))),
-                assert("q_in == f_qin"),
-                assert("take == f_take"),
-                assert(format!("q_ne == (f_qn != {})", lit(e.qw(), 0))),
-                assert(format!("q_full == (f_qn == {depth})")),
-                when(format!("f_qn != {}", lit(e.qw(), 0)), vec![assert("q_head == f_q0")]),
-            ],
-        )]));
-        b.push(comment("The freeze: while en is low the phase ring, the valid bits of the periods in flight and"));
-        b.push(comment("the epoch ring hold, and the queue is not written."));
-        let mut hold = vec![assert("f_e_vld == $past(f_e_vld)")];
-        if e.ii > 1 {
-            hold.push(assert("f_e_ph == $past(f_e_ph)"));
-        }
-        if e.epochs > 1 {
-            hold.push(assert("f_e_ep == $past(f_e_ep)"));
-        }
-        b.push(Item::Comb(vec![when("f_past && !en", vec![assert("!q_in")])]));
-        b.push(Item::Always(vec![when("f_past && !$past(rst) && !$past(en)", hold)]));
-        b
-    }
-
     /// Linking invariants: every stage's registers are the reference's.
     fn linking(&self) -> Vec<Item> {
         let FrontendShape { xw, width, ref span_stages, .. } = *self.s;
@@ -827,99 +593,6 @@ impl Reference<'_> {
         }
         b.push(Item::Comb(vec![when("f_past", link)]));
         b
-    }
-
-    /// The parallel set-up's and the walker's links.
-    fn parallel_links(&self, p: &ParallelSetup) -> Vec<Stmt> {
-        let FrontendShape { yw, cy, height, .. } = *self.s;
-        let ParallelSetup { cnt_w, bits, rw, div_clocks, ref calc_stages, .. } = *p;
-        let (_, nw) = parallel(p);
-        let centre = |r: &str| format!("$signed({{2'b00, {r}, 8'd128}})");
-        let within = |r: &str, lo: &str, hi: &str| vec![assert(format!("{} >= {lo}", centre(r))), assert(format!("{} <= {hi}", centre(r)))];
-        let hmax = lit(yw, height - 1);
-        let st_is = "(f_sb ? (f_sh ? HOLD : DIV) : IDLE)";
-        let mut su = vec![assert(format!("{} <= f_symax", centre("s_last"))), assert(format!("{} >= f_symin", centre("s_first")))];
-        su.extend([assert("s_first <= s_last"), assert(format!("s_last <= {hmax}"))]);
-        let mut wk = vec![assert("w_row == f_wrow"), assert("w_last == f_wlast"), assert("f_wrow <= f_wlast")];
-        wk.extend(within("f_wrow", "f_wymin", "f_wymax"));
-        wk.extend([assert(format!("{} <= f_wymax", centre("f_wlast"))), assert(format!("f_wlast <= {hmax}"))]);
-        let mut link = vec![
-            assert("v_full == f_vf"),
-            when("f_vf", vec![assert("guard_ok == f_vg"), assert("ymin == f_vymin"), assert("ymax == f_vymax")]),
-        ];
-        let ryc = |r: &str| format!("$signed({{{r}, 8'd128}})");
-        for (j, c) in calc_stages.iter().enumerate().map(|(i, c)| (i + 1, c)) {
-            let mut held = vec![assert(format!("{} == {}", c.guard, f_held(j, "g")))];
-            if let Some(r) = &c.ymin {
-                held.push(assert(format!("{r} == {}", f_held(j, "ymin"))));
-            }
-            if let Some(r) = &c.ymax {
-                held.push(assert(format!("{r} == {}", f_held(j, "ymax"))));
-            }
-            if let Some(r) = &c.first_s {
-                held.push(assert(format!("!{r}[{}]", cy - 8)));
-                held.push(assert(format!("{} >= {}", ryc(r), f_held(j, "ymin"))));
-            }
-            for r in c.last_s.iter().chain(&c.last_alt) {
-                held.push(assert(format!("{r} <= {}", slit(cy - 7, height as i64 - 1))));
-                held.push(assert(format!("{} <= {}", ryc(r), f_held(j, "ymax"))));
-            }
-            if let (Some(k), Some(a), Some(z)) = (&c.cull, &c.first_s, &c.last_s) {
-                held.push(when(format!("!{k}"), vec![assert(format!("{a} <= {z}"))]));
-            }
-            link.push(assert(format!("{} == {}", c.valid, f_v(j))));
-            link.push(when(f_v(j), held));
-        }
-        link.extend([
-            assert(format!("st == {st_is}")),
-            when(
-                "f_sb && !f_sh",
-                vec![assert(format!(
-                    "div_cnt == ({} << {}) + {}",
-                    zext("f_sn", nw, cnt_w.max(nw)),
-                    bits.trailing_zeros(),
-                    lit(cnt_w.max(nw), ((rw - 1) % bits) as u64)
-                ))],
-            ),
-            when(format!("f_sn > {}", lit(nw, (div_clocks - 1) as u64)), vec![assert("!(f_sb && !f_sh)")]),
-            when("f_sb", su),
-            assert("w_valid == f_wv"),
-            when("f_wv", wk),
-        ]);
-        link
-    }
-
-    /// The engine's, the queue's and the walker's links. The rows the walker loads are the
-    /// engine's data (taken as given: where they lie is co-simulated), so its links are its
-    /// registers only.
-    fn engine_links(&self, e: &EngineShape) -> Vec<Stmt> {
-        let (phw, qw, pw) = (e.phw(), e.qw(), bits_for(e.depth - 1));
-        let mut link =
-            vec![assert("f_e_vfull == f_vf"), assert("f_e_vld == f_vld"), assert(format!("f_ph <= {}", lit(phw, (e.ii - 1) as u64)))];
-        if e.ii > 1 {
-            link.push(assert(format!("f_e_ph == {} << f_ph", lit(e.ii, 1))));
-        }
-        if e.epochs > 1 {
-            link.push(assert(format!("f_e_ep != {} && (f_e_ep & (f_e_ep - {})) == {}", lit(e.epochs, 0), one(e.epochs), lit(e.epochs, 0))));
-        }
-        // The queue's pointers: the tail is the count past the head, modulo the depth; entry i
-        // from the head is its memory word (rd + i) mod depth.
-        let rd = "{1'b0, f_q_rd}";
-        let wrap = |x: String, k: u32| format!("({x} == {} || {x} == {})", lit(pw + 1, k as u64), lit(pw + 1, (k + e.depth) as u64));
-        link.extend([
-            assert(format!("f_q_cnt == {}", zext("f_qn", qw, pw + 1))),
-            assert(format!("{rd} + f_q_cnt == {{1'b0, f_q_wr}} || {rd} + f_q_cnt == {{1'b0, f_q_wr}} + {}", lit(pw + 1, e.depth as u64))),
-        ]);
-        for i in 0..e.depth {
-            for k in 0..e.depth {
-                link.push(when(
-                    format!("f_qn > {} && {}", lit(qw, i as u64), wrap(format!("{rd} + {}", lit(pw + 1, i as u64)), k)),
-                    vec![assert(format!("f_q_mem{k} == f_q{i}"))],
-                ));
-            }
-        }
-        link.extend([assert("w_valid == f_wv"), when("f_wv", vec![assert("w_row == f_wrow"), assert("w_last == f_wlast")])]);
-        link
     }
 }
 

@@ -1,0 +1,161 @@
+//! The engine form's part of the front-end's properties (`--fe-setup`): the engine's and the
+//! queue's registers the proof reads, and the reference's declarations, updates, port checks
+//! and links for the sequenced set-up and its result queue.
+
+use super::*;
+
+/// The engine's and the queue's registers the properties read, by the names Yosys gives them
+/// once the design is flattened (`instance.register`; `mem[k]`, the queue's entry k, once
+/// `memory_map` has run): `scripts/prove` drives each formal-only wire from its register
+/// (`connect -set`), since Yosys reads no hierarchical reference.
+pub(super) fn engine_probes(e: &EngineShape) -> Vec<(String, String, u32)> {
+    let pw = bits_for(e.depth - 1);
+    let mut v = vec![("f_e_vfull".to_string(), "u_engine.v_full".to_string(), 1), ("f_e_vld".into(), "u_engine.vld".into(), e.periods())];
+    if e.ii > 1 {
+        v.push(("f_e_ph".into(), "u_engine.ph".into(), e.ii));
+    }
+    if e.epochs > 1 {
+        v.push(("f_e_ep".into(), "u_engine.ep".into(), e.epochs));
+    }
+    v.extend([
+        ("f_q_cnt".into(), "u_queue.cnt".into(), pw + 1),
+        ("f_q_rd".into(), "u_queue.rd".into(), pw),
+        ("f_q_wr".into(), "u_queue.wr".into(), pw),
+    ]);
+    v.extend((0..e.depth).map(|k| (format!("f_q_mem{k}"), format!("u_queue.mem[{k}]"), e.entry_w)));
+    v
+}
+
+impl EngineShape {
+    /// The valid bits of the periods in flight (the sequencer's `vld`).
+    pub(super) fn periods(&self) -> u32 {
+        self.latency / self.ii + 1
+    }
+    /// The phase counter's width.
+    pub(super) fn phw(&self) -> u32 {
+        bits_for(self.ii - 1)
+    }
+    /// The queue's count width (holds `depth`).
+    pub(super) fn qw(&self) -> u32 {
+        bits_for(self.depth)
+    }
+}
+
+impl Reference<'_> {
+    /// The engine's reference registers: the vertex register, the phase and the valid bits of
+    /// the periods in flight, and the queue (its count and entries, in order).
+    pub(super) fn engine_declarations(&self, e: &EngineShape) -> Vec<Item> {
+        let mut b = vec![
+            comment("The reference. The vertex register, the engine's phase (0 .. II - 1) and the valid bits of the"),
+            comment("periods in flight (a triangle or a bubble enters at the last phase), the queue: its count and"),
+            comment("its entries, the head first, each as the engine offered it (the result's bits, taken as given)."),
+        ];
+        b.extend([reg("f_vf", 1), reg("f_ph", e.phw()), reg("f_vld", e.periods()), reg("f_qn", e.qw())]);
+        b.extend((0..e.depth).map(|i| reg(&format!("f_q{i}"), e.entry_w)));
+        b
+    }
+
+    /// The engine's clock: (its reset, its update). The phase and the valid bits move only while
+    /// the engine is not frozen; the queue shifts its head out on the walker's take and writes a
+    /// result behind the entries that stay.
+    pub(super) fn engine_update(&self, e: &EngineShape) -> (Vec<Stmt>, Vec<Stmt>) {
+        let (phw, qw, n) = (e.phw(), e.qw(), e.periods());
+        let inc1 = |x: &str| set(x, format!("{x} + {}", one(self.cw)));
+        let last = lit(phw, (e.ii - 1) as u64);
+        let shift_in = if n == 1 { "f_vf".to_string() } else { format!("{{f_vld[{}:0], f_vf}}", n - 2) };
+        let mut st = vec![
+            set("f_errp", "f_due && !res_guard"),
+            when("f_due && f_en && res_guard && res_cull", vec![inc1("f_ncull")]),
+            Stmt::If("f_acc".into(), vec![set("f_vf", "1'b1")], vec![when("f_enter", vec![set("f_vf", "1'b0")])]),
+            when(
+                "f_en",
+                vec![Stmt::If(
+                    format!("f_ph == {last}"),
+                    vec![set("f_ph", lit(phw, 0)), set("f_vld", shift_in)],
+                    vec![set("f_ph", format!("f_ph + {}", one(phw)))],
+                )],
+            ),
+            when("f_take", (1..e.depth).map(|i| set(format!("f_q{}", i - 1), format!("f_q{i}"))).collect()),
+        ];
+        // The slot the pushed result lands in: behind the entries that stay.
+        for i in 0..e.depth {
+            st.push(when(
+                format!("f_qin && f_qn - {} == {}", zext("f_take", 1, qw), lit(qw, i as u64)),
+                vec![set(format!("f_q{i}"), "res")],
+            ));
+        }
+        st.push(set("f_qn", format!("f_qn + {} - {}", zext("f_qin", 1, qw), zext("f_take", 1, qw))));
+        let reset = vec![set("f_vf", "1'b0"), set("f_ph", lit(phw, 0)), set("f_vld", lit(n, 0)), set("f_qn", lit(qw, 0))];
+        (reset, st)
+    }
+
+    /// The engine and its queue at their boundary with the front-end: results due when the
+    /// reference says, the freeze, the queue's writes and reads, its order.
+    pub(super) fn engine_ports(&self, e: &EngineShape) -> Vec<Item> {
+        let depth = lit(e.qw(), e.depth as u64);
+        let mut b = vec![comment("The engine: a result is due exactly at its schedule's latency after its entry plus the clocks")];
+        b.push(comment("frozen; the engine freezes exactly while that result finds the queue full."));
+        b.push(Item::Comb(vec![when("f_past", vec![assert("res_v == f_due"), assert("en == f_en")])]));
+        b.push(comment("The queue: never written when full, never read when empty, written exactly when a result"));
+        b.push(comment("for it is due and it has room, read exactly when the walker takes; its head is the oldest"));
+        b.push(comment("entry not yet taken (entries leave in the order they came, none lost or repeated)."));
+        b.push(Item::Comb(vec![when(
+            "f_past",
+            vec![
+                assert("!(q_in && q_full)"),
+                assert("!(take && !q_ne)"),
+                assert(format!("f_q_cnt <= {}", lit(e.qw(), e.depth as u64))),
+                assert("q_in == f_qin"),
+                assert("take == f_take"),
+                assert(format!("q_ne == (f_qn != {})", lit(e.qw(), 0))),
+                assert(format!("q_full == (f_qn == {depth})")),
+                when(format!("f_qn != {}", lit(e.qw(), 0)), vec![assert("q_head == f_q0")]),
+            ],
+        )]));
+        b.push(comment("The freeze: while en is low the phase ring, the valid bits of the periods in flight and"));
+        b.push(comment("the epoch ring hold, and the queue is not written."));
+        let mut hold = vec![assert("f_e_vld == $past(f_e_vld)")];
+        if e.ii > 1 {
+            hold.push(assert("f_e_ph == $past(f_e_ph)"));
+        }
+        if e.epochs > 1 {
+            hold.push(assert("f_e_ep == $past(f_e_ep)"));
+        }
+        b.push(Item::Comb(vec![when("f_past && !en", vec![assert("!q_in")])]));
+        b.push(Item::Always(vec![when("f_past && !$past(rst) && !$past(en)", hold)]));
+        b
+    }
+
+    /// The engine's, the queue's and the walker's links. The rows the walker loads are the
+    /// engine's data (taken as given: where they lie is co-simulated), so its links are its
+    /// registers only.
+    pub(super) fn engine_links(&self, e: &EngineShape) -> Vec<Stmt> {
+        let (phw, qw, pw) = (e.phw(), e.qw(), bits_for(e.depth - 1));
+        let mut link =
+            vec![assert("f_e_vfull == f_vf"), assert("f_e_vld == f_vld"), assert(format!("f_ph <= {}", lit(phw, (e.ii - 1) as u64)))];
+        if e.ii > 1 {
+            link.push(assert(format!("f_e_ph == {} << f_ph", lit(e.ii, 1))));
+        }
+        if e.epochs > 1 {
+            link.push(assert(format!("f_e_ep != {} && (f_e_ep & (f_e_ep - {})) == {}", lit(e.epochs, 0), one(e.epochs), lit(e.epochs, 0))));
+        }
+        // The queue's pointers: the tail is the count past the head, modulo the depth; entry i
+        // from the head is its memory word (rd + i) mod depth.
+        let rd = "{1'b0, f_q_rd}";
+        let wrap = |x: String, k: u32| format!("({x} == {} || {x} == {})", lit(pw + 1, k as u64), lit(pw + 1, (k + e.depth) as u64));
+        link.extend([
+            assert(format!("f_q_cnt == {}", zext("f_qn", qw, pw + 1))),
+            assert(format!("{rd} + f_q_cnt == {{1'b0, f_q_wr}} || {rd} + f_q_cnt == {{1'b0, f_q_wr}} + {}", lit(pw + 1, e.depth as u64))),
+        ]);
+        for i in 0..e.depth {
+            for k in 0..e.depth {
+                link.push(when(
+                    format!("f_qn > {} && {}", lit(qw, i as u64), wrap(format!("{rd} + {}", lit(pw + 1, i as u64)), k)),
+                    vec![assert(format!("f_q_mem{k} == f_q{i}"))],
+                ));
+            }
+        }
+        link.extend([assert("w_valid == f_wv"), when("f_wv", vec![assert("w_row == f_wrow"), assert("w_last == f_wlast")])]);
+        link
+    }
+}
