@@ -4,13 +4,17 @@
 
 mod engine;
 mod parallel;
+mod shape;
+
+use shape::*;
+pub use shape::{CalcStage, EngineShape, FrontendShape, ParallelSetup, SetupShape, SpanStage};
 
 use super::hw::Hw;
 use super::setup::{self, Setup};
 use super::span;
 use super::stager::Stager;
-use crate::formal::{assert, covers, past_flags, reset_and_stability, slit, when, CUT_TAG, OUT};
-use crate::verilog::{bit, comment, lit, net, reg, set, sext, wire, zext, Item, Stmt};
+use crate::formal::{assert, covers, past_flags, reset_and_stability, when, CUT_TAG, OUT};
+use crate::verilog::{bit, comment, lit, net, reg, set, wire, zext, Item, Stmt};
 
 pub(super) fn emit(hw: &Hw, set_up: Setup, sp: &Stager) -> Item {
     let fe = &hw.fe;
@@ -78,95 +82,6 @@ fn shape(hw: &Hw, sp: &Stager, setup: SetupShape) -> FrontendShape {
     }
 }
 
-/// What the front-end's proof needs from its generator: widths, screen, its set-up's shape.
-pub struct FrontendShape {
-    /// Row bits (`out_y`), vertex x and y bits.
-    pub yw: u32,
-    pub cx: u32,
-    pub cy: u32,
-    pub xw: u32,
-    /// `dI`'s bits (`out_di`).
-    pub dw: u32,
-    /// Screen width and height, pixels.
-    pub width: u64,
-    pub height: u64,
-    /// Clocks from a triangle's transfer to its first span (`Hw::latency`): the cover search's depth.
-    pub latency: u32,
-    /// The set-up in front of the walker.
-    pub setup: SetupShape,
-    /// The span path's register stages between the walker and the output, in order.
-    pub span_stages: Vec<SpanStage>,
-    /// The incremental I0 (`--fe-i0 incremental`): its start engine's clocks. The walker then
-    /// waits while a source starts (`ie_wait`, a data decision taken as given, like a row's
-    /// coverage) and the held triangle is taken once its first row is started (`ie_pv`); the
-    /// engine's own properties bound both waits.
-    pub starts: Option<u32>,
-}
-
-/// The set-up the reference follows in front of the walker.
-pub enum SetupShape {
-    /// CALC (in one clock or in stages), the dividers and the DIV/HOLD state machine.
-    Parallel(ParallelSetup),
-    /// The shared engine (`--fe-setup` a plan) and its result queue.
-    Engine(EngineShape),
-}
-
-/// The parallel set-up's shape.
-pub struct ParallelSetup {
-    /// The dividers' counter width, quotient bits per clock, the reciprocal's quotient bits,
-    /// and the clocks they run (`Hw::div_clocks`).
-    pub cnt_w: u32,
-    pub bits: u32,
-    pub rw: u32,
-    pub div_clocks: u32,
-    /// The set-up dividers' registers (partial remainder, divisor, quotient of each), as Yosys
-    /// names them once the design is flattened (`instance.register`, `*` for a generate loop's
-    /// index): cut.
-    pub div_regs: Vec<String>,
-    /// CALC's stages after the vertex register (none at level 0), in order.
-    pub calc_stages: Vec<CalcStage>,
-    /// The names under which the last CALC stage holds the guard-band check and the cull.
-    pub guard: String,
-    pub cull: String,
-}
-
-/// The shared engine's shape (golden's schedule and the queue behind it).
-pub struct EngineShape {
-    /// Clocks between entries (II), the schedule's latency from the entry to the result, and
-    /// the binding's period in triangles (the epoch ring's length).
-    pub ii: u32,
-    pub latency: u32,
-    pub epochs: u32,
-    /// The queue's entries and an entry's bits.
-    pub depth: u32,
-    pub entry_w: u32,
-}
-
-/// A register stage of the front-end's span path: where it holds a span's valid, row, columns
-/// and `dI`.
-pub struct SpanStage {
-    pub valid: String,
-    pub y: String,
-    pub x: String,
-    pub len: String,
-    pub di: String,
-}
-
-/// A CALC stage of the pipelined set-up: its valid register and where it holds what the
-/// reference follows (the guard-band check; the vertical extent, or the rows made of it).
-pub struct CalcStage {
-    pub valid: String,
-    pub guard: String,
-    pub ymin: Option<String>,
-    pub ymax: Option<String>,
-    /// The first and last rows, signed (`ryw` bits) and clipped, and the cull decision.
-    pub first_s: Option<String>,
-    pub last_s: Option<String>,
-    pub cull: Option<String>,
-    /// Candidates for the last row held before the choice between them (each as `last_s`).
-    pub last_alt: Vec<String>,
-}
-
 /// Properties of `tri_frontend` (SPEC §6; names as `frontend::module` declares them), with the
 /// per-triangle `dI`: its control against a reference model of its stages kept at the ports.
 ///
@@ -226,61 +141,6 @@ pub fn frontend_properties(s: &FrontendShape) -> Item {
         }
     }
     Item::Formal(b)
-}
-
-/// The deepest cover search for the engine's entry (II + 2 clocks).
-const ENTRY_COVER_DEPTH: u32 = 16;
-
-/// The reference model's shape: the stages it follows and its counters' widths.
-#[derive(Clone, Copy)]
-struct Reference<'a> {
-    s: &'a FrontendShape,
-    nsp: usize,
-    cw: u32,
-}
-
-/// The reference's CALC stage j's valid bit (0: the vertex register).
-fn f_v(j: usize) -> String {
-    if j == 0 {
-        "f_vf".to_string()
-    } else {
-        format!("f_c{j}v")
-    }
-}
-/// What the reference holds of a triangle in CALC stage j (`g`: the guard-band check, `ymin`,
-/// `ymax`: its vertical extent); stage 0 is the vertex register.
-fn f_held(j: usize, what: &str) -> String {
-    if j == 0 {
-        format!("f_v{what}")
-    } else {
-        format!("f_c{j}{what}")
-    }
-}
-/// Stage j's triangle moves on; the last stage's move is the set-up's load.
-fn f_mv(j: usize, last: usize) -> String {
-    if j == last {
-        "f_calc".to_string()
-    } else {
-        format!("f_mv{j}")
-    }
-}
-fn one(w: u32) -> String {
-    lit(w, 1)
-}
-/// Bits to hold `n` (at least 1).
-fn bits_for(n: u32) -> u32 {
-    (32 - n.leading_zeros()).max(1)
-}
-/// A valid span (`v`) is on the screen with at least one pixel.
-fn on_screen(v: &str, x: &str, len: &str, xw: u32, width: u64) -> Stmt {
-    let wlim = lit(xw + 2, width);
-    when(
-        v,
-        vec![
-            assert(format!("{len} != {}", lit(xw + 1, 0))),
-            assert(format!("{} + {} <= {wlim}", zext(x, xw, xw + 2), zext(len, xw + 1, xw + 2))),
-        ],
-    )
 }
 
 impl Reference<'_> {

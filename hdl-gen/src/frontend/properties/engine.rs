@@ -2,7 +2,9 @@
 //! queue's registers the proof reads, and the reference's declarations, updates, port checks
 //! and links for the sequenced set-up and its result queue.
 
-use super::*;
+use super::shape::*;
+use crate::formal::*;
+use crate::verilog::*;
 
 /// The engine's and the queue's registers the properties read, by the names Yosys gives them
 /// once the design is flattened (`instance.register`; `mem[k]`, the queue's entry k, once
@@ -24,21 +26,6 @@ pub(super) fn engine_probes(e: &EngineShape) -> Vec<(String, String, u32)> {
     ]);
     v.extend((0..e.depth).map(|k| (format!("f_q_mem{k}"), format!("u_queue.mem[{k}]"), e.entry_w)));
     v
-}
-
-impl EngineShape {
-    /// The valid bits of the periods in flight (the sequencer's `vld`).
-    pub(super) fn periods(&self) -> u32 {
-        self.latency / self.ii + 1
-    }
-    /// The phase counter's width.
-    pub(super) fn phw(&self) -> u32 {
-        bits_for(self.ii - 1)
-    }
-    /// The queue's count width (holds `depth`).
-    pub(super) fn qw(&self) -> u32 {
-        bits_for(self.depth)
-    }
 }
 
 impl Reference<'_> {

@@ -1,7 +1,9 @@
 //! The parallel form's part of the front-end's properties: CALC's stages, the DIV/HOLD state
 //! machine and the dividers' registers in the reference's declarations, updates and links.
 
-use super::*;
+use super::shape::*;
+use crate::formal::*;
+use crate::verilog::*;
 
 /// The parallel set-up's reference: its shape, CALC's last stage (0: the vertex register) and
 /// the divider-clock counter's width.
