@@ -131,12 +131,23 @@ fn set_up_costs_what_the_manifest_says() {
 }
 
 fn set_up_costs(m: &'static verilator_harness::ffi::ModelInfo<verilator_harness::ffi::TriIn, verilator_harness::ffi::FeOut>) {
-    // The model's divider rate, from the latency the build recorded for it.
-    let hw = hdl_gen::frontend::DIV_BITS
-        .map(|div_bits| hdl_gen::frontend::Hw { fe: frontend(m), div_bits, pipeline: m.pipeline })
-        .into_iter()
+    // The model's set-up form and divider rate, from the latency the build recorded for it (a
+    // COSIM_RTL_DIR folder's may be an engine form or the incremental I0, which the model's
+    // description does not name).
+    use golden::frontend::{I0Form, SetupForm};
+    let hw = SetupForm::ALL
+        .iter()
+        .flat_map(|&setup| I0Form::ALL.map(move |i0| (setup, i0)))
+        .filter(|&(setup, i0)| setup == SetupForm::Parallel || i0 == I0Form::Reciprocal)
+        .flat_map(|(setup, i0)| {
+            hdl_gen::frontend::DIV_BITS.map(|div_bits| hdl_gen::frontend::Hw {
+                fe: frontend(m).with_setup(setup).with_i0(i0),
+                div_bits,
+                pipeline: m.pipeline,
+            })
+        })
         .find(|hw| hw.latency() == m.latency)
-        .expect("a divider rate with the model's latency");
+        .expect("a set-up form and divider rate with the model's latency");
     let (walked, dropped) = hw.setup_clocks();
     // Per scanline (`--fe-di scanline`, under COSIM_RTL_DIR) each span of two pixels or more
     // also waits for its divider: a walked one-row triangle may take that much longer.
