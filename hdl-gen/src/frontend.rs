@@ -84,7 +84,6 @@ pub fn submodules(hw: &Hw, names: &Names) -> Vec<Module> {
 /// walker, the span path and the output register, then the properties.
 fn build(hw: &Hw, names: &Names) -> (Module, Vec<golden::pipeline::PipeStage>) {
     let fe = &hw.fe;
-    let wd = fe.widths();
     let mut body = Vec::new();
     if engine::on(hw) {
         assert!(
@@ -97,14 +96,7 @@ fn build(hw: &Hw, names: &Names) -> (Module, Vec<golden::pipeline::PipeStage>) {
         let sp = span::output(hw, names, sp, &mut body);
         let stages = if hw.calc_clocks() > 1 { stage_list(&sp, "span", &golden::pipeline::I0_STAGES) } else { Vec::new() };
         body.push(properties::emit_engine(hw, &sp));
-        let module = Module {
-            name: names.frontend.clone(),
-            header: header(hw, names),
-            params: vec![],
-            ports: ports(fe, &wd).into_iter().chain(span_ports(fe, &wd)).collect(),
-            body,
-        };
-        return (module, stages);
+        return (top(hw, names, body), stages);
     }
     let set_up = setup::emit(hw, names, &mut body);
     walker::emit(hw, names, &mut body);
@@ -121,14 +113,19 @@ fn build(hw: &Hw, names: &Names) -> (Module, Vec<golden::pipeline::PipeStage>) {
     if fe.di == DiMode::Triangle {
         body.push(properties::emit(hw, set_up, &sp));
     }
-    let module = Module {
+    (top(hw, names, body), stages)
+}
+
+/// `tri_frontend` around its body: the same header and ports in every set-up form.
+fn top(hw: &Hw, names: &Names, body: Vec<crate::verilog::Item>) -> Module {
+    let wd = hw.fe.widths();
+    Module {
         name: names.frontend.clone(),
         header: header(hw, names),
         params: vec![],
-        ports: ports(fe, &wd).into_iter().chain(span_ports(fe, &wd)).collect(),
+        ports: ports(&hw.fe, &wd).into_iter().chain(span_ports(&hw.fe, &wd)).collect(),
         body,
-    };
-    (module, stages)
+    }
 }
 
 /// The module's header: configuration, formats, set-up, latency and widths.

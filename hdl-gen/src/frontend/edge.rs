@@ -177,7 +177,7 @@ pub(super) fn module(hw: &Hw, names: &Names) -> Module {
         "rem += rs256 modulo D (one add, compare, subtract); lg/ha is g on the edge's side of the row, else lo/hi.".into(),
         format!("Widths: bound GW = {bound_w} signed, divisor {ediv_w}, rows {row_w}, bounds out {end_w} signed."),
     ];
-    let ports = vec![
+    let mut ports = vec![
         Port::input("clk", 1, "", "rising edge"),
         Port::input("calc_go", 1, "", "CALC's last clock: take this edge's values, start its divisions"),
         Port::input("div_run", 1, "", "the set-up's divider clock"),
@@ -189,15 +189,8 @@ pub(super) fn module(hw: &Hw, names: &Names) -> Module {
         Port::input("right", 1, "", "the interior is on its left: it bounds the span's right end"),
         Port::input("rs", row_w, "unsigned integer", "first row"),
         Port::input("re", row_w, "unsigned integer", "last row"),
-        Port::input("take", 1, "", "the walker loads the set-up result"),
-        Port::input("step", 1, "", "the walker moves to the next row"),
-        Port::input("row", row_w, "unsigned integer", "the walked row"),
-        Port::input("lo", end_w, "signed integer", "the screen's left bound (as -x)").signed(),
-        Port::input("hi", end_w, "signed integer", "the screen's right bound").signed(),
-        Port::output("lg", end_w, "signed integer", "a left edge's bound on the row (as -x), else lo").signed(),
-        Port::output("ha", end_w, "signed integer", "a right edge's bound on the row, else hi").signed(),
     ];
-    let mut ports = ports;
+    ports.extend(walker_ports(row_w, end_w));
     for (port, w, signed, _, name) in state_outputs(hw) {
         let p = Port::output(port, w, if signed { "signed integer" } else { "" }, &format!("for the incremental I0: the edge's {name}"));
         ports.push(if signed { p.signed() } else { p });
@@ -285,7 +278,16 @@ fn module_engine(hw: &Hw, names: &Names) -> Module {
         let p = Port::input(port, w, "", &format!("the set-up result's {port}"));
         ports.push(if port == "g" || port == "qs" { p.signed() } else { p });
     }
-    ports.extend([
+    ports.extend(walker_ports(row_w, end_w));
+    let mut body = dda(&e);
+    let load = ["act", "right", "rs", "re", "d", "g", "rem", "qs", "rs256"].map(|p| set(format!("w_{p}"), p)).to_vec();
+    body.push(walk(&e, load));
+    Module { name: names.fe_edge.clone(), header, params: vec![], ports, body }
+}
+
+/// The walker's side of an edge, the same in every set-up form.
+fn walker_ports(row_w: u32, end_w: u32) -> [Port; 7] {
+    [
         Port::input("take", 1, "", "the walker loads the set-up result"),
         Port::input("step", 1, "", "the walker moves to the next row"),
         Port::input("row", row_w, "unsigned integer", "the walked row"),
@@ -293,9 +295,5 @@ fn module_engine(hw: &Hw, names: &Names) -> Module {
         Port::input("hi", end_w, "signed integer", "the screen's right bound").signed(),
         Port::output("lg", end_w, "signed integer", "a left edge's bound on the row (as -x), else lo").signed(),
         Port::output("ha", end_w, "signed integer", "a right edge's bound on the row, else hi").signed(),
-    ]);
-    let mut body = dda(&e);
-    let load = ["act", "right", "rs", "re", "d", "g", "rem", "qs", "rs256"].map(|p| set(format!("w_{p}"), p)).to_vec();
-    body.push(walk(&e, load));
-    Module { name: names.fe_edge.clone(), header, params: vec![], ports, body }
+    ]
 }
