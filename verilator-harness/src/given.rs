@@ -56,6 +56,24 @@ pub fn parse<A: clap::Parser>() -> (A, Vec<String>) {
     (args, hdl_gen::cli::given_model_args(&m))
 }
 
+/// A binary's start, before it runs anything: its arguments ([`parse`]), the COSIM_RTL_DIR
+/// folder read and described (one that describes no models is a usage error), and a model flag
+/// the folder contradicts refused ([`refuse`]), for the options `opts` makes of the arguments
+/// (`None`: a command without a model). Each failure is one `error:` line and exit status 2.
+pub fn start<A: clap::Parser>(
+    opts: impl FnOnce(&A) -> Option<Result<hdl_gen::Options, hdl_gen::cli::ArgsError>>,
+) -> Result<A, std::process::ExitCode> {
+    let (args, given) = parse::<A>();
+    if let Err(e) = crate::registry::check_folder() {
+        eprintln!("error: {e}");
+        return Err(std::process::ExitCode::from(2));
+    }
+    if let Some(o) = opts(&args) {
+        refuse(&given, o)?;
+    }
+    Ok(args)
+}
+
 /// [`check`] for a binary: the refusal as its one line, exit status 2.
 pub fn refuse(given: &[String], opts: Result<hdl_gen::Options, hdl_gen::cli::ArgsError>) -> Result<(), std::process::ExitCode> {
     // Options generate refuses are the binary's own error, said where it makes them.

@@ -112,18 +112,15 @@ enum Cmd {
 type Bad = String;
 
 fn main() -> ExitCode {
-    let (args, given) = verilator_harness::given::parse::<Args>();
-    // A COSIM_RTL_DIR that describes no models is a usage error, said before anything runs.
-    if let Err(e) = verilator_harness::registry::check_folder() {
-        eprintln!("error: {e}");
-        return ExitCode::from(2);
-    }
-    // A model flag the COSIM_RTL_DIR folder was not generated with is refused, not ignored.
-    if let Cmd::Gen { model, .. } | Cmd::Info { model } = &args.cmd {
-        if let Err(code) = verilator_harness::given::refuse(&given, model.options(None)) {
-            return code;
-        }
-    }
+    // A COSIM_RTL_DIR folder that describes no models, or that a model flag contradicts, is
+    // refused before anything runs.
+    let args = match verilator_harness::given::start::<Args>(|a| match &a.cmd {
+        Cmd::Gen { model, .. } | Cmd::Info { model } => Some(model.options(None)),
+        Cmd::Harness { .. } => None,
+    }) {
+        Ok(args) => args,
+        Err(code) => return code,
+    };
     let run = match args.cmd {
         Cmd::Gen { design, model, width, height, spans, seed, traffic, out } => {
             let traffic = match traffic {

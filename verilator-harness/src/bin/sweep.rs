@@ -163,11 +163,9 @@ impl Cell {
     }
 }
 
-/// What is refused before anything runs: a COSIM_RTL_DIR that describes no models, options
-/// `generate` refuses (whichever models the run has), and a bad --out (now, not after the
-/// sweep's minutes).
+/// What is refused before anything runs besides the folder (`given::start`): options `generate`
+/// refuses (whichever models the run has), and a bad --out (now, not after the sweep's minutes).
 fn refused(args: &Args) -> Result<(), String> {
-    verilator_harness::registry::check_folder().map_err(|e| e.to_string())?;
     args.variant.options(8, Align::Span, None).map_err(|e| e.to_string())?;
     match args.out.as_deref().map(hdl_gen::output::check_writable) {
         Some(Err(e)) => Err(format!("--out: {e}")),
@@ -176,14 +174,15 @@ fn refused(args: &Args) -> Result<(), String> {
 }
 
 fn main() -> ExitCode {
-    let (args, given) = verilator_harness::given::parse::<Args>();
+    // A COSIM_RTL_DIR folder that describes no models, or that a model flag contradicts, is
+    // refused before anything runs.
+    let args = match verilator_harness::given::start::<Args>(|a| Some(a.variant.options(8, Align::Span, None))) {
+        Ok(args) => args,
+        Err(code) => return code,
+    };
     if let Err(e) = refused(&args) {
         eprintln!("error: {e}");
         return ExitCode::from(2);
-    }
-    // A model flag the COSIM_RTL_DIR folder was not generated with is refused, not ignored.
-    if let Err(code) = verilator_harness::given::refuse(&given, args.variant.options(8, golden::Align::Span, None)) {
-        return code;
     }
     let start = Instant::now();
     let screen = Screen { width: args.width, height: args.height };
