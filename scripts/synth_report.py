@@ -57,6 +57,13 @@ def block_form(r):
             for t in tags
         ]
         return r["top"], ", ".join(form) or "—"
+    if r["label"].startswith("chain-"):
+        # 'chain-screen+pl1+ecp5-25f/p16': tri_fb_p16 (and specular_unit), screen alignment,
+        # --pipeline 1, --fe-setup ecp5-25f
+        form, _, _ = r["label"].partition("/")
+        align, *tags = form[len("chain-"):].split("+")
+        parts = [f"--align {align}"] + [level("+" + t) if t.startswith("pl") else f"--fe-setup {t}" for t in tags]
+        return " + ".join(r["top"].split("+")), ", ".join(parts)
     if r["label"].startswith("specular"):
         return r["top"], level(r["label"][len("specular"):]) or "—"
     if r["label"].startswith("ref/"):

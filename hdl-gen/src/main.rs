@@ -58,10 +58,12 @@ enum Command {
         /// A folder written by `generate` (its manifest.json lists the module's ports).
         #[arg(long)]
         rtl: PathBuf,
-        /// The module to wrap, as named in manifest.json.
-        #[arg(long)]
-        module: String,
-        /// The Verilog file to write; the harness module is `<module>_synth`.
+        /// The module to wrap, as named in manifest.json; given more than once, the modules sit
+        /// side by side in one harness (one design to place, as one device must hold them).
+        #[arg(long, required = true)]
+        module: Vec<String>,
+        /// The Verilog file to write; the harness module is `<module>_synth` (`<A>_<B>_synth` for
+        /// several).
         #[arg(long)]
         out: PathBuf,
         /// Register the block's outputs before the XOR tree, or fold them directly (a flip-flop
@@ -202,9 +204,12 @@ fn run(command: Command) -> anyhow::Result<()> {
         Command::SynthWrapper { rtl, module, out, outputs } => {
             let path = rtl.join(hdl_gen::manifest::MANIFEST_FILE);
             let text = read_manifest(&path)?;
-            let ports = hdl_gen::tools::wrapper::ports_from_manifest(&text, &module)?;
+            let blocks = module
+                .into_iter()
+                .map(|m| Ok((m.clone(), hdl_gen::tools::wrapper::ports_from_manifest(&text, &m)?)))
+                .collect::<Result<Vec<_>, hdl_gen::tools::wrapper::WrapperError>>()?;
             output::check_not_input(&out, &[&path])?;
-            output::write_one(&out, hdl_gen::tools::wrapper::module(&module, &ports, outputs)?.render().as_bytes())?;
+            output::write_one(&out, hdl_gen::tools::wrapper::modules(&blocks, outputs)?.render().as_bytes())?;
             eprintln!("wrote {}", out.display());
         }
         Command::Manifest { rtl, role } => {

@@ -114,6 +114,10 @@ fn synth_and_check_rtl_dir_show_the_generators_message() {
         (&["--family", "ecp5", "--arch", "wallace", "--out", o], &["--arch wallace", "wallace"]),
         (&["--pipeline", "7", "--out", o], &["--pipeline", "'7'"]),
         (&["--frontend", "--fe-div-bits", "3", "--out", o], &["--fe-div-bits 3"]),
+        (&["--chain", "3", "--out", o], &["--chain 3", "power of two"]),
+        (&["--chain", "16", "--chain-align", "diagonal", "--out", o], &["--chain 16 --chain-align diagonal", "diagonal"]),
+        (&["--chain", "16", "--fe-setup", "xc7", "--out", o], &["--fe-setup xc7", "xc7"]),
+        (&["--chain"], &["--chain needs a value"]),
         (&["--family", "vhdl"], &["unknown family 'vhdl'"]),
         (&["--seeds"], &["--seeds needs a value"]),
     ];

@@ -55,6 +55,10 @@ pub enum WrapperError {
     /// the harness's text).
     #[error("'{0}' is not a Verilog identifier")]
     Name(String),
+    #[error("module '{0}' is named twice")]
+    DuplicateModule(String),
+    #[error("no module to wrap")]
+    NoModule,
     #[error("module '{block}' lists port '{port}' twice")]
     DuplicatePort { block: String, port: String },
     /// A port, or all inputs or outputs together (the harness's shift chain and output
@@ -108,16 +112,38 @@ pub fn ports_from_manifest(manifest: &str, module: &str) -> Result<Vec<BlockPort
 
 /// The harness module `<block>_synth` around `block`, which must have an input `clk`.
 pub fn module(block: &str, ports: &[BlockPort], outputs: Outputs) -> Result<Module, WrapperError> {
-    check_ports(block, ports)?;
-    if !ports.iter().any(|p| p.name == "clk" && p.dir == Dir::Input && p.width == 1) {
-        return Err(WrapperError::NoClock(block.into()));
+    modules(&[(block.to_string(), ports.to_vec())], outputs)
+}
+
+/// One harness around several blocks side by side (`synth-wrapper --module A --module B`): one
+/// design to place, as a device must hold them together (issue 27: the chain and the specular
+/// unit on one LFE5U-25F). Their inputs share the shift chain and their outputs the XOR tree;
+/// the harness is `<A>_<B>_synth`. One block is [`module`]'s harness, byte for byte.
+pub fn modules(blocks: &[(String, Vec<BlockPort>)], outputs: Outputs) -> Result<Module, WrapperError> {
+    for (k, (block, ports)) in blocks.iter().enumerate() {
+        check_ports(block, ports)?;
+        if blocks[..k].iter().any(|(b, _)| b == block) {
+            return Err(WrapperError::DuplicateModule(block.clone()));
+        }
+        if !ports.iter().any(|p| p.name == "clk" && p.dir == Dir::Input && p.width == 1) {
+            return Err(WrapperError::NoClock(block.clone()));
+        }
     }
-    let ins: Vec<&BlockPort> = ports.iter().filter(|p| p.dir == Dir::Input && p.name != "clk").collect();
-    let outs: Vec<&BlockPort> = ports.iter().filter(|p| p.dir == Dir::Output).collect();
-    let n_in: u32 = ins.iter().map(|p| p.width).sum();
-    let n_out: u32 = outs.iter().map(|p| p.width).sum();
-    if n_in == 0 || n_out == 0 {
-        return Err(WrapperError::NoData(block.into()));
+    let Some((first, _)) = blocks.first() else { return Err(WrapperError::NoModule) };
+    let several = blocks.len() > 1;
+    // Per block: its data inputs and outputs, and the names its wires take in the harness.
+    let ins = |ports: &[BlockPort]| ports.iter().filter(|p| p.dir == Dir::Input && p.name != "clk").cloned().collect::<Vec<_>>();
+    let outs = |ports: &[BlockPort]| ports.iter().filter(|p| p.dir == Dir::Output).cloned().collect::<Vec<_>>();
+    let n_in: u32 = blocks.iter().map(|(_, p)| ins(p).iter().map(|p| p.width).sum::<u32>()).sum();
+    let n_out: u32 = blocks.iter().map(|(_, p)| outs(p).iter().map(|p| p.width).sum::<u32>()).sum();
+    for (block, ports) in blocks {
+        if ins(ports).is_empty() || outs(ports).is_empty() {
+            return Err(WrapperError::NoData(block.clone()));
+        }
+    }
+    if n_in as u64 > MAX_VECTOR_BITS || n_out as u64 > MAX_VECTOR_BITS {
+        let (what, width) = if n_in as u64 > MAX_VECTOR_BITS { ("the inputs together", n_in) } else { ("the outputs together", n_out) };
+        return Err(WrapperError::Width { block: first.clone(), what: what.into(), width: width as u64 });
     }
 
     let mut body = vec![Item::Comment("Input registers: one shift chain from si.".into()), reg("in_q", n_in)];
@@ -125,26 +151,31 @@ pub fn module(block: &str, ports: &[BlockPort], outputs: Outputs) -> Result<Modu
     body.push(Item::Always(vec![set("in_q", shift_in)]));
     body.push(Item::Blank);
 
-    let mut conns = vec![("clk".to_string(), "clk".to_string())];
     let mut off = 0;
-    for p in &ins {
-        let sel = if n_in == 1 {
-            "in_q".to_string()
-        } else if p.width == 1 {
-            format!("in_q[{off}]")
-        } else {
-            format!("in_q[{off} +: {}]", p.width)
-        };
-        conns.push((p.name.clone(), sel));
-        off += p.width;
-    }
     let mut outs_concat = Vec::new();
-    for p in &outs {
-        body.push(Item::Wire { name: format!("o_{}", p.name), width: p.width, signed: false, value: None });
-        conns.push((p.name.clone(), format!("o_{}", p.name)));
-        outs_concat.push(format!("o_{}", p.name));
+    for (block, ports) in blocks {
+        let mut conns = vec![("clk".to_string(), "clk".to_string())];
+        for p in ins(ports) {
+            let sel = if n_in == 1 {
+                "in_q".to_string()
+            } else if p.width == 1 {
+                format!("in_q[{off}]")
+            } else {
+                format!("in_q[{off} +: {}]", p.width)
+            };
+            conns.push((p.name.clone(), sel));
+            off += p.width;
+        }
+        let prefix = if several { format!("o_{block}_") } else { "o_".to_string() };
+        for p in outs(ports) {
+            let wire = format!("{prefix}{}", p.name);
+            body.push(Item::Wire { name: wire.clone(), width: p.width, signed: false, value: None });
+            conns.push((p.name.clone(), wire.clone()));
+            outs_concat.push(wire);
+        }
+        let name = if several { format!("u_{block}") } else { "u_block".into() };
+        body.push(Item::Instance { module: block.clone(), name, params: vec![], conns });
     }
-    body.push(Item::Instance { module: block.to_string(), name: "u_block".into(), params: vec![], conns });
     body.push(Item::Blank);
 
     let all = if outs_concat.len() == 1 { outs_concat[0].clone() } else { format!("{{{}}}", outs_concat.join(", ")) };
@@ -185,10 +216,11 @@ pub fn module(block: &str, ports: &[BlockPort], outputs: Outputs) -> Result<Modu
     }
     body.push(Item::Assign("so".into(), name));
 
+    let names: Vec<&str> = blocks.iter().map(|(b, _)| b.as_str()).collect();
+    let harness = format!("{}_synth", names.join("_"));
     Ok(Module {
-        name: format!("{block}_synth"),
         header: vec![
-            format!("{block}_synth — synthesis harness: {block} between registers, for area and timing reports."),
+            format!("{harness} — synthesis harness: {} between registers, for area and timing reports.", names.join(" and ")),
             "Generated by segshade hdl-gen synth-wrapper; do not edit.".into(),
             String::new(),
             format!("{n_in} input bits arrive through a shift chain from si; {n_out} output bits are {kept} and"),
@@ -201,6 +233,7 @@ pub fn module(block: &str, ports: &[BlockPort], outputs: Outputs) -> Result<Modu
             Port::input("si", 1, "", "serial input into the input registers"),
             Port::output("so", 1, "", "XOR of every output register, pipelined"),
         ],
+        name: harness,
         body,
     })
 }
@@ -245,6 +278,25 @@ mod tests {
         assert!(matches!(&e, WrapperError::NoClock(b) if b == "blk"), "{e}");
         let e = module("blk", &[port("clk", Dir::Input, 1), port("y", Dir::Output, 2)], Outputs::Folded).unwrap_err();
         assert!(matches!(&e, WrapperError::NoData(b) if b == "blk"), "{e}");
+    }
+
+    /// Two blocks in one harness: one shift chain and one fold for both, each its own instance;
+    /// a module named twice is refused.
+    #[test]
+    fn wraps_several_blocks_side_by_side() {
+        let a = vec![port("clk", Dir::Input, 1), port("x", Dir::Input, 3), port("y", Dir::Output, 2)];
+        let b = vec![port("clk", Dir::Input, 1), port("x", Dir::Input, 2), port("y", Dir::Output, 5)];
+        let text = modules(&[("ba".into(), a.clone()), ("bb".into(), b)], Outputs::Registered).unwrap().render();
+        assert!(text.contains("module ba_bb_synth ("), "{text}");
+        assert!(text.contains("ba u_ba (") && text.contains("bb u_bb ("), "{text}");
+        assert!(text.contains(".x(in_q[0 +: 3])") && text.contains(".x(in_q[3 +: 2])"), "{text}");
+        assert!(text.contains("out_q <= {o_ba_y, o_bb_y};"), "{text}");
+        // One block through `modules` is `module`'s harness.
+        let one = modules(&[("ba".into(), a.clone())], Outputs::Folded).unwrap().render();
+        assert_eq!(one, module("ba", &a, Outputs::Folded).unwrap().render());
+        let e = modules(&[("ba".into(), a.clone()), ("ba".into(), a)], Outputs::Registered).unwrap_err();
+        assert!(matches!(&e, WrapperError::DuplicateModule(b) if b == "ba"), "{e}");
+        assert!(matches!(modules(&[], Outputs::Registered).unwrap_err(), WrapperError::NoModule));
     }
 
     /// Values no generated manifest holds are refused before any text is built.
