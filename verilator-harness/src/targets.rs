@@ -19,8 +19,9 @@ use hdl_gen::cli::VariantArgs;
 use hdl_gen::Target;
 use std::fmt::Write as _;
 
-/// The widths swept per form: the iCE40s' p = 4 up to p = 16, the widest for ~100 px.
-pub const WIDTHS: [u32; 3] = [4, 8, 16];
+/// The widths swept per form: the iCE40s' p = 4 up to p = 16, the widest for ~100 px,
+/// and p = 32, so that "the largest p keeping 95 %" is found, not capped by the sweep.
+pub const WIDTHS: [u32; 4] = [4, 8, 16, 32];
 
 /// `tri_frontend`'s Fmax on an ECP5 (speed 6, nextpnr, docs/fpga.md's tables: the 85F unless
 /// said) for the options that decide it (set-up form, pipeline level, quotient bits a clock, `I0`
