@@ -9,7 +9,7 @@ use super::stager::Stager;
 use super::walker::scanline_divider;
 use crate::verilog::{comment, lit, reg, set, wire, zext, Item, Stmt};
 use crate::Names;
-use golden::frontend::{DiMode, Widths};
+use golden::frontend::{DiMode, SetupForm, Widths};
 
 /// The span's first pixel's intensity and, per scanline, its last pixel's, the edge's value
 /// there: the same path twice, under these names.
@@ -26,8 +26,15 @@ struct End {
     out: &'static str,
 }
 
-/// Bits a multiplier tile (MULT18X18D, the iCE40's SB_MAC16 halves) takes per operand, unsigned.
-const TILE_BITS: u32 = 18;
+/// Bits a multiplier tile takes per operand, unsigned: the ECP5's MULT18X18D (and what the other
+/// set-up forms are measured on), or the UP5K's SB_MAC16 for its plan, whose 16 x 16 would
+/// split an 18-bit chunk into four.
+fn tile_bits(hw: &Hw) -> u32 {
+    match hw.fe.setup {
+        SetupForm::Ice40Up5k => 16,
+        _ => 18,
+    }
+}
 /// A chunk of at most this many bits is multiplied in logic, one adder a bit after the first,
 /// instead of taking tiles: a wider one costs more LUT4 than a tile is worth (Yosys 0.23 maps
 /// an 8 x 8 product modulo 2^8 to 111 LUT4, docs/fpga.md).
@@ -48,19 +55,19 @@ fn bits_of(x: &str, w: u32, hi: u32, lo: u32) -> String {
 }
 
 /// Defines `out = (a * b) mod 2^m` (`a` and `b` read as they are in the stage, unsigned) as
-/// tile-sized partial products, only those with a bit below 2^m, each cut to the bits it adds
+/// tile-sized ([`tile_bits`]) partial products, only those with a bit below 2^m, each cut to the bits it adds
 /// there. A plain `*` would take every tile of the full product: synthesis keeps a tile as long
 /// as one of its bits is read. A chunk of at most [`LOGIC_BITS`] bits (the narrower operand's
 /// top, say) is multiplied in logic instead, as shifted adds against the whole other operand.
-fn mul_mod(sp: &mut Stager, out: &str, a: (&str, u32), b: (&str, u32), m: u32) {
-    let terms = partial_products(sp, out, a, b, m);
+fn mul_mod(sp: &mut Stager, tile: u32, out: &str, a: (&str, u32), b: (&str, u32), m: u32) {
+    let terms = partial_products(sp, tile, out, a, b, m);
     sum_partials(sp, out, &terms, m);
 }
 
 /// [`mul_mod`]'s partial products, each its own wire `<out>_<n>`: `(name, width, offset)`.
-fn partial_products(sp: &mut Stager, out: &str, (a, aw): (&str, u32), (b, bw): (&str, u32), m: u32) -> Vec<(String, u32, u32)> {
+fn partial_products(sp: &mut Stager, tile: u32, out: &str, (a, aw): (&str, u32), (b, bw): (&str, u32), m: u32) -> Vec<(String, u32, u32)> {
     let ((a, aw), (b, bw)) = if aw >= bw { ((a, aw), (b, bw)) } else { ((b, bw), (a, aw)) };
-    let chunks = |w: u32| (0..w.div_ceil(TILE_BITS)).map(move |i| (i * TILE_BITS, (w - i * TILE_BITS).min(TILE_BITS)));
+    let chunks = |w: u32| (0..w.div_ceil(tile)).map(move |i| (i * tile, (w - i * tile).min(tile)));
     let mut terms: Vec<(String, u32, u32)> = Vec::new();
     let mut piece = |sp: &mut Stager, (x, xo, xw): (&str, u32, u32), (y, yo, yw): (&str, u32, u32), wx: u32, wy: u32| {
         let off = xo + yo;
@@ -138,6 +145,7 @@ pub(super) fn path(hw: &Hw, body: &mut Vec<Item>) -> Stager {
     // takes its top IW + 1 bits, and the correction is modulo 2^(AW+3): golden's
     // `Widths::reciprocal_quotient`, whose documentation proves the estimate two below at most.
     let s2_w = sum_w - 1;
+    let tile = tile_bits(hw);
     let t = fe.widths().i0_shift();
     let h_w = s2_w - t;
     // The estimate's bits and the ones below: the product modulo 2^(K - t + IW).
@@ -176,7 +184,7 @@ pub(super) fn path(hw: &Hw, body: &mut Vec<Item>) -> Stager {
     sp.note(comment("verilator lint_off UNUSEDSIGNAL"));
     for e in &ends {
         let (gxn, x) = (sp.at("gxn"), sp.at(e.x));
-        mul_mod(&mut sp, e.gx, (&gxn, s2_w - 1), (&x, xw), s2_w - 1);
+        mul_mod(&mut sp, tile, e.gx, (&gxn, s2_w - 1), (&x, xw), s2_w - 1);
     }
     sp.note(comment("verilator lint_on UNUSEDSIGNAL"));
     sp.cut();
@@ -193,7 +201,7 @@ pub(super) fn path(hw: &Hw, body: &mut Vec<Item>) -> Stager {
         sp.def(e.lo, corr_w, false, format!("{s2}[{}:0]", corr_w - 1));
         sp.def(e.h, h_w, false, format!("{s2}[{}:{t}]", s2_w - 1));
         let rn = sp.at("rn");
-        partials.push(partial_products(&mut sp, e.prod, (e.h, h_w), (&rn, recip_w), prod_w));
+        partials.push(partial_products(&mut sp, tile, e.prod, (e.h, h_w), (&rn, recip_w), prod_w));
     }
     sp.cut();
     i0_section(&mut sp);
@@ -211,7 +219,7 @@ pub(super) fn path(hw: &Hw, body: &mut Vec<Item>) -> Stager {
         // q~ An modulo 2^(AW+2), doubled: the correction's modulus.
         let (qt, an) = (sp.at(e.qt), sp.at("an"));
         let half_m = format!("{}_an", e.m);
-        mul_mod(&mut sp, &half_m, (&an, area_w), (&qt, iw), corr_w - 1);
+        mul_mod(&mut sp, tile, &half_m, (&an, area_w), (&qt, iw), corr_w - 1);
         sp.def(e.m, corr_w, false, format!("{{{half_m}, 1'b0}}"));
     }
     sp.cut();
