@@ -35,6 +35,7 @@ fn tile_bits(hw: &Hw) -> u32 {
         _ => 18,
     }
 }
+
 /// A chunk of at most this many bits is multiplied in logic, one adder a bit after the first,
 /// instead of taking tiles: a wider one costs more LUT4 than a tile is worth (Yosys 0.23 maps
 /// an 8 x 8 product modulo 2^8 to 111 LUT4, docs/fpga.md).
@@ -55,9 +56,9 @@ fn bits_of(x: &str, w: u32, hi: u32, lo: u32) -> String {
 }
 
 /// Defines `out = (a * b) mod 2^m` (`a` and `b` read as they are in the stage, unsigned) as
-/// tile-sized ([`tile_bits`]) partial products, only those with a bit below 2^m, each cut to the bits it adds
-/// there. A plain `*` would take every tile of the full product: synthesis keeps a tile as long
-/// as one of its bits is read. A chunk of at most [`LOGIC_BITS`] bits (the narrower operand's
+/// partial products of `tile`-bit chunks ([`tile_bits`]), only those with a bit below 2^m, each
+/// cut to the bits it adds there. A plain `*` would take every tile of the full product:
+/// synthesis keeps a tile as long as one of its bits is read. A chunk of at most [`LOGIC_BITS`] bits (the narrower operand's
 /// top, say) is multiplied in logic instead, as shifted adds against the whole other operand.
 fn mul_mod(sp: &mut Stager, tile: u32, out: &str, a: (&str, u32), b: (&str, u32), m: u32) {
     let terms = partial_products(sp, tile, out, a, b, m);
