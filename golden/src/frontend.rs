@@ -60,8 +60,9 @@
 //! `R = S2n - 2An q~` is then in `[0, 6An)`, below 2^(AW+3): modulo 2^(AW+3) it is exact, and
 //! `q = q~ + (R >= 2An) + (R >= 4An)`. `H` has IW + 1 bits, so the estimate's product is
 //! `(IW + 1) x RW` bits (at the defaults 21 x 23: two 18-bit tiles and a 3-bit slice in logic;
-//! the full `(K-1) x RW` product took eight tiles), and the correction's is `IW x (AW + 2)` bits
-//! modulo 2^(AW+2) (the partial products wholly above it are never built). `t = AW - 1` would
+//! the full `K x RW` product took eight tiles), and the correction's, `q~ An`, is `IW x AW` bits
+//! needed modulo 2^(AW+2) only, doubled to the remainder's 2^(AW+3) (the partial products wholly
+//! above it are never built). `t = AW - 1` would
 //! need one compare but a 22-bit `H`, four tiles. A shift one further (`t = AW + 1`) lets the
 //! estimate fall three below, and a compare dropped leaves two-below uncorrected: the tests plant
 //! both.
