@@ -39,10 +39,33 @@
 //!   Ny (256r + 128 - y0)`, exactly (correctly rounded), with no division per scanline: set-up
 //!   computes one reciprocal `Rn = floor(2^K / (2 An))` of the normalised `An = A << s`
 //!   (`s` leading zeros of A in AW bits, `K = IW + 2 + AW`); per row the walker forms
-//!   `S2n = ((2S + A) << s) mod 2^K` from two running sums and one multiply by the column, and
-//!   `q~ = (S2n Rn) >> K` is the quotient or one below it; one multiply by `2An` and a compare
-//!   correct it. Everything is modular: the values that leave the unit are small, and the sums
-//!   only need to be right modulo 2^K.
+//!   `S2n = ((2S + A) << s) mod 2^(K-1)` from two running sums and one multiply by the column,
+//!   and the span path takes the quotient estimate from its top IW + 1 bits only,
+//!   `q~ = ((S2n >> t) Rn) >> (K - t)` with `t = AW`, which is the quotient or up to two below
+//!   it; one multiply by `2An`, needed only modulo 2^(AW+3), and two compares correct it.
+//!   Everything is modular: the values that leave the unit are small, and the sums only need to
+//!   be right modulo 2^(K-1).
+//!
+//! ## Why the estimate is at most two below the quotient
+//!
+//! At a covered pixel the plane lies in `[0, 2^IW - 1]`, so `q = floor(S2n / 2An) = I0 < 2^IW`
+//! and `S2n < 2An 2^IW < 2^(K-1)`: the true `S2n` fits K - 1 bits, and its residue is itself.
+//! Write `S2n = H 2^t + L` (`L < 2^t`) and `Rn = 2^K / 2An - e` (`0 <= e < 1`). Then
+//!
+//! `S2n / 2An - H Rn / 2^(K-t) = L / 2An + H 2^t e / 2^K`.
+//!
+//! Both terms are at least 0, so `q~ <= q`. The first is below `2^t / 2^AW = 1` (`2An >= 2^AW`
+//! because An is normalised), the second below `2^(K-1) / 2^K = 1/2` (`H 2^t <= S2n`): the
+//! estimate's argument is less than 3/2 below `S2n / 2An >= q`, so `q~ >= q - 2`. The remainder
+//! `R = S2n - 2An q~` is then in `[0, 6An)`, below 2^(AW+3): modulo 2^(AW+3) it is exact, and
+//! `q = q~ + (R >= 2An) + (R >= 4An)`. `H` has IW + 1 bits, so the estimate's product is
+//! `(IW + 1) x RW` bits (at the defaults 21 x 23: two 18-bit tiles and a 3-bit slice in logic;
+//! the full `K x RW` product took eight tiles), and the correction's, `q~ An`, is `IW x AW` bits
+//! needed modulo 2^(AW+2) only, doubled to the remainder's 2^(AW+3) (the partial products wholly
+//! above it are never built). `t = AW - 1` would
+//! need one compare but a 22-bit `H`, four tiles. A shift one further (`t = AW + 1`) lets the
+//! estimate fall three below, and a compare dropped leaves two-below uncorrected: the tests plant
+//! both.
 //!
 //! # Accuracy
 //!
@@ -112,8 +135,8 @@ impl DiMode {
 #[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
 #[serde(rename_all = "lowercase")]
 pub enum I0Form {
-    /// Per row `S2n = 2 (Tn + Gxn lo) + An`, `q~ = (S2n Rn) >> K` and its correction: three
-    /// wide products a row in the span path.
+    /// Per row `S2n = 2 (Tn + Gxn lo) + An`, `q~ = ((S2n >> t) Rn) >> (K - t)` and its
+    /// correction: three products a row in the span path.
     #[default]
     Reciprocal,
     /// Per source of the span's left end, quotient and remainder over `2A` stepped by adds; the
@@ -214,6 +237,40 @@ pub struct Widths {
     pub rw: u32,
     /// Leading-zero count `s` of A.
     pub sw: u32,
+}
+
+impl Widths {
+    /// The bits of `S2n` the quotient estimate drops, `t = AW`: its top IW + 1 bits are all it
+    /// reads, and the estimate is the quotient or up to two below it (module documentation).
+    pub fn i0_shift(&self) -> u32 {
+        self.aw
+    }
+
+    /// Compares the correction makes: one per unit the estimate may fall short.
+    pub const I0_COMPARES: u32 = 2;
+
+    /// The span path's arithmetic from `S2n` (its residue modulo 2^(K-1)), `An` and `Rn`, as
+    /// wide as the RTL's registers (IW bits out): [`Widths::quotient_estimate`], then
+    /// [`Widths::I0_COMPARES`] compares of the remainder.
+    pub fn reciprocal_quotient(&self, s2n: u128, an: u128, rn: u128) -> u32 {
+        self.corrected_quotient(s2n, an, rn, self.i0_shift(), Self::I0_COMPARES)
+    }
+
+    /// The quotient estimate `q~ = ((S2n >> t) Rn) >> (K - t)`, before its correction.
+    pub fn quotient_estimate(&self, s2n: u128, rn: u128, t: u32) -> u128 {
+        ((s2n >> t) * rn) >> (self.k - t)
+    }
+
+    /// `q~ + #{k in 1..=compares : R >= 2k An}` with the remainder `R = S2n - 2An q~` modulo
+    /// 2^(AW+3): the arithmetic for any shift `t` and number of compares (the tests plant a
+    /// shift one too far and a compare dropped).
+    pub fn corrected_quotient(&self, s2n: u128, an: u128, rn: u128, t: u32, compares: u32) -> u32 {
+        let iw = self.k - 2 - self.aw;
+        let qt = self.quotient_estimate(s2n, rn, t) & mask(iw);
+        let rem = s2n.wrapping_sub(qt * 2 * an) & mask(self.aw + 3);
+        let up = (1..=compares as u128).filter(|&k| rem >= 2 * k * an).count() as u128;
+        ((qt + up) & mask(iw)) as u32
+    }
 }
 
 /// A triangle as it stands on the front-end's ports: sub-pixel coordinates, UQ8.F intensities.
@@ -525,15 +582,12 @@ impl FrontEnd {
         }
     }
 
-    /// The walker's intensity for row `r`, first column `c`: `S2n = ((2S + A) << s) mod 2^K`
+    /// The walker's intensity for row `r`, first column `c`: `S2n = ((2S + A) << s) mod 2^(K-1)`
     /// from the running sum `tn` of the row, then the reciprocal and one correction.
     pub fn i0(&self, st: &TriSetup, tn: u128, c: u32) -> u32 {
         let wd = self.widths();
-        let km = mask(wd.k);
-        let s2n = (2 * (tn + st.gxn * c as u128) + st.an) & km;
-        let qt = (s2n * st.rn) >> wd.k;
-        let c2 = s2n.wrapping_sub(qt * 2 * st.an) & mask(wd.aw + 2);
-        qt as u32 + (c2 >= 2 * st.an) as u32
+        let s2n = (2 * (tn + st.gxn * c as u128) + st.an) & mask(wd.k - 1);
+        wd.reciprocal_quotient(s2n, st.an, st.rn)
     }
 
     /// Walks a set-up triangle: `out(y, span)` for every covered row, top to bottom.

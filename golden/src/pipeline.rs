@@ -160,12 +160,12 @@ pub fn i0_registers(level: Pipeline) -> [bool; I0_STAGES.len() - 1] {
 /// The front-end's span path in logical stages, walker first, the output register after the last.
 pub const I0_STAGES: [&str; 7] = [
     "the walker: the row's bounds, clipped, and whether it has a covered pixel",
-    "Gxn lo, the plane's step to the first pixel",
-    "S2n = 2 (Tn + Gxn lo) + An",
-    "S2n Rn, as two partial products when registered apart",
-    "the quotient estimate q~ = (S2n Rn) >> K, the quotient or one below it",
-    "q~ 2An",
-    "I0 = q~ + (S2n - 2 An q~ >= 2 An), the correction",
+    "Gxn lo modulo 2^(K-2), the plane's step to the first pixel",
+    "S2n = 2 (Tn + Gxn lo) + An modulo 2^(K-1)",
+    "its top bits H = S2n >> t and the partial products of H Rn",
+    "the quotient estimate q~ = (H Rn) >> (K - t), the quotient or up to two below it",
+    "q~ 2An modulo 2^(AW+3)",
+    "I0 = q~ + (R >= 2An) + (R >= 4An), R = S2n - 2An q~: the correction",
 ];
 
 /// The front-end set-up's CALC stages when it is pipelined, in order: what each clock computes

@@ -16,10 +16,13 @@
 //! - **edge walker**: one row per clock. Per active edge one DDA step (add, compare, subtract);
 //!   `lo` and `hi` are the max and min of the active bounds, clipped to the screen. It loads the
 //!   next triangle in the clock its current one finishes, so set-up overlaps the walk.
-//! - **I0 pipeline** (two stages after the walker): `S2n = 2 (Tn + Gxn lo) + An` in the
-//!   walker's clock, then `q~ = (S2n Rn) >> K`, then the correction `q~ + (S2n - 2 An q~ >= 2 An)`.
-//!   At `--pipeline 1` and above six stages, one multiply or two adders each
-//!   ([`golden::pipeline::I0_STAGES`]), the product by `Rn` in two registered halves.
+//! - **I0 pipeline** (two stages after the walker): `S2n = 2 (Tn + Gxn lo) + An` modulo
+//!   2^(K-1) in the walker's clock, then `q~ = ((S2n >> t) Rn) >> (K - t)` from its top bits,
+//!   then the correction `q~ + (S2n - 2 An q~ >= 2 An)` modulo 2^(AW+2) (golden's
+//!   `Widths::reciprocal_quotient`). Products modulo a power of two keep only the tile-sized
+//!   partial products with a bit below it (`span::mul_mod`). At `--pipeline 1` and above six
+//!   stages, one multiply or two adders each ([`golden::pipeline::I0_STAGES`]), the product by
+//!   `Rn` in two registered halves.
 //!   One stall signal holds the walker and every stage while the output waits.
 
 mod calc;

@@ -501,7 +501,6 @@ fn engine_mesh_lands_in_memory_once_per_pixel() {
 #[test]
 #[ignore]
 fn engine_planted_faults_are_caught() {
-    use verilator_harness::ffi::{FeOut, TriIn};
     let Some(opts) = engine(golden::setup::Screen { width: 37, height: 23 }, golden::frontend::engine::SetupForm::Ecp5_25f) else { return };
     let base = verilator_harness::ondemand::describe(&opts, verilator_harness::models::Kind::Frontend).unwrap_or_else(|e| panic!("{e}"));
     let seed = verilator_harness::seed("frontend engine faults");
@@ -528,17 +527,64 @@ fn engine_planted_faults_are_caught() {
         ),
         (epoch_line.to_string(), epoch_line.replacen("(ep[2] || ep[5])", "(ep[3] || ep[0])", 1), "a quotient from another epoch's divider"),
     ];
+    assert_faults_caught(&base, "tri_fe_engine.v", "fault", faults, seed, &tris);
+}
+
+/// Each `(from, to, what)`: the model `base` with `from` replaced by `to` in its file `file`
+/// (built on first use, tagged `<base><suffix><k>`) is caught on `tris`.
+fn assert_faults_caught(
+    base: &verilator_harness::models::Model,
+    file: &str,
+    suffix: &str,
+    faults: impl IntoIterator<Item = (String, String, &'static str)>,
+    seed: u64,
+    tris: &[FixedTriangle],
+) {
+    use verilator_harness::ffi::{FeOut, TriIn};
     for (k, (from, to, what)) in faults.into_iter().enumerate() {
         assert_ne!(from, to, "{what}: the fault does not apply");
         let mut m = base.clone();
-        let file = m.sources.iter_mut().find(|(n, _)| n == "tri_fe_engine.v").expect("the engine's file");
-        file.1 = file.1.replacen(&from, &to, 1);
-        m.tag = format!("{}_fault{k}", base.tag);
+        let text = m.sources.iter_mut().find(|(n, _)| n == file).unwrap_or_else(|| panic!("no {file}"));
+        text.1 = text.1.replacen(&from, &to, 1);
+        m.tag = format!("{}_{suffix}{k}", base.tag);
         let info = verilator_harness::ondemand::load::<TriIn, FeOut>(&m).unwrap_or_else(|e| panic!("{e}"));
-        let report = run_frontend(info, seed, Traffic::RANDOM, Stress::NONE, &tris);
+        let report = run_frontend(info, seed, Traffic::RANDOM, Stress::NONE, tris);
         eprintln!("{what}: {} mismatches", report.mismatch_count);
         assert!(!report.ok(), "planted fault not caught: {what}");
     }
+}
+
+/// Negative controls of the span path's truncated reciprocal (golden's
+/// `Widths::reciprocal_quotient`), planted in the generated `tri_frontend.v` at 640x480, level
+/// 0 (each a model built on first use): the compare for an estimate two below dropped (about one
+/// span in 4,000 needs it, golden's random spans), a partial product in logic dropped (the
+/// estimate's top 3 bits of `S2n` against `Rn`), and a tile's partial product dropped (the
+/// correction's top one, 8 bits). The clean model's co-simulation is the default suite's. Slow
+/// tier: three front-end models, about a minute of CPU each to build.
+#[test]
+#[ignore]
+fn span_path_planted_faults_are_caught() {
+    if verilator_harness::registry::rtl_dir().is_some() {
+        eprintln!("span path faults: skipped: COSIM_RTL_DIR provides the models");
+        return;
+    }
+    let opts = hdl_gen::Options { screen: Some(golden::setup::Screen::default()), ..Default::default() };
+    let base = verilator_harness::ondemand::describe(&opts, verilator_harness::models::Kind::Frontend).unwrap_or_else(|e| panic!("{e}"));
+    let seed = verilator_harness::seed("frontend span path faults");
+    let fe = opts.frontend().unwrap().fe;
+    let tris = random_triangles(&mut SeedRng::seed_from_u64(seed), &fe, 3000);
+    let text = &base.sources.iter().find(|(n, _)| n == "tri_frontend.v").expect("the front-end's file").1;
+    let line =
+        |what: &str, f: &dyn Fn(&str) -> bool| text.lines().find(|l| f(l)).unwrap_or_else(|| panic!("no line for {what}")).to_string();
+    let up = line("the correction's code", &|l| l.contains("wire [1:0] i0_up = "));
+    let prod = line("the estimate's sum", &|l| l.contains(" prod = ") && l.contains("prod_2"));
+    let m = line("the correction's sum", &|l| l.contains(" m_an = ") && l.contains("m_an_2"));
+    let faults = [
+        (up.clone(), up.replacen("corr >= an4, ", "1'b0, ", 1).replacen(" ^ (corr >= an4)", "", 1), "the second compare dropped"),
+        (prod.clone(), prod.replacen(" + ({18'd0, prod_2} << 18)", "", 1), "the estimate's partial product in logic dropped"),
+        (m.clone(), m.replacen(" + ({36'd0, m_an_2} << 36)", "", 1), "the correction's top tile dropped"),
+    ];
+    assert_faults_caught(&base, "tri_frontend.v", "i0fault", faults, seed, &tris);
 }
 
 /// The set-up engine's rate: ~10, ~100 and ~1000 px triangles through `tri_shader_p<P>` at full

@@ -272,6 +272,119 @@ fn differs_from_the_host_set_up_only_where_f64_rounds_differently() {
     assert!(i0_diff * 1000 <= spans, "I0 should differ only at rare near-ties: {i0_diff} of {spans}");
 }
 
+/// Walked triangles of every kind in turn until each kind has made `want / 6` spans: `f` takes
+/// one and returns the spans it counts. The small kinds (slivers, tiny triangles) make few spans
+/// each, so every kind gets its own share. Returns the spans per kind.
+fn spans_of_every_kind(rng: &mut Rng, fe: &FrontEnd, want: u64, mut f: impl FnMut(&FixedTriangle, &TriSetup) -> u64) -> [u64; 6] {
+    let (mut per_kind, mut kind) = ([0u64; 6], 0);
+    while per_kind.iter().any(|&n| n < want / 6) {
+        kind = (kind + 1) % 6;
+        if per_kind[kind] >= want / 6 {
+            continue;
+        }
+        let t = random_tri_of(rng, fe, kind);
+        if let Some(st) = fe.setup(&t).1 {
+            per_kind[kind] += f(&t, &st);
+        }
+    }
+    per_kind
+}
+
+/// The span path's truncated reciprocal (`q~` from `S2n >> t`, the correction modulo
+/// 2^(AW+3)) is exact rounding, `round(S / A)`, on 10^6 random spans of every kind at 640x480 and
+/// on every kind on the widest screens, F = 16 and 20, a 16x8 screen and the scanline dI (whose
+/// last pixel takes the same path).
+#[test]
+fn truncated_reciprocal_i0_is_exact_on_a_million_spans() {
+    let configs = [
+        (Config::default(), Screen::default(), DiMode::Triangle, 1_000_000u64),
+        (Config::default(), Screen { width: 4096, height: 4096 }, DiMode::Scanline, 60_000),
+        (Config::new(8, 16, 16, Align::Span).unwrap(), Screen { width: 65536, height: 65536 }, DiMode::Triangle, 60_000),
+        (Config::new(8, 20, 16, Align::Span).unwrap(), Screen { width: 40_000, height: 30_000 }, DiMode::Triangle, 60_000),
+        (Config::new(8, 4, 4, Align::Span).unwrap(), Screen { width: 16, height: 8 }, DiMode::Scanline, 30_000),
+    ];
+    let mut rng = Rng(2727);
+    for (cfg, screen, di, want) in configs {
+        let fe = FrontEnd::new(cfg, screen).unwrap().with_di(di);
+        let exact = |st: &TriSetup, c: u32, r: u32| ((2 * st.plane.s(c as i64, r as i64) + st.plane.a) / (2 * st.plane.a)) as u32;
+        let per_kind = spans_of_every_kind(&mut rng, &fe, want, |t, st| {
+            let mut spans = 0;
+            fe.walk(st, |y, s| {
+                assert_eq!(s.i0, exact(st, s.x0, y), "I0 of row {y} at column {} of {t:?} on {screen:?}", s.x0);
+                spans += 1;
+            });
+            if di == DiMode::Scanline {
+                // The last pixel's I0 is the same path at the span's other end.
+                let km = mask(fe.widths().k);
+                fe.walk(st, |y, s| {
+                    let tn = (st.tn + (y - st.first) as u128 * st.dyn_) & km;
+                    let hi = s.x0 + s.len - 1;
+                    assert_eq!(fe.i0(st, tn, hi), exact(st, hi, y), "last pixel of row {y} of {t:?}");
+                });
+            }
+            spans
+        });
+        eprintln!(
+            "{}x{} F={} {di:?}: I0 exact on {} spans (per kind {per_kind:?})",
+            screen.width,
+            screen.height,
+            cfg.frac,
+            per_kind.iter().sum::<u64>()
+        );
+        assert!(per_kind.iter().all(|&n| n >= want / 6), "every kind of triangle: {per_kind:?}");
+    }
+}
+
+/// Adversarial `S2n` straight into the arithmetic: ties (`S / A` half-way, remainder 0), the
+/// largest remainder, the quotient 0 and 2^IW - 1, areas at 1, at powers of two and either side
+/// (where `Rn` is exact or furthest from it), on every format's widths; and the planted faults it
+/// must catch: `S2n` shifted one bit further, one compare dropped, the estimate uncorrected.
+#[test]
+fn truncated_reciprocal_adversarial_and_negative_controls() {
+    let mut rng = Rng(99);
+    for (cfg, screen) in [
+        (Config::default(), Screen::default()),
+        (Config::new(8, 16, 16, Align::Span).unwrap(), Screen { width: 65536, height: 65536 }),
+        (Config::new(8, 20, 16, Align::Span).unwrap(), Screen { width: 65536, height: 65536 }),
+        (Config::new(8, 4, 4, Align::Span).unwrap(), Screen { width: 16, height: 8 }),
+    ] {
+        let wd = FrontEnd::new(cfg, screen).unwrap().widths();
+        let (aw, iw, t) = (wd.aw as i64, cfg.iw() as i64, wd.i0_shift());
+        let mut areas = vec![1i64, 2, 3, (1 << aw) - 1, (1 << aw) - 2];
+        for b in 1..=aw {
+            areas.extend([0, 1, 2, 3, -1, -2].map(|d| (1i64 << (b - 1)) + d));
+            areas.push(rng.range(1 << (b - 1), 1 << b));
+        }
+        let (mut checked, mut caught_shift, mut caught_compare, mut caught_uncorrected) = (0, 0, 0, 0);
+        for a in areas.into_iter().filter(|&a| (1..1 << aw).contains(&a)) {
+            let s = wd.aw - bits(a as u128);
+            let an = (a as u128) << s;
+            let rn = (1u128 << wd.k) / (2 * an);
+            for q in [0, 1, 2, (1 << iw) - 1, (1 << iw) - 2, rng.range(0, 1 << iw)] {
+                // 2S + A has A's parity: a tie is remainder 0 (A even) or 1; the largest is 2A - 1 or 2A - 2.
+                let p = a % 2;
+                for r in [p, p + 2, 2 * a - 2 + p, 2 * a - 4 + p, 2 * rng.range(0, a) + p] {
+                    if !(0..2 * a).contains(&r) {
+                        continue;
+                    }
+                    let s2n = ((2 * a as u128 * q as u128) + r as u128) << s;
+                    assert_eq!(wd.reciprocal_quotient(s2n, an, rn), q as u32, "A {a} q {q} r {r} in {cfg:?}");
+                    let c = Widths::I0_COMPARES;
+                    caught_shift += (wd.corrected_quotient(s2n, an, rn, t + 1, c) != q as u32) as u32;
+                    caught_compare += (wd.corrected_quotient(s2n, an, rn, t, c - 1) != q as u32) as u32;
+                    caught_uncorrected += (wd.quotient_estimate(s2n, rn, t) != q as u128) as u32;
+                    checked += 1;
+                }
+            }
+        }
+        eprintln!(
+            "{cfg:?}: {checked} adversarial S2n exact; wrong with the shift one further on {caught_shift}, \
+             a compare dropped on {caught_compare}, the estimate alone on {caught_uncorrected}"
+        );
+        assert!(caught_shift > 0 && caught_compare > 0 && caught_uncorrected > 0, "a planted fault went uncaught in {cfg:?}");
+    }
+}
+
 /// Issue 27's exact incremental I0 gives today's spans bit for bit: 10^6 spans of every kind at
 /// 640x480, and every kind on four more screens and formats and the scanline dI. It also prints how
 /// many reciprocal evaluations (starts) a triangle needs, the shared unit's load.
@@ -288,28 +401,20 @@ fn incremental_i0_equals_the_per_row_formula_on_a_million_spans() {
     let mut total = 0u64;
     for (cfg, screen, di, want) in configs {
         let fe = FrontEnd::new(cfg, screen).unwrap().with_di(di);
-        let (mut cost, mut walked, mut per_kind) = (Cost::default(), 0u64, [0u64; 6]);
-        // Every kind its share: the small ones (slivers, tiny triangles) make few spans each.
-        let mut kind = 0;
-        while per_kind.iter().any(|&n| n < want / 6) {
-            kind = (kind + 1) % 6;
-            if per_kind[kind] >= want / 6 {
-                continue;
-            }
-            let t = random_tri_of(&mut rng, &fe, kind);
-            let Some(st) = fe.setup(&t).1 else { continue };
+        let (mut cost, mut walked) = (Cost::default(), 0u64);
+        let per_kind = spans_of_every_kind(&mut rng, &fe, want, |t, st| {
             let mut old = Vec::new();
-            fe.walk(&st, |y, s| old.push((y, s)));
+            fe.walk(st, |y, s| old.push((y, s)));
             let mut new = Vec::new();
-            let c = fe.walk_incremental(&st, |y, s| new.push((y, s)));
+            let c = fe.walk_incremental(st, |y, s| new.push((y, s)));
             assert_eq!(new, old, "{t:?} on {screen:?}, {di:?}");
-            per_kind[kind] += c.spans;
             walked += 1;
             cost.rows += c.rows;
             cost.spans += c.spans;
             cost.starts += c.starts;
             cost.most_starts = cost.most_starts.max(c.most_starts);
-        }
+            c.spans
+        });
         eprintln!(
             "{}x{} F={} {di:?}: {} spans of {walked} triangles (per kind {per_kind:?}); starts {:.2} a triangle, at most {}, {:.3} a span",
             screen.width,

@@ -9,7 +9,7 @@ use super::stager::Stager;
 use super::walker::scanline_divider;
 use crate::verilog::{comment, lit, reg, set, wire, zext, Item, Stmt};
 use crate::Names;
-use golden::frontend::{DiMode, Widths};
+use golden::frontend::{DiMode, SetupForm, Widths};
 
 /// The span's first pixel's intensity and, per scanline, its last pixel's, the edge's value
 /// there: the same path twice, under these names.
@@ -17,14 +17,108 @@ struct End {
     x: &'static str,
     gx: &'static str,
     s2: &'static str,
+    h: &'static str,
     lo: &'static str,
-    pl: &'static str,
-    ph: &'static str,
     prod: &'static str,
     qt: &'static str,
     m: &'static str,
     corr: &'static str,
     out: &'static str,
+}
+
+/// Bits a multiplier tile takes per operand, unsigned: the ECP5's MULT18X18D (and what the other
+/// set-up forms are measured on), or the UP5K's SB_MAC16 for its plan, whose 16 x 16 would
+/// split an 18-bit chunk into four.
+fn tile_bits(hw: &Hw) -> u32 {
+    match hw.fe.setup {
+        SetupForm::Ice40Up5k => 16,
+        _ => 18,
+    }
+}
+
+/// A chunk of at most this many bits is multiplied in logic, one adder a bit after the first,
+/// instead of taking tiles: a wider one costs more LUT4 than a tile is worth (Yosys 0.23 maps
+/// an 8 x 8 product modulo 2^8 to 111 LUT4, docs/fpga.md).
+const LOGIC_BITS: u32 = 3;
+
+/// `x[hi:lo]` of a value as it reads in a stage: its whole self, a slice of a name, or of a
+/// slice (the walker's `hi3[..]`).
+fn bits_of(x: &str, w: u32, hi: u32, lo: u32) -> String {
+    if lo == 0 && hi + 1 == w {
+        return x.to_string();
+    }
+    if let Some((name, range)) = x.strip_suffix(']').and_then(|r| r.split_once('[')) {
+        if let Some(base) = range.split_once(':').and_then(|(_, l)| l.parse::<u32>().ok()) {
+            return format!("{name}[{}:{}]", base + hi, base + lo);
+        }
+    }
+    format!("{x}[{hi}:{lo}]")
+}
+
+/// Defines `out = (a * b) mod 2^m` (`a` and `b` read as they are in the stage, unsigned) as
+/// partial products of `tile`-bit chunks ([`tile_bits`]), only those with a bit below 2^m, each
+/// cut to the bits it adds there. A plain `*` would take every tile of the full product:
+/// synthesis keeps a tile as long as one of its bits is read. A chunk of at most [`LOGIC_BITS`] bits (the narrower operand's
+/// top, say) is multiplied in logic instead, as shifted adds against the whole other operand.
+fn mul_mod(sp: &mut Stager, tile: u32, out: &str, a: (&str, u32), b: (&str, u32), m: u32) {
+    let terms = partial_products(sp, tile, out, a, b, m);
+    sum_partials(sp, out, &terms, m);
+}
+
+/// [`mul_mod`]'s partial products, each its own wire `<out>_<n>`: `(name, width, offset)`.
+fn partial_products(sp: &mut Stager, tile: u32, out: &str, (a, aw): (&str, u32), (b, bw): (&str, u32), m: u32) -> Vec<(String, u32, u32)> {
+    let ((a, aw), (b, bw)) = if aw >= bw { ((a, aw), (b, bw)) } else { ((b, bw), (a, aw)) };
+    let chunks = |w: u32| (0..w.div_ceil(tile)).map(move |i| (i * tile, (w - i * tile).min(tile)));
+    let mut terms: Vec<(String, u32, u32)> = Vec::new();
+    let mut piece = |sp: &mut Stager, (x, xo, xw): (&str, u32, u32), (y, yo, yw): (&str, u32, u32), wx: u32, wy: u32| {
+        let off = xo + yo;
+        if off >= m {
+            return;
+        }
+        let need = m - off;
+        let (nx, ny) = (xw.min(need), yw.min(need));
+        let (sx, sy) = (bits_of(x, wx, xo + nx - 1, xo), bits_of(y, wy, yo + ny - 1, yo));
+        let name = format!("{out}_{}", terms.len());
+        let value = if nx.min(ny) <= LOGIC_BITS {
+            let ((n, nw), (v, vw)) = if nx <= ny { ((sx, nx), (sy, ny)) } else { ((sy, ny), (sx, nx)) };
+            let v = zext(&v, vw, need);
+            (0..nw)
+                .map(|k| {
+                    let shifted = if k == 0 { v.clone() } else { format!("({v} << {k})") };
+                    format!("({{{need}{{{}}}}} & {shifted})", bits_of(&n, nw, k, k))
+                })
+                .collect::<Vec<_>>()
+                .join(" + ")
+        } else {
+            format!("{} * {}", zext(&sx, nx, need), zext(&sy, ny, need))
+        };
+        sp.def(&name, need, false, value);
+        terms.push((name, need, off));
+    };
+    for (bo, bc) in chunks(bw) {
+        if bc <= LOGIC_BITS {
+            piece(sp, (b, bo, bc), (a, 0, aw), bw, aw);
+            continue;
+        }
+        for (ao, ac) in chunks(aw) {
+            piece(sp, (a, ao, ac), (b, bo, bc), aw, bw);
+        }
+    }
+    terms
+}
+
+/// `out`, the sum of [`partial_products`]' terms modulo 2^m, read where the stage is.
+fn sum_partials(sp: &mut Stager, out: &str, terms: &[(String, u32, u32)], m: u32) {
+    let sum = terms.iter().map(|(n, w, off)| {
+        let x = zext(&sp.at(n), *w, m);
+        if *off == 0 {
+            x
+        } else {
+            format!("({x} << {off})")
+        }
+    });
+    let sum = sum.collect::<Vec<_>>().join(" + ");
+    sp.def(out, m, false, sum);
 }
 
 /// Span stage j's valid bit.
@@ -48,38 +142,35 @@ pub(super) fn path(hw: &Hw, body: &mut Vec<Item>) -> Stager {
         sp.note(Item::Blank);
         sp.note(comment(format!("Span path, step {} (stage p{}): {what}.", sp.logical(), sp.stage())));
     };
-    let prod_w = sum_w + recip_w;
-    let corr_w = area_w + 2;
-    let half = recip_w / 2;
-    // The span's first pixel's intensity and, per scanline, its last pixel's, the edge's value
-    // there: the same path twice, under these names.
-    let head = End { x: "x", gx: "gx", s2: "s2n", lo: "lo", pl: "pl", ph: "ph", prod: "prod", qt: "qt", m: "m", corr: "corr", out: "i0" };
-    let tail = End {
-        x: "xh",
-        gx: "gxh",
-        s2: "s2h",
-        lo: "hi",
-        pl: "plh",
-        ph: "phh",
-        prod: "prodh",
-        qt: "qh",
-        m: "mh",
-        corr: "corrh",
-        out: "ilast",
-    };
+    // S2n is kept modulo 2^(K-1) (at a covered pixel it is below that), the quotient estimate
+    // takes its top IW + 1 bits, and the correction is modulo 2^(AW+3): golden's
+    // `Widths::reciprocal_quotient`, whose documentation proves the estimate two below at most.
+    let s2_w = sum_w - 1;
+    let tile = tile_bits(hw);
+    let t = fe.widths().i0_shift();
+    let h_w = s2_w - t;
+    // The estimate's bits and the ones below: the product modulo 2^(K - t + IW).
+    let prod_w = sum_w - t + iw;
+    let corr_w = area_w + 3;
+    let head = End { x: "x", gx: "gx", s2: "s2n", h: "h", lo: "lo", prod: "prod", qt: "qt", m: "m", corr: "corr", out: "i0" };
+    let tail = End { x: "xh", gx: "gxh", s2: "s2h", h: "hh", lo: "hi", prod: "prodh", qt: "qh", m: "mh", corr: "corrh", out: "ilast" };
     let ends: Vec<&End> = if scan { vec![&head, &tail] } else { vec![&head] };
     i0_section(&mut sp);
     for (n, ww, src) in [
         ("y", row_w, "w_row".to_string()),
         ("x", xw, "lo_u".into()),
         ("len", xw + 1, format!("len_w[{xw}:0]")),
-        ("tn", sum_w, "w_tn".into()),
-        ("gxn", sum_w, "w_gxn".into()),
+        ("tn", s2_w - 1, format!("w_tn[{}:0]", s2_w - 2)),
+        ("gxn", s2_w - 1, format!("w_gxn[{}:0]", s2_w - 2)),
         ("an", area_w, "w_an".into()),
         ("rn", recip_w, "w_rn".into()),
     ] {
         sp.input_as(n, ww, false, &src);
     }
+    // The walker's sums are modulo 2^K; the span path reads their residues modulo 2^(K-2).
+    body.push(comment("verilator lint_off UNUSEDSIGNAL"));
+    body.push(wire("unused_sums_top", 4, format!("{{w_tn[{0}:{1}], w_gxn[{0}:{1}]}}", sum_w - 1, sum_w - 2)));
+    body.push(comment("verilator lint_on UNUSEDSIGNAL"));
     if scan {
         sp.input_as("xh", xw, false, &format!("hi3[{}:0]", xw - 1));
         body.push(comment("verilator lint_off UNUSEDSIGNAL"));
@@ -90,69 +181,61 @@ pub(super) fn path(hw: &Hw, body: &mut Vec<Item>) -> Stager {
     }
     sp.cut();
     i0_section(&mut sp);
+    // Gxn lo modulo 2^(K-2): S2n's residue needs no more.
+    sp.note(comment("verilator lint_off UNUSEDSIGNAL"));
     for e in &ends {
-        sp.def(e.gx, sum_w, false, format!("{} * {}", sp.at("gxn"), zext(&sp.at(e.x), xw, sum_w)));
+        let (gxn, x) = (sp.at("gxn"), sp.at(e.x));
+        mul_mod(&mut sp, tile, e.gx, (&gxn, s2_w - 1), (&x, xw), s2_w - 1);
     }
+    sp.note(comment("verilator lint_on UNUSEDSIGNAL"));
     sp.cut();
     i0_section(&mut sp);
     for e in &ends {
-        sp.def(e.s2, sum_w, false, format!("(({} + {}) << 1) + {}", sp.at("tn"), sp.at(e.gx), zext(&sp.at("an"), area_w, sum_w)));
+        let sum = format!("{} + {}", zext(&sp.at("tn"), s2_w - 1, s2_w), zext(&sp.at(e.gx), s2_w - 1, s2_w));
+        sp.def(e.s2, s2_w, false, format!("(({sum}) << 1) + {}", zext(&sp.at("an"), area_w, s2_w)));
     }
     sp.cut();
     i0_section(&mut sp);
-    let split = sp.registered_next();
+    let mut partials = Vec::new();
     for e in &ends {
         let s2 = sp.at(e.s2);
         sp.def(e.lo, corr_w, false, format!("{s2}[{}:0]", corr_w - 1));
-        if split {
-            let rn = sp.at("rn");
-            sp.def(
-                e.pl,
-                sum_w + half,
-                false,
-                format!("{} * {}", zext(&s2, sum_w, sum_w + half), zext(&format!("{rn}[{}:0]", half - 1), half, sum_w + half)),
-            );
-            sp.def(
-                e.ph,
-                sum_w + recip_w - half,
-                false,
-                format!(
-                    "{} * {}",
-                    zext(&s2, sum_w, sum_w + recip_w - half),
-                    zext(&format!("{rn}[{}:{half}]", recip_w - 1), recip_w - half, sum_w + recip_w - half)
-                ),
-            );
-        }
+        sp.def(e.h, h_w, false, format!("{s2}[{}:{t}]", s2_w - 1));
+        let rn = sp.at("rn");
+        partials.push(partial_products(&mut sp, tile, e.prod, (e.h, h_w), (&rn, recip_w), prod_w));
     }
     sp.cut();
     i0_section(&mut sp);
     sp.note(comment("verilator lint_off UNUSEDSIGNAL"));
-    for e in &ends {
-        let prod = if split {
-            let (pl, ph) = (sp.at(e.pl), sp.at(e.ph));
-            format!("{} + ({} << {half})", zext(&pl, sum_w + half, prod_w), zext(&ph, sum_w + recip_w - half, prod_w))
-        } else {
-            format!("{} * {}", zext(&sp.at(e.s2), sum_w, prod_w), zext(&sp.at("rn"), recip_w, prod_w))
-        };
-        sp.def(e.prod, prod_w, false, prod);
+    for (e, terms) in ends.iter().zip(&partials) {
+        sum_partials(&mut sp, e.prod, terms, prod_w);
     }
     sp.note(comment("verilator lint_on UNUSEDSIGNAL"));
     for e in &ends {
-        sp.def(e.qt, iw, false, format!("{}[{}:{sum_w}]", e.prod, sum_w + iw - 1));
+        sp.def(e.qt, iw, false, format!("{}[{}:{}]", e.prod, sum_w - t + iw - 1, sum_w - t));
     }
     sp.cut();
     i0_section(&mut sp);
-    sp.def("an2", corr_w, false, format!("{} << 1", zext(&sp.at("an"), area_w, corr_w)));
     for e in &ends {
-        sp.def(e.m, corr_w, false, format!("{} * an2", zext(&sp.at(e.qt), iw, corr_w)));
+        // q~ An modulo 2^(AW+2), doubled: the correction's modulus.
+        let (qt, an) = (sp.at(e.qt), sp.at("an"));
+        let half_m = format!("{}_an", e.m);
+        mul_mod(&mut sp, tile, &half_m, (&an, area_w), (&qt, iw), corr_w - 1);
+        sp.def(e.m, corr_w, false, format!("{{{half_m}, 1'b0}}"));
     }
     sp.cut();
     i0_section(&mut sp);
-    let an2 = sp.at("an2");
+    let an = sp.at("an");
+    sp.def("an2", corr_w, false, format!("{} << 1", zext(&an, area_w, corr_w)));
+    sp.def("an4", corr_w, false, format!("{} << 2", zext(&an, area_w, corr_w)));
     for e in &ends {
         let (lo, m, qt) = (sp.at(e.lo), sp.at(e.m), sp.at(e.qt));
         sp.def(e.corr, corr_w, false, format!("{lo} - {m}"));
-        sp.def(e.out, iw, false, format!("{qt} + {}", zext(&format!("{} >= {an2}", e.corr), 1, iw)));
+        // R >= 4An implies R >= 2An: the count of the two is this 2-bit code, one add to q~
+        // (two one-bit adds made a three-operand sum, which Yosys maps to LUT4 full adders).
+        let up = format!("{}_up", e.out);
+        sp.def(&up, 2, false, format!("{{{0} >= an4, ({0} >= an2) ^ ({0} >= an4)}}", e.corr));
+        sp.def(e.out, iw, false, format!("{qt} + {}", zext(&up, 2, iw)));
     }
     sp
 }

@@ -79,11 +79,6 @@ impl Stager {
         self.logical += 1;
     }
 
-    /// Whether the boundary after the logical stage being written is registered.
-    pub fn registered_next(&self) -> bool {
-        self.cuts.get(self.logical).copied().unwrap_or(false)
-    }
-
     /// The physical stage being written: registered boundaries behind it.
     pub fn stage(&self) -> usize {
         self.cur
