@@ -10,9 +10,12 @@
 //!   when, over the interval's clocks modulo II, fewer operations of its kind are busy than
 //!   there are units; the smallest II that schedules is the sustained rate. A value held longer
 //!   than II needs `copies` registers (the next triangle writes the next one).
-//! - **Units.** The operations are bound to units by start time over an unrolled stretch of
-//!   triangles (a unit that ran the same operation is preferred, so the binding is static where
-//!   the interval allows); an operation busier than II alternates between units.
+//! - **Units.** Products are placed on a modulo table per tile, so each keeps one tile on every
+//!   triangle ([`per_tile`]: a search over their clocks and tiles at the least latency; when it
+//!   finds none, the tiles are counted by kind as the dividers are). Divisions are bound to
+//!   dividers by start time over an unrolled stretch of triangles (a unit that ran the same
+//!   operation is preferred, so the binding is static where the interval allows); a division
+//!   busier than II alternates between dividers.
 
 use super::{compute, DivForm, Kind, MulUnit, Plan, Program, V};
 use crate::frontend::incremental::Steps;
@@ -168,15 +171,17 @@ impl Schedule {
         let need = |c| timing.iter().filter(|t| t.0 == c).map(|t| t.1).sum::<u32>();
         let mut ii =
             [Class::Mul, Class::Div].iter().map(|&c| if need(c) == 0 { 1 } else { ceil(need(c), caps(c)) }).max().unwrap_or(1).max(1);
-        let start = loop {
-            if let Some(s) = modulo(&prog, &timing, ii, caps) {
-                break s;
+        let Placed { start, unit } = loop {
+            if let Some(start) = modulo(&prog, &timing, ii, caps) {
+                let latency = prog.out.all().iter().map(|v| start[v.0 as usize] + timing[v.0 as usize].2).max().unwrap_or(0);
+                break per_tile(&prog, &timing, ii, plan.mults, plan.dividers, latency).unwrap_or(Placed { start, unit: vec![None; n] });
             }
             ii += 1;
         };
         let ready: Vec<u32> = (0..n).map(|o| start[o] + timing[o].2).collect();
         let latency = prog.out.all().iter().map(|v| ready[v.0 as usize]).max().unwrap_or(0);
-        let slots = (0..n).map(|o| Slot { class: timing[o].0, unit: None, start: start[o], busy: timing[o].1, ready: ready[o] }).collect();
+        let slots =
+            (0..n).map(|o| Slot { class: timing[o].0, unit: unit[o], start: start[o], busy: timing[o].1, ready: ready[o] }).collect();
         let mut s = Schedule {
             plan,
             prog,
@@ -243,8 +248,16 @@ fn timing(prog: &Program, op: &super::Op, plan: &Plan) -> (Class, u32, u32) {
     }
 }
 
-/// Places every operation at its earliest clock where a unit of its kind is free modulo `ii`;
-/// `None` if one does not fit within II clocks of its earliest.
+/// Where the scheduler placed the operations: each one's start clock, and a product's own
+/// tile when the tiles were reserved one by one ([`per_tile`]).
+struct Placed {
+    start: Vec<u32>,
+    unit: Vec<Option<u32>>,
+}
+
+/// Places every operation at its earliest clock where a unit of its kind is free modulo `ii`
+/// (the units counted by kind, not one by one); `None` if one does not fit within II clocks of
+/// its earliest.
 fn modulo(prog: &Program, timing: &[(Class, u32, u32)], ii: u32, caps: impl Fn(Class) -> u32) -> Option<Vec<u32>> {
     let mut usage = [vec![0u32; ii as usize], vec![0u32; ii as usize]];
     let mut start = vec![0u32; prog.ops.len()];
@@ -253,23 +266,146 @@ fn modulo(prog: &Program, timing: &[(Class, u32, u32)], ii: u32, caps: impl Fn(C
         let earliest = op.kind.args().iter().map(|a| ready[a.0 as usize]).max().unwrap_or(0);
         let (c, busy, lat) = timing[o];
         let t = match c {
-            Class::Mul | Class::Div => {
-                let u = &mut usage[(c == Class::Div) as usize];
-                let cap = caps(c);
-                let t = (earliest..earliest + ii).find(|&t| {
-                    let mut add = vec![0u32; ii as usize];
-                    (t..t + busy).for_each(|k| add[(k % ii) as usize] += 1);
-                    add.iter().zip(u.iter()).all(|(a, b)| a + b <= cap)
-                })?;
-                (t..t + busy).for_each(|k| u[(k % ii) as usize] += 1);
-                t
-            }
+            Class::Mul | Class::Div => pooled(&mut usage[(c == Class::Div) as usize], caps(c), earliest, busy)?,
             _ => earliest,
         };
         start[o] = t;
         ready[o] = t + lat;
     }
     Some(start)
+}
+
+/// The earliest clock from `earliest` on where `busy` more clocks of a kind of unit fit the
+/// modulo table `usage` under `cap` units, taken; `None` if none within II clocks.
+fn pooled(usage: &mut [u32], cap: u32, earliest: u32, busy: u32) -> Option<u32> {
+    let ii = usage.len() as u32;
+    let t = (earliest..earliest + ii).find(|&t| {
+        let mut add = vec![0u32; ii as usize];
+        (t..t + busy).for_each(|k| add[(k % ii) as usize] += 1);
+        add.iter().zip(usage.iter()).all(|(a, b)| a + b <= cap)
+    })?;
+    (t..t + busy).for_each(|k| usage[(k % ii) as usize] += 1);
+    Some(t)
+}
+
+/// Search nodes [`per_tile`] may visit for one plan before it settles for the tiles counted by
+/// kind (the named plans need a few hundred).
+const TILE_SEARCH_NODES: u32 = 20_000;
+
+/// The schedule with every product on one tile for every triangle, at II `ii` and the least
+/// latency from `from` up to `from + ii`; `None` if the search finds none within its budget.
+///
+/// Counting tiles by kind only ([`modulo`]) can place products whose clocks no static
+/// assignment covers (at 8 tiles and II = 12 the set-up's did not), and the binding then rotates
+/// products over tiles from triangle to triangle: the tiles' operand multiplexers select by
+/// epoch as well as by phase (278 terms against 150, 1,625 LUT4 more, docs/fpga.md). Here each
+/// tile has its own modulo table and a product takes one tile's clocks. A depth-first search
+/// over the products' (clock, tile) choices, in program order, each at its earliest clock first
+/// and on the tile left with the least free run around it (long runs stay for long products),
+/// bounded by the latency: an operation whose start plus its shortest path to the results
+/// exceeds the bound is cut. Divisions busier than II must alternate between dividers anyway:
+/// they are counted by kind, as in [`modulo`], and bound afterwards ([`Schedule::bind`]).
+fn per_tile(prog: &Program, timing: &[(Class, u32, u32)], ii: u32, tiles: u32, dividers: u32, from: u32) -> Option<Placed> {
+    if timing.iter().any(|t| t.0 == Class::Mul && t.1 > ii) {
+        return None;
+    }
+    let n = prog.ops.len();
+    // The clocks from an operation's start to the last result, with no unit busy.
+    let (mut tail, mut need) = (vec![0u32; n], vec![0u32; n]);
+    for (o, op) in prog.ops.iter().enumerate().rev() {
+        tail[o] = timing[o].2 + need[o];
+        for a in op.kind.args() {
+            need[a.0 as usize] = need[a.0 as usize].max(tail[o]);
+        }
+    }
+    let mut budget = TILE_SEARCH_NODES;
+    let empty = Search {
+        start: vec![0; n],
+        ready: vec![0; n],
+        unit: vec![None; n],
+        tiles: vec![vec![false; ii as usize]; tiles as usize],
+        divs: vec![0; ii as usize],
+    };
+    for bound in from..=from + ii {
+        let ctx = Ctx { prog, timing, tail: &tail, ii, dividers, bound };
+        match ctx.go(0, empty.clone(), &mut budget) {
+            Ok(Some(s)) => return Some(Placed { start: s.start, unit: s.unit }),
+            Ok(None) => continue,
+            Err(()) => return None,
+        }
+    }
+    None
+}
+
+#[derive(Clone)]
+struct Search {
+    start: Vec<u32>,
+    ready: Vec<u32>,
+    unit: Vec<Option<u32>>,
+    tiles: Vec<Vec<bool>>,
+    divs: Vec<u32>,
+}
+
+struct Ctx<'a> {
+    prog: &'a Program,
+    timing: &'a [(Class, u32, u32)],
+    tail: &'a [u32],
+    ii: u32,
+    dividers: u32,
+    bound: u32,
+}
+
+impl Ctx<'_> {
+    /// Places operations `o..` on `s`; `Err` when the budget runs out.
+    fn go(&self, mut o: usize, mut s: Search, budget: &mut u32) -> Result<Option<Search>, ()> {
+        let ii = self.ii;
+        while o < self.prog.ops.len() {
+            let earliest = self.prog.ops[o].kind.args().iter().map(|a| s.ready[a.0 as usize]).max().unwrap_or(0);
+            let (c, busy, lat) = self.timing[o];
+            if earliest + self.tail[o] > self.bound {
+                return Ok(None);
+            }
+            let t = match c {
+                Class::Mul => {
+                    // Each clock in turn; of the tiles free there, each distinct table once.
+                    for t in earliest..earliest + ii {
+                        if t + self.tail[o] > self.bound {
+                            break;
+                        }
+                        let at = |u: usize, k: u32| s.tiles[u][(k % ii) as usize];
+                        let mut free: Vec<(u32, usize)> = Vec::new();
+                        for u in 0..s.tiles.len() {
+                            if (t..t + busy).all(|k| !at(u, k)) && !free.iter().any(|&(_, v)| s.tiles[v] == s.tiles[u]) {
+                                let room = ii - busy;
+                                let before = (1..=room).take_while(|&d| !at(u, t + ii - d)).count() as u32;
+                                let after = (0..room - before).take_while(|&d| !at(u, t + busy + d)).count() as u32;
+                                free.push((before + after, u));
+                            }
+                        }
+                        free.sort();
+                        for (_, u) in free {
+                            *budget = budget.checked_sub(1).ok_or(())?;
+                            let mut next = s.clone();
+                            (t..t + busy).for_each(|k| next.tiles[u][(k % ii) as usize] = true);
+                            (next.start[o], next.ready[o], next.unit[o]) = (t, t + lat, Some(u as u32));
+                            if let Some(done) = self.go(o + 1, next, budget)? {
+                                return Ok(Some(done));
+                            }
+                        }
+                    }
+                    return Ok(None);
+                }
+                Class::Div => match pooled(&mut s.divs, self.dividers, earliest, busy) {
+                    Some(t) if t + self.tail[o] <= self.bound => t,
+                    _ => return Ok(None),
+                },
+                _ => earliest,
+            };
+            (s.start[o], s.ready[o]) = (t, t + lat);
+            o += 1;
+        }
+        Ok(Some(s))
+    }
 }
 
 impl Schedule {
@@ -282,6 +418,17 @@ impl Schedule {
         let tris = 12 * span + 4;
         let steady = 2 * span + 2;
         for c in [Class::Mul, Class::Div] {
+            // Products the scheduler placed tile by tile keep their tile on every triangle.
+            let fixed: Vec<(usize, u32)> =
+                self.slots.iter().enumerate().filter(|(_, s)| s.class == c).filter_map(|(o, s)| s.unit.map(|u| (o, u))).collect();
+            if !fixed.is_empty() {
+                for j in 0..tris {
+                    for &(o, u) in &fixed {
+                        self.note(o, j, u as usize, steady, span);
+                    }
+                }
+                continue;
+            }
             let mut iv: Vec<(u32, usize, usize)> = Vec::new();
             for j in 0..tris {
                 for (o, s) in self.slots.iter().enumerate().filter(|(_, s)| s.class == c) {
@@ -559,6 +706,16 @@ impl Schedule {
             }
         }
         Ok(r)
+    }
+
+    /// The products that do not keep one tile on every triangle of the steady stretch (none
+    /// when [`per_tile`] placed them): each of those makes its tiles' operand multiplexers select
+    /// by epoch as well as by phase.
+    pub fn rotating_products(&self) -> Vec<&str> {
+        (0..self.slots.len())
+            .filter(|&o| self.slots[o].class == Class::Mul && self.binding[o].iter().any(|&u| u != self.binding[o][0]))
+            .map(|o| self.prog.ops[o].name.as_str())
+            .collect()
     }
 
     /// The unit operation `o` runs on for a triangle of epoch `e` (its number modulo

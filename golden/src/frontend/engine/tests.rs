@@ -334,3 +334,28 @@ fn the_binding_is_periodic() {
         }
     }
 }
+
+/// Every product keeps its tile on every triangle, for every plan the generator offers at the
+/// screens of `the_binding_is_periodic` (golden's scheduler reserves the tiles one by one), so
+/// the tiles' operand multiplexers select by phase alone.
+#[test]
+fn the_products_keep_their_tiles() {
+    use crate::frontend::engine::SetupForm;
+    let wide = Config::new(8, 20, 16, Align::Span).unwrap();
+    for (cfg, screen) in
+        [(Config::default(), Screen::default()), (Config::default(), Screen { width: 37, height: 23 }), (wide, Screen::default())]
+    {
+        let fe = FrontEnd::new(cfg, screen).unwrap();
+        for plan in SetupForm::ALL.iter().filter_map(|f| f.plan()) {
+            let s = plan.schedule(&fe).unwrap();
+            assert_eq!(s.rotating_products(), Vec::<&str>::new(), "{plan:?} at {screen:?}");
+        }
+    }
+    // Negative control: a product moved to another tile on every other triangle.
+    let mut bad = Plan::ECP5_25F.schedule(&fe640()).unwrap();
+    let o = (0..bad.slots.len()).find(|&o| bad.slots[o].class == schedule::Class::Mul).unwrap();
+    for (j, u) in bad.binding[o].iter_mut().enumerate() {
+        *u = (*u + j as u32 % 2) % Plan::ECP5_25F.mults;
+    }
+    assert_eq!(bad.rotating_products(), vec![bad.prog.ops[o].name.as_str()]);
+}
