@@ -80,6 +80,10 @@ pub struct Plan {
     pub reciprocal: bool,
     /// The incremental `I0`'s per-source steps are part of the set-up.
     pub i0_steps: bool,
+    /// Shared barrel shifters for the normalising shifts by a value (`ShlBy`: `2A`, and the
+    /// plane's terms by `s`); 0: each shift its own logic, as CALC's. Five 64-bit shifts by a
+    /// 6-bit amount were about 1,560 of the ECP5 plan's engine LUT4 (docs/fpga.md).
+    pub shifters: u32,
 }
 
 impl Plan {
@@ -105,6 +109,7 @@ impl Plan {
         div_form: DivForm::ShiftRemainder,
         reciprocal: true,
         i0_steps: false,
+        shifters: 1,
     };
     /// For the iCE40 UP5K: 2 of its SB_MAC16 and one 1-bit divider, the smallest engine. 15-bit
     /// chunks, 16-bit signed operands (as [`Plan::TILE18_RTL`]): 120 clocks a triangle either way.
@@ -116,6 +121,7 @@ impl Plan {
         div_form: DivForm::ShiftRemainder,
         reciprocal: true,
         i0_steps: false,
+        shifters: 1,
     };
     /// For the iCE40 HX8K, which has no multiplier: one shift-add unit and one divider, a bit a clock.
     pub const ICE40_HX8K: Plan = Plan {
@@ -126,6 +132,7 @@ impl Plan {
         div_form: DivForm::ShiftRemainder,
         reciprocal: false,
         i0_steps: false,
+        shifters: 1,
     };
 }
 

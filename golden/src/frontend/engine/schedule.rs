@@ -21,9 +21,17 @@ use super::{compute, DivForm, Kind, MulUnit, Plan, Program, V};
 use crate::frontend::incremental::Steps;
 use crate::frontend::{FixedTriangle, FrontEnd, Outcome, TriSetup};
 
+/// Clocks from a shift's start on a shared shifter to its value: the selected operands'
+/// register, then the shift into the value's.
+pub const SHIFT_PIPE: u32 = 2;
+
 /// Clocks from a product's last pass to its value: the tile's input and output registers and
 /// the accumulator.
 pub const MUL_PIPE: u32 = 2;
+
+/// LUT4 of a barrel shifter per result bit per amount bit: Yosys 0.23 `synth_ecp5` maps a
+/// 64-bit shift by a 6-bit amount onto 637 LUT4 (and 292 PFUMX, 141 L6MUX21), docs/fpga.md.
+pub const LUT4_PER_SHIFT_BIT: f64 = 637.0 / (64.0 * 6.0);
 
 /// The measured anchor of the LUT estimate: `tri_frontend` at `--pipeline 1`, ECP5-85F, with
 /// today's eight dividers at 1 and 4 quotient bits a clock (docs/fpga.md, stop 24:
@@ -49,6 +57,8 @@ pub enum Class {
     Logic,
     Mul,
     Div,
+    /// A shift by a value on one of the plan's shared barrel shifters.
+    Shift,
 }
 
 /// One operation's place: its unit (index among the multipliers or the dividers, for a
@@ -139,6 +149,16 @@ impl FrontEnd {
 }
 
 impl Plan {
+    /// The units of a kind the plan has (0 for wiring and logic).
+    pub fn units(&self, c: Class) -> u32 {
+        match c {
+            Class::Mul => self.mults,
+            Class::Div => self.dividers,
+            Class::Shift => self.shifters,
+            Class::Wire | Class::Logic => 0,
+        }
+    }
+
     fn check(&self) -> Result<(), EngineError> {
         let r = |what, value, max| if (1..=max).contains(&value) { Ok(()) } else { Err(EngineError::Range { what, value, max }) };
         r("divider quotient bits a clock", self.div_bits, 16)?;
@@ -167,14 +187,18 @@ impl Schedule {
             return Err(EngineError::NoDivider(count(Class::Div)));
         }
         let timing: Vec<(Class, u32, u32)> = prog.ops.iter().map(|o| timing(&prog, o, &plan)).collect();
-        let caps = |c| if c == Class::Mul { plan.mults } else { plan.dividers };
+        let caps = |c| plan.units(c);
         let need = |c| timing.iter().filter(|t| t.0 == c).map(|t| t.1).sum::<u32>();
-        let mut ii =
-            [Class::Mul, Class::Div].iter().map(|&c| if need(c) == 0 { 1 } else { ceil(need(c), caps(c)) }).max().unwrap_or(1).max(1);
+        let mut ii = [Class::Mul, Class::Div, Class::Shift]
+            .iter()
+            .map(|&c| if need(c) == 0 { 1 } else { ceil(need(c), caps(c)) })
+            .max()
+            .unwrap_or(1)
+            .max(1);
         let Placed { start, unit } = loop {
             if let Some(start) = modulo(&prog, &timing, ii, caps) {
                 let latency = prog.out.all().iter().map(|v| start[v.0 as usize] + timing[v.0 as usize].2).max().unwrap_or(0);
-                break per_tile(&prog, &timing, ii, plan.mults, plan.dividers, latency).unwrap_or(Placed { start, unit: vec![None; n] });
+                break per_tile(&prog, &timing, ii, &caps, latency).unwrap_or(Placed { start, unit: vec![None; n] });
             }
             ii += 1;
         };
@@ -226,6 +250,9 @@ fn timing(prog: &Program, op: &super::Op, plan: &Plan) -> (Class, u32, u32) {
     let c = class(&op.kind);
     match (c, op.kind) {
         (Class::Wire, _) => (c, 0, 0),
+        // A shared shifter registers its selected operands, then shifts into the value's
+        // register: the operand multiplexer and the shift are a clock each.
+        (Class::Logic, Kind::ShlBy(..)) if plan.shifters > 0 => (Class::Shift, 1, SHIFT_PIPE),
         (Class::Logic, _) => (c, 0, 1),
         (Class::Mul, Kind::Mul(a, b)) => {
             let (wa, wb) = (prog.ops[a.0 as usize].w, prog.ops[b.0 as usize].w);
@@ -259,20 +286,29 @@ struct Placed {
 /// (the units counted by kind, not one by one); `None` if one does not fit within II clocks of
 /// its earliest.
 fn modulo(prog: &Program, timing: &[(Class, u32, u32)], ii: u32, caps: impl Fn(Class) -> u32) -> Option<Vec<u32>> {
-    let mut usage = [vec![0u32; ii as usize], vec![0u32; ii as usize]];
+    let mut usage = [vec![0u32; ii as usize], vec![0u32; ii as usize], vec![0u32; ii as usize]];
     let mut start = vec![0u32; prog.ops.len()];
     let mut ready = vec![0u32; prog.ops.len()];
     for (o, op) in prog.ops.iter().enumerate() {
         let earliest = op.kind.args().iter().map(|a| ready[a.0 as usize]).max().unwrap_or(0);
         let (c, busy, lat) = timing[o];
         let t = match c {
-            Class::Mul | Class::Div => pooled(&mut usage[(c == Class::Div) as usize], caps(c), earliest, busy)?,
+            Class::Mul | Class::Div | Class::Shift => pooled(&mut usage[pool(c)], caps(c), earliest, busy)?,
             _ => earliest,
         };
         start[o] = t;
         ready[o] = t + lat;
     }
     Some(start)
+}
+
+/// The modulo table of a kind of unit counted by kind.
+fn pool(c: Class) -> usize {
+    match c {
+        Class::Mul => 0,
+        Class::Div => 1,
+        _ => 2,
+    }
 }
 
 /// The earliest clock from `earliest` on where `busy` more clocks of a kind of unit fit the
@@ -305,7 +341,7 @@ const TILE_SEARCH_NODES: u32 = 20_000;
 /// bounded by the latency: an operation whose start plus its shortest path to the results
 /// exceeds the bound is cut. Divisions busier than II must alternate between dividers anyway:
 /// they are counted by kind, as in [`modulo`], and bound afterwards ([`Schedule::bind`]).
-fn per_tile(prog: &Program, timing: &[(Class, u32, u32)], ii: u32, tiles: u32, dividers: u32, from: u32) -> Option<Placed> {
+fn per_tile(prog: &Program, timing: &[(Class, u32, u32)], ii: u32, caps: &dyn Fn(Class) -> u32, from: u32) -> Option<Placed> {
     if timing.iter().any(|t| t.0 == Class::Mul && t.1 > ii) {
         return None;
     }
@@ -323,11 +359,11 @@ fn per_tile(prog: &Program, timing: &[(Class, u32, u32)], ii: u32, tiles: u32, d
         start: vec![0; n],
         ready: vec![0; n],
         unit: vec![None; n],
-        tiles: vec![vec![false; ii as usize]; tiles as usize],
-        divs: vec![0; ii as usize],
+        tiles: vec![vec![false; ii as usize]; caps(Class::Mul) as usize],
+        pools: [vec![0; ii as usize], vec![0; ii as usize], vec![0; ii as usize]],
     };
     for bound in from..=from + ii {
-        let ctx = Ctx { prog, timing, tail: &tail, ii, dividers, bound };
+        let ctx = Ctx { prog, timing, tail: &tail, ii, caps, bound };
         match ctx.go(0, empty.clone(), &mut budget) {
             Ok(Some(s)) => return Some(Placed { start: s.start, unit: s.unit }),
             Ok(None) => continue,
@@ -343,7 +379,7 @@ struct Search {
     ready: Vec<u32>,
     unit: Vec<Option<u32>>,
     tiles: Vec<Vec<bool>>,
-    divs: Vec<u32>,
+    pools: [Vec<u32>; 3],
 }
 
 struct Ctx<'a> {
@@ -351,7 +387,7 @@ struct Ctx<'a> {
     timing: &'a [(Class, u32, u32)],
     tail: &'a [u32],
     ii: u32,
-    dividers: u32,
+    caps: &'a dyn Fn(Class) -> u32,
     bound: u32,
 }
 
@@ -395,7 +431,7 @@ impl Ctx<'_> {
                     }
                     return Ok(None);
                 }
-                Class::Div => match pooled(&mut s.divs, self.dividers, earliest, busy) {
+                Class::Div | Class::Shift => match pooled(&mut s.pools[pool(c)], (self.caps)(c), earliest, busy) {
                     Some(t) if t + self.tail[o] <= self.bound => t,
                     _ => return Ok(None),
                 },
@@ -415,9 +451,11 @@ impl Schedule {
         let span = ceil(self.latency + 1, self.ii) as usize;
         // The binding is kept over 8 span steady triangles, which end a span before the
         // unrolled stretch does: the last triangles see fewer contenders and bind otherwise.
-        let tris = 12 * span + 4;
-        let steady = 2 * span + 2;
-        for c in [Class::Mul, Class::Div] {
+        // They start 6 spans in: the first triangles' greedy choices take a few spans to
+        // settle into the period (at F = 20, XW = 16 with a shared shifter, 2 were too few).
+        let tris = 16 * span + 4;
+        let steady = 6 * span + 2;
+        for c in [Class::Mul, Class::Div, Class::Shift] {
             // Products the scheduler placed tile by tile keep their tile on every triangle.
             let fixed: Vec<(usize, u32)> =
                 self.slots.iter().enumerate().filter(|(_, s)| s.class == c).filter_map(|(o, s)| s.unit.map(|u| (o, u))).collect();
@@ -436,7 +474,7 @@ impl Schedule {
                 }
             }
             iv.sort();
-            let cap = if c == Class::Mul { self.plan.mults } else { self.plan.dividers } as usize;
+            let cap = self.plan.units(c) as usize;
             let mut until = vec![0u32; cap];
             let mut last: Vec<Option<usize>> = vec![None; cap];
             let mut seen: Vec<Vec<usize>> = vec![Vec::new(); cap];
@@ -511,6 +549,8 @@ impl Schedule {
         let mut mul_src: Vec<[Sources; 3]> = vec![Default::default(); plan.mults as usize];
         let mut div_src: Vec<([Sources; 2], [u32; 3])> = vec![Default::default(); plan.dividers as usize];
         let mut width = vec![0u32; plan.mults as usize];
+        // A shifter's operand and amount sources, and its widths.
+        let mut shl_src: Vec<([Sources; 2], [u32; 2])> = vec![Default::default(); plan.shifters as usize];
         for (o, (op, s)) in ops.iter().zip(&self.slots).enumerate() {
             match s.class {
                 Class::Mul => c.mul_passes += s.busy,
@@ -553,6 +593,12 @@ impl Schedule {
                     };
                     (0..3).for_each(|k| u.1[k] = u.1[k].max(ws[k]));
                 }
+                Kind::ShlBy(a, n) => {
+                    let u = &mut shl_src[u];
+                    u.0[0].push((a.0, 0));
+                    u.0[1].push((n.0, 0));
+                    u.1 = [u.1[0].max(op.w), u.1[1].max(w(n))];
+                }
                 _ => unreachable!("only units are bound"),
             }
         }
@@ -572,6 +618,10 @@ impl Schedule {
                     c.lut_mux += mux(distinct(&mut m[0]), width[u]) + mux(distinct(&mut m[1]), width[u]);
                 }
             }
+        }
+        for (src, [wv, wn]) in shl_src.iter_mut() {
+            c.lut_units += (LUT4_PER_SHIFT_BIT * (*wv * *wn) as f64).round() as u32;
+            c.lut_mux += mux(distinct(&mut src[0]), *wv) + mux(distinct(&mut src[1]), *wn);
         }
         for (src, ws) in div_src.iter_mut() {
             c.lut_units += (per_bit * (ws[0] * plan.div_bits) as f64).round() as u32;
@@ -594,8 +644,16 @@ pub fn lut_per_bit_step() -> f64 {
 /// The sum of today's dividers' partial-remainder widths at the defaults (357).
 pub fn today_pw() -> u32 {
     let fe = FrontEnd::new(Default::default(), Default::default()).expect("the defaults");
-    let plan =
-        Plan { mults: 1, mul: Plan::TILE18, dividers: 1, div_bits: 1, div_form: DivForm::ShiftDivisor, reciprocal: false, i0_steps: false };
+    let plan = Plan {
+        mults: 1,
+        mul: Plan::TILE18,
+        dividers: 1,
+        div_bits: 1,
+        div_form: DivForm::ShiftDivisor,
+        reciprocal: false,
+        i0_steps: false,
+        shifters: 0,
+    };
     Program::setup(&fe, &plan).ops.iter().map(|o| if let Kind::Div { pw, .. } = o.kind { pw } else { 0 }).sum()
 }
 
@@ -689,7 +747,7 @@ impl Schedule {
     pub fn verify_binding(&self) -> Result<u32, String> {
         let r = self.epochs().ok_or("the binding has no period")?;
         let span = ceil(self.latency + 1, self.ii);
-        for c in [Class::Mul, Class::Div] {
+        for c in [Class::Mul, Class::Div, Class::Shift] {
             let mut iv: Vec<(u32, u32, u32, usize)> = Vec::new();
             for j in 0..r * (span + 2) {
                 for (o, s) in self.slots.iter().enumerate().filter(|(_, s)| s.class == c) {
@@ -734,7 +792,18 @@ impl Schedule {
             }
         }
         rows.sort_by_key(|r| (r.0, r.1 == Class::Div, r.2));
-        rows.iter().map(|(t, c, u, n, b)| format!("{t:3} {}{u} {n} ({b})\n", if *c == Class::Mul { "mul" } else { "div" })).collect()
+        rows.iter()
+            .map(|(t, c, u, n, b)| {
+                format!(
+                    "{t:3} {}{u} {n} ({b})\n",
+                    match c {
+                        Class::Mul => "mul",
+                        Class::Shift => "shl",
+                        _ => "div",
+                    }
+                )
+            })
+            .collect()
     }
 
     /// Checks the schedule's own rules: every operand ready by its reader's start, no register
@@ -756,8 +825,8 @@ impl Schedule {
         if let Some(o) = (0..need.len()).find(|&o| self.copies[o] < need[o]) {
             return Err(format!("{} has {} register copies, needs {}", self.prog.ops[o].name, self.copies[o], need[o]));
         }
-        for c in [Class::Mul, Class::Div] {
-            let cap = if c == Class::Mul { self.plan.mults } else { self.plan.dividers };
+        for c in [Class::Mul, Class::Div, Class::Shift] {
+            let cap = self.plan.units(c);
             let mut u = vec![0u32; self.ii as usize];
             for s in self.slots.iter().filter(|s| s.class == c) {
                 (s.start..s.start + s.busy).for_each(|k| u[(k % self.ii) as usize] += 1);

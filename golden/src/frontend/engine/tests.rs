@@ -10,7 +10,7 @@ use crate::stimulus::random_fixed_triangles;
 use rand::SeedableRng;
 
 fn plan(mults: u32, dividers: u32, div_bits: u32, reciprocal: bool) -> Plan {
-    Plan { mults, mul: Plan::TILE18, dividers, div_bits, div_form: DivForm::ShiftRemainder, reciprocal, i0_steps: true }
+    Plan { mults, mul: Plan::TILE18, dividers, div_bits, div_form: DivForm::ShiftRemainder, reciprocal, i0_steps: true, shifters: 0 }
 }
 
 /// The screens of the equivalence: the default, a small one at F = 4 and the widest (2^16).
@@ -30,7 +30,8 @@ fn plans() -> Vec<Plan> {
         plan(4, 3, 4, false),
         plan(1, 1, 1, true),
         Plan { mul: MulUnit::ShiftAdd { bits: 4 }, i0_steps: false, ..plan(2, 2, 2, false) },
-        Plan { mul: MulUnit::Tile { bits: 16 }, ..plan(8, 6, 1, true) },
+        Plan { mul: MulUnit::Tile { bits: 16 }, shifters: 1, ..plan(8, 6, 1, true) },
+        Plan { shifters: 2, ..plan(4, 3, 4, false) },
     ]
 }
 
@@ -238,6 +239,7 @@ fn engine_grid() {
         div_form: DivForm::ShiftDivisor,
         reciprocal: false,
         i0_steps: false,
+        shifters: 0,
     };
     println!("{} (today)", row(&today.schedule(&fe).unwrap()));
     for steps in [false, true] {
@@ -256,7 +258,7 @@ fn engine_grid() {
                         for (div_bits, div_form) in
                             [1, 2, 4].into_iter().flat_map(|b| [(b, DivForm::ShiftRemainder), (b, DivForm::ShiftDivisor)])
                         {
-                            let p = Plan { mults, mul, dividers, div_bits, div_form, reciprocal, i0_steps: steps };
+                            let p = Plan { mults, mul, dividers, div_bits, div_form, reciprocal, i0_steps: steps, shifters: 1 };
                             let s = p.schedule(&fe).unwrap();
                             let r = row(&s);
                             if r.contains(&filter) {

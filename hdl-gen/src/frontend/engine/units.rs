@@ -413,3 +413,78 @@ pub(super) fn dividers(v: &Values, seq: &Seq, body: &mut Vec<Item>) -> Vec<Captu
     body.push(Item::Blank);
     caps
 }
+
+/// The shared barrel shifters (`Plan::shifters`): per unit the operand and the amount
+/// selected by phase (AND-OR), registered, then the shift, which the value's register
+/// captures a clock later (golden's `SHIFT_PIPE` = 2). A unit is as wide as its widest shift:
+/// the shift moves bits only upwards, so an operand extended past its value's width gives the
+/// same low bits.
+pub(super) fn shifters(v: &Values, seq: &Seq, body: &mut Vec<Item>) -> Vec<Capture> {
+    let s = v.s;
+    let n = s.plan.shifters as usize;
+    let ops: Vec<usize> = (0..s.slots.len()).filter(|&o| s.slots[o].class == Class::Shift).collect();
+    if ops.is_empty() {
+        return Vec::new();
+    }
+    let amount = |o: usize| match v.op(o).kind {
+        Kind::ShlBy(a, k) => (a, k),
+        _ => unreachable!("{} is not a shift", v.op(o).name),
+    };
+    let mut widths = vec![(0u32, 0u32); n];
+    for &o in &ops {
+        let (_, k) = amount(o);
+        for (u, _) in seq.units_of(s, o) {
+            let w = &mut widths[u as usize];
+            *w = (w.0.max(v.op(o).w), w.1.max(v.op(k.0 as usize).w));
+        }
+    }
+    let mut src: Vec<[Vec<(String, String)>; 2]> = vec![Default::default(); n];
+    let mut caps = Vec::new();
+    for &o in &ops {
+        let (a, k) = amount(o);
+        let t = s.slots[o].start;
+        let mut from = Vec::new();
+        for (u, es) in seq.units_of(s, o) {
+            let (w, wk) = widths[u as usize];
+            let c = seq.when_any(t, &es);
+            src[u as usize][0].push((c.clone(), v.at(a, t).ext(w)));
+            src[u as usize][1].push((c, v.at(k, t).ext(wk)));
+            from.push((es, if v.op(o).w == w { format!("sh{u}_y") } else { format!("sh{u}_y[{}:0]", v.op(o).w - 1) }));
+        }
+        caps.push(Capture { op: o, t: s.slots[o].ready - 1, from });
+    }
+    body.push(comment(format!(
+        "Shifters ({n}): each one's operand and amount selected by phase and registered, then shifted into the value's register."
+    )));
+    for (u, ((w, wk), sr)) in widths.iter().zip(&src).enumerate() {
+        if sr[0].is_empty() {
+            continue;
+        }
+        let (ra, rk) = (format!("sh{u}_a"), format!("sh{u}_n"));
+        body.push(reg(&ra, *w));
+        body.push(reg(&rk, *wk));
+        body.push(Item::Always(vec![Stmt::If(
+            "en".into(),
+            vec![set(&ra, and_or(&merged(&sr[0]), *w)), set(&rk, and_or(&merged(&sr[1]), *wk))],
+            vec![],
+        )]));
+        body.push(comment("verilator lint_off UNUSEDSIGNAL"));
+        body.push(wire(&format!("sh{u}_y"), *w, format!("{ra} << {rk}")));
+        body.push(comment("verilator lint_on UNUSEDSIGNAL"));
+    }
+    body.push(Item::Blank);
+    caps
+}
+
+/// AND-OR sources with the same value merged into one term (the amount is one value's copy
+/// at most clocks).
+fn merged(items: &[(String, String)]) -> Vec<(String, String)> {
+    let mut out: Vec<(Vec<String>, String)> = Vec::new();
+    for (c, x) in items {
+        match out.iter_mut().find(|(_, y)| y == x) {
+            Some((cs, _)) => cs.push(c.clone()),
+            None => out.push((vec![c.clone()], x.clone())),
+        }
+    }
+    out.into_iter().map(|(cs, x)| (if cs.len() == 1 { cs[0].clone() } else { format!("({})", cs.join(" || ")) }, x)).collect()
+}
