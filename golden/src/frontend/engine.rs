@@ -97,14 +97,18 @@ impl Plan {
     pub const TILE18_RTL: MulUnit = MulUnit::Tile { bits: 17 };
 
     /// docs/design.md's recommendation for the ECP5-25F: 12 clocks a triangle on 8 MULT18X18D
-    /// and twelve 1-bit dividers, the incremental steps left to the walker's start evaluator.
-    /// 8 tiles, not 12: the dividers set II = 12 (120 divider clocks on 12), and 8 tiles are the
-    /// fewest the scheduler keeps at 12 (7 give 13), so the front-end with the span path's 17
-    /// per-row products has 25 MULT18X18D, within the LFE5U-25F's 28.
+    /// and fourteen 1-bit dividers, the incremental steps left to the walker's start evaluator.
+    /// 8 tiles, not 12: 8 are the fewest the scheduler keeps at 12 clocks (7 give 13), so the
+    /// front-end with the span path's 17 per-row products has 25 MULT18X18D, within the
+    /// LFE5U-25F's 28. 14 dividers, not the 12 that 120 divider clocks need at II = 12: each
+    /// edge's `Qs` and `g` (16 clocks) and `Rn` (24) then alternate over a pair of dividers of
+    /// their own, by the triangle's parity, where 12 rotated `Qs` and `g` over three dividers
+    /// each: the dividers' operand multiplexers go, and `Qs`'s dividers are 19 bits wide, not
+    /// 27 (tri_frontend 6,092 -> 5,252 LUT4, docs/fpga.md).
     pub const ECP5_25F: Plan = Plan {
         mults: 8,
         mul: Plan::TILE18_RTL,
-        dividers: 12,
+        dividers: 14,
         div_bits: 1,
         div_form: DivForm::ShiftRemainder,
         reciprocal: true,

@@ -12,10 +12,11 @@
 //!   than II needs `copies` registers (the next triangle writes the next one).
 //! - **Units.** Products are placed on a modulo table per tile, so each keeps one tile on every
 //!   triangle ([`per_tile`]: a search over their clocks and tiles at the least latency; when it
-//!   finds none, the tiles are counted by kind as the dividers are). Divisions are bound to
-//!   dividers by start time over an unrolled stretch of triangles (a unit that ran the same
-//!   operation is preferred, so the binding is static where the interval allows); a division
-//!   busier than II alternates between dividers.
+//!   finds none, the tiles are counted by kind as the dividers are). Divisions and shifts keep
+//!   one unit each, or a division busier than II alternates over a pair by the triangle's
+//!   parity, where the units' two-period tables allow (`fixed_rotation`); otherwise they are
+//!   bound by start time over an unrolled stretch of triangles (a unit that ran the same
+//!   operation is preferred), and a division may rotate over three units or more.
 
 use super::{compute, DivForm, Kind, MulUnit, Plan, Program, V};
 use crate::frontend::incremental::Steps;
@@ -467,6 +468,14 @@ impl Schedule {
                 }
                 continue;
             }
+            if let Some(fixed) = self.fixed_rotation(c) {
+                for j in steady..tris {
+                    for (o, us) in &fixed {
+                        self.note(*o, j, us[(j - steady) % us.len()] as usize, steady, span);
+                    }
+                }
+                continue;
+            }
             let mut iv: Vec<(u32, usize, usize)> = Vec::new();
             for j in 0..tris {
                 for (o, s) in self.slots.iter().enumerate().filter(|(_, s)| s.class == c) {
@@ -508,6 +517,51 @@ impl Schedule {
                 }
             }
         }
+    }
+
+    /// Units for every operation of a kind such that each keeps one unit, or, when busier than
+    /// II (up to 2 II), alternates between two by the triangle's parity: `(operation, units by
+    /// parity)`. Each unit has a modulo table of two periods. An operation takes a unit no other
+    /// one uses when there is one (a unit shared by two operations needs an operand multiplexer
+    /// and is as wide as the wider), else the free unit its width fits best. `None` if an
+    /// operation is busier than 2 II or finds no free unit: the binding is then unrolled
+    /// ([`Schedule::bind`]) and may rotate an operation over three units or more, which makes
+    /// each unit's operand multiplexer select by epoch among every operation it runs.
+    fn fixed_rotation(&self, c: Class) -> Option<Vec<(usize, Vec<u32>)>> {
+        let (ii, cap) = (self.ii, self.plan.units(c) as usize);
+        let mut table = vec![vec![false; 2 * ii as usize]; cap];
+        let mut users: Vec<Vec<usize>> = vec![Vec::new(); cap];
+        let mut wide = vec![0u32; cap];
+        let mut ops: Vec<usize> = (0..self.slots.len()).filter(|&o| self.slots[o].class == c).collect();
+        // The busiest first (they need the longest free runs), then by start.
+        ops.sort_by_key(|&o| (std::cmp::Reverse(self.slots[o].busy), self.slots[o].start, o));
+        let mut out = Vec::new();
+        for o in ops {
+            let (t, b) = (self.slots[o].start, self.slots[o].busy);
+            if b > 2 * ii {
+                return None;
+            }
+            // The clocks of the two-period table unit `k` of the operation's units takes.
+            let clocks = |k: u32, n: u32| -> Vec<usize> {
+                let starts: Vec<u32> = if n == 1 { vec![t, t + ii] } else { vec![t + k * ii] };
+                starts.iter().flat_map(|&s| (s..s + b).map(|x| (x % (2 * ii)) as usize)).collect()
+            };
+            let n = if b > ii { 2 } else { 1 };
+            let wo = self.unit_width(o);
+            let mut units = Vec::new();
+            for k in 0..n {
+                let cl = clocks(k, n);
+                let u = (0..cap)
+                    .filter(|u| !units.contains(u) && cl.iter().all(|&x| !table[*u][x]))
+                    .min_by_key(|&u| (!users[u].is_empty(), wo.saturating_sub(wide[u]), wide[u].saturating_sub(wo), u))?;
+                cl.iter().for_each(|&x| table[u][x] = true);
+                users[u].push(o);
+                wide[u] = wide[u].max(wo);
+                units.push(u);
+            }
+            out.push((o, units.into_iter().map(|u| u as u32).collect()));
+        }
+        Some(out)
     }
 
     /// The subtractor a division needs on a divider of the plan's form (0 for a product).

@@ -361,3 +361,28 @@ fn the_products_keep_their_tiles() {
     }
     assert_eq!(bad.rotating_products(), vec![bad.prog.ops[o].name.as_str()]);
 }
+
+/// The ECP5 plan's dividers each run one division, its `Qs`, `g` and `Rn` alternating over a
+/// pair of their own by the triangle's parity (so no divider needs an operand multiplexer);
+/// negative control: on 12 dividers, the fewest 120 divider clocks need at II = 12, divisions
+/// share dividers and rotate over three.
+#[test]
+fn the_ecp5_divisions_keep_their_pairs() {
+    let sharing = |s: &Schedule| -> usize {
+        let mut ops_on: Vec<Vec<usize>> = vec![Vec::new(); s.plan.dividers as usize];
+        for (o, b) in s.binding.iter().enumerate().filter(|(o, _)| s.slots[*o].class == schedule::Class::Div) {
+            for &u in b {
+                if !ops_on[u as usize].contains(&o) {
+                    ops_on[u as usize].push(o);
+                }
+            }
+        }
+        ops_on.iter().filter(|v| v.len() > 1).count()
+    };
+    let s = Plan::ECP5_25F.schedule(&fe640()).unwrap();
+    assert_eq!((s.ii, s.epochs()), (12, Some(2)));
+    assert_eq!(sharing(&s), 0, "{:?}", s.binding);
+    let twelve = Plan { dividers: 12, ..Plan::ECP5_25F }.schedule(&fe640()).unwrap();
+    assert_eq!(twelve.ii, 12);
+    assert!(sharing(&twelve) > 0 && twelve.epochs() > Some(2), "{:?}", twelve.epochs());
+}
