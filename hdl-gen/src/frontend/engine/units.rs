@@ -160,8 +160,9 @@ pub(super) fn multipliers(v: &Values, seq: &Seq, body: &mut Vec<Item>) -> Vec<Ca
         }
     }
     let groups = Groups::new(&keys);
-    // Per unit, its lanes' sources: a, b, first, weight index.
-    let mut src: Vec<[Vec<(String, String)>; 4]> = vec![Default::default(); m];
+    // Per unit, its lanes' sources: a, b, first, weight index, and a tile's operand registers'
+    // loads (a, b).
+    let mut src: Vec<[Vec<(String, String)>; 6]> = vec![Default::default(); m];
     let mut caps = Vec::new();
     for &o in &ops {
         let (a, b, p) = passes(o);
@@ -171,6 +172,7 @@ pub(super) fn multipliers(v: &Values, seq: &Seq, body: &mut Vec<Item>) -> Vec<Ca
             let (gi, li) = groups.of[u as usize].expect("a unit with operations");
             let acc_w = groups.keys[gi][0];
             let u = u as usize;
+            let mut held = [false; 2];
             for (k, &(i, j, x, top_a, top_b)) in p.iter().enumerate() {
                 let t = st + k as u32;
                 let c = seq.when_any(t, &es);
@@ -178,8 +180,17 @@ pub(super) fn multipliers(v: &Values, seq: &Seq, body: &mut Vec<Item>) -> Vec<Ca
                     MulUnit::Tile { bits } => (chunk(&v.at(a, t), i, bits, top_a, sg(a)), chunk(&v.at(b, t), j, bits, top_b, sg(b))),
                     MulUnit::ShiftAdd { bits } => (v.at(a, t).ext(acc_w), chunk(&v.at(b, t), j, bits, top_b, sg(b))),
                 };
-                src[u][0].push((c.clone(), va));
-                src[u][1].push((c.clone(), vb));
+                // A tile's operand register holds a chunk the product's next pass takes again: no
+                // multiplexer term for that pass (a product of 2 x 2 chunks takes 6, not 8).
+                let tile = matches!(plan.mul, MulUnit::Tile { .. });
+                for (port, x) in [(0, va), (1, vb)] {
+                    let again = tile && k > 0 && src[u][port].last().is_some_and(|(_, y)| *y == x) && held[port];
+                    if !again {
+                        src[u][port].push((c.clone(), x));
+                        src[u][4 + port].push((c.clone(), "1'b1".into()));
+                    }
+                    held[port] = true;
+                }
                 if k == 0 {
                     src[u][2].push((c.clone(), "1'b1".into()));
                 }
@@ -207,7 +218,13 @@ pub(super) fn multipliers(v: &Values, seq: &Seq, body: &mut Vec<Item>) -> Vec<Ca
             "Group {gi}: units {} (g_mul{gi}[k]), accumulators of {acc_w} bits.",
             members.iter().map(|u| format!("mul{u}")).collect::<Vec<_>>().join(", ")
         )));
-        for (x, lw) in [("a", lane_a), ("b", lane_b), ("f", 1), ("sh", sh_w)] {
+        let tile = matches!(plan.mul, MulUnit::Tile { .. });
+        let ports: &[(&str, u32)] = if tile {
+            &[("a", lane_a), ("b", lane_b), ("f", 1), ("sh", sh_w), ("la", 1), ("lb", 1)]
+        } else {
+            &[("a", lane_a), ("b", lane_b), ("f", 1), ("sh", sh_w)]
+        };
+        for &(x, lw) in ports {
             body.push(crate::verilog::bus(&bus(x), n * lw));
         }
         // Each product keeps the accumulator's low bits it needs.
@@ -227,6 +244,12 @@ pub(super) fn multipliers(v: &Values, seq: &Seq, body: &mut Vec<Item>) -> Vec<Ca
                 MulUnit::ShiftAdd { .. } => and_or_zero(&sh, sh_w),
             };
             body.push(Item::Assign(lane_bits(&bus("sh"), li, sh_w, sh_w), sh));
+            if tile {
+                for (x, port) in [("la", 4), ("lb", 5)] {
+                    let loads: Vec<String> = sr[port].iter().map(|(c, _)| c.clone()).collect();
+                    body.push(Item::Assign(lane_bits(&bus(x), li, 1, 1), or(&loads)));
+                }
+            }
         }
         let k = format!("m{gi}k");
         let lane = |x: &str, lw: u32| if lw == 1 { format!("{}[{k}]", bus(x)) } else { format!("{}[{k}*{lw} +: {lw}]", bus(x)) };
@@ -264,8 +287,8 @@ fn multiplier(mul: MulUnit, acc_w: u32, (lane_a, lane_b, sh_w): (u32, u32, u32),
             g.push(Item::Always(vec![Stmt::If(
                 "en".into(),
                 vec![
-                    set("ra", lane("a", lane_a)),
-                    set("rb", lane("b", lane_b)),
+                    Stmt::If(lane("la", 1), vec![set("ra", lane("a", lane_a))], vec![]),
+                    Stmt::If(lane("lb", 1), vec![set("rb", lane("b", lane_b))], vec![]),
                     set("f1", lane("f", 1)),
                     set("s1", lane("sh", sh_w)),
                     set("pr", "ra * rb"),
