@@ -82,8 +82,8 @@ pub struct Cost {
     /// Tile passes and divider clocks a triangle.
     pub mul_passes: u32,
     pub div_clocks: u32,
-    /// Estimated LUT4: the dividers (and shift-add multipliers), the units' operand
-    /// multiplexers.
+    /// Estimated LUT4: the dividers (and shift-add multipliers), the barrel shifters (shared
+    /// or each shift's own), the units' operand multiplexers.
     pub lut_units: u32,
     pub lut_mux: u32,
     /// Register bits: every value's copies, and one set-up result (a queue entry).
@@ -613,6 +613,10 @@ impl Schedule {
             }
             if s.class != Class::Wire {
                 c.reg_bits += self.copies[o] * op.w;
+            }
+            // A shift by a value left to logic is a barrel shifter of its own.
+            if let (Class::Logic, Kind::ShlBy(_, n)) = (s.class, op.kind) {
+                c.lut_units += (LUT4_PER_SHIFT_BIT * (op.w * w(n)) as f64).round() as u32;
             }
         }
         for &(o, u) in &self.rotation {
