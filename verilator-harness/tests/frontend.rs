@@ -497,7 +497,8 @@ fn engine_mesh_lands_in_memory_once_per_pixel() {
 /// (each a model built on first use, 37x23) is caught on the triangles the clean model passes:
 /// one logic operation reading its operand's copy of the next triangle (a copy off by one
 /// period), a tile's passes added at the wrong weights (its accumulator never shifted), a division's quotient taken from the
-/// divider of another epoch (a binding rotated). Slow tier.
+/// divider of another epoch (a binding rotated), the shared shifter's amount read from the next
+/// triangle's copy. Slow tier.
 #[test]
 #[ignore]
 fn engine_planted_faults_are_caught() {
@@ -514,10 +515,12 @@ fn engine_planted_faults_are_caught() {
         .expect("a logic operation reading a second copy");
     let weight_line =
         engine.lines().find(|l| l.trim_start().starts_with("assign m") && l.contains("_sh[")).expect("a tile's weight shifts");
-    let epoch_line = engine
+    let shift_line = engine
         .lines()
-        .find(|l| l.contains("<= (") && l.contains("_q[") && l.contains("(ep[2] || ep[5])"))
-        .expect("a quotient captured by epoch");
+        .find(|l| l.trim_start().starts_with("sh0_n <=") && l.contains("_1);"))
+        .expect("a shift's amount read from a second copy");
+    let epoch_line =
+        engine.lines().find(|l| l.contains("<= (") && l.contains("_q[") && l.contains("ep[0]")).expect("a quotient captured by epoch");
     let faults = [
         (copy_line.to_string(), copy_line.replacen("_1 ", "_0 ", 1), "an operand's copy off by one period"),
         (
@@ -525,7 +528,8 @@ fn engine_planted_faults_are_caught() {
             format!("{}= 1'b0;", weight_line.split_once('=').unwrap().0),
             "a tile's passes at the wrong weights (no shift)",
         ),
-        (epoch_line.to_string(), epoch_line.replacen("(ep[2] || ep[5])", "(ep[3] || ep[0])", 1), "a quotient from another epoch's divider"),
+        (epoch_line.to_string(), epoch_line.replacen("ep[0]", "ep[1]", 1), "a quotient from another epoch's divider"),
+        (shift_line.to_string(), shift_line.replacen("_1);", "_0);", 1), "a shared shift's amount from the next triangle's copy"),
     ];
     assert_faults_caught(&base, "tri_fe_engine.v", "fault", faults, seed, &tris);
 }

@@ -80,6 +80,10 @@ pub struct Plan {
     pub reciprocal: bool,
     /// The incremental `I0`'s per-source steps are part of the set-up.
     pub i0_steps: bool,
+    /// Shared barrel shifters for the normalising shifts by a value (`ShlBy`: `2A`, and the
+    /// plane's terms by `s`); 0: each shift its own logic, as CALC's. Five 64-bit shifts by a
+    /// 6-bit amount were about 1,560 of the ECP5 plan's engine LUT4 (docs/fpga.md).
+    pub shifters: u32,
 }
 
 impl Plan {
@@ -93,18 +97,23 @@ impl Plan {
     pub const TILE18_RTL: MulUnit = MulUnit::Tile { bits: 17 };
 
     /// docs/design.md's recommendation for the ECP5-25F: 12 clocks a triangle on 8 MULT18X18D
-    /// and twelve 1-bit dividers, the incremental steps left to the walker's start evaluator.
-    /// 8 tiles, not 12: the dividers set II = 12 (120 divider clocks on 12), and 8 tiles are the
-    /// fewest the scheduler keeps at 12 (7 give 13), so the front-end with the span path's 17
-    /// per-row products has 25 MULT18X18D, within the LFE5U-25F's 28.
+    /// and fourteen 1-bit dividers, the incremental steps left to the walker's start evaluator.
+    /// 8 tiles, not 12: 8 are the fewest the scheduler keeps at 12 clocks (7 give 13), so the
+    /// front-end with the span path's 17 per-row products has 25 MULT18X18D, within the
+    /// LFE5U-25F's 28. 14 dividers, not the 12 that 120 divider clocks need at II = 12: each
+    /// edge's `Qs` and `g` (16 clocks) and `Rn` (24) then alternate over a pair of dividers of
+    /// their own, by the triangle's parity, where 12 rotated `Qs` and `g` over three dividers
+    /// each: the dividers' operand multiplexers go, and `Qs`'s dividers are 19 bits wide, not
+    /// 27 (tri_frontend 6,092 -> 5,252 LUT4, docs/fpga.md).
     pub const ECP5_25F: Plan = Plan {
         mults: 8,
         mul: Plan::TILE18_RTL,
-        dividers: 12,
+        dividers: 14,
         div_bits: 1,
         div_form: DivForm::ShiftRemainder,
         reciprocal: true,
         i0_steps: false,
+        shifters: 1,
     };
     /// For the iCE40 UP5K: 2 of its SB_MAC16 and one 1-bit divider, the smallest engine. 15-bit
     /// chunks, 16-bit signed operands (as [`Plan::TILE18_RTL`]): 120 clocks a triangle either way.
@@ -116,6 +125,7 @@ impl Plan {
         div_form: DivForm::ShiftRemainder,
         reciprocal: true,
         i0_steps: false,
+        shifters: 1,
     };
     /// For the iCE40 HX8K, which has no multiplier: one shift-add unit and one divider, a bit a clock.
     pub const ICE40_HX8K: Plan = Plan {
@@ -126,6 +136,7 @@ impl Plan {
         div_form: DivForm::ShiftRemainder,
         reciprocal: false,
         i0_steps: false,
+        shifters: 1,
     };
 }
 

@@ -98,9 +98,13 @@ fn plan_text(s: &Schedule) -> String {
         DivForm::ShiftDivisor => "divisor shifted",
     };
     format!(
-        "{mul}, {} restoring dividers of {} quotient bit(s) a clock ({form}), division by 2A {}",
+        "{mul}, {} restoring dividers of {} quotient bit(s) a clock ({form}), {}, division by 2A {}",
         p.dividers,
         p.div_bits,
+        match p.shifters {
+            0 => "each shift by a value its own logic".to_string(),
+            k => format!("{k} shared barrel shifter(s)"),
+        },
         if p.reciprocal { "by the reciprocal Rn" } else { "by restoring division" }
     )
 }
@@ -139,7 +143,7 @@ pub(super) fn module(hw: &Hw, names: &Names) -> Module {
         "Structure: the sequencer (phase ring ph, epoch ring ep, valid bits vld, the vertex registers); every value of the".into(),
         "program as v<op>_<name>_<copy> (a register, or a wire for wiring), copy k the triangle k periods older, shifted".into(),
         "when the next triangle's value is written; each logic operation's result t<op>; per unit the operand multiplexers".into(),
-        "(mu_* for the multipliers, du_* for the dividers), selected by phase and epoch; the units as generate loops".into(),
+        "(mu_* for the multipliers, du_* for the dividers, sh<k>_a/_n for the shifters), selected by phase and epoch; the units as generate loops".into(),
         "(g_mul, g_div); the result at the latency (res). en low freezes every register of the engine.".into(),
         String::new(),
         "The units' operations (clock from the entry, unit, operation, clocks busy), golden's listing:".into(),
@@ -203,6 +207,7 @@ pub(super) fn module(hw: &Hw, names: &Names) -> Module {
     body.push(Item::Blank);
     let mut caps = units::multipliers(&v, &seq, &mut body);
     caps.extend(units::dividers(&v, &seq, &mut body));
+    caps.extend(units::shifters(&v, &seq, &mut body));
     for c in caps {
         let w = v.op(c.op).w;
         // The register loads at its phase; the epoch only picks the unit.

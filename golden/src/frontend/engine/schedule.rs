@@ -10,17 +10,29 @@
 //!   when, over the interval's clocks modulo II, fewer operations of its kind are busy than
 //!   there are units; the smallest II that schedules is the sustained rate. A value held longer
 //!   than II needs `copies` registers (the next triangle writes the next one).
-//! - **Units.** The operations are bound to units by start time over an unrolled stretch of
-//!   triangles (a unit that ran the same operation is preferred, so the binding is static where
-//!   the interval allows); an operation busier than II alternates between units.
+//! - **Units.** Products are placed on a modulo table per tile, so each keeps one tile on every
+//!   triangle ([`per_tile`]: a search over their clocks and tiles at the least latency; when it
+//!   finds none, the tiles are counted by kind as the dividers are). Divisions and shifts keep
+//!   one unit each, or a division busier than II alternates over a pair by the triangle's
+//!   parity, where the units' two-period tables allow (`fixed_rotation`); otherwise they are
+//!   bound by start time over an unrolled stretch of triangles (a unit that ran the same
+//!   operation is preferred), and a division may rotate over three units or more.
 
 use super::{compute, DivForm, Kind, MulUnit, Plan, Program, V};
 use crate::frontend::incremental::Steps;
 use crate::frontend::{FixedTriangle, FrontEnd, Outcome, TriSetup};
 
+/// Clocks from a shift's start on a shared shifter to its value: the selected operands'
+/// register, then the shift into the value's.
+pub const SHIFT_PIPE: u32 = 2;
+
 /// Clocks from a product's last pass to its value: the tile's input and output registers and
 /// the accumulator.
 pub const MUL_PIPE: u32 = 2;
+
+/// LUT4 of a barrel shifter per result bit per amount bit: Yosys 0.23 `synth_ecp5` maps a
+/// 64-bit shift by a 6-bit amount onto 637 LUT4 (and 292 PFUMX, 141 L6MUX21), docs/fpga.md.
+pub const LUT4_PER_SHIFT_BIT: f64 = 637.0 / (64.0 * 6.0);
 
 /// The measured anchor of the LUT estimate: `tri_frontend` at `--pipeline 1`, ECP5-85F, with
 /// today's eight dividers at 1 and 4 quotient bits a clock (docs/fpga.md, stop 24:
@@ -46,6 +58,8 @@ pub enum Class {
     Logic,
     Mul,
     Div,
+    /// A shift by a value on one of the plan's shared barrel shifters.
+    Shift,
 }
 
 /// One operation's place: its unit (index among the multipliers or the dividers, for a
@@ -68,8 +82,8 @@ pub struct Cost {
     /// Tile passes and divider clocks a triangle.
     pub mul_passes: u32,
     pub div_clocks: u32,
-    /// Estimated LUT4: the dividers (and shift-add multipliers), the units' operand
-    /// multiplexers.
+    /// Estimated LUT4: the dividers (and shift-add multipliers), the barrel shifters (shared
+    /// or each shift's own), the units' operand multiplexers.
     pub lut_units: u32,
     pub lut_mux: u32,
     /// Register bits: every value's copies, and one set-up result (a queue entry).
@@ -136,6 +150,16 @@ impl FrontEnd {
 }
 
 impl Plan {
+    /// The units of a kind the plan has (0 for wiring and logic).
+    pub fn units(&self, c: Class) -> u32 {
+        match c {
+            Class::Mul => self.mults,
+            Class::Div => self.dividers,
+            Class::Shift => self.shifters,
+            Class::Wire | Class::Logic => 0,
+        }
+    }
+
     fn check(&self) -> Result<(), EngineError> {
         let r = |what, value, max| if (1..=max).contains(&value) { Ok(()) } else { Err(EngineError::Range { what, value, max }) };
         r("divider quotient bits a clock", self.div_bits, 16)?;
@@ -164,19 +188,25 @@ impl Schedule {
             return Err(EngineError::NoDivider(count(Class::Div)));
         }
         let timing: Vec<(Class, u32, u32)> = prog.ops.iter().map(|o| timing(&prog, o, &plan)).collect();
-        let caps = |c| if c == Class::Mul { plan.mults } else { plan.dividers };
+        let caps = |c| plan.units(c);
         let need = |c| timing.iter().filter(|t| t.0 == c).map(|t| t.1).sum::<u32>();
-        let mut ii =
-            [Class::Mul, Class::Div].iter().map(|&c| if need(c) == 0 { 1 } else { ceil(need(c), caps(c)) }).max().unwrap_or(1).max(1);
-        let start = loop {
-            if let Some(s) = modulo(&prog, &timing, ii, caps) {
-                break s;
+        let mut ii = [Class::Mul, Class::Div, Class::Shift]
+            .iter()
+            .map(|&c| if need(c) == 0 { 1 } else { ceil(need(c), caps(c)) })
+            .max()
+            .unwrap_or(1)
+            .max(1);
+        let Placed { start, unit } = loop {
+            if let Some(start) = modulo(&prog, &timing, ii, caps) {
+                let latency = prog.out.all().iter().map(|v| start[v.0 as usize] + timing[v.0 as usize].2).max().unwrap_or(0);
+                break per_tile(&prog, &timing, ii, &caps, latency).unwrap_or(Placed { start, unit: vec![None; n] });
             }
             ii += 1;
         };
         let ready: Vec<u32> = (0..n).map(|o| start[o] + timing[o].2).collect();
         let latency = prog.out.all().iter().map(|v| ready[v.0 as usize]).max().unwrap_or(0);
-        let slots = (0..n).map(|o| Slot { class: timing[o].0, unit: None, start: start[o], busy: timing[o].1, ready: ready[o] }).collect();
+        let slots =
+            (0..n).map(|o| Slot { class: timing[o].0, unit: unit[o], start: start[o], busy: timing[o].1, ready: ready[o] }).collect();
         let mut s = Schedule {
             plan,
             prog,
@@ -221,6 +251,9 @@ fn timing(prog: &Program, op: &super::Op, plan: &Plan) -> (Class, u32, u32) {
     let c = class(&op.kind);
     match (c, op.kind) {
         (Class::Wire, _) => (c, 0, 0),
+        // A shared shifter registers its selected operands, then shifts into the value's
+        // register: the operand multiplexer and the shift are a clock each.
+        (Class::Logic, Kind::ShlBy(..)) if plan.shifters > 0 => (Class::Shift, 1, SHIFT_PIPE),
         (Class::Logic, _) => (c, 0, 1),
         (Class::Mul, Kind::Mul(a, b)) => {
             let (wa, wb) = (prog.ops[a.0 as usize].w, prog.ops[b.0 as usize].w);
@@ -243,33 +276,173 @@ fn timing(prog: &Program, op: &super::Op, plan: &Plan) -> (Class, u32, u32) {
     }
 }
 
-/// Places every operation at its earliest clock where a unit of its kind is free modulo `ii`;
-/// `None` if one does not fit within II clocks of its earliest.
+/// Where the scheduler placed the operations: each one's start clock, and a product's own
+/// tile when the tiles were reserved one by one ([`per_tile`]).
+struct Placed {
+    start: Vec<u32>,
+    unit: Vec<Option<u32>>,
+}
+
+/// Places every operation at its earliest clock where a unit of its kind is free modulo `ii`
+/// (the units counted by kind, not one by one); `None` if one does not fit within II clocks of
+/// its earliest.
 fn modulo(prog: &Program, timing: &[(Class, u32, u32)], ii: u32, caps: impl Fn(Class) -> u32) -> Option<Vec<u32>> {
-    let mut usage = [vec![0u32; ii as usize], vec![0u32; ii as usize]];
+    let mut usage = [vec![0u32; ii as usize], vec![0u32; ii as usize], vec![0u32; ii as usize]];
     let mut start = vec![0u32; prog.ops.len()];
     let mut ready = vec![0u32; prog.ops.len()];
     for (o, op) in prog.ops.iter().enumerate() {
         let earliest = op.kind.args().iter().map(|a| ready[a.0 as usize]).max().unwrap_or(0);
         let (c, busy, lat) = timing[o];
         let t = match c {
-            Class::Mul | Class::Div => {
-                let u = &mut usage[(c == Class::Div) as usize];
-                let cap = caps(c);
-                let t = (earliest..earliest + ii).find(|&t| {
-                    let mut add = vec![0u32; ii as usize];
-                    (t..t + busy).for_each(|k| add[(k % ii) as usize] += 1);
-                    add.iter().zip(u.iter()).all(|(a, b)| a + b <= cap)
-                })?;
-                (t..t + busy).for_each(|k| u[(k % ii) as usize] += 1);
-                t
-            }
+            Class::Mul | Class::Div | Class::Shift => pooled(&mut usage[pool(c)], caps(c), earliest, busy)?,
             _ => earliest,
         };
         start[o] = t;
         ready[o] = t + lat;
     }
     Some(start)
+}
+
+/// The modulo table of a kind of unit counted by kind.
+fn pool(c: Class) -> usize {
+    match c {
+        Class::Mul => 0,
+        Class::Div => 1,
+        _ => 2,
+    }
+}
+
+/// The earliest clock from `earliest` on where `busy` more clocks of a kind of unit fit the
+/// modulo table `usage` under `cap` units, taken; `None` if none within II clocks.
+fn pooled(usage: &mut [u32], cap: u32, earliest: u32, busy: u32) -> Option<u32> {
+    let ii = usage.len() as u32;
+    let t = (earliest..earliest + ii).find(|&t| {
+        let mut add = vec![0u32; ii as usize];
+        (t..t + busy).for_each(|k| add[(k % ii) as usize] += 1);
+        add.iter().zip(usage.iter()).all(|(a, b)| a + b <= cap)
+    })?;
+    (t..t + busy).for_each(|k| usage[(k % ii) as usize] += 1);
+    Some(t)
+}
+
+/// Search nodes [`per_tile`] may visit for one plan before it settles for the tiles counted by
+/// kind (the named plans need a few hundred).
+const TILE_SEARCH_NODES: u32 = 20_000;
+
+/// The schedule with every product on one tile for every triangle, at II `ii` and the least
+/// latency from `from` up to `from + ii`; `None` if the search finds none within its budget.
+///
+/// Counting tiles by kind only ([`modulo`]) can place products whose clocks no static
+/// assignment covers (at 8 tiles and II = 12 the set-up's did not), and the binding then rotates
+/// products over tiles from triangle to triangle: the tiles' operand multiplexers select by
+/// epoch as well as by phase (278 terms against 150, 1,625 LUT4 more, docs/fpga.md). Here each
+/// tile has its own modulo table and a product takes one tile's clocks. A depth-first search
+/// over the products' (clock, tile) choices, in program order, each at its earliest clock first
+/// and on the tile left with the least free run around it (long runs stay for long products),
+/// bounded by the latency: an operation whose start plus its shortest path to the results
+/// exceeds the bound is cut. Divisions busier than II must alternate between dividers anyway:
+/// they are counted by kind, as in [`modulo`], and bound afterwards ([`Schedule::bind`]).
+fn per_tile(prog: &Program, timing: &[(Class, u32, u32)], ii: u32, caps: &dyn Fn(Class) -> u32, from: u32) -> Option<Placed> {
+    if timing.iter().any(|t| t.0 == Class::Mul && t.1 > ii) {
+        return None;
+    }
+    let n = prog.ops.len();
+    // The clocks from an operation's start to the last result, with no unit busy.
+    let (mut tail, mut need) = (vec![0u32; n], vec![0u32; n]);
+    for (o, op) in prog.ops.iter().enumerate().rev() {
+        tail[o] = timing[o].2 + need[o];
+        for a in op.kind.args() {
+            need[a.0 as usize] = need[a.0 as usize].max(tail[o]);
+        }
+    }
+    let mut budget = TILE_SEARCH_NODES;
+    let empty = Search {
+        start: vec![0; n],
+        ready: vec![0; n],
+        unit: vec![None; n],
+        tiles: vec![vec![false; ii as usize]; caps(Class::Mul) as usize],
+        pools: [vec![0; ii as usize], vec![0; ii as usize], vec![0; ii as usize]],
+    };
+    for bound in from..=from + ii {
+        let ctx = Ctx { prog, timing, tail: &tail, ii, caps, bound };
+        match ctx.go(0, empty.clone(), &mut budget) {
+            Ok(Some(s)) => return Some(Placed { start: s.start, unit: s.unit }),
+            Ok(None) => continue,
+            Err(()) => return None,
+        }
+    }
+    None
+}
+
+#[derive(Clone)]
+struct Search {
+    start: Vec<u32>,
+    ready: Vec<u32>,
+    unit: Vec<Option<u32>>,
+    tiles: Vec<Vec<bool>>,
+    pools: [Vec<u32>; 3],
+}
+
+struct Ctx<'a> {
+    prog: &'a Program,
+    timing: &'a [(Class, u32, u32)],
+    tail: &'a [u32],
+    ii: u32,
+    caps: &'a dyn Fn(Class) -> u32,
+    bound: u32,
+}
+
+impl Ctx<'_> {
+    /// Places operations `o..` on `s`; `Err` when the budget runs out.
+    fn go(&self, mut o: usize, mut s: Search, budget: &mut u32) -> Result<Option<Search>, ()> {
+        let ii = self.ii;
+        while o < self.prog.ops.len() {
+            let earliest = self.prog.ops[o].kind.args().iter().map(|a| s.ready[a.0 as usize]).max().unwrap_or(0);
+            let (c, busy, lat) = self.timing[o];
+            if earliest + self.tail[o] > self.bound {
+                return Ok(None);
+            }
+            let t = match c {
+                Class::Mul => {
+                    // Each clock in turn; of the tiles free there, each distinct table once.
+                    for t in earliest..earliest + ii {
+                        if t + self.tail[o] > self.bound {
+                            break;
+                        }
+                        let at = |u: usize, k: u32| s.tiles[u][(k % ii) as usize];
+                        let mut free: Vec<(u32, usize)> = Vec::new();
+                        for u in 0..s.tiles.len() {
+                            if (t..t + busy).all(|k| !at(u, k)) && !free.iter().any(|&(_, v)| s.tiles[v] == s.tiles[u]) {
+                                let room = ii - busy;
+                                let before = (1..=room).take_while(|&d| !at(u, t + ii - d)).count() as u32;
+                                let after = (0..room - before).take_while(|&d| !at(u, t + busy + d)).count() as u32;
+                                free.push((before + after, u));
+                            }
+                        }
+                        free.sort();
+                        for (_, u) in free {
+                            *budget = budget.checked_sub(1).ok_or(())?;
+                            let mut next = s.clone();
+                            (t..t + busy).for_each(|k| next.tiles[u][(k % ii) as usize] = true);
+                            (next.start[o], next.ready[o], next.unit[o]) = (t, t + lat, Some(u as u32));
+                            if let Some(done) = self.go(o + 1, next, budget)? {
+                                return Ok(Some(done));
+                            }
+                        }
+                    }
+                    return Ok(None);
+                }
+                Class::Div | Class::Shift => match pooled(&mut s.pools[pool(c)], (self.caps)(c), earliest, busy) {
+                    Some(t) if t + self.tail[o] <= self.bound => t,
+                    _ => return Ok(None),
+                },
+                _ => earliest,
+            };
+            (s.start[o], s.ready[o]) = (t, t + lat);
+            o += 1;
+        }
+        Ok(Some(s))
+    }
 }
 
 impl Schedule {
@@ -279,9 +452,30 @@ impl Schedule {
         let span = ceil(self.latency + 1, self.ii) as usize;
         // The binding is kept over 8 span steady triangles, which end a span before the
         // unrolled stretch does: the last triangles see fewer contenders and bind otherwise.
-        let tris = 12 * span + 4;
-        let steady = 2 * span + 2;
-        for c in [Class::Mul, Class::Div] {
+        // They start 6 spans in: the first triangles' greedy choices take a few spans to
+        // settle into the period (at F = 20, XW = 16 with a shared shifter, 2 were too few).
+        let tris = 16 * span + 4;
+        let steady = 6 * span + 2;
+        for c in [Class::Mul, Class::Div, Class::Shift] {
+            // Products the scheduler placed tile by tile keep their tile on every triangle.
+            let fixed: Vec<(usize, u32)> =
+                self.slots.iter().enumerate().filter(|(_, s)| s.class == c).filter_map(|(o, s)| s.unit.map(|u| (o, u))).collect();
+            if !fixed.is_empty() {
+                for j in 0..tris {
+                    for &(o, u) in &fixed {
+                        self.note(o, j, u as usize, steady, span);
+                    }
+                }
+                continue;
+            }
+            if let Some(fixed) = self.fixed_rotation(c) {
+                for j in steady..tris {
+                    for (o, us) in &fixed {
+                        self.note(*o, j, us[(j - steady) % us.len()] as usize, steady, span);
+                    }
+                }
+                continue;
+            }
             let mut iv: Vec<(u32, usize, usize)> = Vec::new();
             for j in 0..tris {
                 for (o, s) in self.slots.iter().enumerate().filter(|(_, s)| s.class == c) {
@@ -289,7 +483,7 @@ impl Schedule {
                 }
             }
             iv.sort();
-            let cap = if c == Class::Mul { self.plan.mults } else { self.plan.dividers } as usize;
+            let cap = self.plan.units(c) as usize;
             let mut until = vec![0u32; cap];
             let mut last: Vec<Option<usize>> = vec![None; cap];
             let mut seen: Vec<Vec<usize>> = vec![Vec::new(); cap];
@@ -323,6 +517,51 @@ impl Schedule {
                 }
             }
         }
+    }
+
+    /// Units for every operation of a kind such that each keeps one unit, or, when busier than
+    /// II (up to 2 II), alternates between two by the triangle's parity: `(operation, units by
+    /// parity)`. Each unit has a modulo table of two periods. An operation takes a unit no other
+    /// one uses when there is one (a unit shared by two operations needs an operand multiplexer
+    /// and is as wide as the wider), else the free unit its width fits best. `None` if an
+    /// operation is busier than 2 II or finds no free unit: the binding is then unrolled
+    /// ([`Schedule::bind`]) and may rotate an operation over three units or more, which makes
+    /// each unit's operand multiplexer select by epoch among every operation it runs.
+    fn fixed_rotation(&self, c: Class) -> Option<Vec<(usize, Vec<u32>)>> {
+        let (ii, cap) = (self.ii, self.plan.units(c) as usize);
+        let mut table = vec![vec![false; 2 * ii as usize]; cap];
+        let mut users: Vec<Vec<usize>> = vec![Vec::new(); cap];
+        let mut wide = vec![0u32; cap];
+        let mut ops: Vec<usize> = (0..self.slots.len()).filter(|&o| self.slots[o].class == c).collect();
+        // The busiest first (they need the longest free runs), then by start.
+        ops.sort_by_key(|&o| (std::cmp::Reverse(self.slots[o].busy), self.slots[o].start, o));
+        let mut out = Vec::new();
+        for o in ops {
+            let (t, b) = (self.slots[o].start, self.slots[o].busy);
+            if b > 2 * ii {
+                return None;
+            }
+            // The clocks of the two-period table unit `k` of the operation's units takes.
+            let clocks = |k: u32, n: u32| -> Vec<usize> {
+                let starts: Vec<u32> = if n == 1 { vec![t, t + ii] } else { vec![t + k * ii] };
+                starts.iter().flat_map(|&s| (s..s + b).map(|x| (x % (2 * ii)) as usize)).collect()
+            };
+            let n = if b > ii { 2 } else { 1 };
+            let wo = self.unit_width(o);
+            let mut units = Vec::new();
+            for k in 0..n {
+                let cl = clocks(k, n);
+                let u = (0..cap)
+                    .filter(|u| !units.contains(u) && cl.iter().all(|&x| !table[*u][x]))
+                    .min_by_key(|&u| (!users[u].is_empty(), wo.saturating_sub(wide[u]), wide[u].saturating_sub(wo), u))?;
+                cl.iter().for_each(|&x| table[u][x] = true);
+                users[u].push(o);
+                wide[u] = wide[u].max(wo);
+                units.push(u);
+            }
+            out.push((o, units.into_iter().map(|u| u as u32).collect()));
+        }
+        Some(out)
     }
 
     /// The subtractor a division needs on a divider of the plan's form (0 for a product).
@@ -364,6 +603,8 @@ impl Schedule {
         let mut mul_src: Vec<[Sources; 3]> = vec![Default::default(); plan.mults as usize];
         let mut div_src: Vec<([Sources; 2], [u32; 3])> = vec![Default::default(); plan.dividers as usize];
         let mut width = vec![0u32; plan.mults as usize];
+        // A shifter's operand and amount sources, and its widths.
+        let mut shl_src: Vec<([Sources; 2], [u32; 2])> = vec![Default::default(); plan.shifters as usize];
         for (o, (op, s)) in ops.iter().zip(&self.slots).enumerate() {
             match s.class {
                 Class::Mul => c.mul_passes += s.busy,
@@ -372,6 +613,10 @@ impl Schedule {
             }
             if s.class != Class::Wire {
                 c.reg_bits += self.copies[o] * op.w;
+            }
+            // A shift by a value left to logic is a barrel shifter of its own.
+            if let (Class::Logic, Kind::ShlBy(_, n)) = (s.class, op.kind) {
+                c.lut_units += (LUT4_PER_SHIFT_BIT * (op.w * w(n)) as f64).round() as u32;
             }
         }
         for &(o, u) in &self.rotation {
@@ -406,6 +651,12 @@ impl Schedule {
                     };
                     (0..3).for_each(|k| u.1[k] = u.1[k].max(ws[k]));
                 }
+                Kind::ShlBy(a, n) => {
+                    let u = &mut shl_src[u];
+                    u.0[0].push((a.0, 0));
+                    u.0[1].push((n.0, 0));
+                    u.1 = [u.1[0].max(op.w), u.1[1].max(w(n))];
+                }
                 _ => unreachable!("only units are bound"),
             }
         }
@@ -425,6 +676,10 @@ impl Schedule {
                     c.lut_mux += mux(distinct(&mut m[0]), width[u]) + mux(distinct(&mut m[1]), width[u]);
                 }
             }
+        }
+        for (src, [wv, wn]) in shl_src.iter_mut() {
+            c.lut_units += (LUT4_PER_SHIFT_BIT * (*wv * *wn) as f64).round() as u32;
+            c.lut_mux += mux(distinct(&mut src[0]), *wv) + mux(distinct(&mut src[1]), *wn);
         }
         for (src, ws) in div_src.iter_mut() {
             c.lut_units += (per_bit * (ws[0] * plan.div_bits) as f64).round() as u32;
@@ -447,8 +702,16 @@ pub fn lut_per_bit_step() -> f64 {
 /// The sum of today's dividers' partial-remainder widths at the defaults (357).
 pub fn today_pw() -> u32 {
     let fe = FrontEnd::new(Default::default(), Default::default()).expect("the defaults");
-    let plan =
-        Plan { mults: 1, mul: Plan::TILE18, dividers: 1, div_bits: 1, div_form: DivForm::ShiftDivisor, reciprocal: false, i0_steps: false };
+    let plan = Plan {
+        mults: 1,
+        mul: Plan::TILE18,
+        dividers: 1,
+        div_bits: 1,
+        div_form: DivForm::ShiftDivisor,
+        reciprocal: false,
+        i0_steps: false,
+        shifters: 0,
+    };
     Program::setup(&fe, &plan).ops.iter().map(|o| if let Kind::Div { pw, .. } = o.kind { pw } else { 0 }).sum()
 }
 
@@ -542,7 +805,7 @@ impl Schedule {
     pub fn verify_binding(&self) -> Result<u32, String> {
         let r = self.epochs().ok_or("the binding has no period")?;
         let span = ceil(self.latency + 1, self.ii);
-        for c in [Class::Mul, Class::Div] {
+        for c in [Class::Mul, Class::Div, Class::Shift] {
             let mut iv: Vec<(u32, u32, u32, usize)> = Vec::new();
             for j in 0..r * (span + 2) {
                 for (o, s) in self.slots.iter().enumerate().filter(|(_, s)| s.class == c) {
@@ -561,6 +824,16 @@ impl Schedule {
         Ok(r)
     }
 
+    /// The products that do not keep one tile on every triangle of the steady stretch (none
+    /// when [`per_tile`] placed them): each of those makes its tiles' operand multiplexers select
+    /// by epoch as well as by phase.
+    pub fn rotating_products(&self) -> Vec<&str> {
+        (0..self.slots.len())
+            .filter(|&o| self.slots[o].class == Class::Mul && self.binding[o].iter().any(|&u| u != self.binding[o][0]))
+            .map(|o| self.prog.ops[o].name.as_str())
+            .collect()
+    }
+
     /// The unit operation `o` runs on for a triangle of epoch `e` (its number modulo
     /// [`Schedule::epochs`]).
     pub fn unit_of(&self, o: usize, e: u32) -> Option<u32> {
@@ -577,7 +850,18 @@ impl Schedule {
             }
         }
         rows.sort_by_key(|r| (r.0, r.1 == Class::Div, r.2));
-        rows.iter().map(|(t, c, u, n, b)| format!("{t:3} {}{u} {n} ({b})\n", if *c == Class::Mul { "mul" } else { "div" })).collect()
+        rows.iter()
+            .map(|(t, c, u, n, b)| {
+                format!(
+                    "{t:3} {}{u} {n} ({b})\n",
+                    match c {
+                        Class::Mul => "mul",
+                        Class::Shift => "shl",
+                        _ => "div",
+                    }
+                )
+            })
+            .collect()
     }
 
     /// Checks the schedule's own rules: every operand ready by its reader's start, no register
@@ -599,8 +883,8 @@ impl Schedule {
         if let Some(o) = (0..need.len()).find(|&o| self.copies[o] < need[o]) {
             return Err(format!("{} has {} register copies, needs {}", self.prog.ops[o].name, self.copies[o], need[o]));
         }
-        for c in [Class::Mul, Class::Div] {
-            let cap = if c == Class::Mul { self.plan.mults } else { self.plan.dividers };
+        for c in [Class::Mul, Class::Div, Class::Shift] {
+            let cap = self.plan.units(c);
             let mut u = vec![0u32; self.ii as usize];
             for s in self.slots.iter().filter(|s| s.class == c) {
                 (s.start..s.start + s.busy).for_each(|k| u[(k % self.ii) as usize] += 1);

@@ -10,7 +10,7 @@ use crate::stimulus::random_fixed_triangles;
 use rand::SeedableRng;
 
 fn plan(mults: u32, dividers: u32, div_bits: u32, reciprocal: bool) -> Plan {
-    Plan { mults, mul: Plan::TILE18, dividers, div_bits, div_form: DivForm::ShiftRemainder, reciprocal, i0_steps: true }
+    Plan { mults, mul: Plan::TILE18, dividers, div_bits, div_form: DivForm::ShiftRemainder, reciprocal, i0_steps: true, shifters: 0 }
 }
 
 /// The screens of the equivalence: the default, a small one at F = 4 and the widest (2^16).
@@ -30,7 +30,8 @@ fn plans() -> Vec<Plan> {
         plan(4, 3, 4, false),
         plan(1, 1, 1, true),
         Plan { mul: MulUnit::ShiftAdd { bits: 4 }, i0_steps: false, ..plan(2, 2, 2, false) },
-        Plan { mul: MulUnit::Tile { bits: 16 }, ..plan(8, 6, 1, true) },
+        Plan { mul: MulUnit::Tile { bits: 16 }, shifters: 1, ..plan(8, 6, 1, true) },
+        Plan { shifters: 2, ..plan(4, 3, 4, false) },
     ]
 }
 
@@ -238,6 +239,7 @@ fn engine_grid() {
         div_form: DivForm::ShiftDivisor,
         reciprocal: false,
         i0_steps: false,
+        shifters: 0,
     };
     println!("{} (today)", row(&today.schedule(&fe).unwrap()));
     for steps in [false, true] {
@@ -256,7 +258,7 @@ fn engine_grid() {
                         for (div_bits, div_form) in
                             [1, 2, 4].into_iter().flat_map(|b| [(b, DivForm::ShiftRemainder), (b, DivForm::ShiftDivisor)])
                         {
-                            let p = Plan { mults, mul, dividers, div_bits, div_form, reciprocal, i0_steps: steps };
+                            let p = Plan { mults, mul, dividers, div_bits, div_form, reciprocal, i0_steps: steps, shifters: 1 };
                             let s = p.schedule(&fe).unwrap();
                             let r = row(&s);
                             if r.contains(&filter) {
@@ -333,4 +335,64 @@ fn the_binding_is_periodic() {
             }
         }
     }
+}
+
+/// Every product keeps its tile on every triangle, for every plan the generator offers at the
+/// screens of `the_binding_is_periodic` (golden's scheduler reserves the tiles one by one), so
+/// the tiles' operand multiplexers select by phase alone.
+#[test]
+fn the_products_keep_their_tiles() {
+    use crate::frontend::engine::SetupForm;
+    let wide = Config::new(8, 20, 16, Align::Span).unwrap();
+    for (cfg, screen) in
+        [(Config::default(), Screen::default()), (Config::default(), Screen { width: 37, height: 23 }), (wide, Screen::default())]
+    {
+        let fe = FrontEnd::new(cfg, screen).unwrap();
+        for plan in SetupForm::ALL.iter().filter_map(|f| f.plan()) {
+            let s = plan.schedule(&fe).unwrap();
+            assert_eq!(s.rotating_products(), Vec::<&str>::new(), "{plan:?} at {screen:?}");
+        }
+    }
+    // Negative control: a product moved to another tile on every other triangle.
+    let mut bad = Plan::ECP5_25F.schedule(&fe640()).unwrap();
+    let o = (0..bad.slots.len()).find(|&o| bad.slots[o].class == schedule::Class::Mul).unwrap();
+    for (j, u) in bad.binding[o].iter_mut().enumerate() {
+        *u = (*u + j as u32 % 2) % Plan::ECP5_25F.mults;
+    }
+    assert_eq!(bad.rotating_products(), vec![bad.prog.ops[o].name.as_str()]);
+}
+
+/// The ECP5 plan's dividers each run one division, its `Qs`, `g` and `Rn` alternating over a
+/// pair of their own by the triangle's parity (so no divider needs an operand multiplexer);
+/// negative control: on 12 dividers, the fewest 120 divider clocks need at II = 12, divisions
+/// share dividers and rotate over three.
+#[test]
+fn the_ecp5_divisions_keep_their_pairs() {
+    let sharing = |s: &Schedule| -> usize {
+        let mut ops_on: Vec<Vec<usize>> = vec![Vec::new(); s.plan.dividers as usize];
+        for (o, b) in s.binding.iter().enumerate().filter(|(o, _)| s.slots[*o].class == schedule::Class::Div) {
+            for &u in b {
+                if !ops_on[u as usize].contains(&o) {
+                    ops_on[u as usize].push(o);
+                }
+            }
+        }
+        ops_on.iter().filter(|v| v.len() > 1).count()
+    };
+    let s = Plan::ECP5_25F.schedule(&fe640()).unwrap();
+    assert_eq!((s.ii, s.epochs()), (12, Some(2)));
+    assert_eq!(sharing(&s), 0, "{:?}", s.binding);
+    let twelve = Plan { dividers: 12, ..Plan::ECP5_25F }.schedule(&fe640()).unwrap();
+    assert_eq!(twelve.ii, 12);
+    assert!(sharing(&twelve) > 0 && twelve.epochs() > Some(2), "{:?}", twelve.epochs());
+}
+
+/// The estimate sees the barrel shifters: the ECP5 plan's five shifts by `s` (four of 64 bits)
+/// cost over 1,000 LUT4 more each on its own shifter than on one shared shifter (measured:
+/// about 1,560 against 637 plus its multiplexer, docs/fpga.md).
+#[test]
+fn the_estimate_counts_the_shifters() {
+    let shared = Plan::ECP5_25F.schedule(&fe640()).unwrap().cost;
+    let own = Plan { shifters: 0, ..Plan::ECP5_25F }.schedule(&fe640()).unwrap().cost;
+    assert!(own.lut_units + own.lut_mux > shared.lut_units + shared.lut_mux + 1000, "{own:?} against {shared:?}");
 }

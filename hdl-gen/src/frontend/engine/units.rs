@@ -160,8 +160,9 @@ pub(super) fn multipliers(v: &Values, seq: &Seq, body: &mut Vec<Item>) -> Vec<Ca
         }
     }
     let groups = Groups::new(&keys);
-    // Per unit, its lanes' sources: a, b, first, weight index.
-    let mut src: Vec<[Vec<(String, String)>; 4]> = vec![Default::default(); m];
+    // Per unit, its lanes' sources: a, b, first, weight index, and a tile's operand registers'
+    // loads (a, b).
+    let mut src: Vec<[Vec<(String, String)>; 6]> = vec![Default::default(); m];
     let mut caps = Vec::new();
     for &o in &ops {
         let (a, b, p) = passes(o);
@@ -171,6 +172,7 @@ pub(super) fn multipliers(v: &Values, seq: &Seq, body: &mut Vec<Item>) -> Vec<Ca
             let (gi, li) = groups.of[u as usize].expect("a unit with operations");
             let acc_w = groups.keys[gi][0];
             let u = u as usize;
+            let mut held = [false; 2];
             for (k, &(i, j, x, top_a, top_b)) in p.iter().enumerate() {
                 let t = st + k as u32;
                 let c = seq.when_any(t, &es);
@@ -178,8 +180,17 @@ pub(super) fn multipliers(v: &Values, seq: &Seq, body: &mut Vec<Item>) -> Vec<Ca
                     MulUnit::Tile { bits } => (chunk(&v.at(a, t), i, bits, top_a, sg(a)), chunk(&v.at(b, t), j, bits, top_b, sg(b))),
                     MulUnit::ShiftAdd { bits } => (v.at(a, t).ext(acc_w), chunk(&v.at(b, t), j, bits, top_b, sg(b))),
                 };
-                src[u][0].push((c.clone(), va));
-                src[u][1].push((c.clone(), vb));
+                // A tile's operand register holds a chunk the product's next pass takes again: no
+                // multiplexer term for that pass (a product of 2 x 2 chunks takes 6, not 8).
+                let tile = matches!(plan.mul, MulUnit::Tile { .. });
+                for (port, x) in [(0, va), (1, vb)] {
+                    let again = tile && k > 0 && src[u][port].last().is_some_and(|(_, y)| *y == x) && held[port];
+                    if !again {
+                        src[u][port].push((c.clone(), x));
+                        src[u][4 + port].push((c.clone(), "1'b1".into()));
+                    }
+                    held[port] = true;
+                }
                 if k == 0 {
                     src[u][2].push((c.clone(), "1'b1".into()));
                 }
@@ -207,7 +218,13 @@ pub(super) fn multipliers(v: &Values, seq: &Seq, body: &mut Vec<Item>) -> Vec<Ca
             "Group {gi}: units {} (g_mul{gi}[k]), accumulators of {acc_w} bits.",
             members.iter().map(|u| format!("mul{u}")).collect::<Vec<_>>().join(", ")
         )));
-        for (x, lw) in [("a", lane_a), ("b", lane_b), ("f", 1), ("sh", sh_w)] {
+        let tile = matches!(plan.mul, MulUnit::Tile { .. });
+        let ports: &[(&str, u32)] = if tile {
+            &[("a", lane_a), ("b", lane_b), ("f", 1), ("sh", sh_w), ("la", 1), ("lb", 1)]
+        } else {
+            &[("a", lane_a), ("b", lane_b), ("f", 1), ("sh", sh_w)]
+        };
+        for &(x, lw) in ports {
             body.push(crate::verilog::bus(&bus(x), n * lw));
         }
         // Each product keeps the accumulator's low bits it needs.
@@ -227,6 +244,12 @@ pub(super) fn multipliers(v: &Values, seq: &Seq, body: &mut Vec<Item>) -> Vec<Ca
                 MulUnit::ShiftAdd { .. } => and_or_zero(&sh, sh_w),
             };
             body.push(Item::Assign(lane_bits(&bus("sh"), li, sh_w, sh_w), sh));
+            if tile {
+                for (x, port) in [("la", 4), ("lb", 5)] {
+                    let loads: Vec<String> = sr[port].iter().map(|(c, _)| c.clone()).collect();
+                    body.push(Item::Assign(lane_bits(&bus(x), li, 1, 1), or(&loads)));
+                }
+            }
         }
         let k = format!("m{gi}k");
         let lane = |x: &str, lw: u32| if lw == 1 { format!("{}[{k}]", bus(x)) } else { format!("{}[{k}*{lw} +: {lw}]", bus(x)) };
@@ -264,8 +287,8 @@ fn multiplier(mul: MulUnit, acc_w: u32, (lane_a, lane_b, sh_w): (u32, u32, u32),
             g.push(Item::Always(vec![Stmt::If(
                 "en".into(),
                 vec![
-                    set("ra", lane("a", lane_a)),
-                    set("rb", lane("b", lane_b)),
+                    Stmt::If(lane("la", 1), vec![set("ra", lane("a", lane_a))], vec![]),
+                    Stmt::If(lane("lb", 1), vec![set("rb", lane("b", lane_b))], vec![]),
                     set("f1", lane("f", 1)),
                     set("s1", lane("sh", sh_w)),
                     set("pr", "ra * rb"),
@@ -412,4 +435,79 @@ pub(super) fn dividers(v: &Values, seq: &Seq, body: &mut Vec<Item>) -> Vec<Captu
     }
     body.push(Item::Blank);
     caps
+}
+
+/// The shared barrel shifters (`Plan::shifters`): per unit the operand and the amount
+/// selected by phase (AND-OR), registered, then the shift, which the value's register
+/// captures a clock later (golden's `SHIFT_PIPE` = 2). A unit is as wide as its widest shift:
+/// the shift moves bits only upwards, so an operand extended past its value's width gives the
+/// same low bits.
+pub(super) fn shifters(v: &Values, seq: &Seq, body: &mut Vec<Item>) -> Vec<Capture> {
+    let s = v.s;
+    let n = s.plan.shifters as usize;
+    let ops: Vec<usize> = (0..s.slots.len()).filter(|&o| s.slots[o].class == Class::Shift).collect();
+    if ops.is_empty() {
+        return Vec::new();
+    }
+    let amount = |o: usize| match v.op(o).kind {
+        Kind::ShlBy(a, k) => (a, k),
+        _ => unreachable!("{} is not a shift", v.op(o).name),
+    };
+    let mut widths = vec![(0u32, 0u32); n];
+    for &o in &ops {
+        let (_, k) = amount(o);
+        for (u, _) in seq.units_of(s, o) {
+            let w = &mut widths[u as usize];
+            *w = (w.0.max(v.op(o).w), w.1.max(v.op(k.0 as usize).w));
+        }
+    }
+    let mut src: Vec<[Vec<(String, String)>; 2]> = vec![Default::default(); n];
+    let mut caps = Vec::new();
+    for &o in &ops {
+        let (a, k) = amount(o);
+        let t = s.slots[o].start;
+        let mut from = Vec::new();
+        for (u, es) in seq.units_of(s, o) {
+            let (w, wk) = widths[u as usize];
+            let c = seq.when_any(t, &es);
+            src[u as usize][0].push((c.clone(), v.at(a, t).ext(w)));
+            src[u as usize][1].push((c, v.at(k, t).ext(wk)));
+            from.push((es, if v.op(o).w == w { format!("sh{u}_y") } else { format!("sh{u}_y[{}:0]", v.op(o).w - 1) }));
+        }
+        caps.push(Capture { op: o, t: s.slots[o].ready - 1, from });
+    }
+    body.push(comment(format!(
+        "Shifters ({n}): each one's operand and amount selected by phase and registered, then shifted into the value's register."
+    )));
+    for (u, ((w, wk), sr)) in widths.iter().zip(&src).enumerate() {
+        if sr[0].is_empty() {
+            continue;
+        }
+        let (ra, rk) = (format!("sh{u}_a"), format!("sh{u}_n"));
+        body.push(reg(&ra, *w));
+        body.push(reg(&rk, *wk));
+        body.push(Item::Always(vec![Stmt::If(
+            "en".into(),
+            vec![set(&ra, and_or(&merged(&sr[0]), *w)), set(&rk, and_or(&merged(&sr[1]), *wk))],
+            vec![],
+        )]));
+        body.push(comment("verilator lint_off UNUSEDSIGNAL"));
+        body.push(wire(&format!("sh{u}_y"), *w, format!("{ra} << {rk}")));
+        body.push(comment("verilator lint_on UNUSEDSIGNAL"));
+    }
+    body.push(Item::Blank);
+    caps
+}
+
+/// AND-OR sources with the same value merged into one term (the amount is one value's copy
+/// at most clocks).
+fn merged(items: &[(String, String)]) -> Vec<(String, String)> {
+    let mut out: Vec<(Vec<String>, String)> = Vec::new();
+    for (c, x) in items {
+        match out.iter_mut().find(|(_, y)| y == x) {
+            Some((cs, _)) => cs.push(c.clone()),
+            None => out.push((vec![c.clone()], x.clone())),
+        }
+    }
+    out.into_iter().map(|(cs, x)| (if cs.len() == 1 { cs[0].clone() } else { format!("({})", cs.join(" || ")) }, x)).collect()
 }
