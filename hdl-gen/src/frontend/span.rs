@@ -6,7 +6,7 @@
 use super::divider::DivConns;
 use super::hw::Hw;
 use super::stager::Stager;
-use super::walker::scanline_divider;
+use super::walker::{self, scanline_divider};
 use crate::verilog::{comment, lit, reg, set, wire, zext, Item, Stmt};
 use crate::Names;
 use golden::frontend::{DiMode, Widths};
@@ -69,14 +69,16 @@ pub(super) fn path(hw: &Hw, body: &mut Vec<Item>) -> Stager {
     };
     let ends: Vec<&End> = if scan { vec![&head, &tail] } else { vec![&head] };
     i0_section(&mut sp);
+    // The walker's row, or the row stage's ([`walker::row`]).
+    let row = |n: &str| walker::row(hw, n);
     for (n, ww, src) in [
-        ("y", row_w, "w_row".to_string()),
+        ("y", row_w, row("w_row")),
         ("x", xw, "lo_u".into()),
         ("len", xw + 1, format!("len_w[{xw}:0]")),
-        ("tn", sum_w, "w_tn".into()),
-        ("gxn", sum_w, "w_gxn".into()),
-        ("an", area_w, "w_an".into()),
-        ("rn", recip_w, "w_rn".into()),
+        ("tn", sum_w, row("w_tn")),
+        ("gxn", sum_w, row("w_gxn")),
+        ("an", area_w, row("w_an")),
+        ("rn", recip_w, row("w_rn")),
     ] {
         sp.input_as(n, ww, false, &src);
     }
@@ -86,7 +88,7 @@ pub(super) fn path(hw: &Hw, body: &mut Vec<Item>) -> Stager {
         body.push(wire("unused_di", dw, "w_di"));
         body.push(comment("verilator lint_on UNUSEDSIGNAL"));
     } else {
-        sp.input_as("di", dw, false, "w_di");
+        sp.input_as("di", dw, false, &row("w_di"));
     }
     sp.cut();
     i0_section(&mut sp);
