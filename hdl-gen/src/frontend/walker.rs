@@ -51,23 +51,12 @@ fn row_stage(hw: &Hw, body: &mut Vec<Item>) {
             moves.push(set(r, format!("{side}{k}")));
         }
     }
-    // The bounds' pairwise compares too, so the row stage only selects the minima: with the
-    // compares after the registers the row stage's own clock (compare, select, the pixel
-    // test's add, emit) became the critical path (docs/fpga.md).
-    for (r, side, i, j) in ROW_COMPARES {
-        body.push(reg(&format!("wr_{r}"), 1));
-        moves.push(set(format!("wr_{r}"), format!("{side}{i} <= {side}{j}")));
-    }
     for (n, w) in row_values(hw) {
         body.push(reg(&row(hw, n), w));
         moves.push(set(row(hw, n), n));
     }
     body.push(Item::Always(vec![Stmt::If("rst".into(), vec![set("wr_v", "1'b0")], vec![Stmt::If("adv".into(), moves, vec![])])]));
 }
-
-/// The row stage's compares of the edges' bounds: `(register, side, i, j)` holds `side_i <= side_j`.
-const ROW_COMPARES: [(&str, &str, u32, u32); 6] =
-    [("l01", "lg", 0, 1), ("l02", "lg", 0, 2), ("l12", "lg", 1, 2), ("h01", "ha", 0, 1), ("h02", "ha", 0, 2), ("h12", "ha", 1, 2)];
 
 /// The row stage's registers for the manifest: `(name, bits, signed)`; none without it.
 pub(super) fn row_registers(hw: &Hw) -> Vec<(String, u32, bool)> {
@@ -77,7 +66,6 @@ pub(super) fn row_registers(hw: &Hw) -> Vec<(String, u32, bool)> {
     let end_w = edge::end_width(hw);
     let mut v = vec![("wr_v".to_string(), 1, false)];
     v.extend(["lg", "ha"].iter().flat_map(|side| (0..3).map(move |k| (format!("wr_{side}{k}"), end_w, true))));
-    v.extend(ROW_COMPARES.iter().map(|(r, ..)| (format!("wr_{r}"), 1, false)));
     v.extend(row_values(hw).into_iter().map(|(n, w)| (row(hw, n), w, false)));
     v
 }
@@ -157,14 +145,7 @@ pub(super) fn emit(hw: &Hw, names: &Names, body: &mut Vec<Item>) {
     body.push(comment("The span's ends, the edges compared side by side: x = lo3 = -mg (the smallest left-edge g),"));
     body.push(comment("hi3 the smallest right bound; the row has a pixel when hi3 + mg >= 0."));
     for (end, side) in [("mg", lg), ("hi3", ha)] {
-        // The row stage's compares are registered (`wr_l01`, ...), the walker's formed here.
-        let c = |i: u32, j: u32| {
-            if hw.row_stage() {
-                format!("wr_{}{i}{j}", if end == "mg" { "l" } else { "h" })
-            } else {
-                format!("{side}{i} <= {side}{j}")
-            }
-        };
+        let c = |i: u32, j: u32| format!("{side}{i} <= {side}{j}");
         body.push(swire(end, end_w, format!("({} && {}) ? {side}0 : ({}) ? {side}1 : {side}2", c(0, 1), c(0, 2), c(1, 2))));
     }
     body.push(comment("verilator lint_off UNUSEDSIGNAL"));
