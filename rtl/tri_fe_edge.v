@@ -5,7 +5,7 @@
 // divisions on tri_fe_div (15 quotient bits, 4 a clock, run by the owner's div_cnt):
 // the first bound g = floor(n / D) - B and the step qs = floor(sn / |dy|) - B (B = 2^(GW-1)), remainders kept.
 // Walker (take: load; step: the next row): on an active row g += qs + carry, the remainder
-// rem += rs256 modulo D (one add, compare, subtract); lg/ha is g on the edge's side of the row, else lo/hi.
+// rem += rs256 modulo D (its carry rem >= D - rs256 and both steps side by side); lg/ha is g on the edge's side of the row, else lo/hi.
 // Widths: bound GW = 15 signed, divisor 27, rows 9, bounds out 16 signed.
 
 `default_nettype none
@@ -80,38 +80,39 @@ module tri_fe_edge (
   );
 
   // Walker: the edge's DDA state, loaded from the set-up result.
+  // thr = D - rs256 (> 0: rs256 < D), qs1 = qs + 1: the carry and both steps side by side.
   reg w_act;
   reg w_right;
   reg [8:0] w_rs;
   reg [8:0] w_re;
-  reg [26:0] w_d;
+  reg [26:0] w_thr;
   reg [26:0] w_rem;
   reg [26:0] w_rs256;
   reg signed [14:0] w_g;
   reg signed [14:0] w_qs;
+  reg signed [14:0] w_qs1;
   wire in_rows = w_act && row >= w_rs && row <= w_re;
   wire signed [15:0] gg = {{1{w_g[14]}}, w_g};
   assign lg = (in_rows && !w_right && gg < lo) ? gg : lo;
   assign ha = (in_rows && w_right && gg < hi) ? gg : hi;
-  wire [27:0] rsum = {1'd0, w_rem} + {1'd0, w_rs256};
-  wire cy = rsum >= {1'd0, w_d};
-  // verilator lint_off UNUSEDSIGNAL
-  wire [27:0] rnext = cy ? rsum - {1'd0, w_d} : rsum;
-  // verilator lint_on UNUSEDSIGNAL
+  wire cy = w_rem >= w_thr;
+  wire [26:0] rnext = cy ? w_rem - w_thr : w_rem + w_rs256;
+  wire signed [14:0] gnext = cy ? w_g + w_qs1 : w_g + w_qs;
   always @(posedge clk) begin
     if (take) begin
       w_act <= s_act;
       w_right <= s_right;
       w_rs <= s_rs;
       w_re <= s_re;
-      w_d <= s_d;
+      w_thr <= s_d - {es_p[18:0], 8'd0};
       w_g <= {~ei_q[14], ei_q[13:0]};
       w_rem <= ei_p[26:0];
       w_qs <= {~es_q[14], es_q[13:0]};
+      w_qs1 <= {~es_q[14], es_q[13:0]} + {14'd0, 1'b1};
       w_rs256 <= {es_p[18:0], 8'd0};
     end else if (step && w_act && row >= w_rs) begin
-      w_rem <= rnext[26:0];
-      w_g <= w_g + w_qs + {14'd0, cy};
+      w_rem <= rnext;
+      w_g <= gnext;
     end
   end
 

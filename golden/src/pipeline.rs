@@ -11,6 +11,7 @@
 //! stall holds every stage and the throughput is the same at every level: one segment or pixel
 //! per clock, no bubble between spans.
 
+use crate::frontend::I0Form;
 use serde::{Deserialize, Serialize};
 
 /// One register of a pipeline stage.
@@ -46,7 +47,7 @@ pub fn numbered(body: Vec<(&str, String, Vec<PipeReg>)>) -> Vec<PipeStage> {
 /// | level | segment shader | specular unit | front-end set-up |
 /// |--:|---|---|---|
 /// | 0 | as SPEC's seed: 2 stages | 5 stages | CALC in one clock |
-/// | 1 | + a span register; the BFPI's multiples and the last-segment flag registered | + both multiplies split into registered 4-bit partial products and their sum; the BRDF address registered before the ROM, both ROMs' words registered before any arithmetic: 10 stages | CALC in five clocks ([`SETUP_STAGES`]), overlapped with the dividers; the span path in six ([`I0_STAGES`]) instead of two |
+/// | 1 | + a span register; the BFPI's multiples and the last-segment flag registered | + both multiplies split into registered 4-bit partial products and their sum; the BRDF address registered before the ROM, both ROMs' words registered before any arithmetic: 10 stages | CALC in five clocks ([`SETUP_STAGES`]), overlapped with the dividers; the span path in six ([`I0_STAGES`]) instead of two, behind the walker's row registered ([`Pipeline::row_stage`], the reciprocal `I0`) |
 /// | 2 | + the lane sums registered before round and clamp | as level 1 | as level 1 |
 /// | 3 | + no clock with two adders in a row: the BFPI's first adder level formed as the span enters its register, the rest when it starts; each lane's sum split at the binary point (high part and the fraction's carry registered, joined before the clamp) | as level 1 | as level 1 |
 ///
@@ -143,7 +144,21 @@ impl Pipeline {
             1
         }
     }
+
+    /// Front-end: the walker's row registered ([`ROW_STAGE`]) before the row's span is decided
+    /// (the three edges' bounds compared, the pixel test, the span's ends), so the walker's
+    /// clock is its edges' DDA and their bounds alone: one clock of latency, no change of rate
+    /// (the stage moves on the one stall like every other). Not with the incremental `I0`,
+    /// whose walker waits on the row's own span (a source's start), decided in the walker's
+    /// clock.
+    pub fn row_stage(self, i0: I0Form) -> bool {
+        self.0 >= 1 && i0 == I0Form::Reciprocal
+    }
 }
+
+/// What the front-end's row stage ([`Pipeline::row_stage`]) holds, between the walker and the
+/// span path's first logical stage ([`I0_STAGES`]).
+pub const ROW_STAGE: &str = "the walker's row: each edge's bound on it, clipped to the screen, with the row's sums";
 
 /// The front-end's spans from the walker to the output, in logical stages: which boundaries
 /// between them are registered. SPEC's seed structure (level 0) registers two, after `S2n` and
@@ -204,12 +219,21 @@ mod tests {
 
     #[test]
     fn each_level_adds_to_the_one_before() {
-        let flags = |p: Pipeline| [p.span_stage(), p.sum_stage(), p.split_multiplies(), p.split_adds(), p.calc_clocks() > 1];
+        let flags = |p: Pipeline| {
+            [p.span_stage(), p.sum_stage(), p.split_multiplies(), p.split_adds(), p.calc_clocks() > 1, p.row_stage(I0Form::Reciprocal)]
+        };
         let levels: Vec<_> = Pipeline::all().collect();
         for w in levels.windows(2) {
             let (a, b) = (flags(w[0]), flags(w[1]));
             assert!(a.iter().zip(&b).all(|(x, y)| !x || *y), "level {} drops a stage of level {}", w[1], w[0]);
             assert_ne!(a, b, "level {} adds nothing to level {}", w[1], w[0]);
         }
+    }
+
+    #[test]
+    fn the_row_stage_is_the_reciprocal_forms_above_level_0() {
+        assert!(Pipeline::all().all(|p| !p.row_stage(I0Form::Incremental)), "the incremental walker decides its row itself");
+        assert!(!Pipeline::NONE.row_stage(I0Form::Reciprocal), "level 0 is SPEC's seed structure");
+        assert!(Pipeline::all().skip(1).all(|p| p.row_stage(I0Form::Reciprocal)));
     }
 }

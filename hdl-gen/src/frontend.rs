@@ -22,7 +22,10 @@
 //!   `Widths::reciprocal_quotient`). Products modulo a power of two keep only the tile-sized
 //!   partial products with a bit below it (`span::mul_mod`). At `--pipeline 1` and above six
 //!   stages, one multiply or two adders each ([`golden::pipeline::I0_STAGES`]), the product by
-//!   `Rn` in two registered halves.
+//!   `Rn` in two registered halves, behind a row stage (the reciprocal `I0`): each edge's bound
+//!   on the walked row is registered and the row's span (the minima, the pixel test) decided a
+//!   clock later, so the walker's clock is its DDA alone
+//!   ([`golden::pipeline::Pipeline::row_stage`]).
 //!   One stall signal holds the walker and every stage while the output waits.
 
 mod calc;
@@ -68,6 +71,20 @@ fn stage_list(st: &Stager, name: &str, logic: &[&str]) -> Vec<golden::pipeline::
         .collect()
 }
 
+/// The span path's stages for the manifest: the row stage (`row`, numbered 0: it is the
+/// walker's row, before the span path's first), then `span<j>`.
+fn span_stage_list(hw: &Hw, sp: &Stager) -> Vec<golden::pipeline::PipeStage> {
+    let row = walker::row_registers(hw);
+    let format = |signed: bool| if signed { "signed" } else { "unsigned" };
+    let row = (!row.is_empty()).then(|| golden::pipeline::PipeStage {
+        stage: 0,
+        name: "row".into(),
+        logic: golden::pipeline::ROW_STAGE.into(),
+        regs: row.into_iter().map(|(n, bits, signed)| golden::pipeline::PipeReg::new(&n, bits, format(signed))).collect(),
+    });
+    row.into_iter().chain(stage_list(sp, "span", &golden::pipeline::I0_STAGES)).collect()
+}
+
 pub fn module(hw: &Hw, names: &Names) -> Module {
     build(hw, names).0
 }
@@ -97,7 +114,7 @@ fn build(hw: &Hw, names: &Names) -> (Module, Vec<golden::pipeline::PipeStage>) {
         walker::emit(hw, names, &mut body);
         let sp = span::path(hw, &mut body);
         let sp = span::output(hw, names, sp, &mut body);
-        let stages = if hw.calc_clocks() > 1 { stage_list(&sp, "span", &golden::pipeline::I0_STAGES) } else { Vec::new() };
+        let stages = if hw.calc_clocks() > 1 { span_stage_list(hw, &sp) } else { Vec::new() };
         body.push(properties::emit_engine(hw, &sp));
         return (top(hw, names, body), stages);
     }
@@ -108,7 +125,7 @@ fn build(hw: &Hw, names: &Names) -> (Module, Vec<golden::pipeline::PipeStage>) {
     // Every boundary is registered above level 0, so stage j's logic is logical step j - 1's.
     let stages = if hw.calc_clocks() > 1 {
         let mut v = stage_list(&set_up.st, "calc", &golden::pipeline::SETUP_STAGES);
-        v.extend(stage_list(&sp, "span", &golden::pipeline::I0_STAGES));
+        v.extend(span_stage_list(hw, &sp));
         v
     } else {
         Vec::new()

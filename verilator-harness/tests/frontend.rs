@@ -460,6 +460,15 @@ fn engine_spans_equal_golden_on_a_small_screen() {
     engine_spans_of(opts, 3000);
 }
 
+/// The slow tier: the ECP5 plan at `--target ecp5-25f`'s level (`--pipeline 1`: the set-up's
+/// result behind the row stage and the span path's six stages), on the small screen.
+#[test]
+#[ignore]
+fn engine_spans_equal_golden_at_the_targets_pipeline_level() {
+    let Some(opts) = engine(golden::setup::Screen { width: 37, height: 23 }, golden::frontend::engine::SetupForm::Ecp5_25f) else { return };
+    engine_spans_of(hdl_gen::Options { pipeline: golden::pipeline::Pipeline::at(1), ..opts }, 3000);
+}
+
 /// The slow tier (`--ignored`): the ECP5 plan at 640x480, the iCE40 plans at 37x23 (II = 120 and
 /// 270 clocks a triangle: 3,000 triangles are about a million clocks each); each builds a model
 /// on first use. `cargo nextest run -p verilator-harness --run-ignored only -E 'test(/engine_/)'`.

@@ -1,7 +1,7 @@
 //! `tri_fe_edge`: one edge of the triangle, instanced three times by a `generate` loop in
 //! `tri_frontend`. From CALC's values for the edge to its bound on the walked row: the set-up
 //! result (its rows, its divisor, and its two divisions, the first bound and the step), then the
-//! walker's integer DDA (one add, compare, subtract a row).
+//! walker's integer DDA (a compare and two adds side by side a row).
 
 use super::divider::counter_width;
 use super::divider::{Div, DivConns};
@@ -174,7 +174,7 @@ pub(super) fn module(hw: &Hw, names: &Names) -> Module {
         format!("divisions on {} ({bound_w} quotient bits, {} a clock, run by the owner's div_cnt):", names.fe_div, hw.div_bits),
         "the first bound g = floor(n / D) - B and the step qs = floor(sn / |dy|) - B (B = 2^(GW-1)), remainders kept.".into(),
         "Walker (take: load; step: the next row): on an active row g += qs + carry, the remainder".into(),
-        "rem += rs256 modulo D (one add, compare, subtract); lg/ha is g on the edge's side of the row, else lo/hi.".into(),
+        "rem += rs256 modulo D (its carry rem >= D - rs256 and both steps side by side); lg/ha is g on the edge's side of the row, else lo/hi.".into(),
         format!("Widths: bound GW = {bound_w} signed, divisor {ediv_w}, rows {row_w}, bounds out {end_w} signed."),
     ];
     let mut ports = vec![
@@ -211,19 +211,21 @@ pub(super) fn module(hw: &Hw, names: &Names) -> Module {
         body.extend(d.instance(&names.fe_div, hw.div_bits, cnt_w, &conns, &["q"]));
     }
     let flip = |q: &str| offset_to_signed(q, bound_w);
+    let rs256 = format!("{{es_p[{}:0], 8'd0}}", vy_w - 1);
     body.extend(dda(&e));
     let load = vec![
         set("w_act", "s_act"),
         set("w_right", "s_right"),
         set("w_rs", "s_rs"),
         set("w_re", "s_re"),
-        set("w_d", "s_d"),
+        set("w_thr", format!("s_d - {rs256}")),
         set("w_g", flip("ei_q")),
         set("w_rem", format!("ei_p[{}:0]", ediv_w - 1)),
         set("w_qs", flip("es_q")),
-        set("w_rs256", format!("{{es_p[{}:0], 8'd0}}", vy_w - 1)),
+        set("w_qs1", format!("{} + {}", flip("es_q"), zext("1'b1", 1, bound_w))),
+        set("w_rs256", rs256),
     ];
-    body.push(walk(&e, load));
+    body.push(walk(load));
     for (port, _, _, signal, _) in state_outputs(hw) {
         body.push(Item::Assign(port.into(), signal));
     }
@@ -234,27 +236,28 @@ pub(super) fn module(hw: &Hw, names: &Names) -> Module {
 fn dda(e: &EdgeWidths) -> Vec<Item> {
     let EdgeWidths { row_w, bound_w, ediv_w, end_w, .. } = *e;
     let mut body = vec![Item::Blank, comment("Walker: the edge's DDA state, loaded from the set-up result.")];
-    body.extend([reg("w_act", 1), reg("w_right", 1), reg("w_rs", row_w), reg("w_re", row_w), reg("w_d", ediv_w)]);
-    body.extend([reg("w_rem", ediv_w), reg("w_rs256", ediv_w), sreg("w_g", bound_w), sreg("w_qs", bound_w)]);
+    // The step's carry, rem + rs256 >= D, is decided as rem >= thr (thr = D - rs256, from the
+    // load), and both next remainders and both next bounds (qs, qs + 1) are formed beside it:
+    // the add, compare, add it chained was the staged front-end's clock once the row stage
+    // took the span's decision off the walker (docs/fpga.md).
+    body.push(comment("thr = D - rs256 (> 0: rs256 < D), qs1 = qs + 1: the carry and both steps side by side."));
+    body.extend([reg("w_act", 1), reg("w_right", 1), reg("w_rs", row_w), reg("w_re", row_w), reg("w_thr", ediv_w)]);
+    body.extend([reg("w_rem", ediv_w), reg("w_rs256", ediv_w), sreg("w_g", bound_w), sreg("w_qs", bound_w), sreg("w_qs1", bound_w)]);
     body.push(wire("in_rows", 1, "w_act && row >= w_rs && row <= w_re"));
     body.push(swire("gg", end_w, sext("w_g", bound_w, end_w)));
     // This edge's bound on its side of the row, or the screen's where it bounds none here;
     // a left edge's bound is -g, kept as g (its smallest is the span's left end).
     body.push(Item::Assign("lg".into(), "(in_rows && !w_right && gg < lo) ? gg : lo".into()));
     body.push(Item::Assign("ha".into(), "(in_rows && w_right && gg < hi) ? gg : hi".into()));
-    let d1 = zext("w_d", ediv_w, ediv_w + 1);
-    body.push(wire("rsum", ediv_w + 1, format!("{} + {}", zext("w_rem", ediv_w, ediv_w + 1), zext("w_rs256", ediv_w, ediv_w + 1))));
-    body.push(wire("cy", 1, format!("rsum >= {d1}")));
-    body.push(comment("verilator lint_off UNUSEDSIGNAL"));
-    body.push(wire("rnext", ediv_w + 1, format!("cy ? rsum - {d1} : rsum")));
-    body.push(comment("verilator lint_on UNUSEDSIGNAL"));
+    body.push(wire("cy", 1, "w_rem >= w_thr"));
+    body.push(wire("rnext", ediv_w, "cy ? w_rem - w_thr : w_rem + w_rs256"));
+    body.push(swire("gnext", bound_w, "cy ? w_g + w_qs1 : w_g + w_qs"));
     body
 }
 
 /// The DDA's always block: `load` on take, else a step on an active row.
-fn walk(e: &EdgeWidths, load: Vec<Stmt>) -> Item {
-    let EdgeWidths { bound_w, ediv_w, .. } = *e;
-    let step = vec![set("w_rem", format!("rnext[{}:0]", ediv_w - 1)), set("w_g", format!("w_g + w_qs + {}", zext("cy", 1, bound_w)))];
+fn walk(load: Vec<Stmt>) -> Item {
+    let step = vec![set("w_rem", "rnext"), set("w_g", "gnext")];
     Item::Always(vec![Stmt::If("take".into(), load, vec![Stmt::If("step && w_act && row >= w_rs".into(), step, vec![])])])
 }
 
@@ -270,7 +273,7 @@ fn module_engine(hw: &Hw, names: &Names) -> Module {
         format!("Its set-up result comes from the shared set-up engine ({}) through the queue: rows rs..re, side,", names.fe_engine),
         "divisor D = 256 |dy|, first bound g with its remainder, step qs with rs256 = 256 (its remainder).".into(),
         "Walker (take: load; step: the next row): on an active row g += qs + carry, the remainder".into(),
-        "rem += rs256 modulo D (one add, compare, subtract); lg/ha is g on the edge's side of the row, else lo/hi.".into(),
+        "rem += rs256 modulo D (its carry rem >= D - rs256 and both steps side by side); lg/ha is g on the edge's side of the row, else lo/hi.".into(),
         format!("Widths: bound GW = {bound_w} signed, divisor {ediv_w}, rows {row_w}, bounds out {end_w} signed."),
     ];
     let mut ports = vec![Port::input("clk", 1, "", "rising edge")];
@@ -280,8 +283,9 @@ fn module_engine(hw: &Hw, names: &Names) -> Module {
     }
     ports.extend(walker_ports(row_w, end_w));
     let mut body = dda(&e);
-    let load = ["act", "right", "rs", "re", "d", "g", "rem", "qs", "rs256"].map(|p| set(format!("w_{p}"), p)).to_vec();
-    body.push(walk(&e, load));
+    let mut load = ["act", "right", "rs", "re", "g", "rem", "qs", "rs256"].map(|p| set(format!("w_{p}"), p)).to_vec();
+    load.extend([set("w_thr", "d - rs256"), set("w_qs1", format!("qs + {}", zext("1'b1", 1, bound_w)))]);
+    body.push(walk(load));
     Module { name: names.fe_edge.clone(), header, params: vec![], ports, body }
 }
 

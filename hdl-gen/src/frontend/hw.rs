@@ -58,10 +58,17 @@ impl Hw {
         self.pipeline.calc_clocks()
     }
 
-    /// Register stages between the walker and the output register: 2, or 6 at `--pipeline 1`
-    /// and above ([`golden::pipeline::i0_registers`]).
+    /// Whether the walker's row is registered before its span is decided
+    /// ([`golden::pipeline::Pipeline::row_stage`]).
+    pub fn row_stage(&self) -> bool {
+        self.pipeline.row_stage(self.fe.i0)
+    }
+
+    /// Register stages between the walker and the output register: 2, or at `--pipeline 1`
+    /// and above the row stage and 6 ([`golden::pipeline::i0_registers`]; 6 alone with the
+    /// incremental `I0`).
     pub fn i0_stages(&self) -> u32 {
-        golden::pipeline::i0_registers(self.pipeline).iter().filter(|&&r| r).count() as u32
+        golden::pipeline::i0_registers(self.pipeline).iter().filter(|&&r| r).count() as u32 + self.row_stage() as u32
     }
 
     /// Clocks from a triangle's transfer to the first span's `out_valid` when the walker is

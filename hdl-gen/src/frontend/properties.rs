@@ -7,7 +7,7 @@ mod parallel;
 mod shape;
 
 use shape::*;
-pub use shape::{CalcStage, EngineShape, FrontendShape, ParallelSetup, SetupShape, SpanStage};
+pub use shape::{CalcStage, EngineShape, FrontendShape, ParallelSetup, RowStage, SetupShape, SpanStage};
 
 use super::hw::Hw;
 use super::setup::{self, Setup};
@@ -72,6 +72,27 @@ fn shape(hw: &Hw, sp: &Stager, setup: SetupShape) -> FrontendShape {
         height: fe.screen.height as u64,
         latency: hw.latency(),
         setup,
+        row_stage: hw.row_stage().then(|| RowStage {
+            valid: "wr_v".into(),
+            y: super::walker::row(hw, "w_row"),
+            di: super::walker::row(hw, "w_di"),
+            // An edge's bound is the screen's or inside it (`tri_fe_edge`'s `lg`, `ha`), and
+            // at least its sign-extended `g`'s least (so `-mg` does not overflow).
+            holds: {
+                let w = super::edge::end_width(hw);
+                let least = super::hw::slit(w, -(1i64 << (w - 2)));
+                (0..3)
+                    .flat_map(|k| {
+                        [
+                            format!("wr_lg{k} <= lo0"),
+                            format!("wr_ha{k} <= hi0"),
+                            format!("wr_lg{k} >= {least}"),
+                            format!("wr_ha{k} >= {least}"),
+                        ]
+                    })
+                    .collect()
+            },
+        }),
         span_stages: (1..=sp.stage())
             .map(|j| {
                 let held = |n: &str| sp.held(n, j).expect("a span's fields reach the output");
@@ -93,7 +114,8 @@ fn shape(hw: &Hw, sp: &Stager, setup: SetupShape) -> FrontendShape {
 /// output free: the next triangle's set-up overlaps the walk); the walker walks the rows from
 /// first to last, one per free clock, and each row with covered pixels becomes a span that
 /// moves through the I0 stages (two, or six when pipelined) to the output, every stage moving
-/// when the output is free. With CALC in stages, a triangle moves through them as a queue
+/// when the output is free; with the row stage (`--pipeline 1`, the reciprocal `I0`) every
+/// walked row moves into it first, and whether it has covered pixels is decided there. With CALC in stages, a triangle moves through them as a queue
 /// between the vertex register and the set-up.
 /// Whether a row has covered pixels (the walker's `lo <= hi`), whether a triangle is culled
 /// (its area and row range) and the rows' first and last are the design's data decisions the
@@ -186,12 +208,20 @@ impl Reference<'_> {
             b.push(Item::Reg { name: "f_wymin".into(), width: cy, signed: true });
             b.push(Item::Reg { name: "f_wymax".into(), width: cy, signed: true });
         }
+        if self.s.row_stage.is_some() {
+            b.push(comment("The row stage: the walker's row (valid, row, tag), its coverage decided there."));
+            b.extend([reg("f_rv", 1), reg("f_ry", yw), reg("f_rn", 1)]);
+        }
         b.push(comment("The spans: the walker's row in the I0 stages and the output (valid, row)."));
         for i in 1..=nsp {
             b.extend([reg(&format!("f_{i}v"), 1), reg(&format!("f_{i}y"), yw)]);
         }
         b.extend([reg("f_ov", 1), reg("f_oy", yw)]);
-        b.push(comment("Each span's tag: its triangle's first (the walker has emitted none of it yet: f_wnew)."));
+        b.push(comment(if self.s.row_stage.is_some() {
+            "Each span's tag: its triangle's first (f_wnew: the walker's row is its triangle's first)."
+        } else {
+            "Each span's tag: its triangle's first (the walker has emitted none of it yet: f_wnew)."
+        }));
         b.push(reg("f_wnew", 1));
         for i in 1..=nsp {
             b.push(reg(&format!("f_{i}n"), 1));
@@ -255,10 +285,17 @@ impl Reference<'_> {
         let Reference { nsp, cw, .. } = *self;
         let inc1 = |n: &str| set(n, format!("{n} + {}", one(cw)));
         // The walker moves when the output is free (and, with starts, no source is starting).
+        // `row`: a span leaves the walker, or the row stage, for the span path.
+        let staged = self.s.row_stage.is_some();
+        assert!(!staged || self.s.starts.is_none(), "the incremental walker has no row stage");
         let (wgo, row) = match self.s.starts {
             Some(_) => ("f_adv && !ie_wait", "f_wv && f_cover && !ie_wait"),
+            None if staged => ("f_adv", "f_rv && f_cover"),
             None => ("f_adv", "f_wv && f_cover"),
         };
+        // The walker's row is no longer its triangle's first once it moves on, or (no row stage)
+        // once one of its rows is a span.
+        let first_gone = if staged { "f_adv && f_wv" } else { row };
         let inc = |n: &str, c: &str| when(c, vec![inc1(n)]);
         let mut load = vec![set("f_wv", "1'b1"), set("f_wrow", "s_first"), set("f_wlast", "s_last")];
         if let SetupShape::Parallel(_) = self.s.setup {
@@ -269,16 +306,30 @@ impl Reference<'_> {
             "f_take".into(),
             load,
             vec![
-                when(format!("f_adv && {row}"), vec![set("f_wnew", "1'b0")]),
+                when(if staged { first_gone.to_string() } else { format!("f_adv && {first_gone}") }, vec![set("f_wnew", "1'b0")]),
                 when(
                     format!("{wgo} && f_wv"),
                     vec![Stmt::If("f_wend".into(), vec![set("f_wv", "1'b0")], vec![set("f_wrow", format!("f_wrow + {}", one(yw)))])],
                 ),
             ],
         );
+        // With the row stage a row is tagged its triangle's first as it leaves the walker, or
+        // when the row ahead of it (its triangle's) was tagged and had no pixel.
+        let into_spans = if staged {
+            vec![
+                set("f_rv", "f_wv"),
+                set("f_ry", "f_wrow"),
+                set("f_rn", "f_wnew || (f_rn && !(f_rv && f_cover))"),
+                set("f_1v", row),
+                set("f_1y", "f_ry"),
+                set("f_1n", "f_rn"),
+            ]
+        } else {
+            vec![set("f_1v", row), set("f_1y", "f_wrow"), set("f_1n", "f_wnew")]
+        };
         let spans = when(
             "f_adv",
-            vec![set("f_1v", row), set("f_1y", "f_wrow"), set("f_1n", "f_wnew")]
+            into_spans
                 .into_iter()
                 .chain((2..=nsp).flat_map(|i| ["v", "y", "n"].map(|f| set(format!("f_{i}{f}"), format!("f_{}{f}", i - 1)))))
                 .chain(["v", "y", "n"].map(|f| set(format!("f_o{f}"), format!("f_{nsp}{f}"))))
@@ -294,6 +345,7 @@ impl Reference<'_> {
             reset
                 .into_iter()
                 .chain([set("f_wv", "1'b0")])
+                .chain(staged.then(|| set("f_rv", "1'b0")))
                 .chain((1..=nsp).map(|i| set(format!("f_{i}v"), "1'b0")))
                 .chain([
                     set("f_ov", "1'b0"),
@@ -447,7 +499,16 @@ impl Reference<'_> {
         for (i, sp) in span_stages.iter().enumerate().map(|(k, sp)| (k + 1, sp)).rev() {
             link.push(when(format!("f_{i}v && !f_{i}n"), vec![assert(format!("{} == ({})", sp.di, ahead(i + 1)))]));
         }
-        link.push(when("f_wv && !f_wnew", vec![assert(format!("w_di == ({})", ahead(1)))]));
+        match &self.s.row_stage {
+            Some(r) => {
+                link.push(assert(format!("{} == f_rv", r.valid)));
+                link.push(when("f_rv", std::iter::once(assert(format!("{} == f_ry", r.y))).chain(r.holds.iter().map(assert)).collect()));
+                link.push(when("f_rv && !f_rn", vec![assert(format!("{} == ({})", r.di, ahead(1)))]));
+                // A walked row after its triangle's first has that triangle's row ahead of it.
+                link.push(when("f_wv && !f_wnew", vec![assert("f_rv"), assert(format!("w_di == {}", r.di))]));
+            }
+            None => link.push(when("f_wv && !f_wnew", vec![assert(format!("w_di == ({})", ahead(1)))])),
+        }
         for sp in span_stages {
             link.push(on_screen(&sp.valid, &sp.x, &sp.len, xw, width));
         }

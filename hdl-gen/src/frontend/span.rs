@@ -6,7 +6,7 @@
 use super::divider::DivConns;
 use super::hw::Hw;
 use super::stager::Stager;
-use super::walker::scanline_divider;
+use super::walker::{self, scanline_divider};
 use crate::verilog::{comment, lit, reg, set, wire, zext, Item, Stmt};
 use crate::Names;
 use golden::frontend::{DiMode, SetupForm, Widths};
@@ -156,14 +156,16 @@ pub(super) fn path(hw: &Hw, body: &mut Vec<Item>) -> Stager {
     let tail = End { x: "xh", gx: "gxh", s2: "s2h", h: "hh", lo: "hi", prod: "prodh", qt: "qh", m: "mh", corr: "corrh", out: "ilast" };
     let ends: Vec<&End> = if scan { vec![&head, &tail] } else { vec![&head] };
     i0_section(&mut sp);
+    // The walker's row, or the row stage's ([`walker::row`]).
+    let row = |n: &str| walker::row(hw, n);
     for (n, ww, src) in [
-        ("y", row_w, "w_row".to_string()),
+        ("y", row_w, row("w_row")),
         ("x", xw, "lo_u".into()),
         ("len", xw + 1, format!("len_w[{xw}:0]")),
-        ("tn", s2_w - 1, format!("w_tn[{}:0]", s2_w - 2)),
-        ("gxn", s2_w - 1, format!("w_gxn[{}:0]", s2_w - 2)),
-        ("an", area_w, "w_an".into()),
-        ("rn", recip_w, "w_rn".into()),
+        ("tn", s2_w - 1, format!("{}[{}:0]", row("w_tn"), s2_w - 2)),
+        ("gxn", s2_w - 1, format!("{}[{}:0]", row("w_gxn"), s2_w - 2)),
+        ("an", area_w, row("w_an")),
+        ("rn", recip_w, row("w_rn")),
     ] {
         sp.input_as(n, ww, false, &src);
     }
@@ -177,7 +179,7 @@ pub(super) fn path(hw: &Hw, body: &mut Vec<Item>) -> Stager {
         body.push(wire("unused_di", dw, "w_di"));
         body.push(comment("verilator lint_on UNUSEDSIGNAL"));
     } else {
-        sp.input_as("di", dw, false, "w_di");
+        sp.input_as("di", dw, false, &row("w_di"));
     }
     sp.cut();
     i0_section(&mut sp);

@@ -5,7 +5,7 @@
 use super::divider::Div;
 use super::edge;
 use super::hw::{slit, Hw};
-use crate::verilog::{assign, comment, lit, net, reg, set, sext, swire, wire, Item, Stmt};
+use crate::verilog::{assign, comment, lit, net, reg, set, sext, sreg, swire, wire, Item, Stmt};
 use crate::Names;
 use golden::frontend::{DiMode, Widths};
 
@@ -14,6 +14,62 @@ use golden::frontend::{DiMode, Widths};
 pub(super) fn scanline_divider(hw: &Hw) -> (Div, u32) {
     let (xw, iw) = (hw.fe.cfg.xbits, hw.fe.cfg.iw());
     (Div { name: "u_sdv", pw: xw + iw + 2, qb: iw }, 32 - (iw - 1).leading_zeros())
+}
+
+/// The walker's values the span path reads (`w_row`, `w_tn`, ...) where it reads them: the
+/// row stage's registers when there is one ([`Hw::row_stage`]).
+pub(super) fn row(hw: &Hw, walker: &str) -> String {
+    match walker.strip_prefix("w_") {
+        Some(name) if hw.row_stage() => format!("wr_{name}"),
+        _ => walker.into(),
+    }
+}
+
+/// The walker's values the row stage holds besides the edges' bounds: the span path's inputs.
+fn row_values(hw: &Hw) -> Vec<(&'static str, u32)> {
+    let Widths { yw: row_w, aw: area_w, k: sum_w, rw: recip_w, .. } = hw.fe.widths();
+    // The span path reads the sums modulo 2^(K-2) only (`S2n` is kept modulo 2^(K-1)).
+    let mut v = vec![("w_row", row_w), ("w_tn", sum_w - 2), ("w_gxn", sum_w - 2), ("w_an", area_w), ("w_rn", recip_w)];
+    // Per scanline the span's dI is its own division's: the triangle's is not read.
+    if hw.fe.di == DiMode::Triangle {
+        v.push(("w_di", hw.fe.cfg.dw()));
+    }
+    v
+}
+
+/// The row stage: the walked row (valid, each edge's bound, the span path's inputs) registered,
+/// moving on the one stall.
+fn row_stage(hw: &Hw, body: &mut Vec<Item>) {
+    let end_w = edge::end_width(hw);
+    body.push(comment("Row stage: the walked row registered, each edge's bound on it and the row's sums: the row's"));
+    body.push(comment("span is decided from these a clock after the walker (wr_v: a row, with a pixel or not)."));
+    body.push(reg("wr_v", 1));
+    let mut moves = vec![set("wr_v", "w_valid")];
+    for side in ["lg", "ha"] {
+        for k in 0..3 {
+            let r = format!("wr_{side}{k}");
+            body.push(sreg(&r, end_w));
+            moves.push(set(r, format!("{side}{k}")));
+        }
+    }
+    for (n, w) in row_values(hw) {
+        body.push(reg(&row(hw, n), w));
+        let sums = matches!(n, "w_tn" | "w_gxn");
+        moves.push(set(row(hw, n), if sums { format!("{n}[{}:0]", w - 1) } else { n.to_string() }));
+    }
+    body.push(Item::Always(vec![Stmt::If("rst".into(), vec![set("wr_v", "1'b0")], vec![Stmt::If("adv".into(), moves, vec![])])]));
+}
+
+/// The row stage's registers for the manifest: `(name, bits, signed)`; none without it.
+pub(super) fn row_registers(hw: &Hw) -> Vec<(String, u32, bool)> {
+    if !hw.row_stage() {
+        return Vec::new();
+    }
+    let end_w = edge::end_width(hw);
+    let mut v = vec![("wr_v".to_string(), 1, false)];
+    v.extend(["lg", "ha"].iter().flat_map(|side| (0..3).map(move |k| (format!("wr_{side}{k}"), end_w, true))));
+    v.extend(row_values(hw).into_iter().map(|(n, w)| (row(hw, n), w, false)));
+    v
 }
 
 pub(super) fn emit(hw: &Hw, names: &Names, body: &mut Vec<Item>) {
@@ -75,11 +131,22 @@ pub(super) fn emit(hw: &Hw, names: &Names, body: &mut Vec<Item>) {
         body.push(swire(&format!("lg{k}"), end_w, format!("e_lg[{}:{}]", (k + 1) * end_w - 1, k * end_w)));
         body.push(swire(&format!("ha{k}"), end_w, format!("e_ha[{}:{}]", (k + 1) * end_w - 1, k * end_w)));
     }
+    // The row's span is decided from the edges' bounds in the walker's clock, or a clock later
+    // from the row stage's registers (`--pipeline 1`): the bounds then the minima, the pixel test
+    // and `emit` into the span path's first valid were the staged front-end's critical path.
+    let row_valid = if hw.row_stage() {
+        assert!(!inc, "the incremental walker decides its row in its own clock");
+        row_stage(hw, body);
+        "wr_v"
+    } else {
+        "w_valid"
+    };
+    let (lg, ha) = if hw.row_stage() { ("wr_lg", "wr_ha") } else { ("lg", "ha") };
     // Side by side rather than in a chain, and no negation before the pixel test or the length:
-    // this is the walker's row clock, the staged front-end's limit at 2 and 1 quotient bits.
+    // this was the walker's row clock, the staged front-end's limit at 2 and 1 quotient bits.
     body.push(comment("The span's ends, the edges compared side by side: x = lo3 = -mg (the smallest left-edge g),"));
     body.push(comment("hi3 the smallest right bound; the row has a pixel when hi3 + mg >= 0."));
-    for (end, side) in [("mg", "lg"), ("hi3", "ha")] {
+    for (end, side) in [("mg", lg), ("hi3", ha)] {
         let c = |i: u32, j: u32| format!("{side}{i} <= {side}{j}");
         body.push(swire(end, end_w, format!("({} && {}) ? {side}0 : ({}) ? {side}1 : {side}2", c(0, 1), c(0, 2), c(1, 2))));
     }
@@ -94,7 +161,7 @@ pub(super) fn emit(hw: &Hw, names: &Names, body: &mut Vec<Item>) {
         body.push(wire("emit", 1, "px && !ie_wait"));
         body.push(assign("w_step", format!("{step_when} && !ie_wait")));
     } else {
-        body.push(wire("emit", 1, format!("w_valid && !room[{end_w}]")));
+        body.push(wire("emit", 1, format!("{row_valid} && !room[{end_w}]")));
     }
     body.push(wire("lo_u", xw, format!("lo3[{}:0]", xw - 1)));
     let mut load = vec![set("w_valid", "1'b1"), set("w_row", "s_first"), set("w_last", "s_last")];

@@ -22,7 +22,10 @@ pub struct FrontendShape {
     pub latency: u32,
     /// The set-up in front of the walker.
     pub setup: SetupShape,
-    /// The span path's register stages between the walker and the output, in order.
+    /// The row stage between the walker and the span path (`--pipeline 1`, reciprocal `I0`),
+    /// where the row's coverage is decided; without it the walker's row is.
+    pub row_stage: Option<RowStage>,
+    /// The span path's register stages between the walker (or the row stage) and the output, in order.
     pub span_stages: Vec<SpanStage>,
     /// The incremental I0 (`--fe-i0 incremental`): its start engine's clocks. The walker then
     /// waits while a source starts (`ie_wait`, a data decision taken as given, like a row's
@@ -78,6 +81,16 @@ pub struct SpanStage {
     pub x: String,
     pub len: String,
     pub di: String,
+}
+
+/// The row stage: where it holds the walked row's valid (a row, covered or not), row and `dI`.
+pub struct RowStage {
+    pub valid: String,
+    pub y: String,
+    pub di: String,
+    /// What holds of its registers as the walker's signals they load (each edge's bounds
+    /// within the screen's): conditions on a valid row.
+    pub holds: Vec<String>,
 }
 
 /// A CALC stage of the pipelined set-up: its valid register and where it holds what the
