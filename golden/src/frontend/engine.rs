@@ -99,7 +99,7 @@ impl Plan {
     /// docs/design.md's recommendation for the ECP5-25F: 12 clocks a triangle on 8 MULT18X18D
     /// and fourteen 1-bit dividers, the incremental steps left to the walker's start evaluator.
     /// 8 tiles, not 12: 8 are the fewest the scheduler keeps at 12 clocks (7 give 13), so the
-    /// front-end with the span path's 17 per-row products has 25 MULT18X18D, within the
+    /// front-end with the span path's 9 per-row tiles has 17 MULT18X18D, within the
     /// LFE5U-25F's 28. 14 dividers, not the 12 that 120 divider clocks need at II = 12: each
     /// edge's `Qs` and `g` (16 clocks) and `Rn` (24) then alternate over a pair of dividers of
     /// their own, by the triangle's parity, where 12 rotated `Qs` and `g` over three dividers
