@@ -27,6 +27,7 @@
 //!   [`FrontEnd::setup`] and [`FrontEnd::i0_steps`].
 
 mod build;
+mod placement;
 pub mod schedule;
 #[cfg(test)]
 mod tests;
