@@ -58,6 +58,13 @@ impl Hw {
         self.pipeline.calc_clocks()
     }
 
+    /// Bits of `S2n` the span path keeps: it is formed modulo 2^(K-1) (golden's
+    /// `Widths::reciprocal_quotient`: at a covered pixel it is below that), so the row's sums
+    /// `Tn` and `Gxn lo` are read modulo 2^(K-2).
+    pub fn s2n_bits(&self) -> u32 {
+        self.fe.widths().k - 1
+    }
+
     /// Whether the walker's row is registered before its span is decided
     /// ([`golden::pipeline::Pipeline::row_stage`]).
     pub fn row_stage(&self) -> bool {

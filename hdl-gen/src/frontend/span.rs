@@ -145,7 +145,7 @@ pub(super) fn path(hw: &Hw, body: &mut Vec<Item>) -> Stager {
     // S2n is kept modulo 2^(K-1) (at a covered pixel it is below that), the quotient estimate
     // takes its top IW + 1 bits, and the correction is modulo 2^(AW+3): golden's
     // `Widths::reciprocal_quotient`, whose documentation proves the estimate two below at most.
-    let s2_w = sum_w - 1;
+    let s2_w = hw.s2n_bits();
     let tile = tile_bits(hw);
     let t = fe.widths().i0_shift();
     let h_w = s2_w - t;

@@ -27,9 +27,10 @@ pub(super) fn row(hw: &Hw, walker: &str) -> String {
 
 /// The walker's values the row stage holds besides the edges' bounds: the span path's inputs.
 fn row_values(hw: &Hw) -> Vec<(&'static str, u32)> {
-    let Widths { yw: row_w, aw: area_w, k: sum_w, rw: recip_w, .. } = hw.fe.widths();
-    // The span path reads the sums modulo 2^(K-2) only (`S2n` is kept modulo 2^(K-1)).
-    let mut v = vec![("w_row", row_w), ("w_tn", sum_w - 2), ("w_gxn", sum_w - 2), ("w_an", area_w), ("w_rn", recip_w)];
+    let Widths { yw: row_w, aw: area_w, rw: recip_w, .. } = hw.fe.widths();
+    // The span path reads the sums modulo 2^(K-2) only ([`Hw::s2n_bits`]).
+    let sums = hw.s2n_bits() - 1;
+    let mut v = vec![("w_row", row_w), ("w_tn", sums), ("w_gxn", sums), ("w_an", area_w), ("w_rn", recip_w)];
     // Per scanline the span's dI is its own division's: the triangle's is not read.
     if hw.fe.di == DiMode::Triangle {
         v.push(("w_di", hw.fe.cfg.dw()));
