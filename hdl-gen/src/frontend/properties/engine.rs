@@ -79,7 +79,7 @@ impl Reference<'_> {
     /// The engine and its queue at their boundary with the front-end: results due when the
     /// reference says, the freeze, the queue's writes and reads, its order.
     pub(super) fn engine_ports(&self, e: &EngineShape) -> Vec<Item> {
-        let depth = lit(e.qw(), e.depth as u64);
+        let (depth, none) = (lit(e.qw(), e.depth as u64), lit(e.qw(), 0));
         let mut b = vec![comment("The engine: a result is due exactly at its schedule's latency after its entry plus the clocks")];
         b.push(comment("frozen; the engine freezes exactly while that result finds the queue full."));
         b.push(Item::Comb(vec![when("f_past", vec![assert("res_v == f_due"), assert("en == f_en")])]));
@@ -91,12 +91,12 @@ impl Reference<'_> {
             vec![
                 assert("!(q_in && q_full)"),
                 assert("!(take && !q_ne)"),
-                assert(format!("f_q_cnt <= {}", lit(e.qw(), e.depth as u64))),
+                assert(format!("f_q_cnt <= {depth}")),
                 assert("q_in == f_qin"),
                 assert("take == f_take"),
-                assert(format!("q_ne == (f_qn != {})", lit(e.qw(), 0))),
+                assert(format!("q_ne == (f_qn != {none})")),
                 assert(format!("q_full == (f_qn == {depth})")),
-                when(format!("f_qn != {}", lit(e.qw(), 0)), vec![assert("q_head == f_q0")]),
+                when(format!("f_qn != {none}"), vec![assert("q_head == f_q0")]),
             ],
         )]));
         b.push(comment("The freeze: while en is low the phase ring, the valid bits of the periods in flight and"));
