@@ -459,6 +459,7 @@ module tri_frontend (
 
   // verilator lint_off UNUSEDSIGNAL
   wire [3:0] unused_sums_top = {w_tn[63:62], w_gxn[63:62]};
+  wire [7:0] unused_gxn_low = w_gxn[7:0];
   // verilator lint_on UNUSEDSIGNAL
   reg p1_v;
   reg p2_v;
@@ -481,40 +482,43 @@ module tri_frontend (
 
   // Span path, step 0 (stage p0): the walker: the row's bounds, clipped, and whether it has a covered pixel.
 
-  // Span path, step 1 (stage p0): Gxn lo modulo 2^(K-2), the plane's step to the first pixel.
+  // Span path, step 1 (stage p0): the partial products of (Gxn >> 8) lo, the plane's step to the first pixel (Gxn's low 8 bits are zero).
+  wire [53:0] gx_0 = {36'd0, w_gxn[25:8]} * {42'd0, lo_u};
+  wire [35:0] gx_1 = {18'd0, w_gxn[43:26]} * {24'd0, lo_u};
+  wire [17:0] gx_2 = w_gxn[61:44] * {6'd0, lo_u};
+
+  // Span path, step 2 (stage p0): their sum, Gxn lo modulo 2^(K-2).
   // verilator lint_off UNUSEDSIGNAL
-  wire [61:0] gx_0 = {44'd0, w_gxn[17:0]} * {50'd0, lo_u};
-  wire [43:0] gx_1 = {26'd0, w_gxn[35:18]} * {32'd0, lo_u};
-  wire [25:0] gx_2 = {8'd0, w_gxn[53:36]} * {14'd0, lo_u};
-  wire [7:0] gx_3 = w_gxn[61:54] * lo_u[7:0];
-  wire [61:0] gx = gx_0 + ({18'd0, gx_1} << 18) + ({36'd0, gx_2} << 36) + ({54'd0, gx_3} << 54);
+  wire [53:0] gx = gx_0 + ({18'd0, gx_1} << 18) + ({36'd0, gx_2} << 36);
   // verilator lint_on UNUSEDSIGNAL
 
-  // Span path, step 2 (stage p0): S2n = 2 (Tn + Gxn lo) + An modulo 2^(K-1).
-  wire [62:0] s2n = (({1'd0, w_tn[61:0]} + {1'd0, gx}) << 1) + {21'd0, w_an};
+  // Span path, step 3 (stage p0): S2n = 2 (Tn + Gxn lo) + An modulo 2^(K-1).
+  wire [62:0] s2n = (({1'd0, w_tn[61:0]} + {1'd0, {gx, 8'd0}}) << 1) + {21'd0, w_an};
 
-  // Span path, step 3 (stage p1): its top bits H = S2n >> t and the partial products of H Rn.
+  // Span path, step 4 (stage p1): its top bits H = S2n >> t and the partial products of H Rn.
   wire [44:0] lo = p1_s2n[44:0];
   wire [20:0] h = p1_s2n[62:42];
   wire [41:0] prod_0 = {24'd0, p1_rn[17:0]} * {24'd0, h[17:0]};
   wire [23:0] prod_1 = {19'd0, p1_rn[22:18]} * {6'd0, h[17:0]};
   wire [23:0] prod_2 = ({24{h[18:18]}} & {1'd0, p1_rn}) + ({24{h[19:19]}} & ({1'd0, p1_rn} << 1)) + ({24{h[20:20]}} & ({1'd0, p1_rn} << 2));
 
-  // Span path, step 4 (stage p1): the quotient estimate q~ = (H Rn) >> (K - t), the quotient or up to two below it.
+  // Span path, step 5 (stage p1): the quotient estimate q~ = (H Rn) >> (K - t), the quotient or up to two below it.
   // verilator lint_off UNUSEDSIGNAL
   wire [41:0] prod = prod_0 + ({18'd0, prod_1} << 18) + ({18'd0, prod_2} << 18);
   // verilator lint_on UNUSEDSIGNAL
   wire [19:0] qt = prod[41:22];
 
-  // Span path, step 5 (stage p2): q~ 2An modulo 2^(AW+3).
+  // Span path, step 6 (stage p2): the partial products of q~ An modulo 2^(AW+2).
   wire [43:0] m_an_0 = {26'd0, p2_an[17:0]} * {26'd0, p2_qt[17:0]};
   wire [25:0] m_an_1 = {8'd0, p2_an[35:18]} * {8'd0, p2_qt[17:0]};
-  wire [7:0] m_an_2 = {2'd0, p2_an[41:36]} * p2_qt[7:0];
+  wire [7:0] m_an_2 = ({8{p2_an[36:36]}} & p2_qt[7:0]) + ({8{p2_an[37:37]}} & (p2_qt[7:0] << 1)) + ({8{p2_an[38:38]}} & (p2_qt[7:0] << 2)) + ({8{p2_an[39:39]}} & (p2_qt[7:0] << 3)) + ({8{p2_an[40:40]}} & (p2_qt[7:0] << 4)) + ({8{p2_an[41:41]}} & (p2_qt[7:0] << 5));
   wire [25:0] m_an_3 = ({26{p2_qt[18:18]}} & p2_an[25:0]) + ({26{p2_qt[19:19]}} & (p2_an[25:0] << 1));
+
+  // Span path, step 7 (stage p2): their sum, doubled: q~ 2An modulo 2^(AW+3).
   wire [43:0] m_an = m_an_0 + ({18'd0, m_an_1} << 18) + ({36'd0, m_an_2} << 36) + ({18'd0, m_an_3} << 18);
   wire [44:0] m = {m_an, 1'b0};
 
-  // Span path, step 6 (stage p2): I0 = q~ + (R >= 2An) + (R >= 4An), R = S2n - 2An q~: the correction.
+  // Span path, step 8 (stage p2): I0 = q~ + (R >= 2An) + (R >= 4An), R = S2n - 2An q~: the correction.
   wire [44:0] an2 = {3'd0, p2_an} << 1;
   wire [44:0] an4 = {3'd0, p2_an} << 2;
   wire [44:0] corr = p2_lo - m;

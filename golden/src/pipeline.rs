@@ -47,7 +47,7 @@ pub fn numbered(body: Vec<(&str, String, Vec<PipeReg>)>) -> Vec<PipeStage> {
 /// | level | segment shader | specular unit | front-end set-up |
 /// |--:|---|---|---|
 /// | 0 | as SPEC's seed: 2 stages | 5 stages | CALC in one clock |
-/// | 1 | + a span register; the BFPI's multiples and the last-segment flag registered | + both multiplies split into registered 4-bit partial products and their sum; the BRDF address registered before the ROM, both ROMs' words registered before any arithmetic: 10 stages | CALC in five clocks ([`SETUP_STAGES`]), overlapped with the dividers; the span path in six ([`I0_STAGES`]) instead of two, behind the walker's row registered ([`Pipeline::row_stage`], the reciprocal `I0`) |
+/// | 1 | + a span register; the BFPI's multiples and the last-segment flag registered | + both multiplies split into registered 4-bit partial products and their sum; the BRDF address registered before the ROM, both ROMs' words registered before any arithmetic: 10 stages | CALC in five clocks ([`SETUP_STAGES`]), overlapped with the dividers; the span path in eight ([`I0_STAGES`]) instead of two, behind the walker's row registered ([`Pipeline::row_stage`], the reciprocal `I0`) |
 /// | 2 | + the lane sums registered before round and clamp | as level 1 | as level 1 |
 /// | 3 | + no clock with two adders in a row: the BFPI's first adder level formed as the span enters its register, the rest when it starts; each lane's sum split at the binary point (high part and the fraction's carry registered, joined before the clamp) | as level 1 | as level 1 |
 ///
@@ -162,24 +162,29 @@ pub const ROW_STAGE: &str = "the walker's row: each edge's bound on it, clipped 
 
 /// The front-end's spans from the walker to the output, in logical stages: which boundaries
 /// between them are registered. SPEC's seed structure (level 0) registers two, after `S2n` and
-/// after the quotient estimate; from level 1 every one is, so each clock has one multiply or
-/// two adders at most ([`I0_STAGES`]).
+/// after the quotient estimate; from level 1 every one is, so each clock has one multiply, or
+/// the adders joining a product's partial products, or two adders at most ([`I0_STAGES`]).
 pub fn i0_registers(level: Pipeline) -> [bool; I0_STAGES.len() - 1] {
     if level.0 >= 1 {
         [true; I0_STAGES.len() - 1]
     } else {
-        [false, false, true, false, true, false]
+        [false, false, false, true, false, true, false, false]
     }
 }
 
 /// The front-end's span path in logical stages, walker first, the output register after the last.
-pub const I0_STAGES: [&str; 7] = [
+/// Each product is its tiles' partial products in one stage and the adders joining them in the
+/// next, so at level 1 no clock has a tile and its adders in a row (the correction's product and
+/// its sum in one clock were the 25F's critical path, docs/fpga.md).
+pub const I0_STAGES: [&str; 9] = [
     "the walker: the row's bounds, clipped, and whether it has a covered pixel",
-    "Gxn lo modulo 2^(K-2), the plane's step to the first pixel",
+    "the partial products of (Gxn >> 8) lo, the plane's step to the first pixel (Gxn's low 8 bits are zero)",
+    "their sum, Gxn lo modulo 2^(K-2)",
     "S2n = 2 (Tn + Gxn lo) + An modulo 2^(K-1)",
     "its top bits H = S2n >> t and the partial products of H Rn",
     "the quotient estimate q~ = (H Rn) >> (K - t), the quotient or up to two below it",
-    "q~ 2An modulo 2^(AW+3)",
+    "the partial products of q~ An modulo 2^(AW+2)",
+    "their sum, doubled: q~ 2An modulo 2^(AW+3)",
     "I0 = q~ + (R >= 2An) + (R >= 4An), R = S2n - 2An q~: the correction",
 ];
 

@@ -571,9 +571,10 @@ fn assert_faults_caught(
 /// `Widths::reciprocal_quotient`), planted in the generated `tri_frontend.v` at 640x480, level
 /// 0 (each a model built on first use): the compare for an estimate two below dropped (about one
 /// span in 4,000 needs it, golden's random spans), a partial product in logic dropped (the
-/// estimate's top 3 bits of `S2n` against `Rn`), and a tile's partial product dropped (the
-/// correction's top one, 8 bits). The clean model's co-simulation is the default suite's. Slow
-/// tier: three front-end models, about a minute of CPU each to build.
+/// estimate's top 3 bits of `S2n` against `Rn`), the correction's corner dropped (`An`'s top 6
+/// bits against `q~`'s low 8, in logic since issue 27's stop 30), and a tile's partial product
+/// of `Gxn lo` dropped (its top one, of `Gxn >> 8`). The clean model's co-simulation is the
+/// default suite's. Slow tier: four front-end models, about a minute of CPU each to build.
 #[test]
 #[ignore]
 fn span_path_planted_faults_are_caught() {
@@ -592,10 +593,12 @@ fn span_path_planted_faults_are_caught() {
     let up = line("the correction's code", &|l| l.contains("wire [1:0] i0_up = "));
     let prod = line("the estimate's sum", &|l| l.contains(" prod = ") && l.contains("prod_2"));
     let m = line("the correction's sum", &|l| l.contains(" m_an = ") && l.contains("m_an_2"));
+    let gx = line("Gxn lo's sum", &|l| l.contains(" gx = ") && l.contains("gx_2"));
     let faults = [
         (up.clone(), up.replacen("corr >= an4, ", "1'b0, ", 1).replacen(" ^ (corr >= an4)", "", 1), "the second compare dropped"),
         (prod.clone(), prod.replacen(" + ({18'd0, prod_2} << 18)", "", 1), "the estimate's partial product in logic dropped"),
-        (m.clone(), m.replacen(" + ({36'd0, m_an_2} << 36)", "", 1), "the correction's top tile dropped"),
+        (m.clone(), m.replacen(" + ({36'd0, m_an_2} << 36)", "", 1), "the correction's corner in logic dropped"),
+        (gx.clone(), gx.replacen(" + ({36'd0, gx_2} << 36)", "", 1), "Gxn lo's top tile dropped"),
     ];
     assert_faults_caught(&base, "tri_frontend.v", "i0fault", faults, seed, &tris);
 }

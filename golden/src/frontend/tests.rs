@@ -335,6 +335,17 @@ fn truncated_reciprocal_i0_is_exact_on_a_million_spans() {
     }
 }
 
+/// The span path's formats for its adversarial tests: the defaults at 640x480, the widest screens
+/// at F = 16 and 20, the narrowest format on 16x8.
+fn span_path_formats() -> [(Config, Screen); 4] {
+    [
+        (Config::default(), Screen::default()),
+        (Config::new(8, 16, 16, Align::Span).unwrap(), Screen { width: 65536, height: 65536 }),
+        (Config::new(8, 20, 16, Align::Span).unwrap(), Screen { width: 65536, height: 65536 }),
+        (Config::new(8, 4, 4, Align::Span).unwrap(), Screen { width: 16, height: 8 }),
+    ]
+}
+
 /// Adversarial `S2n` straight into the arithmetic: ties (`S / A` half-way, remainder 0), the
 /// largest remainder, the quotient 0 and 2^IW - 1, areas at 1, at powers of two and either side
 /// (where `Rn` is exact or furthest from it), on every format's widths; and the planted faults it
@@ -342,12 +353,7 @@ fn truncated_reciprocal_i0_is_exact_on_a_million_spans() {
 #[test]
 fn truncated_reciprocal_adversarial_and_negative_controls() {
     let mut rng = Rng(99);
-    for (cfg, screen) in [
-        (Config::default(), Screen::default()),
-        (Config::new(8, 16, 16, Align::Span).unwrap(), Screen { width: 65536, height: 65536 }),
-        (Config::new(8, 20, 16, Align::Span).unwrap(), Screen { width: 65536, height: 65536 }),
-        (Config::new(8, 4, 4, Align::Span).unwrap(), Screen { width: 16, height: 8 }),
-    ] {
+    for (cfg, screen) in span_path_formats() {
         let wd = FrontEnd::new(cfg, screen).unwrap().widths();
         let (aw, iw, t) = (wd.aw as i64, cfg.iw() as i64, wd.i0_shift());
         let mut areas = vec![1i64, 2, 3, (1 << aw) - 1, (1 << aw) - 2];
@@ -382,6 +388,59 @@ fn truncated_reciprocal_adversarial_and_negative_controls() {
              a compare dropped on {caught_compare}, the estimate alone on {caught_uncorrected}"
         );
         assert!(caught_shift > 0 && caught_compare > 0 && caught_uncorrected > 0, "a planted fault went uncaught in {cfg:?}");
+    }
+}
+
+/// The span path's `Gxn lo` from `Gxn >> 8` ([`Widths::gx_lo`]): `Gxn`'s low 8 bits are zero on
+/// every set-up (every kind of triangle, the widest screens, F = 16 and 20, 16x8), and `Gxn lo`
+/// from them equals the full product. The planted fault drops one bit more than the fewest
+/// trailing zeros seen (`8 + s`, the smallest `s` the guard band allows): the check catches it
+/// on some of the same spans (it moves `S2n`'s low bits, the remainder's, so `I0` itself only
+/// near a tie). The exactness of the spans themselves is the million-span
+/// test's (`FrontEnd::i0` is this form). About 0.2 s.
+#[test]
+fn gxn_low_bits_are_zero_and_a_planted_shift_is_caught() {
+    let mut rng = Rng(2708);
+    for (cfg, screen) in span_path_formats() {
+        let fe = FrontEnd::new(cfg, screen).unwrap();
+        let wd = fe.widths();
+        let z = Widths::GXN_ZEROS;
+        let km = mask(wd.k);
+        let mut set_ups = Vec::new();
+        spans_of_every_kind(&mut rng, &fe, 12_000, |t, st| {
+            assert_eq!(st.gxn & mask(z), 0, "Gxn's low {z} bits of {t:?}");
+            set_ups.push(*st);
+            let mut n = 0;
+            fe.walk(st, |_, sp| {
+                // Both ends: the scanline dI's last pixel takes the same path.
+                for c in [sp.x0, sp.x0 + sp.len - 1] {
+                    let full = (st.gxn * c as u128) & mask(wd.k - 2);
+                    assert_eq!(wd.gx_lo(st.gxn, c, z), full, "Gxn lo at column {c} of {t:?}");
+                }
+                n += 1;
+            });
+            n
+        });
+        let fewest = set_ups.iter().filter(|st| st.gxn != 0).map(|st| st.gxn.trailing_zeros()).min().unwrap();
+        assert!(fewest >= z);
+        let (mut spans, mut caught, mut caught_i0) = (0u64, 0u64, 0u64);
+        for st in &set_ups {
+            fe.walk(st, |y, sp| {
+                let c = sp.x0 + sp.len - 1;
+                caught += (wd.gx_lo(st.gxn, c, fewest + 1) != (st.gxn * c as u128) & mask(wd.k - 2)) as u64;
+                let planted = wd.gx_lo(st.gxn, sp.x0, fewest + 1);
+                let tn = (st.tn + (y - st.first) as u128 * st.dyn_) & km;
+                let s2n = (2 * (tn + planted) + st.an) & mask(wd.k - 1);
+                caught_i0 += (wd.reciprocal_quotient(s2n, st.an, st.rn) != sp.i0) as u64;
+                spans += 1;
+            });
+        }
+        eprintln!(
+            "{cfg:?} on {screen:?}: Gxn lo from Gxn >> {z} exact on {spans} spans; fewest trailing zeros {fewest}; \
+             Gxn >> {} wrong on {caught} (their I0 on {caught_i0})",
+            fewest + 1
+        );
+        assert!(caught > 0, "the planted Gxn >> {} went uncaught on {screen:?}", fewest + 1);
     }
 }
 

@@ -72,7 +72,7 @@ impl Hw {
     }
 
     /// Register stages between the walker and the output register: 2, or at `--pipeline 1`
-    /// and above the row stage and 6 ([`golden::pipeline::i0_registers`]; 6 alone with the
+    /// and above the row stage and 8 ([`golden::pipeline::i0_registers`]; 8 alone with the
     /// incremental `I0`).
     pub fn i0_stages(&self) -> u32 {
         golden::pipeline::i0_registers(self.pipeline).iter().filter(|&&r| r).count() as u32 + self.row_stage() as u32

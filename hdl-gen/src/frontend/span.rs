@@ -41,6 +41,18 @@ fn tile_bits(hw: &Hw) -> u32 {
 /// an 8 x 8 product modulo 2^8 to 111 LUT4, docs/fpga.md).
 const LOGIC_BITS: u32 = 3;
 
+/// A piece whose shifted adds come to at most this many adder bits ([`adder_bits`]) is made in
+/// logic too, whatever its narrower side: the correction's corner, `An`'s top 6 bits against the
+/// 8 bits of `q~` below 2^(AW+2) at the defaults (25 adder bits), took a whole tile for 8
+/// product bits. The estimate's 3-bit slice is 45; its next piece, 5 x 18 bits, 86, a tile.
+const LOGIC_ADDER_BITS: u32 = 48;
+
+/// The adder bits of an `n`-bit chunk times a wider one in logic modulo 2^need: each shifted
+/// copy after the first adds the bits it has below 2^need.
+fn adder_bits(n: u32, need: u32) -> u32 {
+    (1..n).map(|k| need.saturating_sub(k)).sum()
+}
+
 /// `x[hi:lo]` of a value as it reads in a stage: its whole self, a slice of a name, or of a
 /// slice (the walker's `hi3[..]`).
 fn bits_of(x: &str, w: u32, hi: u32, lo: u32) -> String {
@@ -55,17 +67,14 @@ fn bits_of(x: &str, w: u32, hi: u32, lo: u32) -> String {
     format!("{x}[{hi}:{lo}]")
 }
 
-/// Defines `out = (a * b) mod 2^m` (`a` and `b` read as they are in the stage, unsigned) as
-/// partial products of `tile`-bit chunks ([`tile_bits`]), only those with a bit below 2^m, each
-/// cut to the bits it adds there. A plain `*` would take every tile of the full product:
-/// synthesis keeps a tile as long as one of its bits is read. A chunk of at most [`LOGIC_BITS`] bits (the narrower operand's
-/// top, say) is multiplied in logic instead, as shifted adds against the whole other operand.
-fn mul_mod(sp: &mut Stager, tile: u32, out: &str, a: (&str, u32), b: (&str, u32), m: u32) {
-    let terms = partial_products(sp, tile, out, a, b, m);
-    sum_partials(sp, out, &terms, m);
-}
-
-/// [`mul_mod`]'s partial products, each its own wire `<out>_<n>`: `(name, width, offset)`.
+/// The partial products of `out = (a * b) mod 2^m` (`a` and `b` read as they are in the stage,
+/// unsigned), which [`sum_partials`] joins (a stage later from `--pipeline 1`): the products of
+/// `tile`-bit chunks ([`tile_bits`]), only those with a bit below 2^m, each cut to the bits it
+/// adds there, each its own wire `<out>_<n>`, returned as `(name, width, offset)`. A plain `*`
+/// would take every tile of the full product: synthesis keeps a tile as long as one of its bits
+/// is read. A chunk of at most [`LOGIC_BITS`] bits (the narrower operand's top, say) is
+/// multiplied in logic instead, as shifted adds against the whole other operand, and so is a
+/// piece of at most [`LOGIC_ADDER_BITS`] adder bits.
 fn partial_products(sp: &mut Stager, tile: u32, out: &str, (a, aw): (&str, u32), (b, bw): (&str, u32), m: u32) -> Vec<(String, u32, u32)> {
     let ((a, aw), (b, bw)) = if aw >= bw { ((a, aw), (b, bw)) } else { ((b, bw), (a, aw)) };
     let chunks = |w: u32| (0..w.div_ceil(tile)).map(move |i| (i * tile, (w - i * tile).min(tile)));
@@ -79,7 +88,7 @@ fn partial_products(sp: &mut Stager, tile: u32, out: &str, (a, aw): (&str, u32),
         let (nx, ny) = (xw.min(need), yw.min(need));
         let (sx, sy) = (bits_of(x, wx, xo + nx - 1, xo), bits_of(y, wy, yo + ny - 1, yo));
         let name = format!("{out}_{}", terms.len());
-        let value = if nx.min(ny) <= LOGIC_BITS {
+        let value = if nx.min(ny) <= LOGIC_BITS || adder_bits(nx.min(ny), need) <= LOGIC_ADDER_BITS {
             let ((n, nw), (v, vw)) = if nx <= ny { ((sx, nx), (sy, ny)) } else { ((sy, ny), (sx, nx)) };
             let v = zext(&v, vw, need);
             (0..nw)
@@ -152,6 +161,9 @@ pub(super) fn path(hw: &Hw, body: &mut Vec<Item>) -> Stager {
     // The estimate's bits and the ones below: the product modulo 2^(K - t + IW).
     let prod_w = sum_w - t + iw;
     let corr_w = area_w + 3;
+    // Gxn lo is `((Gxn >> z) lo) << z`: the product is z bits narrower (golden's `Widths::gx_lo`).
+    let zeros = Widths::GXN_ZEROS;
+    let gx_w = s2_w - 1 - zeros;
     let head = End { x: "x", gx: "gx", s2: "s2n", h: "h", lo: "lo", prod: "prod", qt: "qt", m: "m", corr: "corr", out: "i0" };
     let tail = End { x: "xh", gx: "gxh", s2: "s2h", h: "hh", lo: "hi", prod: "prodh", qt: "qh", m: "mh", corr: "corrh", out: "ilast" };
     let ends: Vec<&End> = if scan { vec![&head, &tail] } else { vec![&head] };
@@ -163,15 +175,18 @@ pub(super) fn path(hw: &Hw, body: &mut Vec<Item>) -> Stager {
         ("x", xw, "lo_u".into()),
         ("len", xw + 1, format!("len_w[{xw}:0]")),
         ("tn", s2_w - 1, format!("{}[{}:0]", row("w_tn"), s2_w - 2)),
-        ("gxn", s2_w - 1, format!("{}[{}:0]", row("w_gxn"), s2_w - 2)),
+        ("gxn", gx_w, format!("{}[{}:{zeros}]", row("w_gxn"), s2_w - 2)),
         ("an", area_w, row("w_an")),
         ("rn", recip_w, row("w_rn")),
     ] {
         sp.input_as(n, ww, false, &src);
     }
-    // The walker's sums are modulo 2^K; the span path reads their residues modulo 2^(K-2).
+    // The walker's sums are modulo 2^K; the span path reads their residues modulo 2^(K-2), and
+    // Gxn's low bits are zero (golden's `Widths::GXN_ZEROS`).
     body.push(comment("verilator lint_off UNUSEDSIGNAL"));
     body.push(wire("unused_sums_top", 4, format!("{{w_tn[{0}:{1}], w_gxn[{0}:{1}]}}", sum_w - 1, sum_w - 2)));
+    let gxn_low = format!("{}[{}:0]", row("w_gxn"), zeros - 1);
+    body.push(wire("unused_gxn_low", zeros, gxn_low));
     body.push(comment("verilator lint_on UNUSEDSIGNAL"));
     if scan {
         sp.input_as("xh", xw, false, &format!("hi3[{}:0]", xw - 1));
@@ -183,17 +198,25 @@ pub(super) fn path(hw: &Hw, body: &mut Vec<Item>) -> Stager {
     }
     sp.cut();
     i0_section(&mut sp);
-    // Gxn lo modulo 2^(K-2): S2n's residue needs no more.
-    sp.note(comment("verilator lint_off UNUSEDSIGNAL"));
+    // Gxn lo modulo 2^(K-2): S2n's residue needs no more. Its partial products in one stage,
+    // their sum in the next.
+    let mut gx_partials = Vec::new();
     for e in &ends {
         let (gxn, x) = (sp.at("gxn"), sp.at(e.x));
-        mul_mod(&mut sp, tile, e.gx, (&gxn, s2_w - 1), (&x, xw), s2_w - 1);
+        gx_partials.push(partial_products(&mut sp, tile, e.gx, (&gxn, gx_w), (&x, xw), gx_w));
+    }
+    sp.cut();
+    i0_section(&mut sp);
+    sp.note(comment("verilator lint_off UNUSEDSIGNAL"));
+    for (e, terms) in ends.iter().zip(&gx_partials) {
+        sum_partials(&mut sp, e.gx, terms, gx_w);
     }
     sp.note(comment("verilator lint_on UNUSEDSIGNAL"));
     sp.cut();
     i0_section(&mut sp);
     for e in &ends {
-        let sum = format!("{} + {}", zext(&sp.at("tn"), s2_w - 1, s2_w), zext(&sp.at(e.gx), s2_w - 1, s2_w));
+        let gx = format!("{{{}, {}}}", sp.at(e.gx), lit(zeros, 0));
+        let sum = format!("{} + {}", zext(&sp.at("tn"), s2_w - 1, s2_w), zext(&gx, s2_w - 1, s2_w));
         sp.def(e.s2, s2_w, false, format!("(({sum}) << 1) + {}", zext(&sp.at("an"), area_w, s2_w)));
     }
     sp.cut();
@@ -218,11 +241,18 @@ pub(super) fn path(hw: &Hw, body: &mut Vec<Item>) -> Stager {
     }
     sp.cut();
     i0_section(&mut sp);
+    // q~ An modulo 2^(AW+2), doubled: the correction's modulus. Its partial products in one
+    // stage, their sum in the next.
+    let mut m_partials = Vec::new();
     for e in &ends {
-        // q~ An modulo 2^(AW+2), doubled: the correction's modulus.
         let (qt, an) = (sp.at(e.qt), sp.at("an"));
+        m_partials.push(partial_products(&mut sp, tile, &format!("{}_an", e.m), (&an, area_w), (&qt, iw), corr_w - 1));
+    }
+    sp.cut();
+    i0_section(&mut sp);
+    for (e, terms) in ends.iter().zip(&m_partials) {
         let half_m = format!("{}_an", e.m);
-        mul_mod(&mut sp, tile, &half_m, (&an, area_w), (&qt, iw), corr_w - 1);
+        sum_partials(&mut sp, &half_m, terms, corr_w - 1);
         sp.def(e.m, corr_w, false, format!("{{{half_m}, 1'b0}}"));
     }
     sp.cut();
