@@ -63,7 +63,9 @@
 //! `(IW + 1) x RW` bits (at the defaults 21 x 23: two 18-bit tiles and a 3-bit slice in logic;
 //! the full `K x RW` product took eight tiles), and the correction's, `q~ An`, is `IW x AW` bits
 //! needed modulo 2^(AW+2) only, doubled to the remainder's 2^(AW+3) (the partial products wholly
-//! above it are never built). `t = AW - 1` would
+//! above it are never built; at the defaults two tiles, the 2 top bits of `q~` and the corner of
+//! `An`'s top 6 bits against `q~`'s low 8 in logic). With `Gxn lo`'s three (54 x 12 bits, from
+//! `Gxn >> 8`: [`Widths::GXN_ZEROS`]) the span path takes 7 tiles a row. `t = AW - 1` would
 //! need one compare but a 22-bit `H`, four tiles. A shift one further (`t = AW + 1`) lets the
 //! estimate fall three below, and a compare dropped leaves two-below uncorrected: the tests plant
 //! both.

@@ -147,7 +147,7 @@ pub struct VariantArgs {
     pub fe_setup: Option<SetupForm>,
     /// Register stages added for clock rate, 0..3 (golden::pipeline): 1 registers the span and
     /// the shader's increments, splits the specular unit's multiplies, and stages the
-    /// front-end (CALC in five clocks, its span path in six), 2 also the shader's lane sums, 3 cuts the shader's adders
+    /// front-end (CALC in five clocks, its span path in eight), 2 also the shader's lane sums, 3 cuts the shader's adders
     /// so no clock has two in a row (same stages as 2). Values and throughput are the same at every
     /// level; latency grows (manifest.json). 0, the default: SPEC's seed structure, smallest
     /// and shortest (docs/fpga.md compares the levels). Or the target's choice.

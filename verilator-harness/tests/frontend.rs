@@ -461,7 +461,7 @@ fn engine_spans_equal_golden_on_a_small_screen() {
 }
 
 /// The slow tier: the ECP5 plan at `--target ecp5-25f`'s level (`--pipeline 1`: the set-up's
-/// result behind the row stage and the span path's six stages), on the small screen.
+/// result behind the row stage and the span path's eight stages), on the small screen.
 #[test]
 #[ignore]
 fn engine_spans_equal_golden_at_the_targets_pipeline_level() {
