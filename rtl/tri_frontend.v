@@ -465,16 +465,17 @@ module tri_frontend (
   reg p2_v;
   // Stage registers: p<j>_<name> holds <name> in stage j (whole values: a stage
   // may read a slice only).
+  reg [41:0] p1_an;
   reg [62:0] p1_s2n;
   reg [22:0] p1_rn;
-  reg [41:0] p1_an;
   reg [8:0] p1_y;
   reg [11:0] p1_x;
   reg [12:0] p1_len;
   reg [20:0] p1_di;
   reg [19:0] p2_qt;
   reg [41:0] p2_an;
-  reg [44:0] p2_lo;
+  reg [44:0] p2_corr_a2;
+  reg [44:0] p2_corr_a4;
   reg [8:0] p2_y;
   reg [11:0] p2_x;
   reg [12:0] p2_len;
@@ -495,8 +496,12 @@ module tri_frontend (
   // Span path, step 3 (stage p0): S2n = 2 (Tn + Gxn lo) + An modulo 2^(K-1).
   wire [62:0] s2n = (({1'd0, w_tn[61:0]} + {1'd0, {gx, 8'd0}}) << 1) + {21'd0, w_an};
 
-  // Span path, step 4 (stage p1): its top bits H = S2n >> t and the partial products of H Rn.
+  // Span path, step 4 (stage p1): its top bits H = S2n >> t and the partial products of H Rn; S2n - 2An and S2n - 4An modulo 2^(AW+3).
+  wire [44:0] an2 = {3'd0, p1_an} << 1;
+  wire [44:0] an4 = {3'd0, p1_an} << 2;
   wire [44:0] lo = p1_s2n[44:0];
+  wire [44:0] corr_a2 = lo - an2;
+  wire [44:0] corr_a4 = lo - an4;
   wire [20:0] h = p1_s2n[62:42];
   wire [41:0] prod_0 = {24'd0, p1_rn[17:0]} * {24'd0, h[17:0]};
   wire [23:0] prod_1 = {19'd0, p1_rn[22:18]} * {6'd0, h[17:0]};
@@ -508,22 +513,26 @@ module tri_frontend (
   // verilator lint_on UNUSEDSIGNAL
   wire [19:0] qt = prod[41:22];
 
-  // Span path, step 6 (stage p2): the partial products of q~ An modulo 2^(AW+2).
+  // Span path, step 6 (stage p2): the partial products of q~ An modulo 2^(AW+2); q~ + 1 and q~ + 2.
   wire [43:0] m_an_0 = {26'd0, p2_an[17:0]} * {26'd0, p2_qt[17:0]};
   wire [25:0] m_an_1 = {8'd0, p2_an[35:18]} * {8'd0, p2_qt[17:0]};
   wire [7:0] m_an_2 = ({8{p2_an[36:36]}} & p2_qt[7:0]) + ({8{p2_an[37:37]}} & (p2_qt[7:0] << 1)) + ({8{p2_an[38:38]}} & (p2_qt[7:0] << 2)) + ({8{p2_an[39:39]}} & (p2_qt[7:0] << 3)) + ({8{p2_an[40:40]}} & (p2_qt[7:0] << 4)) + ({8{p2_an[41:41]}} & (p2_qt[7:0] << 5));
   wire [25:0] m_an_3 = ({26{p2_qt[18:18]}} & p2_an[25:0]) + ({26{p2_qt[19:19]}} & (p2_an[25:0] << 1));
+  wire [19:0] qt1 = p2_qt + 20'd1;
+  wire [19:0] qt2 = p2_qt + 20'd2;
 
   // Span path, step 7 (stage p2): their sum, doubled: q~ 2An modulo 2^(AW+3).
   wire [43:0] m_an = m_an_0 + ({18'd0, m_an_1} << 18) + ({36'd0, m_an_2} << 36) + ({18'd0, m_an_3} << 18);
   wire [44:0] m = {m_an, 1'b0};
 
-  // Span path, step 8 (stage p2): I0 = q~ + (R >= 2An) + (R >= 4An), R = S2n - 2An q~: the correction.
-  wire [44:0] an2 = {3'd0, p2_an} << 1;
-  wire [44:0] an4 = {3'd0, p2_an} << 2;
-  wire [44:0] corr = p2_lo - m;
-  wire [1:0] i0_up = {corr >= an4, (corr >= an2) ^ (corr >= an4)};
-  wire [19:0] i0 = p2_qt + {18'd0, i0_up};
+  // Span path, step 8 (stage p2): I0 = q~ + (R >= 2An) + (R >= 4An), R = S2n - 2An q~: the correction, R >= 2k An the sign of (S2n - 2k An) - 2An q~.
+  // verilator lint_off UNUSEDSIGNAL
+  wire [44:0] corr2 = p2_corr_a2 - m;
+  wire [44:0] corr4 = p2_corr_a4 - m;
+  // verilator lint_on UNUSEDSIGNAL
+  wire i0_ge2 = !corr2[44];
+  wire i0_ge4 = !corr4[44];
+  wire [19:0] i0 = i0_ge4 ? qt2 : i0_ge2 ? qt1 : p2_qt;
   always @(posedge clk) begin
     if (rst) begin
       p1_v <= 1'b0;
@@ -532,16 +541,17 @@ module tri_frontend (
     end else if (adv) begin
       p1_v <= emit;
       p2_v <= p1_v;
+      p1_an <= w_an;
       p1_s2n <= s2n;
       p1_rn <= w_rn;
-      p1_an <= w_an;
       p1_y <= w_row;
       p1_x <= lo_u;
       p1_len <= len_w[12:0];
       p1_di <= w_di;
       p2_qt <= qt;
       p2_an <= p1_an;
-      p2_lo <= lo;
+      p2_corr_a2 <= corr_a2;
+      p2_corr_a4 <= corr_a4;
       p2_y <= p1_y;
       p2_x <= p1_x;
       p2_len <= p1_len;

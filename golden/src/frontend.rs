@@ -59,7 +59,11 @@
 //! because An is normalised), the second below `2^(K-1) / 2^K = 1/2` (`H 2^t <= S2n`): the
 //! estimate's argument is less than 3/2 below `S2n / 2An >= q`, so `q~ >= q - 2`. The remainder
 //! `R = S2n - 2An q~` is then in `[0, 6An)`, below 2^(AW+3): modulo 2^(AW+3) it is exact, and
-//! `q = q~ + (R >= 2An) + (R >= 4An)`. `H` has IW + 1 bits, so the estimate's product is
+//! `q = q~ + (R >= 2An) + (R >= 4An)`. Neither compare needs a comparator behind the
+//! subtraction: `R - 2k An` (k = 1, 2) lies in `[-2k An, (6 - 2k) An)`, within `(-2^(AW+2),
+//! 2^(AW+2))` as `An < 2^AW`, so it is negative exactly when bit AW + 2 of its residue modulo
+//! 2^(AW+3) is set, and that residue is `((S2n - 2k An) - 2An q~) mod 2^(AW+3)`, whose first
+//! difference does not wait for the product. `H` has IW + 1 bits, so the estimate's product is
 //! `(IW + 1) x RW` bits (at the defaults 21 x 23: two 18-bit tiles and a 3-bit slice in logic;
 //! the full `K x RW` product took eight tiles), and the correction's, `q~ An`, is `IW x AW` bits
 //! needed modulo 2^(AW+2) only, doubled to the remainder's 2^(AW+3) (the partial products wholly
@@ -277,13 +281,18 @@ impl Widths {
 
     /// `q~ + #{k in 1..=compares : R >= 2k An}` with the remainder `R = S2n - 2An q~` modulo
     /// 2^(AW+3): the arithmetic for any shift `t` and number of compares (the tests plant a
-    /// shift one too far and a compare dropped).
+    /// shift one too far and a compare dropped). As the RTL forms it, each compare is the top
+    /// bit of `((S2n - 2k An) - 2An q~) mod 2^(AW+3)`, the first difference formed beside the
+    /// products: `R - 2k An` lies in `[-4An, 4An)`, `4An < 2^(AW+2)`, so it is negative exactly
+    /// when its residue has bit AW + 2 set (module documentation).
     pub fn corrected_quotient(&self, s2n: u128, an: u128, rn: u128, t: u32, compares: u32) -> u32 {
         let iw = self.k - 2 - self.aw;
+        let m = mask(self.aw + 3);
         let qt = self.quotient_estimate(s2n, rn, t) & mask(iw);
-        let rem = s2n.wrapping_sub(qt * 2 * an) & mask(self.aw + 3);
-        let up = (1..=compares as u128).filter(|&k| rem >= 2 * k * an).count() as u128;
-        ((qt + up) & mask(iw)) as u32
+        let prod = (qt * 2 * an) & m;
+        let negative = |k: u128| (((s2n.wrapping_sub(2 * k * an) & m).wrapping_sub(prod) & m) >> (self.aw + 2)) == 1;
+        let up = (1..=compares as u128).filter(|&k| !negative(k));
+        ((qt + up.count() as u128) & mask(iw)) as u32
     }
 }
 

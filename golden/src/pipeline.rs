@@ -181,11 +181,11 @@ pub const I0_STAGES: [&str; 9] = [
     "the partial products of (Gxn >> 8) lo, the plane's step to the first pixel (Gxn's low 8 bits are zero)",
     "their sum, Gxn lo modulo 2^(K-2)",
     "S2n = 2 (Tn + Gxn lo) + An modulo 2^(K-1)",
-    "its top bits H = S2n >> t and the partial products of H Rn",
+    "its top bits H = S2n >> t and the partial products of H Rn; S2n - 2An and S2n - 4An modulo 2^(AW+3)",
     "the quotient estimate q~ = (H Rn) >> (K - t), the quotient or up to two below it",
-    "the partial products of q~ An modulo 2^(AW+2)",
+    "the partial products of q~ An modulo 2^(AW+2); q~ + 1 and q~ + 2",
     "their sum, doubled: q~ 2An modulo 2^(AW+3)",
-    "I0 = q~ + (R >= 2An) + (R >= 4An), R = S2n - 2An q~: the correction",
+    "I0 = q~ + (R >= 2An) + (R >= 4An), R = S2n - 2An q~: the correction, R >= 2k An the sign of (S2n - 2k An) - 2An q~",
 ];
 
 /// The front-end set-up's CALC stages when it is pipelined, in order: what each clock computes

@@ -222,9 +222,17 @@ pub(super) fn path(hw: &Hw, body: &mut Vec<Item>) -> Stager {
     sp.cut();
     i0_section(&mut sp);
     let mut partials = Vec::new();
+    let an = sp.at("an");
+    sp.def("an2", corr_w, false, format!("{} << 1", zext(&an, area_w, corr_w)));
+    sp.def("an4", corr_w, false, format!("{} << 2", zext(&an, area_w, corr_w)));
     for e in &ends {
         let s2 = sp.at(e.s2);
         sp.def(e.lo, corr_w, false, format!("{s2}[{}:0]", corr_w - 1));
+        // The remainder's residue less 2An and 4An, ahead of the product (golden's
+        // `Widths::corrected_quotient`): the correction then subtracts the product once.
+        for k in [2, 4] {
+            sp.def(&format!("{}_a{k}", e.corr), corr_w, false, format!("{} - an{k}", e.lo));
+        }
         sp.def(e.h, h_w, false, format!("{s2}[{}:{t}]", s2_w - 1));
         let rn = sp.at("rn");
         partials.push(partial_products(&mut sp, tile, e.prod, (e.h, h_w), (&rn, recip_w), prod_w));
@@ -247,6 +255,10 @@ pub(super) fn path(hw: &Hw, body: &mut Vec<Item>) -> Stager {
     for e in &ends {
         let (qt, an) = (sp.at(e.qt), sp.at("an"));
         m_partials.push(partial_products(&mut sp, tile, &format!("{}_an", e.m), (&an, area_w), (&qt, iw), corr_w - 1));
+        // The corrected quotient's other two values, beside the product.
+        for k in [1, 2] {
+            sp.def(&format!("{}{k}", e.qt), iw, false, format!("{qt} + {}", lit(iw, k)));
+        }
     }
     sp.cut();
     i0_section(&mut sp);
@@ -257,17 +269,23 @@ pub(super) fn path(hw: &Hw, body: &mut Vec<Item>) -> Stager {
     }
     sp.cut();
     i0_section(&mut sp);
-    let an = sp.at("an");
-    sp.def("an2", corr_w, false, format!("{} << 1", zext(&an, area_w, corr_w)));
-    sp.def("an4", corr_w, false, format!("{} << 2", zext(&an, area_w, corr_w)));
     for e in &ends {
-        let (lo, m, qt) = (sp.at(e.lo), sp.at(e.m), sp.at(e.qt));
-        sp.def(e.corr, corr_w, false, format!("{lo} - {m}"));
-        // R >= 4An implies R >= 2An: the count of the two is this 2-bit code, one add to q~
-        // (two one-bit adds made a three-operand sum, which Yosys maps to LUT4 full adders).
-        let up = format!("{}_up", e.out);
-        sp.def(&up, 2, false, format!("{{{0} >= an4, ({0} >= an2) ^ ({0} >= an4)}}", e.corr));
-        sp.def(e.out, iw, false, format!("{qt} + {}", zext(&up, 2, iw)));
+        let m = sp.at(e.m);
+        // R - 2k An = ((S2n - 2k An) - 2An q~) mod 2^(AW+3) is negative exactly when its top bit
+        // is set (golden's `Widths::corrected_quotient`), and R >= 4An implies R >= 2An: one
+        // subtraction and a select of q~, q~ + 1, q~ + 2 (a compare after the subtraction and an
+        // add after it were the 25F's critical path, docs/fpga.md).
+        sp.note(comment("verilator lint_off UNUSEDSIGNAL"));
+        for k in [2, 4] {
+            let a = sp.at(&format!("{}_a{k}", e.corr));
+            sp.def(&format!("{}{k}", e.corr), corr_w, false, format!("{a} - {m}"));
+        }
+        sp.note(comment("verilator lint_on UNUSEDSIGNAL"));
+        for k in [2, 4] {
+            sp.def(&format!("{}_ge{k}", e.out), 1, false, format!("!{}{k}[{}]", e.corr, corr_w - 1));
+        }
+        let (qt, qt1, qt2) = (sp.at(e.qt), sp.at(&format!("{}1", e.qt)), sp.at(&format!("{}2", e.qt)));
+        sp.def(e.out, iw, false, format!("{0}_ge4 ? {qt2} : {0}_ge2 ? {qt1} : {qt}", e.out));
     }
     sp
 }
