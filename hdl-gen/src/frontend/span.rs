@@ -270,24 +270,29 @@ pub(super) fn path(hw: &Hw, body: &mut Vec<Item>) -> Stager {
     sp.cut();
     i0_section(&mut sp);
     for e in &ends {
-        let m = sp.at(e.m);
-        // R - 2k An = ((S2n - 2k An) - 2An q~) mod 2^(AW+3) is negative exactly when its top bit
-        // is set (golden's `Widths::corrected_quotient`), and R >= 4An implies R >= 2An: one
-        // subtraction and a select of q~, q~ + 1, q~ + 2 (a compare after the subtraction and an
-        // add after it were the 25F's critical path, docs/fpga.md).
-        sp.note(comment("verilator lint_off UNUSEDSIGNAL"));
-        for k in [2, 4] {
-            let a = sp.at(&format!("{}_a{k}", e.corr));
-            sp.def(&format!("{}{k}", e.corr), corr_w, false, format!("{a} - {m}"));
-        }
-        sp.note(comment("verilator lint_on UNUSEDSIGNAL"));
-        for k in [2, 4] {
-            sp.def(&format!("{}_ge{k}", e.out), 1, false, format!("!{}{k}[{}]", e.corr, corr_w - 1));
-        }
-        let (qt, qt1, qt2) = (sp.at(e.qt), sp.at(&format!("{}1", e.qt)), sp.at(&format!("{}2", e.qt)));
-        sp.def(e.out, iw, false, format!("{0}_ge4 ? {qt2} : {0}_ge2 ? {qt1} : {qt}", e.out));
+        correction(&mut sp, e, iw, corr_w);
     }
     sp
+}
+
+/// The last stage: `I0` from `q~`, `q~ + 1`, `q~ + 2` by the signs of `R - 2An` and `R - 4An`.
+/// `R - 2k An = ((S2n - 2k An) - 2An q~) mod 2^(AW+3)` is negative exactly when its top bit is
+/// set (golden's `Widths::corrected_quotient`), and R >= 4An implies R >= 2An: one subtraction
+/// and a select (a compare after the subtraction and an add after it were the 25F's critical
+/// path, docs/fpga.md).
+fn correction(sp: &mut Stager, e: &End, iw: u32, corr_w: u32) {
+    let m = sp.at(e.m);
+    sp.note(comment("verilator lint_off UNUSEDSIGNAL"));
+    for k in [2, 4] {
+        let a = sp.at(&format!("{}_a{k}", e.corr));
+        sp.def(&format!("{}{k}", e.corr), corr_w, false, format!("{a} - {m}"));
+    }
+    sp.note(comment("verilator lint_on UNUSEDSIGNAL"));
+    for k in [2, 4] {
+        sp.def(&format!("{}_ge{k}", e.out), 1, false, format!("!{}{k}[{}]", e.corr, corr_w - 1));
+    }
+    let (qt, qt1, qt2) = (sp.at(e.qt), sp.at(&format!("{}1", e.qt)), sp.at(&format!("{}2", e.qt)));
+    sp.def(e.out, iw, false, format!("{0}_ge4 ? {qt2} : {0}_ge2 ? {qt1} : {qt}", e.out));
 }
 
 /// The output register, loaded from the span path's last stage (per scanline, after the span's
