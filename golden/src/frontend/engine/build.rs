@@ -1,7 +1,7 @@
 //! The set-up as a program: [`FrontEnd::setup`]'s arithmetic, one operation a line, with the
 //! widths the RTL's registers have (`Widths`, and CALC's own in `hdl-gen/src/frontend/calc.rs`).
 
-use super::{EdgeOut, Kind, Op, Outputs, Plan, Program, StepOut, V};
+use super::{DivForm, EdgeOut, Kind, Op, Outputs, Plan, Program, StepOut, V};
 use crate::frontend::{FrontEnd, Widths};
 use crate::setup::SUBPIXEL;
 
@@ -190,8 +190,12 @@ impl Program {
         }
         // The rows and columns of the bounding box; cull.
         let (first, last, cull) = rows(&mut b, fe, &x, &y, azero, kill);
-        // Per edge: its rows, its DDA's step and first bound.
-        let edges: Vec<EdgeOut> = dirs.iter().enumerate().map(|(k, dir)| edge(&mut b, &wd, k, dir, &x, &y, first, last)).collect();
+        // Per edge: its rows, its DDA's step and first bound. The engine's dividers take g by
+        // |dy| (`edge`); today's (`DivForm::ShiftDivisor`, the parallel form's, which the LUT
+        // estimate's calibration counts) by D.
+        let short_g = plan.div_form == DivForm::ShiftRemainder;
+        let edges: Vec<EdgeOut> =
+            dirs.iter().enumerate().map(|(k, dir)| edge(&mut b, &wd, k, dir, &x, &y, (first, last), short_g)).collect();
         // The plane: the normal from unoriented products, oriented.
         let d1 = b.sub("d1", i[1], i[0], iw + 1);
         let d2 = b.sub("d2", i[2], i[0], iw + 1);
@@ -349,7 +353,7 @@ struct Dir {
 /// Edge k's rows, its DDA's step `Qs` and first bound `g`, both divisions biased by
 /// B = 2^(GW-1) divisors so the dividends are non-negative (q = value + B).
 #[allow(clippy::too_many_arguments)]
-fn edge(b: &mut B, wd: &Widths, k: usize, dir: &Dir, x: &[V; 3], y: &[V; 3], first: V, last: V) -> EdgeOut {
+fn edge(b: &mut B, wd: &Widths, k: usize, dir: &Dir, x: &[V; 3], y: &[V; 3], (first, last): (V, V), short_g: bool) -> EdgeOut {
     let Widths { cx, cy, gw, .. } = *wd;
     let Dir { ea, dx, dy, up, dyz, ntl } = *dir;
     let rw_s = cy - 7;
@@ -387,7 +391,19 @@ fn edge(b: &mut B, wd: &Widths, k: usize, dir: &Dir, x: &[V; 3], y: &[V; 3], fir
     let e = b.sub(&format!("et{k}"), e, ntl, cx + cy + 5);
     let bd = b.shl(&format!("BD{k}"), d, gw - 1, wd.dw_edge + gw, false);
     let n = b.add(&format!("n{k}"), e, bd, cx + cy + 5);
-    let (gb, rem) = b.div(&format!("g{k}"), n, d, gw, gw + wd.dw_edge, wd.dw_edge);
+    let (gb, rem) = if short_g {
+        // D = 256 |dy| has eight zero bits: floor(n / D) = floor((n >> 8) / |dy|), and the
+        // remainder is that division's, shifted back, with n's low byte. So the divider is as
+        // wide as |dy| (CY bits, as Qs's), not as D (CY + 8): Qs's and g's dividers are one width.
+        let nh = b.op(format!("n{k}>>8"), Kind::Shr(n, 8), cx + cy - 3, false);
+        let zero = b.c(0);
+        let nl = b.op(format!("n{k}lo"), Kind::Add(n, zero), 8, false);
+        let (gb, rh) = b.div(&format!("g{k}"), nh, ady, gw, gw + cy, cy);
+        let rh8 = b.shl(&format!("rem8_{k}"), rh, 8, wd.dw_edge, false);
+        (gb, b.op(format!("rem{k}"), Kind::Add(rh8, nl), wd.dw_edge, false))
+    } else {
+        b.div(&format!("g{k}"), n, d, gw, gw + wd.dw_edge, wd.dw_edge)
+    };
     let g = b.add_c(&format!("g{k}-B"), gb, -bias, gw);
     EdgeOut { dyz, right, active, rs, re, g, rem, d, qs, rs256 }
 }
