@@ -16,7 +16,14 @@ struct B {
 }
 
 impl B {
+    /// An operation, or the same operation already in the program (same kind, operands, width
+    /// and signedness; its first name stays): the set-up's formulas repeat a few (edge 2's
+    /// direction is `dx1`, `dy1`; its rows' compares are `ymin`'s and `ymax`'s; its `128 - xa`
+    /// is the plane's `xo`), and each repeat would be one more register and its logic.
     fn op(&mut self, name: impl Into<String>, kind: Kind, w: u32, signed: bool) -> V {
+        if let Some(k) = self.ops.iter().position(|o| o.kind == kind && o.w == w && o.signed == signed) {
+            return V(k as u32);
+        }
         self.ops.push(Op { kind, w, signed, name: name.into() });
         V(self.ops.len() as u32 - 1)
     }
