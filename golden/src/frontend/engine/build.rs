@@ -196,13 +196,14 @@ impl Program {
             dirs.push(Dir { ea, dx, dy, up, dyz, ntl });
         }
         // The rows and columns of the bounding box; cull.
-        let (first, last, cull) = rows(&mut b, fe, &x, &y, azero, kill);
+        let (rt, rb) = vrows(&mut b, &wd, &y);
+        let (first, last, cull) = rows(&mut b, fe, &x, &y, &rt, azero, kill);
         // Per edge: its rows, its DDA's step and first bound. The engine's dividers take g by
         // |dy| (`edge`); today's (`DivForm::ShiftDivisor`, the parallel form's, which the LUT
         // estimate's calibration counts) by D.
         let short_g = plan.div_form == DivForm::ShiftRemainder;
         let edges: Vec<EdgeOut> =
-            dirs.iter().enumerate().map(|(k, dir)| edge(&mut b, &wd, k, dir, &x, &y, (first, last), short_g)).collect();
+            dirs.iter().enumerate().map(|(k, dir)| edge(&mut b, &wd, k, dir, &x, &y, (&rt, &rb), (first, last), short_g)).collect();
         // The plane: the normal from unoriented products, oriented.
         let d1 = b.sub("d1", i[1], i[0], iw + 1);
         let d2 = b.sub("d2", i[2], i[0], iw + 1);
@@ -315,30 +316,45 @@ fn i0_steps(b: &mut B, wd: &Widths, iw: u32, by_a: &ByA, aabs: V, nx: V, ny: V, 
     (col0, [edge[0], edge[1], edge[2]])
 }
 
+/// Each vertex's first row at or below it and last row above it (centres at +128 sub-pixels):
+/// the edges' rows and the first row are least or greatest of these.
+fn vrows(b: &mut B, wd: &Widths, y: &[V; 3]) -> ([V; 3], [V; 3]) {
+    let (cy, rw_s) = (wd.cy, wd.cy - 7);
+    let row = |b: &mut B, n: &str, v: V, c: i128| {
+        let t = b.add_c(&format!("{n}_c"), v, c, cy + 1);
+        b.op(n, Kind::Shr(t, 8), rw_s, true)
+    };
+    let rt = [0, 1, 2].map(|k| row(b, &format!("rt{k}"), y[k], 127));
+    let rb = [0, 1, 2].map(|k| row(b, &format!("rb{k}"), y[k], -128));
+    (rt, rb)
+}
+
 /// The rows and columns of the bounding box (centres at +128 sub-pixels), and cull.
-fn rows(b: &mut B, fe: &FrontEnd, x: &[V; 3], y: &[V; 3], azero: V, kill: V) -> (V, V, V) {
+fn rows(b: &mut B, fe: &FrontEnd, x: &[V; 3], y: &[V; 3], rt: &[V; 3], azero: V, kill: V) -> (V, V, V) {
     let Widths { cx, cy, .. } = fe.widths();
     let (w, h) = (fe.screen.width as i128, fe.screen.height as i128);
-    let ymin = b.min("ymin", y[0], y[1], true);
-    let ymin = b.min("ymin", ymin, y[2], true);
+    // The first row and the columns as the least or greatest of the vertices' own (a floor of a
+    // shift is monotone): selects of row and column numbers, not of sub-pixel coordinates.
+    let t = b.min("first_raw", rt[0], rt[1], true);
+    let t = b.min("first_raw", t, rt[2], true);
+    let first = b.max_c("first", t, 0);
     let ymax = b.min("ymax", y[0], y[1], false);
     let ymax = b.min("ymax", ymax, y[2], false);
-    let xmin = b.min("xmin", x[0], x[1], true);
-    let xmin = b.min("xmin", xmin, x[2], true);
-    let xmax = b.min("xmax", x[0], x[1], false);
-    let xmax = b.min("xmax", xmax, x[2], false);
     let rw_s = cy - 7;
-    let t = b.add_c("ymin_c", ymin, 127, cy + 1);
-    let t = b.op("first_raw", Kind::Shr(t, 8), rw_s, true);
-    let first = b.max_c("first", t, 0);
     let t = b.add_c("ymax_c", ymax, -128, cy + 1);
     let t = b.sub("ymax_k", t, kill, cy + 1);
     let t = b.op("last_raw", Kind::Shr(t, 8), rw_s, true);
     let last = b.min_c("last", t, h - 1);
-    let t = b.add_c("xmin_c", xmin, 127, cx + 1);
-    let cfirst = b.op("cfirst", Kind::Shr(t, 8), cx - 7, true);
-    let t = b.add_c("xmax_c", xmax, -128, cx + 1);
-    let clast = b.op("clast", Kind::Shr(t, 8), cx - 7, true);
+    let col = |b: &mut B, n: &str, v: V, c: i128| {
+        let t = b.add_c(&format!("{n}_c"), v, c, cx + 1);
+        b.op(n, Kind::Shr(t, 8), cx - 7, true)
+    };
+    let cf = [0, 1, 2].map(|k| col(b, &format!("cf{k}"), x[k], 127));
+    let cl = [0, 1, 2].map(|k| col(b, &format!("cl{k}"), x[k], -128));
+    let cfirst = b.min("cfirst", cf[0], cf[1], true);
+    let cfirst = b.min("cfirst", cfirst, cf[2], true);
+    let clast = b.min("clast", cl[0], cl[1], false);
+    let clast = b.min("clast", clast, cl[2], false);
     let mut cull = azero;
     for c in [b.lt(last, first), b.lt(clast, cfirst), b.gt_c(cfirst, w - 1), b.lt_c(clast, 0)] {
         cull = b.or(cull, c);
@@ -360,19 +376,25 @@ struct Dir {
 /// Edge k's rows, its DDA's step `Qs` and first bound `g`, both divisions biased by
 /// B = 2^(GW-1) divisors so the dividends are non-negative (q = value + B).
 #[allow(clippy::too_many_arguments)]
-fn edge(b: &mut B, wd: &Widths, k: usize, dir: &Dir, x: &[V; 3], y: &[V; 3], (first, last): (V, V), short_g: bool) -> EdgeOut {
+fn edge(
+    b: &mut B,
+    wd: &Widths,
+    k: usize,
+    dir: &Dir,
+    x: &[V; 3],
+    y: &[V; 3],
+    (rt, rb): (&[V; 3], &[V; 3]),
+    (first, last): (V, V),
+    short_g: bool,
+) -> EdgeOut {
     let Widths { cx, cy, gw, .. } = *wd;
     let Dir { ea, dx, dy, up, dyz, ntl } = *dir;
-    let rw_s = cy - 7;
     let bias = 1i128 << (gw - 1);
     let eb = (k + 2) % 3;
-    let yt = b.min(&format!("yt{k}"), y[ea], y[eb], true);
-    let yb = b.min(&format!("yb{k}"), y[ea], y[eb], false);
-    let t = b.add_c(&format!("ytc{k}"), yt, 127, cy + 1);
-    let t = b.op(format!("rs_raw{k}"), Kind::Shr(t, 8), rw_s, true);
+    // The edge's rows from its vertices' own row numbers (`vrows`), as `rows` takes the first.
+    let t = b.min(&format!("rs_raw{k}"), rt[ea], rt[eb], true);
     let rs = b.min(&format!("rs{k}"), t, first, false);
-    let t = b.add_c(&format!("ybc{k}"), yb, -128, cy + 1);
-    let t = b.op(format!("re_raw{k}"), Kind::Shr(t, 8), rw_s, true);
+    let t = b.min(&format!("re_raw{k}"), rb[ea], rb[eb], false);
     let re = b.min(&format!("re{k}"), t, last, true);
     let empty = b.lt(re, rs);
     let nz = b.not(dyz);
