@@ -1,7 +1,7 @@
 //! The set-up as a program: [`FrontEnd::setup`]'s arithmetic, one operation a line, with the
 //! widths the RTL's registers have (`Widths`, and CALC's own in `hdl-gen/src/frontend/calc.rs`).
 
-use super::{EdgeOut, Kind, Op, Outputs, Plan, Program, StepOut, V};
+use super::{DivForm, EdgeOut, Kind, Op, Outputs, Plan, Program, StepOut, V};
 use crate::frontend::{FrontEnd, Widths};
 use crate::setup::SUBPIXEL;
 
@@ -16,7 +16,14 @@ struct B {
 }
 
 impl B {
+    /// An operation, or the same operation already in the program (same kind, operands, width
+    /// and signedness; its first name stays): the set-up's formulas repeat a few (edge 2's
+    /// direction is `dx1`, `dy1`; its rows' compares are `ymin`'s and `ymax`'s; its `128 - xa`
+    /// is the plane's `xo`), and each repeat would be one more register and its logic.
     fn op(&mut self, name: impl Into<String>, kind: Kind, w: u32, signed: bool) -> V {
+        if let Some(k) = self.ops.iter().position(|o| o.kind == kind && o.w == w && o.signed == signed) {
+            return V(k as u32);
+        }
         self.ops.push(Op { kind, w, signed, name: name.into() });
         V(self.ops.len() as u32 - 1)
     }
@@ -189,9 +196,14 @@ impl Program {
             dirs.push(Dir { ea, dx, dy, up, dyz, ntl });
         }
         // The rows and columns of the bounding box; cull.
-        let (first, last, cull) = rows(&mut b, fe, &x, &y, azero, kill);
-        // Per edge: its rows, its DDA's step and first bound.
-        let edges: Vec<EdgeOut> = dirs.iter().enumerate().map(|(k, dir)| edge(&mut b, &wd, k, dir, &x, &y, first, last)).collect();
+        let (rt, rb) = vrows(&mut b, &wd, &y);
+        let (first, last, cull) = rows(&mut b, fe, &x, &y, &rt, azero, kill);
+        // Per edge: its rows, its DDA's step and first bound. The engine's dividers take g by
+        // |dy| (`edge`); today's (`DivForm::ShiftDivisor`, the parallel form's, which the LUT
+        // estimate's calibration counts) by D.
+        let short_g = plan.div_form == DivForm::ShiftRemainder;
+        let edges: Vec<EdgeOut> =
+            dirs.iter().enumerate().map(|(k, dir)| edge(&mut b, &wd, k, dir, &x, &y, (&rt, &rb), (first, last), short_g)).collect();
         // The plane: the normal from unoriented products, oriented.
         let d1 = b.sub("d1", i[1], i[0], iw + 1);
         let d2 = b.sub("d2", i[2], i[0], iw + 1);
@@ -304,30 +316,45 @@ fn i0_steps(b: &mut B, wd: &Widths, iw: u32, by_a: &ByA, aabs: V, nx: V, ny: V, 
     (col0, [edge[0], edge[1], edge[2]])
 }
 
+/// Each vertex's first row at or below it and last row above it (centres at +128 sub-pixels):
+/// the edges' rows and the first row are least or greatest of these.
+fn vrows(b: &mut B, wd: &Widths, y: &[V; 3]) -> ([V; 3], [V; 3]) {
+    let (cy, rw_s) = (wd.cy, wd.cy - 7);
+    let row = |b: &mut B, n: &str, v: V, c: i128| {
+        let t = b.add_c(&format!("{n}_c"), v, c, cy + 1);
+        b.op(n, Kind::Shr(t, 8), rw_s, true)
+    };
+    let rt = [0, 1, 2].map(|k| row(b, &format!("rt{k}"), y[k], 127));
+    let rb = [0, 1, 2].map(|k| row(b, &format!("rb{k}"), y[k], -128));
+    (rt, rb)
+}
+
 /// The rows and columns of the bounding box (centres at +128 sub-pixels), and cull.
-fn rows(b: &mut B, fe: &FrontEnd, x: &[V; 3], y: &[V; 3], azero: V, kill: V) -> (V, V, V) {
+fn rows(b: &mut B, fe: &FrontEnd, x: &[V; 3], y: &[V; 3], rt: &[V; 3], azero: V, kill: V) -> (V, V, V) {
     let Widths { cx, cy, .. } = fe.widths();
     let (w, h) = (fe.screen.width as i128, fe.screen.height as i128);
-    let ymin = b.min("ymin", y[0], y[1], true);
-    let ymin = b.min("ymin", ymin, y[2], true);
+    // The first row and the columns as the least or greatest of the vertices' own (a floor of a
+    // shift is monotone): selects of row and column numbers, not of sub-pixel coordinates.
+    let t = b.min("first_raw", rt[0], rt[1], true);
+    let t = b.min("first_raw", t, rt[2], true);
+    let first = b.max_c("first", t, 0);
     let ymax = b.min("ymax", y[0], y[1], false);
     let ymax = b.min("ymax", ymax, y[2], false);
-    let xmin = b.min("xmin", x[0], x[1], true);
-    let xmin = b.min("xmin", xmin, x[2], true);
-    let xmax = b.min("xmax", x[0], x[1], false);
-    let xmax = b.min("xmax", xmax, x[2], false);
     let rw_s = cy - 7;
-    let t = b.add_c("ymin_c", ymin, 127, cy + 1);
-    let t = b.op("first_raw", Kind::Shr(t, 8), rw_s, true);
-    let first = b.max_c("first", t, 0);
     let t = b.add_c("ymax_c", ymax, -128, cy + 1);
     let t = b.sub("ymax_k", t, kill, cy + 1);
     let t = b.op("last_raw", Kind::Shr(t, 8), rw_s, true);
     let last = b.min_c("last", t, h - 1);
-    let t = b.add_c("xmin_c", xmin, 127, cx + 1);
-    let cfirst = b.op("cfirst", Kind::Shr(t, 8), cx - 7, true);
-    let t = b.add_c("xmax_c", xmax, -128, cx + 1);
-    let clast = b.op("clast", Kind::Shr(t, 8), cx - 7, true);
+    let col = |b: &mut B, n: &str, v: V, c: i128| {
+        let t = b.add_c(&format!("{n}_c"), v, c, cx + 1);
+        b.op(n, Kind::Shr(t, 8), cx - 7, true)
+    };
+    let cf = [0, 1, 2].map(|k| col(b, &format!("cf{k}"), x[k], 127));
+    let cl = [0, 1, 2].map(|k| col(b, &format!("cl{k}"), x[k], -128));
+    let cfirst = b.min("cfirst", cf[0], cf[1], true);
+    let cfirst = b.min("cfirst", cfirst, cf[2], true);
+    let clast = b.min("clast", cl[0], cl[1], false);
+    let clast = b.min("clast", clast, cl[2], false);
     let mut cull = azero;
     for c in [b.lt(last, first), b.lt(clast, cfirst), b.gt_c(cfirst, w - 1), b.lt_c(clast, 0)] {
         cull = b.or(cull, c);
@@ -349,19 +376,25 @@ struct Dir {
 /// Edge k's rows, its DDA's step `Qs` and first bound `g`, both divisions biased by
 /// B = 2^(GW-1) divisors so the dividends are non-negative (q = value + B).
 #[allow(clippy::too_many_arguments)]
-fn edge(b: &mut B, wd: &Widths, k: usize, dir: &Dir, x: &[V; 3], y: &[V; 3], first: V, last: V) -> EdgeOut {
+fn edge(
+    b: &mut B,
+    wd: &Widths,
+    k: usize,
+    dir: &Dir,
+    x: &[V; 3],
+    y: &[V; 3],
+    (rt, rb): (&[V; 3], &[V; 3]),
+    (first, last): (V, V),
+    short_g: bool,
+) -> EdgeOut {
     let Widths { cx, cy, gw, .. } = *wd;
     let Dir { ea, dx, dy, up, dyz, ntl } = *dir;
-    let rw_s = cy - 7;
     let bias = 1i128 << (gw - 1);
     let eb = (k + 2) % 3;
-    let yt = b.min(&format!("yt{k}"), y[ea], y[eb], true);
-    let yb = b.min(&format!("yb{k}"), y[ea], y[eb], false);
-    let t = b.add_c(&format!("ytc{k}"), yt, 127, cy + 1);
-    let t = b.op(format!("rs_raw{k}"), Kind::Shr(t, 8), rw_s, true);
+    // The edge's rows from its vertices' own row numbers (`vrows`), as `rows` takes the first.
+    let t = b.min(&format!("rs_raw{k}"), rt[ea], rt[eb], true);
     let rs = b.min(&format!("rs{k}"), t, first, false);
-    let t = b.add_c(&format!("ybc{k}"), yb, -128, cy + 1);
-    let t = b.op(format!("re_raw{k}"), Kind::Shr(t, 8), rw_s, true);
+    let t = b.min(&format!("re_raw{k}"), rb[ea], rb[eb], false);
     let re = b.min(&format!("re{k}"), t, last, true);
     let empty = b.lt(re, rs);
     let nz = b.not(dyz);
@@ -387,7 +420,19 @@ fn edge(b: &mut B, wd: &Widths, k: usize, dir: &Dir, x: &[V; 3], y: &[V; 3], fir
     let e = b.sub(&format!("et{k}"), e, ntl, cx + cy + 5);
     let bd = b.shl(&format!("BD{k}"), d, gw - 1, wd.dw_edge + gw, false);
     let n = b.add(&format!("n{k}"), e, bd, cx + cy + 5);
-    let (gb, rem) = b.div(&format!("g{k}"), n, d, gw, gw + wd.dw_edge, wd.dw_edge);
+    let (gb, rem) = if short_g {
+        // D = 256 |dy| has eight zero bits: floor(n / D) = floor((n >> 8) / |dy|), and the
+        // remainder is that division's, shifted back, with n's low byte. So the divider is as
+        // wide as |dy| (CY bits, as Qs's), not as D (CY + 8): Qs's and g's dividers are one width.
+        let nh = b.op(format!("n{k}>>8"), Kind::Shr(n, 8), cx + cy - 3, false);
+        let zero = b.c(0);
+        let nl = b.op(format!("n{k}lo"), Kind::Add(n, zero), 8, false);
+        let (gb, rh) = b.div(&format!("g{k}"), nh, ady, gw, gw + cy, cy);
+        let rh8 = b.shl(&format!("rem8_{k}"), rh, 8, wd.dw_edge, false);
+        (gb, b.op(format!("rem{k}"), Kind::Add(rh8, nl), wd.dw_edge, false))
+    } else {
+        b.div(&format!("g{k}"), n, d, gw, gw + wd.dw_edge, wd.dw_edge)
+    };
     let g = b.add_c(&format!("g{k}-B"), gb, -bias, gw);
     EdgeOut { dyz, right, active, rs, re, g, rem, d, qs, rs256 }
 }

@@ -277,13 +277,16 @@ fn multiplier(mul: MulUnit, acc_w: u32, (lane_a, lane_b, sh_w): (u32, u32, u32),
             } else {
                 g.push(sreg("pr", pw));
             }
-            g.extend([reg("f2", 1), reg("s2", 1), reg("acc", acc_w)]);
+            g.extend([reg("acc", acc_w)]);
             let pe = if acc_w > pw { crate::verilog::sext("pr", pw, acc_w) } else { format!("pr[{}:0]", acc_w - 1) };
             g.push(wire("pe", acc_w, pe));
-            // Cleared on a product's first pass, shifted a chunk up when the weight drops.
-            let up = if acc_w > bits { format!("{{acc[{}:0], {bits}'d0}}", acc_w - bits - 1) } else { format!("{acc_w}'d0") };
-            g.push(wire("held", acc_w, format!("f2 ? {acc_w}'d0 : s2 ? {up} : acc")));
-            g.push(wire("accn", acc_w, "held + pe"));
+            // The sum so far, cleared for a product's first pass and shifted a chunk up when the
+            // weight drops, both as it is written the clock before (the pass's flags are known a
+            // clock ahead: f1, s1), so a cleared register or its zero low bits are the
+            // flip-flops' synchronous reset, not a multiplexer before the adder.
+            let up = if acc_w > bits { format!("{{accn[{}:0], {bits}'d0}}", acc_w - bits - 1) } else { format!("{acc_w}'d0") };
+            g.push(wire("accn", acc_w, "acc + pe"));
+            g.push(wire("held", acc_w, format!("f1 ? {acc_w}'d0 : s1 ? {up} : accn")));
             g.push(Item::Always(vec![Stmt::If(
                 "en".into(),
                 vec![
@@ -292,9 +295,7 @@ fn multiplier(mul: MulUnit, acc_w: u32, (lane_a, lane_b, sh_w): (u32, u32, u32),
                     set("f1", lane("f", 1)),
                     set("s1", lane("sh", sh_w)),
                     set("pr", "ra * rb"),
-                    set("f2", "f1"),
-                    set("s2", "s1"),
-                    set("acc", "accn"),
+                    set("acc", "held"),
                 ],
                 vec![],
             )]));
