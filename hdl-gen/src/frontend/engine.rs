@@ -15,6 +15,7 @@
 //! path to watch for timing.
 
 mod queue;
+mod seq;
 mod sequencer;
 mod units;
 mod values;
@@ -109,8 +110,11 @@ fn plan_text(s: &Schedule) -> String {
     )
 }
 
-/// `tri_fe_engine`.
+/// `tri_fe_engine`: the pipelined engine, or the sequential one where the form has it.
 pub(super) fn module(hw: &Hw, names: &Names) -> Module {
+    if let Some(q) = hw.sequential() {
+        return seq::module(hw, &q, &names.fe_engine).module;
+    }
     let s = hw.engine().expect("the engine form");
     assert_eq!(s.plan.div_form, DivForm::ShiftRemainder, "the RTL's dividers shift the remainder");
     s.verify().unwrap_or_else(|e| panic!("golden's schedule: {e}"));
@@ -149,25 +153,7 @@ pub(super) fn module(hw: &Hw, names: &Names) -> Module {
         "The units' operations (clock from the entry, unit, operation, clocks busy), golden's listing:".into(),
     ];
     header.extend(s.listing().lines().map(|l| format!("  {l}")));
-    let ports = {
-        let mut p = vec![
-            Port::input("clk", 1, "", "rising edge"),
-            Port::input("rst", 1, "", "synchronous, active high: drops the triangles in flight"),
-            Port::input("en", 1, "", "low: the whole engine holds (the queue cannot take the result due)"),
-            Port::input("in_valid", 1, "", "triangle valid"),
-            Port::output("in_ready", 1, "", "triangle accepted when in_valid && in_ready"),
-        ];
-        for k in 0..3 {
-            p.push(Port::input(&format!("in_x{k}"), wd.cx, "", &format!("vertex {k} x")).signed());
-            p.push(Port::input(&format!("in_y{k}"), wd.cy, "", &format!("vertex {k} y")).signed());
-            p.push(Port::input(&format!("in_i{k}"), iw, "", &format!("vertex {k} intensity")));
-        }
-        p.push(Port::output("res_v", 1, "", "a triangle's result is due this clock"));
-        p.push(Port::output("res_guard", 1, "", "its vertices are inside the guard band"));
-        p.push(Port::output("res_cull", 1, "", "it covers no pixel"));
-        p.push(Port::output("res", res_w, "", "its set-up result, the walker's fields (tri_frontend unpacks them)"));
-        p
-    };
+    let ports = ports(hw, res_w);
     let mut body = Vec::new();
     sequencer::emit(&seq, &wd, iw, s.latency, &mut body);
     // Values: many copies and wiring nets are read only in part or by some readers.
@@ -229,6 +215,30 @@ pub(super) fn module(hw: &Hw, names: &Names) -> Module {
     Module { name: names.fe_engine.clone(), header, params: vec![], ports, body }
 }
 
+/// The engine's ports, whichever form (the pipelined engine and the sequential one share them
+/// and their contract).
+pub(super) fn ports(hw: &Hw, res_w: u32) -> Vec<Port> {
+    let wd = hw.fe.widths();
+    let iw = hw.fe.cfg.iw();
+    let mut p = vec![
+        Port::input("clk", 1, "", "rising edge"),
+        Port::input("rst", 1, "", "synchronous, active high: drops the triangles in flight"),
+        Port::input("en", 1, "", "low: the whole engine holds (the queue cannot take the result due)"),
+        Port::input("in_valid", 1, "", "triangle valid"),
+        Port::output("in_ready", 1, "", "triangle accepted when in_valid && in_ready"),
+    ];
+    for k in 0..3 {
+        p.push(Port::input(&format!("in_x{k}"), wd.cx, "", &format!("vertex {k} x")).signed());
+        p.push(Port::input(&format!("in_y{k}"), wd.cy, "", &format!("vertex {k} y")).signed());
+        p.push(Port::input(&format!("in_i{k}"), iw, "", &format!("vertex {k} intensity")));
+    }
+    p.push(Port::output("res_v", 1, "", "a triangle's result is due this clock"));
+    p.push(Port::output("res_guard", 1, "", "its vertices are inside the guard band"));
+    p.push(Port::output("res_cull", 1, "", "it covers no pixel"));
+    p.push(Port::output("res", res_w, "", "its set-up result, the walker's fields (tri_frontend unpacks them)"));
+    p
+}
+
 /// Loading value `o`'s copy 0 with `val`, its older copies shifting one on.
 fn shift(v: &Values, o: usize, val: String) -> Vec<Stmt> {
     let n = v.name(o);
@@ -251,11 +261,11 @@ pub(super) fn setup(hw: &Hw, names: &Names, body: &mut Vec<Item>) {
     let s = hw.engine().expect("the engine form");
     let fields = fields(hw, &s);
     let res_w: u32 = fields.iter().map(|f| f.w).sum();
+    let (ii, latency, _) = hw.engine_timing().expect("the engine form");
     body.push(comment(format!(
-        "Set-up: the shared engine ({}, II = {} clocks a triangle, latency {}), then its result queue ({}, {} entries).",
+        "Set-up: the {} engine ({}, II = {ii} clocks a triangle, latency {latency}), then its result queue ({}, {} entries).",
+        if hw.sequential().is_some() { "sequential" } else { "shared" },
         names.fe_engine,
-        s.ii,
-        s.latency,
         names.fe_queue,
         super::QUEUE_DEPTH
     )));

@@ -19,8 +19,9 @@
 //!   flip-flops, read without a port. Constants are the RAM's initial contents, never
 //!   overwritten; the triangle's nine inputs are written first, from the vertex register.
 //! - **The microprogram** ([`SeqSchedule`]): a list schedule by each operation's longest path
-//!   to the results, under one issue, `read_ports` RAM reads and one RAM write a clock and each
-//!   unit busy from its load to its write; then addresses by a linear scan over the
+//!   to the results, under one issue, `read_ports` RAM reads and one write (the register
+//!   file's or the flag file's: one write bus) a clock and each unit busy from its load to its
+//!   write; then addresses by a linear scan over the
 //!   values' lifetimes (a value holds its address from its write to its last read, so two
 //!   values share an address only one after the other). A result is captured into the queue
 //!   entry as it is written. The next triangle enters when the last value is written.
@@ -66,13 +67,14 @@ impl SeqPlan {
     /// The UP5K: 2 of its SB_MAC16 and one divider.
     pub const ICE40_UP5K: SeqPlan = SeqPlan { units: Plan::ICE40_UP5K, read_ports: 2, bank_bits: 16, bank_depth: 256 };
 
-    /// The sequential plan for an iCE40 form; `None` for the others (the ECP5 and the parallel
-    /// set-up keep the pipelined engine and CALC).
+    /// The form whose engine is sequential: the HX8K's (`--fe-setup ice40-hx8k`). The UP5K's
+    /// keeps the pipelined engine until the RTL's multiplier runs its SB_MAC16 passes (golden
+    /// sequences [`SeqPlan::ICE40_UP5K`] and its tests check it); the ECP5 and the parallel
+    /// set-up keep theirs.
     pub fn for_form(form: SetupForm) -> Option<SeqPlan> {
         match form {
             SetupForm::Ice40Hx8k => Some(SeqPlan::ICE40_HX8K),
-            SetupForm::Ice40Up5k => Some(SeqPlan::ICE40_UP5K),
-            SetupForm::Parallel | SetupForm::Ecp5_25f => None,
+            SetupForm::Ice40Up5k | SetupForm::Parallel | SetupForm::Ecp5_25f => None,
         }
     }
 
@@ -329,7 +331,6 @@ impl SeqSchedule {
             waiting.swap_remove(i);
             let (e, lat) = ex[o];
             let earliest = prog.ops[o].kind.args().iter().map(|a| avail(&slots, a.0 as usize)).max().unwrap_or(0);
-            let ram = !is_flag(&prog, V(o as u32));
             let reads = wide_reads(o);
             let rem = rem_of[o];
             let mut t = earliest;
@@ -339,7 +340,7 @@ impl SeqSchedule {
                     _ => t + READ + lat,
                 };
                 let fits_io = get(&tb.reads, t) + reads <= plan.read_ports
-                    && !(ram && get(&tb.writes, write))
+                    && !get(&tb.writes, write)
                     && !(rem.is_some() && get(&tb.writes, write + 1));
                 // One operation issues a clock (the read ports' consumer is the microword's).
                 let unit = match e {
@@ -355,9 +356,7 @@ impl SeqSchedule {
                 }
             };
             *at(&mut tb.reads, issue) += reads;
-            if ram {
-                *at(&mut tb.writes, write) = true;
-            }
+            *at(&mut tb.writes, write) = true;
             let exec = match e {
                 Exec::Alu => {
                     *at(&mut tb.issue, issue) = true;
@@ -526,7 +525,7 @@ impl SeqSchedule {
             if !matches!(s.exec, Exec::Rem | Exec::Input) {
                 *reads.entry(s.issue).or_default() += ops[o].kind.args().iter().filter(|a| !is_flag(&self.prog, **a)).count() as u32;
             }
-            if let Loc::Ram(_) = s.loc {
+            if s.loc != Loc::None {
                 if let Some(p) = writes.insert(s.write, o) {
                     return Err(format!("{} and {} both write at clock {}", name(p), name(o), s.write));
                 }
@@ -594,6 +593,13 @@ impl SeqSchedule {
     /// Runs the microprogram on `tris`, one after another from reset, on a register file
     /// poisoned but for the constants; each triangle's set-up as the queue entry captures it.
     pub fn run(&self, tris: &[FixedTriangle]) -> Vec<Result3> {
+        let caps = self.captures(tris);
+        tris.iter().zip(caps).map(|(t, c)| self.prog.out.extract(t, |v| c[v.0 as usize])).collect()
+    }
+
+    /// The clocked run of [`SeqSchedule::run`]: per triangle, every value as it was written (a
+    /// constant's own value; 0 for the dead).
+    pub fn captures(&self, tris: &[FixedTriangle]) -> Vec<Vec<i128>> {
         let n = self.prog.ops.len();
         let (words, flags) = self.words();
         // Reset contents: a pattern no value is likely to equal, different at every address.
@@ -644,17 +650,19 @@ impl SeqSchedule {
                     captured[o] = value[o];
                 }
             }
-            out.push(self.prog.out.extract(t, |v| match self.prog.ops[v.0 as usize].kind {
-                Kind::Const(c) => c,
-                _ => captured[v.0 as usize],
-            }));
+            for (o, op) in self.prog.ops.iter().enumerate() {
+                if let Kind::Const(c) = op.kind {
+                    captured[o] = c;
+                }
+            }
+            out.push(captured.clone());
         }
         out
     }
 }
 
 impl FrontEnd {
-    /// The sequential engine's microprogram for an iCE40 form (`None` for the others).
+    /// The sequential engine's microprogram, for the form that has one ([`SeqPlan::for_form`]).
     pub fn sequential_engine(&self) -> Option<Result<SeqSchedule, SeqError>> {
         SeqPlan::for_form(self.setup).map(|p| p.schedule(self))
     }
@@ -663,7 +671,7 @@ impl FrontEnd {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::format::Config;
+    use crate::format::{Align, Config};
     use crate::frontend::engine::reference;
     use crate::rng::{test_seed, SeedRng};
     use crate::setup::Screen;
@@ -683,13 +691,22 @@ mod tests {
         [Screen::default(), Screen { width: 37, height: 23 }].map(|s| FrontEnd::new(Config::default(), s).unwrap())
     }
 
-    /// Both iCE40 plans, sequenced, equal `setup` on 500 random triangles of every kind at
-    /// 640x480 and 37x23, run back to back from reset (about 0.3 s).
+    /// The engine tests' other screens: F = 4 on 16x8, and the widest (F = 16, XW = 16).
+    fn other_screens() -> [FrontEnd; 2] {
+        [
+            FrontEnd::new(Config::new(8, 4, 4, Align::Span).unwrap(), Screen { width: 16, height: 8 }).unwrap(),
+            FrontEnd::new(Config::new(8, 16, 16, Align::Span).unwrap(), Screen { width: 65536, height: 65536 }).unwrap(),
+        ]
+    }
+
+    /// Both iCE40 plans, sequenced, equal `setup` on random triangles of every kind, run back
+    /// to back from reset: 500 at 640x480 and 37x23, 200 at 16x8 (F = 4) and on the widest
+    /// screen (about 0.3 s).
     #[test]
     fn the_sequential_plans_equal_setup() {
         let mut rng = SeedRng::seed_from_u64(test_seed("the_sequential_plans_equal_setup"));
-        for fe in screens() {
-            let tris = random_fixed_triangles(&mut rng, &fe, 500);
+        for (fe, n) in screens().into_iter().map(|f| (f, 500)).chain(other_screens().into_iter().map(|f| (f, 200))) {
+            let tris = random_fixed_triangles(&mut rng, &fe, n);
             for plan in [SeqPlan::ICE40_HX8K, SeqPlan::ICE40_UP5K] {
                 let s = plan.schedule(&fe).unwrap();
                 s.verify().unwrap();
@@ -751,7 +768,7 @@ mod tests {
     #[test]
     #[ignore]
     fn sequential_figures() {
-        for fe in screens() {
+        for fe in screens().into_iter().chain(other_screens()) {
             for (plan, form) in [(SeqPlan::ICE40_HX8K, SetupForm::Ice40Hx8k), (SeqPlan::ICE40_UP5K, SetupForm::Ice40Up5k)] {
                 let s = plan.schedule(&fe).unwrap();
                 let p = form.plan().unwrap().schedule(&fe).unwrap();
