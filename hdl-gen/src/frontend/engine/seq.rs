@@ -49,7 +49,7 @@ struct Layout {
 }
 
 impl Layout {
-    fn new(aw: u32, fb: u32, sw: u32, cb: u32) -> Layout {
+    fn new(aw: u32, fb: u32, sw: u32, cb: u32, wb: u32) -> Layout {
         let fields = vec![
             ("ra", aw),
             ("rb", aw),
@@ -74,7 +74,7 @@ impl Layout {
             ("fwe", 1),
             ("fwa", fb),
             ("src", 4),
-            ("ww", sw),
+            ("wc", wb),
             ("wsg", 1),
             ("cap", cb),
         ];
@@ -147,7 +147,11 @@ pub fn module(hw: &Hw, s: &SeqSchedule, name: &str) -> SeqEngine {
         }
     }
     let cb = bits(groups.len() as u64);
-    let l = Layout::new(aw, fb, sw, cb);
+    // The widths values are written at: few, so the write's wrap reads a table, not a shifter.
+    let mut widths: Vec<u32> = (0..ops.len()).filter(|&o| !matches!(s.slots[o].exec, Exec::Dead | Exec::Const)).map(|o| ops[o].w).collect();
+    widths.sort();
+    widths.dedup();
+    let l = Layout::new(aw, fb, sw, cb, bits(widths.len() as u64 - 1));
     let mut mw = vec![Word::default(); c as usize + 2];
     let addr = |v: V| match s.slots[v.0 as usize].loc {
         Loc::Ram(a) => a,
@@ -233,7 +237,7 @@ pub fn module(hw: &Hw, s: &SeqSchedule, name: &str) -> SeqEngine {
         let wt = sl.write;
         let x = &mut mw[wt as usize];
         x.set("src", src, wt);
-        x.set("ww", op.w as u64, wt);
+        x.set("wc", widths.iter().position(|&k| k == op.w).unwrap() as u64, wt);
         x.set("wsg", op.signed as u64, wt);
         match sl.loc {
             Loc::Ram(a) => {
@@ -400,15 +404,19 @@ pub fn module(hw: &Hw, s: &SeqSchedule, name: &str) -> SeqEngine {
         (FN_NOT, one("~|x0")),
         (FN_SEL, "|x0 ? x1 : x2".to_string()),
         (FN_LZC, format!("{{{{{}{{1'b0}}}}, lz}}", w - sw)),
-        (FN_SHL, "x0 << u_imm".to_string()),
+        (FN_SHL, "shl".to_string()),
         (FN_SHR, "$signed(x0) >>> u_imm".to_string()),
-        (FN_SHLV, format!("(x1 >= {w}) ? {w}'d0 : x0 << x1[{}:0]", sw - 1)),
+        (FN_SHLV, "shl".to_string()),
     ];
     let mut e = "x0".to_string();
     for (f, x) in alu.iter().rev() {
         e = format!("(u_fn == 4'd{f}) ? ({x}) :\n        {e}");
     }
     let _ = FN_PASS;
+    // One left shifter: by the microword's constant, or by the value on x1 (all out at W or more).
+    b.push(wire("shl_by", 1, format!("u_fn == 4'd{FN_SHLV}")));
+    b.push(wire("shl_amt", sw, format!("shl_by ? x1[{}:0] : u_imm", sw - 1)));
+    b.push(wire("shl", w, format!("(shl_by && x1 >= {w}) ? {w}'d0 : x0 << shl_amt")));
     b.push(wire("alu", w, e));
     b.push(Item::Always(vec![Stmt::If("en".into(), vec![set("ar", "alu")], vec![])]));
     b.push(Item::Blank);
@@ -499,8 +507,22 @@ pub fn module(hw: &Hw, s: &SeqSchedule, name: &str) -> SeqEngine {
     }
     let _ = SRC_ALU;
     b.push(wire("raw", w, src));
-    b.push(wire("wmask", w, format!("{{{w}{{1'b1}}}} >> ({w} - u_ww)")));
-    b.push(wire("wsign", 1, "raw[u_ww - 1]"));
+    b.push(reg("wmask", w));
+    b.push(reg("wsign", 1));
+    let wb = bits(widths.len() as u64 - 1);
+    let arms: Vec<(String, Vec<Stmt>)> = widths
+        .iter()
+        .enumerate()
+        .map(|(k, &x)| {
+            let m = if x >= w { format!("{{{w}{{1'b1}}}}") } else { format!("{{{{{}{{1'b0}}}}, {{{x}{{1'b1}}}}}}", w - x) };
+            (format!("{wb}'d{k}"), vec![Stmt::Blocking("wmask".into(), m), Stmt::Blocking("wsign".into(), format!("raw[{}]", x - 1))])
+        })
+        .collect();
+    b.push(Item::Comb(vec![Stmt::Case {
+        sel: "u_wc".into(),
+        arms,
+        default: vec![Stmt::Blocking("wmask".into(), format!("{{{w}{{1'b1}}}}")), Stmt::Blocking("wsign".into(), "1'b0".into())],
+    }]));
     b.push(Item::Assign("bus".into(), "(raw & wmask) | ((u_wsg && wsign) ? ~wmask : {".to_string() + &format!("{w}{{1'b0}}}})")));
     b.push(Item::Blank);
     b.push(comment("The result: each field loads as its value is written."));
