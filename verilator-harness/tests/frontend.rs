@@ -505,8 +505,8 @@ fn sequential_engine_spans_equal_golden() {
     let fe = opts.frontend().unwrap().fe;
     let tris = random_triangles(&mut SeedRng::seed_from_u64(seed), &fe, 1000);
     let engine = &base.sources.iter().find(|(n, _)| n == "tri_fe_engine.v").expect("the engine's file").1;
-    let sub = engine.lines().find(|l| l.contains("(x0 - x1)")).expect("the ALU's subtract");
-    let faults = [(sub.to_string(), sub.replacen("(x0 - x1)", "(x0 + x1)", 1), "the ALU's subtract made an add")];
+    let sub = engine.lines().find(|l| l.contains(" sub = ")).expect("the ALU's subtract select");
+    let faults = [(sub.to_string(), sub.replacen(" sub = u_fn == 4'd2 || ", " sub = ", 1), "the ALU's subtract made an add")];
     assert_faults_caught(&base, "tri_fe_engine.v", "seqfault", faults, seed, &tris);
 }
 

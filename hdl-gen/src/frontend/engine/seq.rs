@@ -372,52 +372,81 @@ pub fn module(hw: &Hw, s: &SeqSchedule, name: &str) -> SeqEngine {
     }
     b.push(comment("The ALU, its result registered (written the clock after)."));
     b.push(reg("ar", w));
+    // Leading zeros of x0's low n bits (the program's counts: one width at the named screens),
+    // halving: the top half zero or not, a bit of the count each, below it ones so that zero
+    // counts n. Log depth, where a bit-serial chain would set the clock.
+    let mut lzn: Vec<u32> = ops.iter().filter_map(|o| if let Kind::Lzc(_, n) = o.kind { Some(n) } else { None }).collect();
+    lzn.sort();
+    lzn.dedup();
     b.push(reg("lz", sw));
-    b.push(Item::Integer("j".into()));
-    b.push(reg("lz_on", 1));
-    // Leading zeros of x0 in `imm` bits: from bit imm - 1 down, while the bits are zero.
-    b.push(Item::Comb(vec![
-        Stmt::Blocking("lz".into(), format!("{sw}'d0")),
-        Stmt::Blocking("lz_on".into(), "1'b1".into()),
-        Stmt::For {
-            var: "j".into(),
-            count: w.to_string(),
-            body: vec![Stmt::If(
-                format!("{} - j < u_imm", w - 1),
-                vec![Stmt::If(
-                    format!("lz_on && !x0[{} - j]", w - 1),
-                    vec![Stmt::Blocking("lz".into(), format!("lz + {sw}'d1"))],
-                    vec![Stmt::Blocking("lz_on".into(), "1'b0".into())],
-                )],
-                vec![],
-            )],
-        },
-    ]));
-    let one = |e: &str| format!("{{{{{}{{1'b0}}}}, {e}}}", w - 1);
-    let alu = [
-        (FN_ADD, "x0 + x1".to_string()),
-        (FN_SUB, "x0 - x1".to_string()),
-        (FN_LT, one("$signed(x0) < $signed(x1)")),
-        (FN_EQ, one("x0 == x1")),
-        (FN_AND, one("|x0 && |x1")),
-        (FN_OR, one("|x0 || |x1")),
-        (FN_NOT, one("~|x0")),
-        (FN_SEL, "|x0 ? x1 : x2".to_string()),
-        (FN_LZC, format!("{{{{{}{{1'b0}}}}, lz}}", w - sw)),
-        (FN_SHL, "shl".to_string()),
-        (FN_SHR, "$signed(x0) >>> u_imm".to_string()),
-        (FN_SHLV, "shl".to_string()),
-    ];
-    let mut e = "x0".to_string();
-    for (f, x) in alu.iter().rev() {
-        e = format!("(u_fn == 4'd{f}) ? ({x}) :\n        {e}");
+    // The last stage reads only the top bit of its pair.
+    b.push(comment("verilator lint_off UNUSEDSIGNAL"));
+    let mut sel = Vec::new();
+    for &n in &lzn {
+        let p = (n + 1).next_power_of_two();
+        let lb = p.trailing_zeros();
+        let mut st = vec![Stmt::Blocking(format!("lz{n}_v{lb}"), format!("{{x0[{}:0], {{{}{{1'b1}}}}}}", n - 1, p - n))];
+        b.push(reg(&format!("lz{n}_v{lb}"), p));
+        b.push(reg(&format!("lz{n}"), lb));
+        for k in (0..lb).rev() {
+            let h = 1u32 << k;
+            let (v, nv) = (format!("lz{n}_v{}", k + 1), format!("lz{n}_v{k}"));
+            if k > 0 {
+                b.push(reg(&nv, h));
+            }
+            st.push(Stmt::Blocking(format!("lz{n}[{k}]"), format!("{v}[{}:{h}] == {h}'d0", 2 * h - 1)));
+            if k > 0 {
+                st.push(Stmt::Blocking(nv, format!("lz{n}[{k}] ? {v}[{}:0] : {v}[{}:{h}]", h - 1, 2 * h - 1)));
+            }
+        }
+        b.push(Item::Comb(st));
+        b.push(comment("verilator lint_on UNUSEDSIGNAL"));
+        sel.push((n, format!("{{{{{}{{1'b0}}}}, lz{n}}}", sw - lb)));
     }
-    let _ = FN_PASS;
-    // One left shifter: by the microword's constant, or by the value on x1 (all out at W or more).
+    let mut e = format!("{sw}'d0");
+    for (n, x) in sel.iter().rev() {
+        e = format!("(u_imm == {sw}'d{n}) ? {x} : {e}");
+    }
+    b.push(Item::Comb(vec![Stmt::Blocking("lz".into(), e)]));
+    let one = |e: &str| format!("{{{{{}{{1'b0}}}}, {e}}}", w - 1);
+    // One adder for add, subtract and the signed compare (the difference's sign, corrected
+    // where the operands' signs differ); one left shifter for shifts by a constant and by the
+    // value on x1 (all out at W or more).
+    b.push(wire("sub", 1, format!("u_fn == 4'd{FN_SUB} || u_fn == 4'd{FN_LT}")));
+    b.push(comment("verilator lint_off UNUSEDSIGNAL"));
+    b.push(wire("as1", w + 1, format!("{{x0, 1'b1}} + {{x1 ^ {{{w}{{sub}}}}, sub}}")));
+    b.push(comment("verilator lint_on UNUSEDSIGNAL"));
+    b.push(wire("addsub", w, format!("as1[{w}:1]")));
+    b.push(wire("lt", 1, format!("(x0[{0}] != x1[{0}]) ? x0[{0}] : addsub[{0}]", w - 1)));
     b.push(wire("shl_by", 1, format!("u_fn == 4'd{FN_SHLV}")));
     b.push(wire("shl_amt", sw, format!("shl_by ? x1[{}:0] : u_imm", sw - 1)));
     b.push(wire("shl", w, format!("(shl_by && x1 >= {w}) ? {w}'d0 : x0 << shl_amt")));
-    b.push(wire("alu", w, e));
+    // Right shifts are by constants, and few (one at the named screens): a multiplexer over them.
+    let mut shrs: Vec<u32> = ops.iter().filter_map(|o| if let Kind::Shr(_, n) = o.kind { Some(n) } else { None }).collect();
+    shrs.sort();
+    shrs.dedup();
+    b.push(reg("shr", w));
+    let arms = shrs.iter().map(|n| (format!("{sw}'d{n}"), vec![Stmt::Blocking("shr".into(), format!("$signed(x0) >>> {n}"))])).collect();
+    b.push(Item::Comb(vec![Stmt::Case { sel: "u_imm".into(), arms, default: vec![Stmt::Blocking("shr".into(), "x0".into())] }]));
+    let alu = [
+        (vec![FN_ADD, FN_SUB], "addsub".to_string()),
+        (vec![FN_LT], one("lt")),
+        (vec![FN_EQ], one("x0 == x1")),
+        (vec![FN_AND], one("|x0 && |x1")),
+        (vec![FN_OR], one("|x0 || |x1")),
+        (vec![FN_NOT], one("~|x0")),
+        (vec![FN_SEL], "|x0 ? x1 : x2".to_string()),
+        (vec![FN_LZC], format!("{{{{{}{{1'b0}}}}, lz}}", w - sw)),
+        (vec![FN_SHL, FN_SHLV], "shl".to_string()),
+        (vec![FN_SHR], "shr".to_string()),
+    ];
+    // A parallel case: Yosys builds one multiplexer per bit, not a chain of twelve.
+    b.push(reg("alu", w));
+    let arms = alu
+        .iter()
+        .map(|(fs, x)| (fs.iter().map(|f| format!("4'd{f}")).collect::<Vec<_>>().join(", "), vec![Stmt::Blocking("alu".into(), x.clone())]))
+        .collect();
+    b.push(Item::Comb(vec![Stmt::Case { sel: "u_fn".into(), arms, default: vec![Stmt::Blocking("alu".into(), "x0".into())] }]));
     b.push(Item::Always(vec![Stmt::If("en".into(), vec![set("ar", "alu")], vec![])]));
     b.push(Item::Blank);
     b.push(comment(
@@ -490,8 +519,8 @@ pub fn module(hw: &Hw, s: &SeqSchedule, name: &str) -> SeqEngine {
     b.push(Item::Blank);
     b.push(comment("The write bus: the source the microword names, wrapped to the value's width and sign."));
     let ins = ["nx0", "nx1", "nx2", "ny0", "ny1", "ny2", "ni0", "ni1", "ni2"];
-    let mut src = "ar".to_string();
-    for (k, n) in ins.iter().enumerate().rev() {
+    let mut srcs: Vec<(u64, String)> = vec![(SRC_MUL, "macc".into()), (SRC_DIVQ, "dq".into()), (SRC_DIVR, "dr".into())];
+    for (k, n) in ins.iter().enumerate() {
         let (wv, sg) = if k < 3 {
             (wd.cx, true)
         } else if k < 6 {
@@ -499,14 +528,11 @@ pub fn module(hw: &Hw, s: &SeqSchedule, name: &str) -> SeqEngine {
         } else {
             (iw, false)
         };
-        let ext = if sg { crate::verilog::sext(n, wv, w) } else { crate::verilog::zext(n, wv, w) };
-        src = format!("(u_src == 4'd{}) ? {ext} :\n        {src}", SRC_IN + k as u64);
+        srcs.push((SRC_IN + k as u64, if sg { crate::verilog::sext(n, wv, w) } else { crate::verilog::zext(n, wv, w) }));
     }
-    for (k, x) in [(SRC_DIVR, "dr".to_string()), (SRC_DIVQ, "dq".into()), (SRC_MUL, "macc".into())] {
-        src = format!("(u_src == 4'd{k}) ? {x} :\n        {src}");
-    }
-    let _ = SRC_ALU;
-    b.push(wire("raw", w, src));
+    b.push(reg("raw", w));
+    let arms = srcs.into_iter().map(|(k, x)| (format!("4'd{k}"), vec![Stmt::Blocking("raw".into(), x)])).collect();
+    b.push(Item::Comb(vec![Stmt::Case { sel: "u_src".into(), arms, default: vec![Stmt::Blocking("raw".into(), "ar".into())] }]));
     b.push(reg("wmask", w));
     b.push(reg("wsign", 1));
     let wb = bits(widths.len() as u64 - 1);
