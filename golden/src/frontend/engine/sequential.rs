@@ -701,12 +701,12 @@ mod tests {
     }
 
     /// Both iCE40 plans, sequenced, equal `setup` on random triangles of every kind, run back
-    /// to back from reset: 500 at 640x480 and 37x23, 200 at 16x8 (F = 4) and on the widest
-    /// screen (about 0.3 s).
+    /// to back from reset: 300 at 640x480 and 37x23, 100 at 16x8 (F = 4) and on the widest
+    /// screen (about 0.2 s; the co-simulation runs 1,000 a screen through the RTL).
     #[test]
     fn the_sequential_plans_equal_setup() {
         let mut rng = SeedRng::seed_from_u64(test_seed("the_sequential_plans_equal_setup"));
-        for (fe, n) in screens().into_iter().map(|f| (f, 500)).chain(other_screens().into_iter().map(|f| (f, 200))) {
+        for (fe, n) in screens().into_iter().map(|f| (f, 300)).chain(other_screens().into_iter().map(|f| (f, 100))) {
             let tris = random_fixed_triangles(&mut rng, &fe, n);
             for plan in [SeqPlan::ICE40_HX8K, SeqPlan::ICE40_UP5K] {
                 let s = plan.schedule(&fe).unwrap();
