@@ -281,10 +281,12 @@ pub fn module(hw: &Hw, s: &SeqSchedule, name: &str) -> SeqEngine {
 
     let mut b: Vec<Item> = Vec::new();
     let cw = bits(c as u64 - 1);
-    b.push(comment("Sequencer: the clock of the triangle (pc), the vertex register, a valid bit per period in flight."));
+    b.push(comment("Sequencer: the clock of the triangle (pc), the vertex register (v*) and the entered triangle's inputs"));
+    b.push(comment("(n*), a valid bit per period in flight, boot (the first period after reset)."));
     b.push(reg("pc", cw));
     b.push(reg("vld", 2));
     b.push(reg("v_full", 1));
+    b.push(reg("boot", 1));
     for k in 0..3 {
         for (v, wv, sg) in [("x", wd.cx, true), ("y", wd.cy, true), ("i", iw, false)] {
             for p in ["v", "n"] {
@@ -323,7 +325,6 @@ pub fn module(hw: &Hw, s: &SeqSchedule, name: &str) -> SeqEngine {
     b.push(wire("mpc", cw, format!("rst ? {cw}'d0 : pc_n")));
     b.push(reg("mw", mwn));
     b.push(reg("cq", w));
-    b.push(reg("boot", 1));
     let arms = |vals: &[String], lhs: &str| -> Vec<(String, Vec<Stmt>)> {
         vals.iter().enumerate().map(|(k, v)| (format!("{cw}'d{k}"), vec![set(lhs, v.clone())])).collect()
     };
