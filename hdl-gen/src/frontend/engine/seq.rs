@@ -10,7 +10,7 @@
 //! engine; co-simulated in `verilator-harness/tests/frontend.rs` (`sequential_engine_*`, slow
 //! tier). docs/design.md, *A sequential engine for the iCE40 HX8K*.
 
-use super::{fields, Field};
+use super::result::{fields, ports, Field};
 use crate::frontend::hw::Hw;
 use crate::verilog::{comment, reg, set, sreg, wire, Item, Module, Param, Stmt};
 use golden::frontend::engine::schedule::Class;
@@ -265,7 +265,7 @@ pub fn module(hw: &Hw, s: &SeqSchedule, name: &str) -> SeqEngine {
     let consts: Vec<String> = s.preload.iter().map(|&(_, v)| format!("{w}'h{:x}", (v as u128) & mask)).collect();
 
     let res_w: u32 = fields.iter().map(|f| f.w).sum();
-    let ports = super::ports(hw, res_w);
+    let ports = ports(hw, res_w);
     let params: Vec<Param> = Vec::new();
     let header = vec![
         format!("{name} — the sequential set-up engine (issue 27; docs/design.md): golden's microprogram on one ALU."),
