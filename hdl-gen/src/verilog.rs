@@ -661,16 +661,9 @@ fn render_stmts(o: &mut String, stmts: &[Stmt], level: usize) {
                 writeln!(o, "case ({sel})").unwrap();
                 for (label, body) in arms.iter().map(|(l, b)| (l.as_str(), b)).chain([("default", default)]) {
                     let mut inner = String::new();
-                    render_stmts(&mut inner, body, level + 1);
+                    render_stmts(&mut inner, body, 0);
                     indent(o, level + 1);
-                    if body.len() == 1 {
-                        write!(o, "{label}: {}", inner.trim_start()).unwrap();
-                    } else {
-                        writeln!(o, "{label}: begin").unwrap();
-                        o.push_str(&inner);
-                        indent(o, level + 1);
-                        o.push_str("end\n");
-                    }
+                    writeln!(o, "{label}: begin {}end", inner.replace('\n', " ")).unwrap();
                 }
                 indent(o, level);
                 o.push_str("endcase\n");
