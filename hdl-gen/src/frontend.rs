@@ -174,11 +174,12 @@ fn header(hw: &Hw, names: &Names) -> Vec<String> {
             format!("Guard band: -{w} <= x < {}, -{h} <= y < {} pixels; a triangle outside it is dropped and pulses err.", 2 * w, 2 * h),
             "Coverage and spans: exactly golden::setup's and golden::frontend's, as the parallel form's, bit for bit.".into(),
             format!(
-                "Set-up: the shared engine {} (golden's plan {}: II = {} clocks a triangle, latency {}), then a queue of {} results;",
+                "Set-up: the {} engine {} (golden's plan {}: II = {} clocks a triangle, latency {}), then a queue of {} results;",
+                if hw.sequential().is_some() { "sequential" } else { "shared" },
                 names.fe_engine,
                 fe.setup.name(),
-                s.ii,
-                s.latency,
+                hw.engine_timing().map_or(s.ii, |t| t.0),
+                hw.engine_timing().map_or(s.latency, |t| t.1),
                 QUEUE_DEPTH
             ),
             format!("{} clocks per triangle, walked or dropped; the next triangles' set-up overlaps the walk.", hw.setup_clocks().0),

@@ -400,12 +400,12 @@ pub fn render(opts: &Options, names: &Names, modules: &[Module], unit: &Specular
             i0: hw.fe.i0,
             start_clocks: hw.start_clocks(),
             setup: hw.fe.setup,
-            engine: hw.engine().map(|s| Engine {
+            engine: hw.engine().zip(hw.engine_timing()).map(|(s, (ii, latency, epochs))| Engine {
                 module: names.fe_engine.clone(),
                 plan: s.plan,
-                ii: s.ii,
-                latency: s.latency,
-                epochs: s.epochs().expect("a periodic binding (golden's tests)"),
+                ii,
+                latency,
+                epochs,
                 queue_depth: crate::frontend::QUEUE_DEPTH,
             }),
             span_div_clocks: hw.span_div_clocks(),

@@ -107,6 +107,13 @@ pub enum Stmt {
     Cover(String),
     /// Formal only: `label: stmt`, given to every assert and cover when the block renders.
     Labelled(String, Box<Stmt>),
+    /// `case (sel) label: ...; default: ...; endcase`: a table (synthesis maps a registered one
+    /// to block RAM, Yosys's `proc_rom`), one arm a line.
+    Case {
+        sel: String,
+        arms: Vec<(String, Vec<Stmt>)>,
+        default: Vec<Stmt>,
+    },
 }
 
 pub fn set(lhs: impl Into<String>, rhs: impl Into<String>) -> Stmt {
@@ -649,6 +656,17 @@ fn render_stmts(o: &mut String, stmts: &[Stmt], level: usize) {
                 render_stmts(o, body, level + 1);
                 indent(o, level);
                 o.push_str("end\n");
+            }
+            Stmt::Case { sel, arms, default } => {
+                writeln!(o, "case ({sel})").unwrap();
+                for (label, body) in arms.iter().map(|(l, b)| (l.as_str(), b)).chain([("default", default)]) {
+                    let mut inner = String::new();
+                    render_stmts(&mut inner, body, 0);
+                    indent(o, level + 1);
+                    writeln!(o, "{label}: begin {}end", inner.replace('\n', " ")).unwrap();
+                }
+                indent(o, level);
+                o.push_str("endcase\n");
             }
             Stmt::Forever(body) => {
                 o.push_str("forever begin\n");

@@ -485,6 +485,31 @@ fn engine_spans_equal_golden_at_640x480_and_on_the_ice40_plans() {
     }
 }
 
+/// The sequential engine (`--fe-setup ice40-hx8k`, issue 27: golden's microprogram on one ALU,
+/// the values in a block-RAM register file) at 37x23 and 640x480, levels 0 and 1 (the target's),
+/// 1,000 triangles each (about 330 clocks a triangle); a fault planted in its ALU (the subtract
+/// made an add) is caught. Slow tier: `cargo nextest run -p verilator-harness --run-ignored only
+/// -E 'test(/sequential_engine/)'`.
+#[test]
+#[ignore]
+fn sequential_engine_spans_equal_golden() {
+    use golden::frontend::engine::SetupForm;
+    let small = golden::setup::Screen { width: 37, height: 23 };
+    for (screen, level) in [(small, 0), (golden::setup::Screen::default(), 0), (small, 1)] {
+        let Some(opts) = engine(screen, SetupForm::Ice40Hx8k) else { return };
+        engine_spans_of(hdl_gen::Options { pipeline: golden::pipeline::Pipeline::at(level), ..opts }, 1000);
+    }
+    let Some(opts) = engine(small, SetupForm::Ice40Hx8k) else { return };
+    let base = verilator_harness::ondemand::describe(&opts, verilator_harness::models::Kind::Frontend).unwrap_or_else(|e| panic!("{e}"));
+    let seed = verilator_harness::seed("frontend sequential engine fault");
+    let fe = opts.frontend().unwrap().fe;
+    let tris = random_triangles(&mut SeedRng::seed_from_u64(seed), &fe, 1000);
+    let engine = &base.sources.iter().find(|(n, _)| n == "tri_fe_engine.v").expect("the engine's file").1;
+    let sub = engine.lines().find(|l| l.contains(" sub = ")).expect("the ALU's subtract select");
+    let faults = [(sub.to_string(), sub.replacen(" sub = u_fn == 4'd2 || ", " sub = ", 1), "the ALU's subtract made an add")];
+    assert_faults_caught(&base, "tri_fe_engine.v", "seqfault", faults, seed, &tris);
+}
+
 /// The shared-edge mesh through `tri_fb_p8` with the engine's front-end: every pixel of the
 /// screen written exactly once, at 37x23 and 640x480. Slow tier (a chain model each).
 #[test]

@@ -29,6 +29,7 @@
 mod build;
 mod placement;
 pub mod schedule;
+pub mod sequential;
 #[cfg(test)]
 mod tests;
 

@@ -9,71 +9,35 @@
 //! - [`values`]: the values' registers, their copies, wiring and logic.
 //! - [`units`]: the units' operand multiplexers and the units.
 //! - [`queue`]: the set-up result queue.
+//! - [`result`]: the set-up result's fields and the engine's ports, which both forms share.
+//! - [`seq`]: the HX8K's sequential engine (golden's microprogram), on the same ports.
 //!
 //! One enable, `en`, freezes the whole engine (every register of it) while a result is due and
 //! the queue is full: simple, and its fan-out (every engine register's clock enable) is the
 //! path to watch for timing.
 
 mod queue;
+mod result;
+mod seq;
 mod sequencer;
 mod units;
 mod values;
 
 use super::hw::Hw;
-use crate::verilog::{comment, reg, set, Item, Module, Port, Stmt};
+use crate::verilog::{comment, reg, set, Item, Module, Stmt};
 use crate::Names;
 use golden::frontend::engine::schedule::{Class, Schedule};
 use golden::frontend::engine::{DivForm, Kind, MulUnit, V};
-use golden::frontend::Widths;
 use sequencer::Seq;
 use values::Values;
+
+use result::{fields, ports};
 
 use queue::module as queue_module;
 
 /// Whether this front-end's set-up is the shared engine.
 pub(super) fn on(hw: &Hw) -> bool {
     hw.engine_form()
-}
-
-/// One field of the set-up result the walker reads: its name, the program's value and its
-/// width in the queue.
-pub(super) struct Field {
-    pub name: String,
-    pub v: V,
-    pub w: u32,
-}
-
-/// The set-up result's fields, in the queue entry's order (the first least significant).
-pub(super) fn fields(hw: &Hw, s: &Schedule) -> Vec<Field> {
-    let Widths { yw, aw, k, rw, gw, dw_edge, .. } = hw.fe.widths();
-    let o = &s.prog.out;
-    let f = |name: &str, v: V, w: u32| Field { name: name.into(), v, w };
-    let mut v = vec![
-        f("first", o.first, yw),
-        f("last", o.last, yw),
-        f("di", o.di, hw.fe.cfg.dw()),
-        f("an", o.an, aw),
-        f("rn", o.rn, rw),
-        f("tn", o.tn, k),
-        f("dyn", o.dyn_, k),
-        f("gxn", o.gxn, k),
-    ];
-    for (j, e) in o.edges.iter().enumerate() {
-        for (n, x, w) in [
-            ("act", e.active, 1),
-            ("right", e.right, 1),
-            ("rs", e.rs, yw),
-            ("re", e.re, yw),
-            ("d", e.d, dw_edge),
-            ("g", e.g, gw),
-            ("rem", e.rem, dw_edge),
-            ("qs", e.qs, gw),
-            ("rs256", e.rs256, dw_edge),
-        ] {
-            v.push(f(&format!("e{j}_{n}"), x, w));
-        }
-    }
-    v
 }
 
 /// The queue entry's width.
@@ -109,8 +73,11 @@ fn plan_text(s: &Schedule) -> String {
     )
 }
 
-/// `tri_fe_engine`.
+/// `tri_fe_engine`: the pipelined engine, or the sequential one where the form has it.
 pub(super) fn module(hw: &Hw, names: &Names) -> Module {
+    if let Some(q) = hw.sequential() {
+        return seq::module(hw, &q, &names.fe_engine).module;
+    }
     let s = hw.engine().expect("the engine form");
     assert_eq!(s.plan.div_form, DivForm::ShiftRemainder, "the RTL's dividers shift the remainder");
     s.verify().unwrap_or_else(|e| panic!("golden's schedule: {e}"));
@@ -149,25 +116,7 @@ pub(super) fn module(hw: &Hw, names: &Names) -> Module {
         "The units' operations (clock from the entry, unit, operation, clocks busy), golden's listing:".into(),
     ];
     header.extend(s.listing().lines().map(|l| format!("  {l}")));
-    let ports = {
-        let mut p = vec![
-            Port::input("clk", 1, "", "rising edge"),
-            Port::input("rst", 1, "", "synchronous, active high: drops the triangles in flight"),
-            Port::input("en", 1, "", "low: the whole engine holds (the queue cannot take the result due)"),
-            Port::input("in_valid", 1, "", "triangle valid"),
-            Port::output("in_ready", 1, "", "triangle accepted when in_valid && in_ready"),
-        ];
-        for k in 0..3 {
-            p.push(Port::input(&format!("in_x{k}"), wd.cx, "", &format!("vertex {k} x")).signed());
-            p.push(Port::input(&format!("in_y{k}"), wd.cy, "", &format!("vertex {k} y")).signed());
-            p.push(Port::input(&format!("in_i{k}"), iw, "", &format!("vertex {k} intensity")));
-        }
-        p.push(Port::output("res_v", 1, "", "a triangle's result is due this clock"));
-        p.push(Port::output("res_guard", 1, "", "its vertices are inside the guard band"));
-        p.push(Port::output("res_cull", 1, "", "it covers no pixel"));
-        p.push(Port::output("res", res_w, "", "its set-up result, the walker's fields (tri_frontend unpacks them)"));
-        p
-    };
+    let ports = ports(hw, res_w);
     let mut body = Vec::new();
     sequencer::emit(&seq, &wd, iw, s.latency, &mut body);
     // Values: many copies and wiring nets are read only in part or by some readers.
@@ -251,11 +200,11 @@ pub(super) fn setup(hw: &Hw, names: &Names, body: &mut Vec<Item>) {
     let s = hw.engine().expect("the engine form");
     let fields = fields(hw, &s);
     let res_w: u32 = fields.iter().map(|f| f.w).sum();
+    let (ii, latency, _) = hw.engine_timing().expect("the engine form");
     body.push(comment(format!(
-        "Set-up: the shared engine ({}, II = {} clocks a triangle, latency {}), then its result queue ({}, {} entries).",
+        "Set-up: the {} engine ({}, II = {ii} clocks a triangle, latency {latency}), then its result queue ({}, {} entries).",
+        if hw.sequential().is_some() { "sequential" } else { "shared" },
         names.fe_engine,
-        s.ii,
-        s.latency,
         names.fe_queue,
         super::QUEUE_DEPTH
     )));

@@ -39,6 +39,22 @@ impl Hw {
         self.fe.engine().map(|s| s.expect("the named plans schedule (golden's tests)"))
     }
 
+    /// The sequential engine's microprogram (golden's), for the form that has one
+    /// (`--fe-setup ice40-hx8k`): it replaces the pipelined engine's RTL, on the same ports.
+    pub fn sequential(&self) -> Option<golden::frontend::engine::sequential::SeqSchedule> {
+        self.fe.sequential_engine().map(|s| s.expect("the sequential plans schedule (golden's tests)"))
+    }
+
+    /// The engine's clocks, whichever form: clocks between entries (II), from an entry to its
+    /// result (latency), and the binding's period in triangles. The sequential engine runs a
+    /// triangle a period and offers its result as the next enters: II = latency.
+    pub fn engine_timing(&self) -> Option<(u32, u32, u32)> {
+        if let Some(s) = self.sequential() {
+            return Some((s.clocks, s.clocks, 1));
+        }
+        self.engine().map(|s| (s.ii, s.latency, s.epochs().expect("a periodic binding (golden's tests)")))
+    }
+
     /// Clocks the dividers run: the reciprocal's RW quotient bits, `div_bits` a clock.
     pub fn div_clocks(&self) -> u32 {
         self.fe.widths().rw.div_ceil(self.div_bits)
@@ -86,8 +102,8 @@ impl Hw {
     /// entry clock, the schedule's latency, the queue, the walker's load and the span path: the
     /// figure is the worst case of the slot's wait.
     pub fn latency(&self) -> u32 {
-        if let Some(s) = self.engine() {
-            return s.ii + s.latency + 3 + self.i0_stages();
+        if let Some((ii, latency, _)) = self.engine_timing() {
+            return ii + latency + 3 + self.i0_stages();
         }
         self.calc_clocks() + self.div_clocks() + 2 + self.i0_stages() + self.span_div_clocks() + self.start_clocks()
     }
@@ -116,8 +132,8 @@ impl Hw {
     /// the triangle ahead's division, so neither depends on the pipeline level.
     /// With the shared engine every triangle takes one entry slot, II clocks, walked or dropped.
     pub fn setup_clocks(&self) -> (u32, u32) {
-        if let Some(s) = self.engine() {
-            return (s.ii, s.ii);
+        if let Some((ii, ..)) = self.engine_timing() {
+            return (ii, ii);
         }
         (self.div_clocks() + 1 + self.start_clocks(), 1)
     }

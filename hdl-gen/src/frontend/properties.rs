@@ -52,9 +52,18 @@ pub(super) fn emit(hw: &Hw, set_up: Setup, sp: &Stager) -> Item {
 /// the shared engine and its result queue.
 pub(super) fn emit_engine(hw: &Hw, sp: &Stager) -> Item {
     let s = hw.engine().expect("the engine form");
-    let epochs = s.verify_binding().unwrap_or_else(|e| panic!("golden's binding: {e}"));
-    let engine =
-        EngineShape { ii: s.ii, latency: s.latency, epochs, depth: super::QUEUE_DEPTH, entry_w: super::engine::entry_bits(hw, &s) };
+    let (ii, latency, epochs) = hw.engine_timing().expect("the engine form");
+    if hw.sequential().is_none() {
+        s.verify_binding().unwrap_or_else(|e| panic!("golden's binding: {e}"));
+    }
+    let engine = EngineShape {
+        ii,
+        latency,
+        epochs,
+        depth: super::QUEUE_DEPTH,
+        entry_w: super::engine::entry_bits(hw, &s),
+        binary_phase: hw.sequential().is_some(),
+    };
     frontend_properties(&shape(hw, sp, SetupShape::Engine(engine)))
 }
 

@@ -13,7 +13,9 @@ use crate::verilog::*;
 pub(super) fn engine_probes(e: &EngineShape) -> Vec<(String, String, u32)> {
     let pw = bits_for(e.depth - 1);
     let mut v = vec![("f_e_vfull".to_string(), "u_engine.v_full".to_string(), 1), ("f_e_vld".into(), "u_engine.vld".into(), e.periods())];
-    if e.ii > 1 {
+    if e.binary_phase {
+        v.push(("f_e_ph".into(), "u_engine.pc".into(), e.phw()));
+    } else if e.ii > 1 {
         v.push(("f_e_ph".into(), "u_engine.ph".into(), e.ii));
     }
     if e.epochs > 1 {
@@ -120,7 +122,9 @@ impl Reference<'_> {
         let (phw, qw, pw) = (e.phw(), e.qw(), bits_for(e.depth - 1));
         let mut link =
             vec![assert("f_e_vfull == f_vf"), assert("f_e_vld == f_vld"), assert(format!("f_ph <= {}", lit(phw, (e.ii - 1) as u64)))];
-        if e.ii > 1 {
+        if e.binary_phase {
+            link.push(assert("f_e_ph == f_ph"));
+        } else if e.ii > 1 {
             link.push(assert(format!("f_e_ph == {} << f_ph", lit(e.ii, 1))));
         }
         if e.epochs > 1 {

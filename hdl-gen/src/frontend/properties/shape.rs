@@ -71,6 +71,8 @@ pub struct EngineShape {
     /// The queue's entries and an entry's bits.
     pub depth: u32,
     pub entry_w: u32,
+    /// The engine's phase is a binary counter (`pc`, the sequential engine's), not a one-hot ring.
+    pub binary_phase: bool,
 }
 
 /// A register stage of the front-end's span path: where it holds a span's valid, row, columns

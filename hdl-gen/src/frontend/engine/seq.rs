@@ -1,0 +1,658 @@
+//! The sequential set-up engine (issue 27, the iCE40 plans): golden's microprogram
+//! ([`golden::frontend::engine::sequential::SeqSchedule`]) printed as a machine: a microcode
+//! ROM of one word a clock, a register file of two block-RAM copies (a read port each, one
+//! write port), a flag file, one ALU, the plan's shift-add multiplier and restoring divider,
+//! and the result fields captured as their values are written. Its ports and its contract are
+//! `tri_fe_engine`'s: a triangle (or a bubble) enters every `clocks` clocks, its result is due
+//! `clocks` clocks later, `en` low freezes every register.
+//!
+//! `--fe-setup ice40-hx8k` (and `--target ice40-hx8k`) takes it in place of the pipelined
+//! engine; co-simulated in `verilator-harness/tests/frontend.rs` (`sequential_engine_*`, slow
+//! tier). docs/design.md, *A sequential engine for the iCE40 HX8K*.
+
+use super::result::{fields, ports, Field};
+use crate::frontend::hw::Hw;
+use crate::verilog::{comment, reg, set, sreg, wire, Item, Module, Param, Stmt};
+use golden::frontend::engine::schedule::Class;
+use golden::frontend::engine::sequential::{Exec, Loc, SeqSchedule, ALU_LAT, READ};
+use golden::frontend::engine::{Kind, MulUnit, V};
+
+/// The ALU's functions (the microword's `fn` field).
+const FN_PASS: u64 = 0;
+const FN_ADD: u64 = 1;
+const FN_SUB: u64 = 2;
+const FN_LT: u64 = 3;
+const FN_EQ: u64 = 4;
+const FN_AND: u64 = 5;
+const FN_OR: u64 = 6;
+const FN_NOT: u64 = 7;
+const FN_SEL: u64 = 8;
+const FN_LZC: u64 = 9;
+const FN_SHL: u64 = 10;
+const FN_SHR: u64 = 11;
+const FN_SHLV: u64 = 12;
+
+/// The write bus's sources (the microword's `src` field); an input `k` is `SRC_IN + k`.
+const SRC_ALU: u64 = 0;
+const SRC_MUL: u64 = 1;
+const SRC_DIVQ: u64 = 2;
+const SRC_DIVR: u64 = 3;
+const SRC_IN: u64 = 4;
+
+fn bits(n: u64) -> u32 {
+    (64 - n.leading_zeros()).max(1)
+}
+
+/// The microword's fields, least significant first: name and width.
+struct Layout {
+    fields: Vec<(&'static str, u32)>,
+}
+
+impl Layout {
+    fn new(aw: u32, fb: u32, sw: u32, cb: u32, wb: u32) -> Layout {
+        let fields = vec![
+            ("ra", aw),
+            ("rb", aw),
+            ("fn", 4),
+            ("fl0", 1),
+            ("fl1", 1),
+            ("fl2", 1),
+            ("pb0", 1),
+            ("pb1", 1),
+            ("pb2", 1),
+            ("fa0", fb),
+            ("fa1", fb),
+            ("fa2", fb),
+            ("imm", sw),
+            ("mld", 1),
+            ("mn", sw),
+            ("mbs", 1),
+            ("dld", 1),
+            ("dqb", sw),
+            ("we", 1),
+            ("wa", aw),
+            ("fwe", 1),
+            ("fwa", fb),
+            ("src", 4),
+            ("wc", wb),
+            ("wsg", 1),
+            ("cap", cb),
+        ];
+        Layout { fields }
+    }
+    fn width(&self) -> u32 {
+        self.fields.iter().map(|f| f.1).sum()
+    }
+    fn at(&self, name: &str) -> (u32, u32) {
+        let mut lo = 0;
+        for &(n, w) in &self.fields {
+            if n == name {
+                return (lo, w);
+            }
+            lo += w;
+        }
+        panic!("no field {name}")
+    }
+}
+
+/// One microword under construction: each field set at most once.
+#[derive(Clone, Default)]
+struct Word(std::collections::BTreeMap<&'static str, u64>);
+
+impl Word {
+    fn set(&mut self, k: &'static str, v: u64, clock: u32) {
+        if let Some(old) = self.0.insert(k, v) {
+            assert_eq!(old, v, "microword field {k} set twice at clock {clock}");
+        }
+    }
+    fn hex(&self, l: &Layout) -> String {
+        let mut v: u128 = 0;
+        for (k, x) in &self.0 {
+            let (lo, w) = l.at(k);
+            assert!(*x < 1u64 << w.min(63), "field {k} = {x} wider than {w}");
+            v |= (*x as u128) << lo;
+        }
+        let digits = l.width().div_ceil(4) as usize;
+        format!("{v:0digits$x}")
+    }
+}
+
+/// The block: golden's microprogram and constants are its tables (case statements read into a
+/// register, which synthesis maps to block RAM), so the block needs no image file.
+pub struct SeqEngine {
+    pub module: Module,
+}
+
+/// What every part of the block reads: golden's microprogram and the block's widths (the
+/// register file's word, a shift amount, `pc`, an address) and clocks a triangle.
+struct Cx<'a> {
+    hw: &'a Hw,
+    s: &'a SeqSchedule,
+    w: u32,
+    sw: u32,
+    cw: u32,
+    aw: u32,
+    c: u32,
+}
+
+/// The microprogram as [`microprogram`] lays it out.
+struct Micro {
+    l: Layout,
+    micro: Vec<String>,
+    groups: Vec<V>,
+    widths: Vec<u32>,
+}
+
+/// `name`: the sequential engine of `hw` (an iCE40 form), with `s` golden's microprogram.
+pub fn module(hw: &Hw, s: &SeqSchedule, name: &str) -> SeqEngine {
+    s.verify().unwrap_or_else(|e| panic!("golden's microprogram: {e}"));
+    assert!(matches!(s.plan.units.mul, MulUnit::ShiftAdd { bits: 1 }), "the RTL's multiplier is shift-add, a bit a clock");
+    assert_eq!(s.plan.units.div_bits, 1, "the RTL's divider takes a bit a clock");
+    let pipe = hw.engine().expect("an engine form");
+    let fields: Vec<Field> = fields(hw, &pipe);
+    assert_eq!(pipe.prog.out, s.prog.out, "one program");
+    let w = s.cost.ram_width;
+    let (words, flags) = s.words();
+    let c = s.clocks;
+    let cx = Cx { hw, s, w, sw: bits(w as u64), cw: bits(c as u64 - 1), aw: bits(words as u64 - 1), c };
+    let Micro { l, micro, groups, widths } = microprogram(&cx, &fields);
+    let nconst = s.preload.len() as u32;
+    assert!(s.preload.iter().enumerate().all(|(k, p)| p.0 == k as u32), "the constants at the first addresses");
+    assert!(nconst < c, "the constants are written within the first period");
+    let mask = if w >= 128 { u128::MAX } else { (1u128 << w) - 1 };
+    let consts: Vec<String> = s.preload.iter().map(|&(_, v)| format!("{w}'h{:x}", (v as u128) & mask)).collect();
+
+    let res_w: u32 = fields.iter().map(|f| f.w).sum();
+    let ports = ports(hw, res_w);
+    let params: Vec<Param> = Vec::new();
+    let header = vec![
+        format!("{name} — the sequential set-up engine (issue 27; docs/design.md): golden's microprogram on one ALU."),
+        "Generated by segshade hdl-gen from golden::frontend::engine::sequential; do not edit.".into(),
+        String::new(),
+        format!(
+            "{c} clocks a triangle; register file {words} x {w} bits (two copies, a read port each), {flags} flags, microword {} bits.",
+            l.width()
+        ),
+        "Microword fields (least significant first): ".to_string()
+            + &l.fields.iter().map(|(n, w)| format!("{n}:{w}")).collect::<Vec<_>>().join(" "),
+    ];
+
+    let mut b: Vec<Item> = Vec::new();
+    sequencer(&cx, &mut b);
+    memories(&cx, &l, &micro, &consts, &mut b);
+    alu(&cx, &mut b);
+    units(&cx, &mut b);
+    write_bus(&cx, &widths, &mut b);
+    results(&cx, &fields, &groups, &mut b);
+    SeqEngine { module: Module { name: name.into(), header, params, ports, body: b } }
+}
+
+/// The microprogram's words (one a clock), their layout, the capture groups (each output value
+/// written once, every field of it loading then) and the widths values are written at.
+fn microprogram(cx: &Cx, fields: &[Field]) -> Micro {
+    let (s, w, sw, aw, c) = (cx.s, cx.w, cx.sw, cx.aw, cx.c);
+    let ops = &s.prog.ops;
+    let (_, flags) = s.words();
+    let fb = bits(flags.max(1) as u64 - 1);
+    // Capture groups: each output value written once, every field of it loads then.
+    let out = &s.prog.out;
+    let mut groups: Vec<V> = Vec::new();
+    for v in fields.iter().map(|f| f.v).chain([out.guard_ok, out.cull]) {
+        if !groups.contains(&v) && !matches!(ops[v.0 as usize].kind, Kind::Const(_)) {
+            groups.push(v);
+        }
+    }
+    let cb = bits(groups.len() as u64);
+    // The widths values are written at: few, so the write's wrap reads a table, not a shifter.
+    let mut widths: Vec<u32> = (0..ops.len()).filter(|&o| !matches!(s.slots[o].exec, Exec::Dead | Exec::Const)).map(|o| ops[o].w).collect();
+    widths.sort();
+    widths.dedup();
+    let l = Layout::new(aw, fb, sw, cb, bits(widths.len() as u64 - 1));
+    let mut mw = vec![Word::default(); c as usize + 2];
+    let addr = |v: V| match s.slots[v.0 as usize].loc {
+        Loc::Ram(a) => a,
+        l => panic!("{} is not in the register file: {l:?}", ops[v.0 as usize].name),
+    };
+    for (o, op) in ops.iter().enumerate() {
+        let sl = s.slots[o];
+        let t = sl.issue;
+        // Operands: the wide ones on ports A then B, the flags from the flag file.
+        let mut args = op.kind.args();
+        if let Kind::Mul(a, b) = op.kind {
+            // The shift-add unit steps through its second operand: the narrower.
+            if ops[a.0 as usize].w < ops[b.0 as usize].w {
+                args = vec![b, a];
+            }
+        }
+        let exec = sl.exec;
+        if matches!(exec, Exec::Alu | Exec::Unit(..)) {
+            let mut port = 0;
+            for (j, a) in args.iter().enumerate() {
+                let (fl, pb, fa) = (["fl0", "fl1", "fl2"][j], ["pb0", "pb1", "pb2"][j], ["fa0", "fa1", "fa2"][j]);
+                match s.slots[a.0 as usize].loc {
+                    Loc::Flag(k) => {
+                        mw[t as usize + 1].set(fl, 1, t + 1);
+                        mw[t as usize + 1].set(fa, k as u64, t + 1);
+                    }
+                    _ => {
+                        mw[t as usize].set(["ra", "rb"][port], addr(*a) as u64, t);
+                        mw[t as usize + 1].set(pb, port as u64, t + 1);
+                        port += 1;
+                    }
+                }
+            }
+            let x = &mut mw[(t + READ) as usize];
+            let e = t + READ;
+            match (exec, op.kind) {
+                (Exec::Unit(Class::Mul, _), _) => {
+                    let nb = ops[args[1].0 as usize].w;
+                    x.set("mld", 1, e);
+                    x.set("mn", nb as u64, e);
+                    x.set("mbs", ops[args[1].0 as usize].signed as u64, e);
+                }
+                (Exec::Unit(Class::Div, _), Kind::Div { qb, .. }) => {
+                    x.set("dld", 1, e);
+                    x.set("dqb", qb as u64, e);
+                }
+                (Exec::Alu, k) => {
+                    let (f, imm) = match k {
+                        Kind::Wire(_) => (FN_PASS, 0),
+                        Kind::Add(..) => (FN_ADD, 0),
+                        Kind::Sub(..) => (FN_SUB, 0),
+                        Kind::Lt(..) => (FN_LT, 0),
+                        Kind::Eq(..) => (FN_EQ, 0),
+                        Kind::And(..) => (FN_AND, 0),
+                        Kind::Or(..) => (FN_OR, 0),
+                        Kind::Not(_) => (FN_NOT, 0),
+                        Kind::Sel(..) => (FN_SEL, 0),
+                        Kind::Lzc(_, n) => (FN_LZC, n),
+                        Kind::Shl(_, n) => (FN_SHL, n),
+                        Kind::Shr(_, n) => (FN_SHR, n),
+                        Kind::ShlBy(..) => (FN_SHLV, 0),
+                        k => panic!("{k:?} on the ALU"),
+                    };
+                    assert!(imm <= w, "shift or count {imm} beyond the word");
+                    x.set("fn", f, e);
+                    x.set("imm", imm as u64, e);
+                    assert_eq!(sl.write, t + READ + ALU_LAT, "the ALU's result is written the clock after");
+                }
+                other => panic!("{other:?} issued"),
+            }
+        }
+        if matches!(exec, Exec::Dead | Exec::Const) {
+            continue;
+        }
+        let src = match (exec, op.kind) {
+            (Exec::Alu, _) => SRC_ALU,
+            (Exec::Unit(Class::Mul, _), _) => SRC_MUL,
+            (Exec::Unit(Class::Div, _), _) => SRC_DIVQ,
+            (Exec::Rem, _) => SRC_DIVR,
+            (Exec::Input, Kind::In(k)) => SRC_IN + k as u64,
+            other => panic!("{other:?} writes"),
+        };
+        let wt = sl.write;
+        let x = &mut mw[wt as usize];
+        x.set("src", src, wt);
+        x.set("wc", widths.iter().position(|&k| k == op.w).unwrap() as u64, wt);
+        x.set("wsg", op.signed as u64, wt);
+        match sl.loc {
+            Loc::Ram(a) => {
+                x.set("we", 1, wt);
+                x.set("wa", a as u64, wt);
+            }
+            Loc::Flag(a) => {
+                x.set("fwe", 1, wt);
+                x.set("fwa", a as u64, wt);
+            }
+            Loc::None => panic!("{} written nowhere", op.name),
+        }
+        if let Some(g) = groups.iter().position(|&v| v.0 as usize == o) {
+            x.set("cap", g as u64 + 1, wt);
+        }
+    }
+    assert!(mw[c as usize..].iter().all(|x| x.0.is_empty()), "the microprogram ends within its clocks");
+    let mwn = l.width();
+    assert!(mwn <= 128, "a microword of {mwn} bits");
+    let micro: Vec<String> = mw[..c as usize].iter().map(|x| format!("{mwn}'h{}", x.hex(&l))).collect();
+    Micro { l, micro, groups, widths }
+}
+
+/// The sequencer: `pc`, the vertex register, the entered triangle's inputs, the valid bits, boot.
+fn sequencer(cx: &Cx, b: &mut Vec<Item>) {
+    let (wd, iw, cw, c) = (cx.hw.fe.widths(), cx.hw.fe.cfg.iw(), cx.cw, cx.c);
+    b.push(comment("Sequencer: the clock of the triangle (pc), the vertex register (v*) and the entered triangle's inputs"));
+    b.push(comment("(n*), a valid bit per period in flight, boot (the first period after reset)."));
+    b.push(reg("pc", cw));
+    b.push(reg("vld", 2));
+    b.push(reg("v_full", 1));
+    b.push(reg("boot", 1));
+    for k in 0..3 {
+        for (v, wv, sg) in [("x", wd.cx, true), ("y", wd.cy, true), ("i", iw, false)] {
+            for p in ["v", "n"] {
+                b.push(if sg { sreg(&format!("{p}{v}{k}"), wv) } else { reg(&format!("{p}{v}{k}"), wv) });
+            }
+        }
+    }
+    let last = format!("pc == {cw}'d{}", c - 1);
+    b.push(wire("enter", 1, format!("en && {last}")));
+    b.push(wire("pc_n", cw, format!("({last}) ? {cw}'d0 : pc + {cw}'d1")));
+    b.push(Item::Assign("in_ready".into(), "!v_full || enter".into()));
+    b.push(Item::Assign("res_v".into(), format!("pc == {cw}'d0 && vld[1]")));
+    let mut take = vec![set("v_full", "1'b1")];
+    let mut entry = vec![set("vld", "{vld[0], v_full}")];
+    for k in 0..3 {
+        for (v, p) in [("x", "in_x"), ("y", "in_y"), ("i", "in_i")] {
+            take.push(set(format!("v{v}{k}"), format!("{p}{k}")));
+            entry.push(set(format!("n{v}{k}"), format!("v{v}{k}")));
+        }
+    }
+    b.push(Item::Always(vec![Stmt::If(
+        "rst".into(),
+        vec![set("v_full", "1'b0"), set("vld", "2'd0"), set("pc", format!("{cw}'d0")), set("boot", "1'b1")],
+        vec![
+            Stmt::If("in_valid && in_ready".into(), take, vec![Stmt::If("enter".into(), vec![set("v_full", "1'b0")], vec![])]),
+            Stmt::If(
+                "en".into(),
+                vec![set("pc", "pc_n"), Stmt::If(last.clone(), [entry, vec![set("boot", "1'b0")]].concat(), vec![])],
+                vec![],
+            ),
+        ],
+    )]));
+    b.push(Item::Blank);
+}
+
+/// The microprogram's and the constants' tables, the microword's fields, the register file and the flag file.
+fn memories(cx: &Cx, l: &Layout, micro: &[String], consts: &[String], b: &mut Vec<Item>) {
+    let (w, cw, aw) = (cx.w, cx.cw, cx.aw);
+    let (words, flags) = cx.s.words();
+    let nconst = consts.len();
+    let mwn = l.width();
+    b.push(comment("The microprogram: word t is clock t's (reset reads word 0); beside it the constants, written into the"));
+    b.push(comment("register file in the first period after reset (boot), which is always a bubble's."));
+    b.push(wire("mpc", cw, format!("rst ? {cw}'d0 : pc_n")));
+    b.push(reg("mw", mwn));
+    b.push(reg("cq", w));
+    let arms = |vals: &[String], lhs: &str| -> Vec<(String, Vec<Stmt>)> {
+        vals.iter().enumerate().map(|(k, v)| (format!("{cw}'d{k}"), vec![set(lhs, v.clone())])).collect()
+    };
+    b.push(Item::Always(vec![Stmt::If(
+        "rst || en".into(),
+        vec![
+            Stmt::Case { sel: "mpc".into(), arms: arms(micro, "mw"), default: vec![set("mw", format!("{mwn}'d0"))] },
+            Stmt::Case { sel: "mpc".into(), arms: arms(consts, "cq"), default: vec![set("cq", format!("{w}'d0"))] },
+        ],
+        vec![],
+    )]));
+    for &(n, fw) in &l.fields {
+        let (lo, _) = l.at(n);
+        b.push(wire(&format!("u_{n}"), fw, if fw == 1 { format!("mw[{lo}]") } else { format!("mw[{}:{lo}]", lo + fw - 1) }));
+    }
+    b.push(Item::Blank);
+    b.push(comment("The register file: two copies written together, a registered read port each; the flag file."));
+    b.push(Item::Memory { name: "rfa".into(), width: w, depth: words });
+    b.push(Item::Memory { name: "rfb".into(), width: w, depth: words });
+    b.push(reg("da", w));
+    b.push(reg("db", w));
+    b.push(reg("fl", flags.max(1)));
+    b.push(crate::verilog::net("bus", w));
+    b.push(Item::Always(vec![Stmt::If(
+        "en".into(),
+        vec![
+            set("da", "rfa[u_ra]"),
+            set("db", "rfb[u_rb]"),
+            Stmt::If(
+                "boot".into(),
+                vec![Stmt::If(
+                    format!("pc < {cw}'d{nconst}"),
+                    vec![set(format!("rfa[pc[{}:0]]", aw - 1), "cq"), set(format!("rfb[pc[{}:0]]", aw - 1), "cq")],
+                    vec![],
+                )],
+                vec![Stmt::If("u_we".into(), vec![set("rfa[u_wa]", "bus"), set("rfb[u_wa]", "bus")], vec![])],
+            ),
+            Stmt::If("u_fwe".into(), vec![set("fl[u_fwa]", "bus[0]")], vec![]),
+        ],
+        vec![],
+    )]));
+    b.push(Item::Blank);
+}
+
+/// The operands and the ALU.
+fn alu(cx: &Cx, b: &mut Vec<Item>) {
+    let (w, sw, ops) = (cx.w, cx.sw, &cx.s.prog.ops);
+    b.push(comment("Operands: a flag from the flag file, else the port the microword names."));
+    for j in 0..3 {
+        b.push(wire(&format!("x{j}"), w, format!("u_fl{j} ? {{{{{}{{1'b0}}}}, fl[u_fa{j}]}} : (u_pb{j} ? db : da)", w - 1)));
+    }
+    b.push(comment("The ALU, its result registered (written the clock after)."));
+    b.push(reg("ar", w));
+    // Leading zeros of x0's low n bits (the program's counts: one width at the named screens),
+    // halving: the top half zero or not, a bit of the count each, below it ones so that zero
+    // counts n. Log depth, where a bit-serial chain would set the clock.
+    let mut lzn: Vec<u32> = ops.iter().filter_map(|o| if let Kind::Lzc(_, n) = o.kind { Some(n) } else { None }).collect();
+    lzn.sort();
+    lzn.dedup();
+    b.push(reg("lz", sw));
+    // The last stage reads only the top bit of its pair.
+    b.push(comment("verilator lint_off UNUSEDSIGNAL"));
+    let mut sel = Vec::new();
+    for &n in &lzn {
+        let p = (n + 1).next_power_of_two();
+        let lb = p.trailing_zeros();
+        let mut st = vec![Stmt::Blocking(format!("lz{n}_v{lb}"), format!("{{x0[{}:0], {{{}{{1'b1}}}}}}", n - 1, p - n))];
+        b.push(reg(&format!("lz{n}_v{lb}"), p));
+        b.push(reg(&format!("lz{n}"), lb));
+        for k in (0..lb).rev() {
+            let h = 1u32 << k;
+            let (v, nv) = (format!("lz{n}_v{}", k + 1), format!("lz{n}_v{k}"));
+            if k > 0 {
+                b.push(reg(&nv, h));
+            }
+            st.push(Stmt::Blocking(format!("lz{n}[{k}]"), format!("{v}[{}:{h}] == {h}'d0", 2 * h - 1)));
+            if k > 0 {
+                st.push(Stmt::Blocking(nv, format!("lz{n}[{k}] ? {v}[{}:0] : {v}[{}:{h}]", h - 1, 2 * h - 1)));
+            }
+        }
+        b.push(Item::Comb(st));
+        b.push(comment("verilator lint_on UNUSEDSIGNAL"));
+        sel.push((n, format!("{{{{{}{{1'b0}}}}, lz{n}}}", sw - lb)));
+    }
+    let mut e = format!("{sw}'d0");
+    for (n, x) in sel.iter().rev() {
+        e = format!("(u_imm == {sw}'d{n}) ? {x} : {e}");
+    }
+    b.push(Item::Comb(vec![Stmt::Blocking("lz".into(), e)]));
+    let one = |e: &str| format!("{{{{{}{{1'b0}}}}, {e}}}", w - 1);
+    // One adder for add, subtract and the signed compare (the difference's sign, corrected
+    // where the operands' signs differ); one left shifter for shifts by a constant and by the
+    // value on x1 (all out at W or more).
+    b.push(wire("sub", 1, format!("u_fn == 4'd{FN_SUB} || u_fn == 4'd{FN_LT}")));
+    b.push(comment("verilator lint_off UNUSEDSIGNAL"));
+    b.push(wire("as1", w + 1, format!("{{x0, 1'b1}} + {{x1 ^ {{{w}{{sub}}}}, sub}}")));
+    b.push(comment("verilator lint_on UNUSEDSIGNAL"));
+    b.push(wire("addsub", w, format!("as1[{w}:1]")));
+    b.push(wire("lt", 1, format!("(x0[{0}] != x1[{0}]) ? x0[{0}] : addsub[{0}]", w - 1)));
+    b.push(wire("shl_by", 1, format!("u_fn == 4'd{FN_SHLV}")));
+    b.push(wire("shl_amt", sw, format!("shl_by ? x1[{}:0] : u_imm", sw - 1)));
+    b.push(wire("shl", w, format!("(shl_by && x1 >= {w}) ? {w}'d0 : x0 << shl_amt")));
+    // Right shifts are by constants, and few (one at the named screens): a multiplexer over them.
+    let mut shrs: Vec<u32> = ops.iter().filter_map(|o| if let Kind::Shr(_, n) = o.kind { Some(n) } else { None }).collect();
+    shrs.sort();
+    shrs.dedup();
+    b.push(reg("shr", w));
+    let arms = shrs.iter().map(|n| (format!("{sw}'d{n}"), vec![Stmt::Blocking("shr".into(), format!("$signed(x0) >>> {n}"))])).collect();
+    b.push(Item::Comb(vec![Stmt::Case { sel: "u_imm".into(), arms, default: vec![Stmt::Blocking("shr".into(), "x0".into())] }]));
+    let alu = [
+        (vec![FN_ADD, FN_SUB], "addsub".to_string()),
+        (vec![FN_LT], one("lt")),
+        (vec![FN_EQ], one("x0 == x1")),
+        (vec![FN_AND], one("|x0 && |x1")),
+        (vec![FN_OR], one("|x0 || |x1")),
+        (vec![FN_NOT], one("~|x0")),
+        (vec![FN_SEL], "|x0 ? x1 : x2".to_string()),
+        (vec![FN_LZC], format!("{{{{{}{{1'b0}}}}, lz}}", w - sw)),
+        (vec![FN_SHL, FN_SHLV], "shl".to_string()),
+        (vec![FN_SHR], "shr".to_string()),
+    ];
+    // A parallel case: Yosys builds one multiplexer per bit, not a chain of twelve.
+    b.push(reg("alu", w));
+    let arms = alu
+        .iter()
+        .map(|(fs, x)| (fs.iter().map(|f| format!("4'd{f}")).collect::<Vec<_>>().join(", "), vec![Stmt::Blocking("alu".into(), x.clone())]))
+        .collect();
+    b.push(Item::Comb(vec![Stmt::Case { sel: "u_fn".into(), arms, default: vec![Stmt::Blocking("alu".into(), "x0".into())] }]));
+    b.push(Item::Always(vec![Stmt::If("en".into(), vec![set("ar", "alu")], vec![])]));
+    b.push(Item::Blank);
+}
+
+/// The shift-add multiplier and the restoring divider.
+fn units(cx: &Cx, b: &mut Vec<Item>) {
+    let (w, sw, ops) = (cx.w, cx.sw, &cx.s.prog.ops);
+    b.push(comment(
+        "The shift-add multiplier: the product modulo 2^W, a bit of the second operand a clock (its sign bit's weight negative).",
+    ));
+    for (n, wn) in [("ma", w), ("mb", w), ("macc", w), ("mcnt", sw), ("mbs_r", 1)] {
+        b.push(reg(n, wn));
+    }
+    b.push(Item::Always(vec![Stmt::If(
+        "en".into(),
+        vec![Stmt::If(
+            "u_mld".into(),
+            vec![set("ma", "x0"), set("mb", "x1"), set("macc", format!("{w}'d0")), set("mcnt", "u_mn"), set("mbs_r", "u_mbs")],
+            vec![Stmt::If(
+                format!("mcnt != {sw}'d0"),
+                vec![
+                    set("macc", format!("mb[0] ? ((mcnt == {sw}'d1 && mbs_r) ? macc - ma : macc + ma) : macc")),
+                    set("ma", "ma << 1"),
+                    set("mb", "mb >> 1"),
+                    set("mcnt", format!("mcnt - {sw}'d1")),
+                ],
+                vec![],
+            )],
+        )],
+        vec![],
+    )]));
+    b.push(Item::Blank);
+    b.push(comment("The restoring divider: the remainder shifted past the divisor, the dividend's low qb bits shifted in, a bit a clock."));
+    let mut qbs: Vec<u32> = ops.iter().filter_map(|o| if let Kind::Div { qb, .. } = o.kind { Some(qb) } else { None }).collect();
+    qbs.sort();
+    qbs.dedup();
+    for (n, wn) in [("dr", w), ("dd", w), ("dn", w), ("dq", w), ("dcnt", sw), ("dr0", w), ("dn0", w)] {
+        b.push(reg(n, wn));
+    }
+    b.push(wire("dt", w + 1, format!("{{dr, dn[{}]}}", w - 1)));
+    // The partial remainder stays below the divisor: it fits W bits after each step.
+    b.push(wire("dge", 1, "dt >= {1'b0, dd}"));
+    // Its top bit is zero wherever it is taken.
+    b.push(comment("verilator lint_off UNUSEDSIGNAL"));
+    b.push(wire("dsub", w + 1, "dt - {1'b0, dd}"));
+    b.push(comment("verilator lint_on UNUSEDSIGNAL"));
+    // The quotient widths are few: a multiplexer over them, not a barrel shifter.
+    let mut top = vec![Stmt::Blocking("dr0".into(), "x0".into()), Stmt::Blocking("dn0".into(), "x0".into())];
+    for q in qbs.iter().rev() {
+        top = vec![Stmt::If(
+            format!("u_dqb == {sw}'d{q}"),
+            vec![Stmt::Blocking("dr0".into(), format!("x0 >> {q}")), Stmt::Blocking("dn0".into(), format!("x0 << {}", w - q))],
+            top,
+        )];
+    }
+    b.push(Item::Comb(top));
+    b.push(Item::Always(vec![Stmt::If(
+        "en".into(),
+        vec![Stmt::If(
+            "u_dld".into(),
+            vec![set("dr", "dr0"), set("dn", "dn0"), set("dd", "x1"), set("dq", format!("{w}'d0")), set("dcnt", "u_dqb")],
+            vec![Stmt::If(
+                format!("dcnt != {sw}'d0"),
+                vec![
+                    set("dr", format!("dge ? dsub[{0}:0] : dt[{0}:0]", w - 1)),
+                    set("dq", format!("{{dq[{}:0], dge}}", w - 2)),
+                    set("dn", "dn << 1"),
+                    set("dcnt", format!("dcnt - {sw}'d1")),
+                ],
+                vec![],
+            )],
+        )],
+        vec![],
+    )]));
+    b.push(Item::Blank);
+}
+
+/// The write bus: its source, wrapped to the value's width and sign.
+fn write_bus(cx: &Cx, widths: &[u32], b: &mut Vec<Item>) {
+    let (wd, iw, w) = (cx.hw.fe.widths(), cx.hw.fe.cfg.iw(), cx.w);
+    b.push(comment("The write bus: the source the microword names, wrapped to the value's width and sign."));
+    let ins = ["nx0", "nx1", "nx2", "ny0", "ny1", "ny2", "ni0", "ni1", "ni2"];
+    let mut srcs: Vec<(u64, String)> = vec![(SRC_MUL, "macc".into()), (SRC_DIVQ, "dq".into()), (SRC_DIVR, "dr".into())];
+    for (k, n) in ins.iter().enumerate() {
+        let (wv, sg) = if k < 3 {
+            (wd.cx, true)
+        } else if k < 6 {
+            (wd.cy, true)
+        } else {
+            (iw, false)
+        };
+        srcs.push((SRC_IN + k as u64, if sg { crate::verilog::sext(n, wv, w) } else { crate::verilog::zext(n, wv, w) }));
+    }
+    b.push(reg("raw", w));
+    let arms = srcs.into_iter().map(|(k, x)| (format!("4'd{k}"), vec![Stmt::Blocking("raw".into(), x)])).collect();
+    b.push(Item::Comb(vec![Stmt::Case { sel: "u_src".into(), arms, default: vec![Stmt::Blocking("raw".into(), "ar".into())] }]));
+    b.push(reg("wmask", w));
+    b.push(reg("wsign", 1));
+    let wb = bits(widths.len() as u64 - 1);
+    let arms: Vec<(String, Vec<Stmt>)> = widths
+        .iter()
+        .enumerate()
+        .map(|(k, &x)| {
+            let m = if x >= w { format!("{{{w}{{1'b1}}}}") } else { format!("{{{{{}{{1'b0}}}}, {{{x}{{1'b1}}}}}}", w - x) };
+            (format!("{wb}'d{k}"), vec![Stmt::Blocking("wmask".into(), m), Stmt::Blocking("wsign".into(), format!("raw[{}]", x - 1))])
+        })
+        .collect();
+    b.push(Item::Comb(vec![Stmt::Case {
+        sel: "u_wc".into(),
+        arms,
+        default: vec![Stmt::Blocking("wmask".into(), format!("{{{w}{{1'b1}}}}")), Stmt::Blocking("wsign".into(), "1'b0".into())],
+    }]));
+    b.push(Item::Assign("bus".into(), "(raw & wmask) | ((u_wsg && wsign) ? ~wmask : {".to_string() + &format!("{w}{{1'b0}}}})")));
+    b.push(Item::Blank);
+}
+
+/// The result fields, each loaded as its value is written.
+fn results(cx: &Cx, fields: &[Field], groups: &[V], b: &mut Vec<Item>) {
+    let (ops, out) = (&cx.s.prog.ops, &cx.s.prog.out);
+    let cb = bits(groups.len() as u64);
+    b.push(comment("The result: each field loads as its value is written."));
+    let mut loads = Vec::new();
+    let name_of = |v: V| -> Option<String> {
+        if v == out.guard_ok {
+            return Some("c_guard".into());
+        }
+        if v == out.cull {
+            return Some("c_cull".into());
+        }
+        None
+    };
+    let mut parts = Vec::new();
+    for f in fields {
+        let n = format!("c_{}", f.name);
+        match ops[f.v.0 as usize].kind {
+            Kind::Const(k) => parts.push(format!("{}'d{}", f.w, k)),
+            _ => {
+                b.push(reg(&n, f.w));
+                let g = groups.iter().position(|&v| v == f.v).unwrap() + 1;
+                loads.push(Stmt::If(format!("u_cap == {cb}'d{g}"), vec![set(&n, format!("bus[{}:0]", f.w - 1))], vec![]));
+                parts.push(n);
+            }
+        }
+    }
+    for v in [out.guard_ok, out.cull] {
+        let n = name_of(v).unwrap();
+        b.push(reg(&n, 1));
+        let g = groups.iter().position(|&x| x == v).unwrap() + 1;
+        loads.push(Stmt::If(format!("u_cap == {cb}'d{g}"), vec![set(&n, "bus[0]")], vec![]));
+    }
+    b.push(Item::Always(vec![Stmt::If("en".into(), loads, vec![])]));
+    parts.reverse();
+    b.push(Item::Assign("res".into(), format!("{{{}}}", parts.join(", "))));
+    b.push(Item::Assign("res_guard".into(), "c_guard".into()));
+    b.push(Item::Assign("res_cull".into(), "c_cull".into()));
+}
