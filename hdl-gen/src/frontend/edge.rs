@@ -133,7 +133,7 @@ pub(super) fn instances(hw: &Hw, names: &Names, buses: &EdgeBuses) -> Item {
     let lane = |bus: &str, w: u32| if w == 1 { format!("{bus}[k]") } else { format!("{bus}[k*{w} +: {w}]") };
     let engine = hw.engine_form();
     let walker: &[(&str, &str)] = if e.tracked {
-        &[("go", "w_go"), ("next", "w_next"), ("more", "w_more"), ("first", "s_first")]
+        &[("go", "adv"), ("next", "w_next"), ("more", "w_more"), ("first", "s_first")]
     } else {
         &[("take", "w_load"), ("step", "w_step")]
     };
@@ -263,8 +263,16 @@ fn dda(e: &EdgeWidths) -> Vec<Item> {
     // a left edge's bound is -g, kept as g (its smallest is the span's left end).
     body.push(Item::Assign("lg".into(), "(in_rows && !w_right && gg < lo) ? gg : lo".into()));
     body.push(Item::Assign("ha".into(), "(in_rows && w_right && gg < hi) ? gg : hi".into()));
-    body.push(wire("cy", 1, "w_rem >= w_thr"));
-    body.push(wire("rnext", ediv_w, "cy ? w_rem - w_thr : w_rem + w_rs256"));
+    if tracked {
+        // The carry as the borrow of the subtraction it selects: one carry chain, where the
+        // compare on its own was mapped to a tree of LUTs in front of the bound's select.
+        body.push(wire("dif", ediv_w + 1, format!("{} - {}", zext("w_rem", ediv_w, ediv_w + 1), zext("w_thr", ediv_w, ediv_w + 1))));
+        body.push(wire("cy", 1, format!("!dif[{ediv_w}]")));
+        body.push(wire("rnext", ediv_w, format!("cy ? dif[{}:0] : w_rem + w_rs256", ediv_w - 1)));
+    } else {
+        body.push(wire("cy", 1, "w_rem >= w_thr"));
+        body.push(wire("rnext", ediv_w, "cy ? w_rem - w_thr : w_rem + w_rs256"));
+    }
     body.push(swire("gnext", bound_w, "cy ? w_g + w_qs1 : w_g + w_qs"));
     body
 }
@@ -333,7 +341,7 @@ fn walker_ports(e: &EdgeWidths) -> Vec<Port> {
     let EdgeWidths { row_w, end_w, .. } = *e;
     let moves = if e.tracked {
         vec![
-            Port::input("go", 1, "", "the walker moves (not reset, not stalled): next or more then holds"),
+            Port::input("go", 1, "", "the walker is not stalled: next or more then holds (in a reset, the edge waits for a load)"),
             Port::input("next", 1, "", "the walker's next row is the set-up result's first: it loads it"),
             Port::input("more", 1, "", "the walker has a row after this one: it steps"),
             Port::input("first", row_w, "unsigned integer", "the set-up result's first row, walked once it is loaded"),

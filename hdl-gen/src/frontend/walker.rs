@@ -145,12 +145,13 @@ pub(super) fn emit(hw: &Hw, names: &Names, body: &mut Vec<Item>) {
     // The incremental I0's walker also waits for its start engine (`ie_wait`, declared below).
     let step_when = "!rst && !take && adv && w_valid && !w_end";
     // Behind the row stages the walker's load and step are chosen from its registers (w_next,
-    // w_more) and its stall gates the registers' enables alone (w_go): `take`, the two
-    // together, fanned out to every walker and edge register was a long path (docs/fpga.md).
+    // w_more) and its stall gates the registers' enables alone (`adv`, the edges' `go`): `take`,
+    // the two together, fanned out to every walker and edge register was a long path
+    // (docs/fpga.md). The edges' enables leave out the reset: an edge's state matters only under
+    // the walker's valid, which the reset clears, and its next load sets all of it.
     let tracked = hw.row_stage();
     if tracked {
         let next = if engine { "q_ne && (!w_valid || w_end)" } else { "st == HOLD && (!w_valid || w_end)" };
-        body.push(wire("w_go", 1, "!rst && adv"));
         body.push(wire("w_next", 1, next));
         body.push(wire("w_more", 1, "w_valid && !w_end"));
     } else {
