@@ -33,6 +33,12 @@ pub(super) fn row_at(hw: &Hw, walker: &str, j: u32) -> String {
     }
 }
 
+/// The least of `<side>0`, `<side>1`, `<side>2`: the three compares side by side, then a select.
+fn least_of_three(side: &str) -> String {
+    let c = |i: u32, j: u32| format!("{side}{i} <= {side}{j}");
+    format!("({} && {}) ? {side}0 : ({}) ? {side}1 : {side}2", c(0, 1), c(0, 2), c(1, 2))
+}
+
 /// Row stage `j`'s valid (1, 2): a row, with a pixel or not.
 pub(super) fn row_valid(j: u32) -> &'static str {
     ["wr_v", "we_v"][j as usize - 1]
@@ -81,8 +87,7 @@ fn row_stages(hw: &Hw, body: &mut Vec<Item>) {
     body.push(comment("The span's ends from the row's bounds, the edges compared side by side: mg the smallest"));
     body.push(comment("left-edge g (x = -mg), hi3 the smallest right bound."));
     for (end, side) in [("mg", "wr_lg"), ("hi3", "wr_ha")] {
-        let c = |i: u32, j: u32| format!("{side}{i} <= {side}{j}");
-        body.push(swire(&format!("{end}_w"), end_w, format!("({} && {}) ? {side}0 : ({}) ? {side}1 : {side}2", c(0, 1), c(0, 2), c(1, 2))));
+        body.push(swire(&format!("{end}_w"), end_w, least_of_three(side)));
     }
     body.push(reg(v2, 1));
     body.extend([sreg("we_mg", end_w), sreg("we_hi3", end_w)]);
@@ -203,8 +208,7 @@ pub(super) fn emit(hw: &Hw, names: &Names, body: &mut Vec<Item>) {
         body.push(comment("The span's ends, the edges compared side by side: x = lo3 = -mg (the smallest left-edge g),"));
         body.push(comment("hi3 the smallest right bound; the row has a pixel when hi3 + mg >= 0."));
         for (end, side) in [("mg", "lg"), ("hi3", "ha")] {
-            let c = |i: u32, j: u32| format!("{side}{i} <= {side}{j}");
-            body.push(swire(end, end_w, format!("({} && {}) ? {side}0 : ({}) ? {side}1 : {side}2", c(0, 1), c(0, 2), c(1, 2))));
+            body.push(swire(end, end_w, least_of_three(side)));
         }
     }
     body.push(comment("verilator lint_off UNUSEDSIGNAL"));
