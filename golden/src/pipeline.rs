@@ -47,7 +47,7 @@ pub fn numbered(body: Vec<(&str, String, Vec<PipeReg>)>) -> Vec<PipeStage> {
 /// | level | segment shader | specular unit | front-end set-up |
 /// |--:|---|---|---|
 /// | 0 | as SPEC's seed: 2 stages | 5 stages | CALC in one clock |
-/// | 1 | + a span register; the BFPI's multiples and the last-segment flag registered | + both multiplies split into registered 4-bit partial products and their sum; the BRDF address registered before the ROM, both ROMs' words registered before any arithmetic: 10 stages | CALC in five clocks ([`SETUP_STAGES`]), overlapped with the dividers; the span path in eight ([`I0_STAGES`]) instead of two, behind the walker's row registered ([`Pipeline::row_stage`], the reciprocal `I0`) |
+/// | 1 | + a span register; the BFPI's multiples and the last-segment flag registered | + both multiplies split into registered 4-bit partial products and their sum; the BRDF address registered before the ROM, both ROMs' words registered before any arithmetic: 10 stages | CALC in five clocks ([`SETUP_STAGES`]), overlapped with the dividers; the span path in eight ([`I0_STAGES`]) instead of two, behind the walker's row registered and its span's ends registered ([`Pipeline::row_stages`], the reciprocal `I0`) |
 /// | 2 | + the lane sums registered before round and clamp | as level 1 | as level 1 |
 /// | 3 | + no clock with two adders in a row: the BFPI's first adder level formed as the span enters its register, the rest when it starts; each lane's sum split at the binary point (high part and the fraction's carry registered, joined before the clamp) | as level 1 | as level 1 |
 ///
@@ -145,20 +145,34 @@ impl Pipeline {
         }
     }
 
-    /// Front-end: the walker's row registered ([`ROW_STAGE`]) before the row's span is decided
+    /// Front-end: the walker's row registered ([`ROW_STAGES`]) before the row's span is decided
     /// (the three edges' bounds compared, the pixel test, the span's ends), so the walker's
-    /// clock is its edges' DDA and their bounds alone: one clock of latency, no change of rate
-    /// (the stage moves on the one stall like every other). Not with the incremental `I0`,
+    /// clock is its edges' DDA and their bounds alone: no change of rate (the stages move on the
+    /// one stall like every other), a clock of latency per stage. Not with the incremental `I0`,
     /// whose walker waits on the row's own span (a source's start), decided in the walker's
     /// clock.
     pub fn row_stage(self, i0: I0Form) -> bool {
-        self.0 >= 1 && i0 == I0Form::Reciprocal
+        self.row_stages(i0) > 0
+    }
+
+    /// The row stages' count ([`Pipeline::row_stage`]): 0, or [`ROW_STAGES`]' two, the span's
+    /// ends (the edges' pairwise compares and selects) registered before the pixel test and
+    /// the span's start and length (they were one clock, 13.7 ns on the ECP5-25F; docs/fpga.md).
+    pub fn row_stages(self, i0: I0Form) -> u32 {
+        if self.0 >= 1 && i0 == I0Form::Reciprocal {
+            ROW_STAGES.len() as u32
+        } else {
+            0
+        }
     }
 }
 
-/// What the front-end's row stage ([`Pipeline::row_stage`]) holds, between the walker and the
-/// span path's first logical stage ([`I0_STAGES`]).
-pub const ROW_STAGE: &str = "the walker's row: each edge's bound on it, clipped to the screen, with the row's sums";
+/// What the front-end's row stages ([`Pipeline::row_stages`]) hold, between the walker and the
+/// span path's first logical stage ([`I0_STAGES`]), in order.
+pub const ROW_STAGES: [&str; 2] = [
+    "the walker's row: each edge's bound on it, clipped to the screen, with the row's sums",
+    "the row's span ends: the least left-edge bound and the least right bound (the edges compared pairwise, then selected), with the row's sums",
+];
 
 /// The front-end's spans from the walker to the output, in logical stages: which boundaries
 /// between them are registered. SPEC's seed structure (level 0) registers two, after `S2n` and
@@ -240,5 +254,6 @@ mod tests {
         assert!(Pipeline::all().all(|p| !p.row_stage(I0Form::Incremental)), "the incremental walker decides its row itself");
         assert!(!Pipeline::NONE.row_stage(I0Form::Reciprocal), "level 0 is SPEC's seed structure");
         assert!(Pipeline::all().skip(1).all(|p| p.row_stage(I0Form::Reciprocal)));
+        assert!(Pipeline::all().all(|p| p.row_stage(I0Form::Reciprocal) == (p.row_stages(I0Form::Reciprocal) == ROW_STAGES.len() as u32)));
     }
 }

@@ -22,10 +22,10 @@
 //!   `Widths::reciprocal_quotient`). Products modulo a power of two keep only the tile-sized
 //!   partial products with a bit below it (`span::mul_mod`). At `--pipeline 1` and above six
 //!   stages, one multiply or two adders each ([`golden::pipeline::I0_STAGES`]), the product by
-//!   `Rn` in two registered halves, behind a row stage (the reciprocal `I0`): each edge's bound
-//!   on the walked row is registered and the row's span (the minima, the pixel test) decided a
-//!   clock later, so the walker's clock is its DDA alone
-//!   ([`golden::pipeline::Pipeline::row_stage`]).
+//!   `Rn` in two registered halves, behind two row stages (the reciprocal `I0`): each edge's
+//!   bound on the walked row is registered, the row's span ends (the minima) a clock later, and
+//!   the pixel test and the span's start and length decided from those, so the walker's clock is
+//!   its DDA alone ([`golden::pipeline::Pipeline::row_stages`]).
 //!   One stall signal holds the walker and every stage while the output waits.
 
 mod calc;
@@ -71,18 +71,20 @@ fn stage_list(st: &Stager, name: &str, logic: &[&str]) -> Vec<golden::pipeline::
         .collect()
 }
 
-/// The span path's stages for the manifest: the row stage (`row`, numbered 0: it is the
-/// walker's row, before the span path's first), then `span<j>`.
+/// The span path's stages for the manifest: the row stages (`row`, then `row_ends`, numbered
+/// 0: they are the walker's row, before the span path's first), then `span<j>`.
 fn span_stage_list(hw: &Hw, sp: &Stager) -> Vec<golden::pipeline::PipeStage> {
-    let row = walker::row_registers(hw);
     let format = |signed: bool| if signed { "signed" } else { "unsigned" };
-    let row = (!row.is_empty()).then(|| golden::pipeline::PipeStage {
-        stage: 0,
-        name: "row".into(),
-        logic: golden::pipeline::ROW_STAGE.into(),
-        regs: row.into_iter().map(|(n, bits, signed)| golden::pipeline::PipeReg::new(&n, bits, format(signed))).collect(),
-    });
-    row.into_iter().chain(stage_list(sp, "span", &golden::pipeline::I0_STAGES)).collect()
+    let rows =
+        walker::row_registers(hw).into_iter().zip(["row", "row_ends"]).zip(golden::pipeline::ROW_STAGES).map(|((regs, name), logic)| {
+            golden::pipeline::PipeStage {
+                stage: 0,
+                name: name.into(),
+                logic: logic.into(),
+                regs: regs.into_iter().map(|(n, bits, signed)| golden::pipeline::PipeReg::new(&n, bits, format(signed))).collect(),
+            }
+        });
+    rows.chain(stage_list(sp, "span", &golden::pipeline::I0_STAGES)).collect()
 }
 
 pub fn module(hw: &Hw, names: &Names) -> Module {

@@ -117,6 +117,8 @@ fn synth_and_check_rtl_dir_show_the_generators_message() {
         (&["--chain", "3", "--out", o], &["--chain 3", "power of two"]),
         (&["--chain", "16", "--chain-align", "diagonal", "--out", o], &["--chain 16 --chain-align diagonal", "diagonal"]),
         (&["--chain", "16", "--fe-setup", "xc7", "--out", o], &["--fe-setup xc7", "xc7"]),
+        (&["--chain-specular", "0", "--out", o], &["--chain-specular is for --chain"]),
+        (&["--chain", "16", "--chain-specular", "7", "--out", o], &["--chain-specular 7", "'7'"]),
         (&["--chain"], &["--chain needs a value"]),
         (&["--family", "vhdl"], &["unknown family 'vhdl'"]),
         (&["--seeds"], &["--seeds needs a value"]),

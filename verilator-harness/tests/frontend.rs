@@ -568,6 +568,41 @@ fn engine_planted_faults_are_caught() {
     assert_faults_caught(&base, "tri_fe_engine.v", "fault", faults, seed, &tris);
 }
 
+/// Negative controls of the walker behind the row stages (`--pipeline 1`, the ECP5 plan at
+/// 37x23, each a model built on first use): an edge's place among its rows moved onto its first
+/// row a row late, an edge starting at the walk's first row never entered, and the span's left
+/// end taken from one edge alone in the row stages (12,188, 17,523 and 14,763 mismatches). Caught on the triangles the clean model passes
+/// (`engine_spans_equal_golden_at_the_targets_pipeline_level`). (The place not moved past an
+/// edge's last row is no fault: beyond its end vertex an edge's line lies outside the triangle,
+/// so its bound never wins.) Slow tier: three models, about a minute of CPU each to build.
+#[test]
+#[ignore]
+fn walker_planted_faults_are_caught() {
+    let Some(opts) = engine(golden::setup::Screen { width: 37, height: 23 }, golden::frontend::engine::SetupForm::Ecp5_25f) else { return };
+    let opts = hdl_gen::Options { pipeline: golden::pipeline::Pipeline::at(1), ..opts };
+    let base = verilator_harness::ondemand::describe(&opts, verilator_harness::models::Kind::Frontend).unwrap_or_else(|e| panic!("{e}"));
+    let seed = verilator_harness::seed("frontend walker faults");
+    let fe = opts.frontend().unwrap().fe;
+    let tris = random_triangles(&mut SeedRng::seed_from_u64(seed), &fe, 3000);
+    let text = |file: &str| base.sources.iter().find(|(n, _)| n == file).unwrap_or_else(|| panic!("no {file}")).1.clone();
+    let line = |text: &str, what: &str, f: &dyn Fn(&str) -> bool| {
+        text.lines().find(|l| f(l)).unwrap_or_else(|| panic!("no line for {what}")).to_string()
+    };
+    let edge = text("tri_fe_edge.v");
+    let step = line(&edge, "the row's place moved against rs", &|l| l.contains("w_ge <= w_ge ||"));
+    let load = line(&edge, "the row's place loaded against rs", &|l| l.contains("w_ge <= first >= rs;"));
+    let one = step.split(" + ").nth(1).and_then(|t| t.split(" == ").next()).expect("the step's row + 1").to_string();
+    let faults = [
+        (step.clone(), step.replacen(&format!(" + {one}"), "", 1), "an edge's first row entered a row late"),
+        (load.clone(), load.replacen(">=", ">", 1), "an edge starting at the walk's first row never entered"),
+    ];
+    assert_faults_caught(&base, "tri_fe_edge.v", "wfault", faults, seed, &tris);
+    let fe_text = text("tri_frontend.v");
+    let mg = line(&fe_text, "the span's left end", &|l| l.contains("we_mg <= mg_w;"));
+    let faults = [(mg.clone(), mg.replacen("mg_w", "wr_lg0", 1), "the span's left end from one edge alone")];
+    assert_faults_caught(&base, "tri_frontend.v", "wsfault", faults, seed, &tris);
+}
+
 /// Each `(from, to, what)`: the model `base` with `from` replaced by `to` in its file `file`
 /// (built on first use, tagged `<base><suffix><k>`) is caught on `tris`.
 fn assert_faults_caught(

@@ -87,11 +87,16 @@ impl Hw {
         self.pipeline.row_stage(self.fe.i0)
     }
 
+    /// The row stages' count ([`golden::pipeline::Pipeline::row_stages`]): 0 or 2.
+    pub fn row_stages(&self) -> u32 {
+        self.pipeline.row_stages(self.fe.i0)
+    }
+
     /// Register stages between the walker and the output register: 2, or at `--pipeline 1`
-    /// and above the row stage and 8 ([`golden::pipeline::i0_registers`]; 8 alone with the
+    /// and above the row stages and 8 ([`golden::pipeline::i0_registers`]; 8 alone with the
     /// incremental `I0`).
     pub fn i0_stages(&self) -> u32 {
-        golden::pipeline::i0_registers(self.pipeline).iter().filter(|&&r| r).count() as u32 + self.row_stage() as u32
+        golden::pipeline::i0_registers(self.pipeline).iter().filter(|&&r| r).count() as u32 + self.row_stages()
     }
 
     /// Clocks from a triangle's transfer to the first span's `out_valid` when the walker is

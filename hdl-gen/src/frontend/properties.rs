@@ -67,6 +67,37 @@ pub(super) fn emit_engine(hw: &Hw, sp: &Stager) -> Item {
     frontend_properties(&shape(hw, sp, SetupShape::Engine(engine)))
 }
 
+/// Row stage `j` (1, 2): where it holds the row, and what holds of its registers as the
+/// walker's signals they load: each edge's bound (the first), the span's ends (the second) are
+/// the screen's or inside it, and at least a sign-extended `g`'s least (so `-mg` does not
+/// overflow).
+fn row_stage(hw: &Hw, j: u32) -> RowStage {
+    let w = super::edge::end_width(hw);
+    let least = super::hw::slit(w, -(1i64 << (w - 2)));
+    // Per group (an edge's pair of bounds, or the span's two ends): each within the screen's,
+    // then each at least `least`.
+    let groups: Vec<[(String, &str); 2]> = if j == 1 {
+        (0..3).map(|k| [(format!("wr_lg{k}"), "lo0"), (format!("wr_ha{k}"), "hi0")]).collect()
+    } else {
+        vec![[("we_mg".into(), "lo0"), ("we_hi3".into(), "hi0")]]
+    };
+    let holds = groups
+        .iter()
+        .flat_map(|g| {
+            g.iter()
+                .map(|(r, screen)| format!("{r} <= {screen}"))
+                .chain(g.iter().map(|(r, _)| format!("{r} >= {least}")))
+                .collect::<Vec<_>>()
+        })
+        .collect();
+    RowStage {
+        valid: super::walker::row_valid(j).into(),
+        y: super::walker::row_at(hw, "w_row", j),
+        di: super::walker::row_at(hw, "w_di", j),
+        holds,
+    }
+}
+
 /// What both forms share: widths, screen, the span path's stages.
 fn shape(hw: &Hw, sp: &Stager, setup: SetupShape) -> FrontendShape {
     let fe = &hw.fe;
@@ -81,27 +112,7 @@ fn shape(hw: &Hw, sp: &Stager, setup: SetupShape) -> FrontendShape {
         height: fe.screen.height as u64,
         latency: hw.latency(),
         setup,
-        row_stage: hw.row_stage().then(|| RowStage {
-            valid: "wr_v".into(),
-            y: super::walker::row(hw, "w_row"),
-            di: super::walker::row(hw, "w_di"),
-            // An edge's bound is the screen's or inside it (`tri_fe_edge`'s `lg`, `ha`), and
-            // at least its sign-extended `g`'s least (so `-mg` does not overflow).
-            holds: {
-                let w = super::edge::end_width(hw);
-                let least = super::hw::slit(w, -(1i64 << (w - 2)));
-                (0..3)
-                    .flat_map(|k| {
-                        [
-                            format!("wr_lg{k} <= lo0"),
-                            format!("wr_ha{k} <= hi0"),
-                            format!("wr_lg{k} >= {least}"),
-                            format!("wr_ha{k} >= {least}"),
-                        ]
-                    })
-                    .collect()
-            },
-        }),
+        row_stages: (1..=hw.row_stages()).map(|j| row_stage(hw, j)).collect(),
         span_stages: (1..=sp.stage())
             .map(|j| {
                 let held = |n: &str| sp.held(n, j).expect("a span's fields reach the output");
@@ -217,16 +228,18 @@ impl Reference<'_> {
             b.push(Item::Reg { name: "f_wymin".into(), width: cy, signed: true });
             b.push(Item::Reg { name: "f_wymax".into(), width: cy, signed: true });
         }
-        if self.s.row_stage.is_some() {
-            b.push(comment("The row stage: the walker's row (valid, row, tag), its coverage decided there."));
-            b.extend([reg("f_rv", 1), reg("f_ry", yw), reg("f_rn", 1)]);
+        if !self.s.row_stages.is_empty() {
+            b.push(comment("The row stages: the walker's row (valid, row, tag), its coverage decided in the last."));
+            for j in 1..=self.s.row_stages.len() {
+                b.extend([reg(&format!("f_r{j}v"), 1), reg(&format!("f_r{j}y"), yw), reg(&format!("f_r{j}n"), 1)]);
+            }
         }
         b.push(comment("The spans: the walker's row in the I0 stages and the output (valid, row)."));
         for i in 1..=nsp {
             b.extend([reg(&format!("f_{i}v"), 1), reg(&format!("f_{i}y"), yw)]);
         }
         b.extend([reg("f_ov", 1), reg("f_oy", yw)]);
-        b.push(comment(if self.s.row_stage.is_some() {
+        b.push(comment(if !self.s.row_stages.is_empty() {
             "Each span's tag: its triangle's first (f_wnew: the walker's row is its triangle's first)."
         } else {
             "Each span's tag: its triangle's first (the walker has emitted none of it yet: f_wnew)."
@@ -295,13 +308,15 @@ impl Reference<'_> {
         let inc1 = |n: &str| set(n, format!("{n} + {}", one(cw)));
         // The walker moves when the output is free (and, with starts, no source is starting).
         // `row`: a span leaves the walker, or the row stage, for the span path.
-        let staged = self.s.row_stage.is_some();
+        let rows = self.s.row_stages.len();
+        let staged = rows > 0;
         assert!(!staged || self.s.starts.is_none(), "the incremental walker has no row stage");
         let (wgo, row) = match self.s.starts {
-            Some(_) => ("f_adv && !ie_wait", "f_wv && f_cover && !ie_wait"),
-            None if staged => ("f_adv", "f_rv && f_cover"),
-            None => ("f_adv", "f_wv && f_cover"),
+            Some(_) => ("f_adv && !ie_wait", "f_wv && f_cover && !ie_wait".to_string()),
+            None if staged => ("f_adv", format!("f_r{rows}v && f_cover")),
+            None => ("f_adv", "f_wv && f_cover".to_string()),
         };
+        let row = row.as_str();
         // The walker's row is no longer its triangle's first once it moves on, or (no row stage)
         // once one of its rows is a span.
         let first_gone = if staged { "f_adv && f_wv" } else { row };
@@ -322,17 +337,22 @@ impl Reference<'_> {
                 ),
             ],
         );
-        // With the row stage a row is tagged its triangle's first as it leaves the walker, or
-        // when the row ahead of it (its triangle's) was tagged and had no pixel.
+        // With row stages a row is tagged its triangle's first as it leaves the walker, or, in
+        // the last (where its coverage is decided), when the row ahead of it (its triangle's)
+        // was tagged and had no pixel.
         let into_spans = if staged {
-            vec![
-                set("f_rv", "f_wv"),
-                set("f_ry", "f_wrow"),
-                set("f_rn", "f_wnew || (f_rn && !(f_rv && f_cover))"),
-                set("f_1v", row),
-                set("f_1y", "f_ry"),
-                set("f_1n", "f_rn"),
-            ]
+            let mut v = Vec::new();
+            for j in 1..=rows {
+                let (pv, py, pn) = if j == 1 {
+                    ("f_wv".into(), "f_wrow".into(), "f_wnew".into())
+                } else {
+                    (format!("f_r{}v", j - 1), format!("f_r{}y", j - 1), format!("f_r{}n", j - 1))
+                };
+                let n = if j == rows { format!("{pn} || (f_r{j}n && !(f_r{j}v && f_cover))") } else { pn };
+                v.extend([set(format!("f_r{j}v"), pv), set(format!("f_r{j}y"), py), set(format!("f_r{j}n"), n)]);
+            }
+            v.extend([set("f_1v", row), set("f_1y", format!("f_r{rows}y")), set("f_1n", format!("f_r{rows}n"))]);
+            v
         } else {
             vec![set("f_1v", row), set("f_1y", "f_wrow"), set("f_1n", "f_wnew")]
         };
@@ -354,7 +374,7 @@ impl Reference<'_> {
             reset
                 .into_iter()
                 .chain([set("f_wv", "1'b0")])
-                .chain(staged.then(|| set("f_rv", "1'b0")))
+                .chain((1..=rows).map(|j| set(format!("f_r{j}v"), "1'b0")))
                 .chain((1..=nsp).map(|i| set(format!("f_{i}v"), "1'b0")))
                 .chain([
                     set("f_ov", "1'b0"),
@@ -508,15 +528,23 @@ impl Reference<'_> {
         for (i, sp) in span_stages.iter().enumerate().map(|(k, sp)| (k + 1, sp)).rev() {
             link.push(when(format!("f_{i}v && !f_{i}n"), vec![assert(format!("{} == ({})", sp.di, ahead(i + 1)))]));
         }
-        match &self.s.row_stage {
-            Some(r) => {
-                link.push(assert(format!("{} == f_rv", r.valid)));
-                link.push(when("f_rv", std::iter::once(assert(format!("{} == f_ry", r.y))).chain(r.holds.iter().map(assert)).collect()));
-                link.push(when("f_rv && !f_rn", vec![assert(format!("{} == ({})", r.di, ahead(1)))]));
-                // A walked row after its triangle's first has that triangle's row ahead of it.
-                link.push(when("f_wv && !f_wnew", vec![assert("f_rv"), assert(format!("w_di == {}", r.di))]));
-            }
-            None => link.push(when("f_wv && !f_wnew", vec![assert(format!("w_di == ({})", ahead(1)))])),
+        let rows = &self.s.row_stages;
+        if rows.is_empty() {
+            link.push(when("f_wv && !f_wnew", vec![assert(format!("w_di == ({})", ahead(1)))]));
+        }
+        // The dI ahead of row stage j (1-based; j = rows.len() + 1: the span path's).
+        let ahead_row = |j: usize| (j..=rows.len()).rev().fold(ahead(1), |acc, k| format!("f_r{k}v ? {} : {acc}", rows[k - 1].di));
+        for (j, r) in rows.iter().enumerate().map(|(k, r)| (k + 1, r)) {
+            link.push(assert(format!("{} == f_r{j}v", r.valid)));
+            link.push(when(
+                format!("f_r{j}v"),
+                std::iter::once(assert(format!("{} == f_r{j}y", r.y))).chain(r.holds.iter().map(assert)).collect(),
+            ));
+            link.push(when(format!("f_r{j}v && !f_r{j}n"), vec![assert(format!("{} == ({})", r.di, ahead_row(j + 1)))]));
+        }
+        if let Some(r) = rows.first() {
+            // A walked row after its triangle's first has that triangle's row ahead of it.
+            link.push(when("f_wv && !f_wnew", vec![assert("f_r1v"), assert(format!("w_di == {}", r.di))]));
         }
         for sp in span_stages {
             link.push(on_screen(&sp.valid, &sp.x, &sp.len, xw, width));

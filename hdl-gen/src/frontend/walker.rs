@@ -17,12 +17,31 @@ pub(super) fn scanline_divider(hw: &Hw) -> (Div, u32) {
 }
 
 /// The walker's values the span path reads (`w_row`, `w_tn`, ...) where it reads them: the
-/// row stage's registers when there is one ([`Hw::row_stage`]).
+/// last row stage's registers when there are row stages ([`Hw::row_stages`]).
 pub(super) fn row(hw: &Hw, walker: &str) -> String {
-    match walker.strip_prefix("w_") {
-        Some(name) if hw.row_stage() => format!("wr_{name}"),
+    row_at(hw, walker, hw.row_stages())
+}
+
+/// A walker's value in row stage `j` (1, 2): `wr_<name>` in the first, `we_<name>` in the
+/// second; the walker's own register in stage 0.
+pub(super) fn row_at(hw: &Hw, walker: &str, j: u32) -> String {
+    assert!(j <= hw.row_stages(), "row stage {j} of {}", hw.row_stages());
+    match (walker.strip_prefix("w_"), j) {
+        (Some(name), 1) => format!("wr_{name}"),
+        (Some(name), 2) => format!("we_{name}"),
         _ => walker.into(),
     }
+}
+
+/// The least of `<side>0`, `<side>1`, `<side>2`: the three compares side by side, then a select.
+fn least_of_three(side: &str) -> String {
+    let c = |i: u32, j: u32| format!("{side}{i} <= {side}{j}");
+    format!("({} && {}) ? {side}0 : ({}) ? {side}1 : {side}2", c(0, 1), c(0, 2), c(1, 2))
+}
+
+/// Row stage `j`'s valid (1, 2): a row, with a pixel or not.
+pub(super) fn row_valid(j: u32) -> &'static str {
+    ["wr_v", "we_v"][j as usize - 1]
 }
 
 /// The walker's values the row stage holds besides the edges' bounds: the span path's inputs.
@@ -38,14 +57,18 @@ fn row_values(hw: &Hw) -> Vec<(&'static str, u32)> {
     v
 }
 
-/// The row stage: the walked row (valid, each edge's bound, the span path's inputs) registered,
-/// moving on the one stall.
-fn row_stage(hw: &Hw, body: &mut Vec<Item>) {
+/// The row stages: the walked row (valid, each edge's bound, the span path's inputs)
+/// registered; then the span's ends chosen from those bounds and registered with the row
+/// (valid, the span path's inputs) a clock later; all moving on the one stall.
+fn row_stages(hw: &Hw, body: &mut Vec<Item>) {
+    assert_eq!(hw.row_stages(), 2, "the row stages are the walked row, then its span's ends");
     let end_w = edge::end_width(hw);
-    body.push(comment("Row stage: the walked row registered, each edge's bound on it and the row's sums: the row's"));
-    body.push(comment("span is decided from these a clock after the walker (wr_v: a row, with a pixel or not)."));
-    body.push(reg("wr_v", 1));
-    let mut moves = vec![set("wr_v", "w_valid")];
+    body.push(comment("Row stages: the walked row registered, each edge's bound on it and the row's sums (wr_*); its"));
+    body.push(comment("span's ends chosen from these and registered with the row a clock later (we_*); the span is"));
+    body.push(comment("decided from those (wr_v, we_v: a row, with a pixel or not)."));
+    let (v1, v2) = (row_valid(1), row_valid(2));
+    body.push(reg(v1, 1));
+    let mut moves = vec![set(v1, "w_valid")];
     for side in ["lg", "ha"] {
         for k in 0..3 {
             let r = format!("wr_{side}{k}");
@@ -54,23 +77,42 @@ fn row_stage(hw: &Hw, body: &mut Vec<Item>) {
         }
     }
     for (n, w) in row_values(hw) {
-        body.push(reg(&row(hw, n), w));
+        body.push(reg(&row_at(hw, n, 1), w));
         let sums = matches!(n, "w_tn" | "w_gxn");
-        moves.push(set(row(hw, n), if sums { format!("{n}[{}:0]", w - 1) } else { n.to_string() }));
+        moves.push(set(row_at(hw, n, 1), if sums { format!("{n}[{}:0]", w - 1) } else { n.to_string() }));
     }
-    body.push(Item::Always(vec![Stmt::If("rst".into(), vec![set("wr_v", "1'b0")], vec![Stmt::If("adv".into(), moves, vec![])])]));
+    // The edges compared side by side, each end a three-way select: these compares and selects
+    // then the add of the pixel test were one clock, the staged front-end's longest in the
+    // walker (docs/fpga.md).
+    body.push(comment("The span's ends from the row's bounds, the edges compared side by side: mg the smallest"));
+    body.push(comment("left-edge g (x = -mg), hi3 the smallest right bound."));
+    for (end, side) in [("mg", "wr_lg"), ("hi3", "wr_ha")] {
+        body.push(swire(&format!("{end}_w"), end_w, least_of_three(side)));
+    }
+    body.push(reg(v2, 1));
+    body.extend([sreg("we_mg", end_w), sreg("we_hi3", end_w)]);
+    moves.extend([set(v2, v1), set("we_mg", "mg_w"), set("we_hi3", "hi3_w")]);
+    for (n, w) in row_values(hw) {
+        body.push(reg(&row_at(hw, n, 2), w));
+        moves.push(set(row_at(hw, n, 2), row_at(hw, n, 1)));
+    }
+    let reset = vec![set(v1, "1'b0"), set(v2, "1'b0")];
+    body.push(Item::Always(vec![Stmt::If("rst".into(), reset, vec![Stmt::If("adv".into(), moves, vec![])])]));
 }
 
-/// The row stage's registers for the manifest: `(name, bits, signed)`; none without it.
-pub(super) fn row_registers(hw: &Hw) -> Vec<(String, u32, bool)> {
+/// The row stages' registers for the manifest, one list a stage: `(name, bits, signed)`; none
+/// without them.
+pub(super) fn row_registers(hw: &Hw) -> Vec<Vec<(String, u32, bool)>> {
     if !hw.row_stage() {
         return Vec::new();
     }
     let end_w = edge::end_width(hw);
-    let mut v = vec![("wr_v".to_string(), 1, false)];
-    v.extend(["lg", "ha"].iter().flat_map(|side| (0..3).map(move |k| (format!("wr_{side}{k}"), end_w, true))));
-    v.extend(row_values(hw).into_iter().map(|(n, w)| (row(hw, n), w, false)));
-    v
+    let mut first = vec![(row_valid(1).to_string(), 1, false)];
+    first.extend(["lg", "ha"].iter().flat_map(|side| (0..3).map(move |k| (format!("wr_{side}{k}"), end_w, true))));
+    first.extend(row_values(hw).into_iter().map(|(n, w)| (row_at(hw, n, 1), w, false)));
+    let mut second = vec![(row_valid(2).to_string(), 1, false), ("we_mg".to_string(), end_w, true), ("we_hi3".to_string(), end_w, true)];
+    second.extend(row_values(hw).into_iter().map(|(n, w)| (row_at(hw, n, 2), w, false)));
+    vec![first, second]
 }
 
 pub(super) fn emit(hw: &Hw, names: &Names, body: &mut Vec<Item>) {
@@ -105,13 +147,25 @@ pub(super) fn emit(hw: &Hw, names: &Names, body: &mut Vec<Item>) {
     body.push(swire("lo0", end_w, slit(end_w, 0)));
     body.push(swire("hi0", end_w, slit(end_w, w - 1)));
     body.push(comment("The edges: loaded with the set-up result, stepped a row; each one's bound on the row."));
-    body.push(wire("w_load", 1, "!rst && take"));
     // The incremental I0's walker also waits for its start engine (`ie_wait`, declared below).
     let step_when = "!rst && !take && adv && w_valid && !w_end";
-    if inc {
-        body.push(net("w_step", 1));
+    // Behind the row stages the walker's load and step are chosen from its registers (w_next,
+    // w_more) and its stall gates the registers' enables alone (`adv`, the edges' `go`): `take`,
+    // the two together, fanned out to every walker and edge register was a long path
+    // (docs/fpga.md). The edges' enables leave out the reset: an edge's state matters only under
+    // the walker's valid, which the reset clears, and its next load sets all of it.
+    let tracked = hw.row_stage();
+    if tracked {
+        let next = if engine { "q_ne && (!w_valid || w_end)" } else { "st == HOLD && (!w_valid || w_end)" };
+        body.push(wire("w_next", 1, next));
+        body.push(wire("w_more", 1, "w_valid && !w_end"));
     } else {
-        body.push(wire("w_step", 1, step_when));
+        body.push(wire("w_load", 1, "!rst && take"));
+        if inc {
+            body.push(net("w_step", 1));
+        } else {
+            body.push(wire("w_step", 1, step_when));
+        }
     }
     body.push(net("e_lg", 3 * end_w));
     body.push(net("e_ha", 3 * end_w));
@@ -132,24 +186,30 @@ pub(super) fn emit(hw: &Hw, names: &Names, body: &mut Vec<Item>) {
         body.push(swire(&format!("lg{k}"), end_w, format!("e_lg[{}:{}]", (k + 1) * end_w - 1, k * end_w)));
         body.push(swire(&format!("ha{k}"), end_w, format!("e_ha[{}:{}]", (k + 1) * end_w - 1, k * end_w)));
     }
-    // The row's span is decided from the edges' bounds in the walker's clock, or a clock later
-    // from the row stage's registers (`--pipeline 1`): the bounds then the minima, the pixel test
-    // and `emit` into the span path's first valid were the staged front-end's critical path.
+    // The row's span is decided from the edges' bounds in the walker's clock, or two clocks
+    // later from the row stages' registers (`--pipeline 1`): the bounds then the minima, the
+    // pixel test and `emit` into the span path's first valid were the staged front-end's
+    // critical path.
     let row_valid = if hw.row_stage() {
         assert!(!inc, "the incremental walker decides its row in its own clock");
-        row_stage(hw, body);
-        "wr_v"
+        row_stages(hw, body);
+        row_valid(2)
     } else {
         "w_valid"
     };
-    let (lg, ha) = if hw.row_stage() { ("wr_lg", "wr_ha") } else { ("lg", "ha") };
-    // Side by side rather than in a chain, and no negation before the pixel test or the length:
-    // this was the walker's row clock, the staged front-end's limit at 2 and 1 quotient bits.
-    body.push(comment("The span's ends, the edges compared side by side: x = lo3 = -mg (the smallest left-edge g),"));
-    body.push(comment("hi3 the smallest right bound; the row has a pixel when hi3 + mg >= 0."));
-    for (end, side) in [("mg", lg), ("hi3", ha)] {
-        let c = |i: u32, j: u32| format!("{side}{i} <= {side}{j}");
-        body.push(swire(end, end_w, format!("({} && {}) ? {side}0 : ({}) ? {side}1 : {side}2", c(0, 1), c(0, 2), c(1, 2))));
+    if hw.row_stage() {
+        body.push(comment("The span from the row's ends: x = lo3 = -mg; the row has a pixel when hi3 + mg >= 0."));
+        body.push(swire("mg", end_w, "we_mg"));
+        body.push(swire("hi3", end_w, "we_hi3"));
+    } else {
+        // Side by side rather than in a chain, and no negation before the pixel test or the
+        // length: this was the walker's row clock, the staged front-end's limit at 2 and 1
+        // quotient bits.
+        body.push(comment("The span's ends, the edges compared side by side: x = lo3 = -mg (the smallest left-edge g),"));
+        body.push(comment("hi3 the smallest right bound; the row has a pixel when hi3 + mg >= 0."));
+        for (end, side) in [("mg", "lg"), ("hi3", "ha")] {
+            body.push(swire(end, end_w, least_of_three(side)));
+        }
     }
     body.push(comment("verilator lint_off UNUSEDSIGNAL"));
     body.push(swire("lo3", end_w, "-mg"));
@@ -175,19 +235,18 @@ pub(super) fn emit(hw: &Hw, names: &Names, body: &mut Vec<Item>) {
         set("w_dyn", "s_dyn"),
     ]);
     let step = vec![set("w_row", format!("w_row + {}", lit(row_w, 1))), set("w_tn", "w_tn + w_dyn")];
-    body.push(Item::Always(vec![Stmt::If(
-        "rst".into(),
-        vec![set("w_valid", "1'b0")],
+    let walked = vec![Stmt::If("w_end".into(), vec![set("w_valid", "1'b0")], step)];
+    let moves = if tracked {
+        // As the edges: the stall gates the enables, the registers choose the load or the step.
+        vec![Stmt::If("adv".into(), vec![Stmt::If("w_next".into(), load, vec![Stmt::If("w_valid".into(), walked, vec![])])], vec![])]
+    } else {
         vec![Stmt::If(
             "take".into(),
             load,
-            vec![Stmt::If(
-                if inc { "adv && w_valid && !ie_wait" } else { "adv && w_valid" }.into(),
-                vec![Stmt::If("w_end".into(), vec![set("w_valid", "1'b0")], step)],
-                vec![],
-            )],
-        )],
-    )]));
+            vec![Stmt::If(if inc { "adv && w_valid && !ie_wait" } else { "adv && w_valid" }.into(), walked, vec![])],
+        )]
+    };
+    body.push(Item::Always(vec![Stmt::If("rst".into(), vec![set("w_valid", "1'b0")], moves)]));
     body.push(Item::Blank);
     if inc {
         super::incremental::engine(hw, body);

@@ -22,9 +22,9 @@ pub struct FrontendShape {
     pub latency: u32,
     /// The set-up in front of the walker.
     pub setup: SetupShape,
-    /// The row stage between the walker and the span path (`--pipeline 1`, reciprocal `I0`),
-    /// where the row's coverage is decided; without it the walker's row is.
-    pub row_stage: Option<RowStage>,
+    /// The row stages between the walker and the span path (`--pipeline 1`, reciprocal `I0`),
+    /// in order; the row's coverage is decided from the last; without them the walker's row is.
+    pub row_stages: Vec<RowStage>,
     /// The span path's register stages between the walker (or the row stage) and the output, in order.
     pub span_stages: Vec<SpanStage>,
     /// The incremental I0 (`--fe-i0 incremental`): its start engine's clocks. The walker then
@@ -85,7 +85,7 @@ pub struct SpanStage {
     pub di: String,
 }
 
-/// The row stage: where it holds the walked row's valid (a row, covered or not), row and `dI`.
+/// A row stage: where it holds the walked row's valid (a row, covered or not), row and `dI`.
 pub struct RowStage {
     pub valid: String,
     pub y: String,
