@@ -1,7 +1,7 @@
 //! Every co-simulation suite of the harness in one test binary, so the verilated models are
 //! linked once. One module per suite; run one with `cargo test -p verilator-harness --test
 //! suites segment::` (or `bfpi::`, `specular::`, `render::`, `render_cli::`, `reliability::`, `cli_harness::`,
-//! `frontend::`, `writer::`, `waveforms::`, `axis::`, `readme::`).
+//! `frontend::`, `frontend_faults::`, `writer::`, `waveforms::`, `axis::`, `readme::`).
 
 /// Tests `slice_0` .. `slice_7`, slice `k` calling `$run(k)`: one soaked random test cut into
 /// [`verilator_harness::soak::SLICES`] tests, so nextest's partitions spread it over machines.
@@ -47,6 +47,7 @@ mod axis;
 mod bfpi;
 mod cli_harness;
 mod frontend;
+mod frontend_faults;
 mod ondemand;
 mod readme;
 mod reliability;
