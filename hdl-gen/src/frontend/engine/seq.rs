@@ -11,6 +11,7 @@
 //! tier). docs/design.md, *A sequential engine for the iCE40 HX8K*.
 
 use super::result::{fields, ports, Field};
+use super::units::bits_for;
 use crate::frontend::hw::Hw;
 use crate::verilog::{comment, reg, set, sreg, wire, Item, Module, Param, Stmt};
 use golden::frontend::engine::schedule::Class;
@@ -38,10 +39,6 @@ const SRC_MUL: u64 = 1;
 const SRC_DIVQ: u64 = 2;
 const SRC_DIVR: u64 = 3;
 const SRC_IN: u64 = 4;
-
-fn bits(n: u64) -> u32 {
-    (64 - n.leading_zeros()).max(1)
-}
 
 /// The microword's fields, least significant first: name and width.
 struct Layout {
@@ -154,7 +151,7 @@ pub fn module(hw: &Hw, s: &SeqSchedule, name: &str) -> SeqEngine {
     let w = s.cost.ram_width;
     let (words, flags) = s.words();
     let c = s.clocks;
-    let cx = Cx { hw, s, w, sw: bits(w as u64), cw: bits(c as u64 - 1), aw: bits(words as u64 - 1), c };
+    let cx = Cx { hw, s, w, sw: bits_for(w), cw: bits_for(c - 1), aw: bits_for(words - 1), c };
     let Micro { l, micro, groups, widths } = microprogram(&cx, &fields);
     let nconst = s.preload.len() as u32;
     assert!(s.preload.iter().enumerate().all(|(k, p)| p.0 == k as u32), "the constants at the first addresses");
@@ -193,7 +190,7 @@ fn microprogram(cx: &Cx, fields: &[Field]) -> Micro {
     let (s, w, sw, aw, c) = (cx.s, cx.w, cx.sw, cx.aw, cx.c);
     let ops = &s.prog.ops;
     let (_, flags) = s.words();
-    let fb = bits(flags.max(1) as u64 - 1);
+    let fb = bits_for(flags.max(1) - 1);
     // Capture groups: each output value written once, every field of it loads then.
     let out = &s.prog.out;
     let mut groups: Vec<V> = Vec::new();
@@ -202,12 +199,12 @@ fn microprogram(cx: &Cx, fields: &[Field]) -> Micro {
             groups.push(v);
         }
     }
-    let cb = bits(groups.len() as u64);
+    let cb = bits_for(groups.len() as u32);
     // The widths values are written at: few, so the write's wrap reads a table, not a shifter.
     let mut widths: Vec<u32> = (0..ops.len()).filter(|&o| !matches!(s.slots[o].exec, Exec::Dead | Exec::Const)).map(|o| ops[o].w).collect();
     widths.sort();
     widths.dedup();
-    let l = Layout::new(aw, fb, sw, cb, bits(widths.len() as u64 - 1));
+    let l = Layout::new(aw, fb, sw, cb, bits_for(widths.len() as u32 - 1));
     let mut mw = vec![Word::default(); c as usize + 2];
     let addr = |v: V| match s.slots[v.0 as usize].loc {
         Loc::Ram(a) => a,
@@ -598,7 +595,7 @@ fn write_bus(cx: &Cx, widths: &[u32], b: &mut Vec<Item>) {
     b.push(Item::Comb(vec![Stmt::Case { sel: "u_src".into(), arms, default: vec![Stmt::Blocking("raw".into(), "ar".into())] }]));
     b.push(reg("wmask", w));
     b.push(reg("wsign", 1));
-    let wb = bits(widths.len() as u64 - 1);
+    let wb = bits_for(widths.len() as u32 - 1);
     let arms: Vec<(String, Vec<Stmt>)> = widths
         .iter()
         .enumerate()
@@ -619,7 +616,7 @@ fn write_bus(cx: &Cx, widths: &[u32], b: &mut Vec<Item>) {
 /// The result fields, each loaded as its value is written.
 fn results(cx: &Cx, fields: &[Field], groups: &[V], b: &mut Vec<Item>) {
     let (ops, out) = (&cx.s.prog.ops, &cx.s.prog.out);
-    let cb = bits(groups.len() as u64);
+    let cb = bits_for(groups.len() as u32);
     b.push(comment("The result: each field loads as its value is written."));
     let mut loads = Vec::new();
     let name_of = |v: V| -> Option<String> {

@@ -44,7 +44,8 @@ fn or(conds: &[String]) -> String {
     }
 }
 
-fn bits_for(max: u32) -> u32 {
+/// Bits to hold `max` (at least 1): a shift amount's, an address's or a counter's width.
+pub(super) fn bits_for(max: u32) -> u32 {
     (32 - max.leading_zeros()).max(1)
 }
 
