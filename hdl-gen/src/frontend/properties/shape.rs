@@ -5,6 +5,7 @@
 
 use crate::formal::{assert, when};
 use crate::verilog::{lit, zext, Stmt};
+pub(super) use crate::widths::bits_for;
 
 /// What the front-end's proof needs from its generator: widths, screen, its set-up's shape.
 pub struct FrontendShape {
@@ -163,10 +164,6 @@ pub(super) fn f_mv(j: usize, last: usize) -> String {
 }
 pub(super) fn one(w: u32) -> String {
     lit(w, 1)
-}
-/// Bits to hold `n` (at least 1).
-pub(super) fn bits_for(n: u32) -> u32 {
-    (32 - n.leading_zeros()).max(1)
 }
 /// A valid span (`v`) is on the screen with at least one pixel.
 pub(super) fn on_screen(v: &str, x: &str, len: &str, xw: u32, width: u64) -> Stmt {
