@@ -183,7 +183,9 @@ impl VariantArgs {
         if fe_i0 == I0Form::Incremental && self.fe_di == DiMode::Scanline {
             return Err(ArgsError::IncrementalScanline);
         }
-        if fe_setup != SetupForm::Parallel && (fe_i0 != I0Form::Reciprocal || self.fe_di != DiMode::Triangle) {
+        // The HX8K's sequential engine takes the incremental I0 too (its span path has no product).
+        let i0_ok = fe_i0 == I0Form::Reciprocal || fe_setup == SetupForm::Ice40Hx8k;
+        if fe_setup != SetupForm::Parallel && (!i0_ok || self.fe_di != DiMode::Triangle) {
             return Err(ArgsError::EngineForm(fe_setup.name()));
         }
         let opts = Options {
