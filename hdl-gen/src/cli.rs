@@ -29,7 +29,7 @@ pub enum ArgsError {
     TreeUnpipelined,
     #[error("--fe-i0 incremental takes --fe-di triangle: the per-scanline dI needs the reciprocal's I0 at every span's last pixel")]
     IncrementalScanline,
-    #[error("--fe-setup {0} takes --fe-di triangle and --fe-i0 reciprocal: its engine computes the per-triangle set-up only")]
+    #[error("--fe-setup {0} takes --fe-di triangle and --fe-i0 reciprocal (only ice40-hx8k also takes incremental): its engine computes the per-triangle set-up only")]
     EngineForm(&'static str),
     #[error("--width/--height: {0}")]
     Screen(#[from] golden::frontend::FrontEndError),
@@ -141,7 +141,7 @@ pub struct VariantArgs {
     /// eight dividers, the default) or the shared set-up engine on a device's plan, `ecp5-25f`,
     /// `ice40-up5k` or `ice40-hx8k` (golden's `Plan`: a few shared multipliers and dividers
     /// sequenced over several clocks a triangle, behind a set-up result queue; docs/design.md).
-    /// Same spans bit for bit. The engine forms take `--fe-di triangle --fe-i0 reciprocal`.
+    /// Same spans bit for bit. The engine forms take `--fe-di triangle --fe-i0 reciprocal` (`ice40-hx8k` also `--fe-i0 incremental`).
     /// Default: `parallel`, or the target's choice.
     #[arg(long = "fe-setup", value_enum)]
     pub fe_setup: Option<SetupForm>,

@@ -32,7 +32,6 @@ use sequencer::Seq;
 use values::Values;
 
 use result::{fields, ports};
-pub(super) use units::bits_for;
 
 use queue::module as queue_module;
 

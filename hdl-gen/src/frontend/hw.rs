@@ -118,6 +118,20 @@ impl Hw {
         self.fe.start_clocks().0
     }
 
+    /// The incremental I0's shift-add start (`FrontEnd::start_product_clocks` above 1): the
+    /// width of its clock count within a product, `ie_k` (0 .. clocks - 1).
+    pub fn start_count_bits(&self) -> u32 {
+        (32 - (self.fe.start_product_clocks() - 1).leading_zeros()).max(1)
+    }
+
+    /// The exact plane's widths, CALC's oriented `Nx` and `Ny` (signed), as the incremental I0's
+    /// range checks read them.
+    pub fn plane_widths(&self) -> (u32, u32) {
+        let Widths { cx, cy, .. } = self.fe.widths();
+        let iw = self.fe.cfg.iw();
+        (iw + cy + 3, iw + cx + 3)
+    }
+
     /// Clocks from a triangle's transfer to the first segment out of `tri_shader_p<P>` when idle:
     /// the front-end's latency, then the shader's at the chain's pipeline level.
     pub fn shader_latency(&self) -> u32 {

@@ -30,10 +30,8 @@ pub(super) fn on(hw: &Hw) -> bool {
 }
 
 /// Exact plane widths: CALC's oriented `Nx` and `Ny` (signed).
-pub(crate) fn plane_widths(hw: &Hw) -> (u32, u32) {
-    let Widths { cx, cy, .. } = hw.fe.widths();
-    let iw = hw.fe.cfg.iw();
-    (iw + cy + 3, iw + cx + 3)
+fn plane_widths(hw: &Hw) -> (u32, u32) {
+    hw.plane_widths()
 }
 
 /// The set-up result's extra registers: the exact plane, for the steps' range checks.
@@ -189,7 +187,7 @@ pub(super) fn engine(hw: &Hw, body: &mut Vec<Item>) {
     ]);
     if m > 1 {
         body.push(comment("The shift-add multiplier: the multiplicand shifted up and the multiplier down a bit a clock."));
-        body.extend([reg("ie_k", super::engine::bits_for(m - 1)), reg("ie_sa", p_w), reg("ie_sb", b_w)]);
+        body.extend([reg("ie_k", hw.start_count_bits()), reg("ie_sa", p_w), reg("ie_sb", b_w)]);
     }
     first_row(hw, &ew, body);
     body.push(comment("The walker's start goes first: it takes the engine from a first-row start, which starts again."));
@@ -207,7 +205,7 @@ pub(super) fn engine(hw: &Hw, body: &mut Vec<Item>) {
             set("ie_p", format!("ie_mb[0] ? {} : {}", zext("ie_ma", a_w, p_w), lit(p_w, 0))),
             set("ie_sa", format!("{} << 1", zext("ie_ma", a_w, p_w))),
             set("ie_sb", "ie_mb >> 1"),
-            set("ie_k", lit(super::engine::bits_for(m - 1), 1)),
+            set("ie_k", lit(hw.start_count_bits(), 1)),
         ]
     };
     let mut go =
@@ -216,7 +214,9 @@ pub(super) fn engine(hw: &Hw, body: &mut Vec<Item>) {
     let mut busy = issue;
     busy.extend(prog);
     if m > 1 {
-        let kw = super::engine::bits_for(m - 1);
+        let kw = hw.start_count_bits();
+        // The last step issues no product: the engine idles with its clock count at 0.
+        busy.push(Stmt::If("ie_last".into(), vec![set("ie_k", lit(kw, 0))], vec![]));
         let add = vec![
             set("ie_p", format!("ie_p + (ie_sb[0] ? ie_sa : {})", lit(p_w, 0))),
             set("ie_sa", "ie_sa << 1"),
@@ -227,7 +227,7 @@ pub(super) fn engine(hw: &Hw, body: &mut Vec<Item>) {
     }
     let mut reset = vec![set("ie_busy", "1'b0"), set("ie_t", lit(4, 0)), set("ie_pv", "1'b0")];
     if m > 1 {
-        reset.push(set("ie_k", lit(super::engine::bits_for(m - 1), 0)));
+        reset.push(set("ie_k", lit(hw.start_count_bits(), 0)));
     }
     body.push(Item::Always(vec![Stmt::If(
         "rst".into(),

@@ -572,7 +572,7 @@ fn starts(m: u32, held: &str) -> Vec<Item> {
         t(0)
     ))];
     if m > 1 {
-        let kw = super::engine::bits_for(m - 1);
+        let kw = bits_for(m - 1);
         engine.push(assert(format!("ie_busy ? ie_k <= {} : ie_k == {}", lit(kw, (m - 1) as u64), lit(kw, 0))));
     }
     engine.extend([

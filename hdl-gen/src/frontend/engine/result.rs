@@ -32,7 +32,7 @@ pub(crate) fn fields(hw: &Hw, s: &Schedule) -> Vec<Field> {
     ];
     if hw.fe.i0 == golden::frontend::I0Form::Incremental {
         // The incremental I0's starts check their steps' range on the exact plane.
-        let (nx_w, ny_w) = crate::frontend::incremental::plane_widths(hw);
+        let (nx_w, ny_w) = hw.plane_widths();
         v.extend([f("nx", o.nx, nx_w), f("ny", o.ny, ny_w), f("a", o.a, aw)]);
     }
     for (j, e) in o.edges.iter().enumerate() {

@@ -45,7 +45,7 @@ fn or(conds: &[String]) -> String {
 }
 
 /// Bits to hold `max` (at least 1): a shift amount's, an address's or a counter's width.
-pub(in crate::frontend) fn bits_for(max: u32) -> u32 {
+pub(super) fn bits_for(max: u32) -> u32 {
     (32 - max.leading_zeros()).max(1)
 }
 
