@@ -501,8 +501,14 @@ fn sequential_engine_spans_equal_golden() {
         engine_spans_of(hdl_gen::Options { pipeline: golden::pipeline::Pipeline::at(level), ..opts }, 1000);
     }
     let Some(opts) = engine(small, SetupForm::Ice40Hx8k) else { return };
-    let fault = LineFault { file: "tri_fe_engine.v", line: " sub = ", from: " sub = u_fn == 4'd2 || ", to: " sub = " };
-    fault.caught(&opts, "frontend sequential engine fault", "seqfault", "the ALU's subtract made an add");
+    let base = verilator_harness::ondemand::describe(&opts, verilator_harness::models::Kind::Frontend).unwrap_or_else(|e| panic!("{e}"));
+    let seed = verilator_harness::seed("frontend sequential engine fault");
+    let fe = opts.frontend().unwrap().fe;
+    let tris = random_triangles(&mut SeedRng::seed_from_u64(seed), &fe, 1000);
+    let engine = &base.sources.iter().find(|(n, _)| n == "tri_fe_engine.v").expect("the engine's file").1;
+    let sub = engine.lines().find(|l| l.contains(" sub = ")).expect("the ALU's subtract select");
+    let faults = [(sub.to_string(), sub.replacen(" sub = u_fn == 4'd2 || ", " sub = ", 1), "the ALU's subtract made an add")];
+    assert_faults_caught(&base, "tri_fe_engine.v", "seqfault", faults, seed, &tris);
 }
 
 /// A fault planted in one line of a front-end's file: in `file`'s first line holding `line`,
