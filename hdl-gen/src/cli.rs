@@ -290,4 +290,17 @@ mod tests {
         }
         assert!(Cli::try_parse_from(["t", "--target", "ecp5-85f"]).is_err());
     }
+
+    /// The HX8K's sequential engine takes the incremental I0 (its span path without a product);
+    /// the other engines refuse it with one message.
+    #[test]
+    fn only_the_hx8k_engine_takes_the_incremental_i0() {
+        let hx = options(&["--target", "ice40-hx8k", "--fe-i0", "incremental"]);
+        assert_eq!((hx.fe_setup, hx.fe_i0), (SetupForm::Ice40Hx8k, I0Form::Incremental));
+        for plan in ["ecp5-25f", "ice40-up5k"] {
+            let cli = Cli::try_parse_from(["t", "--fe-setup", plan, "--fe-i0", "incremental"]).expect("the flags parse");
+            let err = cli.model.options(None).expect_err("a pipelined engine with the incremental I0");
+            assert!(matches!(err, ArgsError::EngineForm(p) if p == plan), "{plan}: {err}");
+        }
+    }
 }
