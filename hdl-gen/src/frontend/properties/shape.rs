@@ -28,7 +28,8 @@ pub struct FrontendShape {
     pub row_stages: Vec<RowStage>,
     /// The span path's register stages between the walker (or the row stage) and the output, in order.
     pub span_stages: Vec<SpanStage>,
-    /// The incremental I0 (`--fe-i0 incremental`): its start engine's clocks. The walker then
+    /// The incremental I0 (`--fe-i0 incremental`): its start engine's clocks a product (1, or
+    /// the HX8K's shift-add's RW, counted by `ie_k`). The walker then
     /// waits while a source starts (`ie_wait`, a data decision taken as given, like a row's
     /// coverage) and the held triangle is taken once its first row is started (`ie_pv`); the
     /// engine's own properties bound both waits.
