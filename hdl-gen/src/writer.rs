@@ -4,7 +4,7 @@
 
 mod properties;
 
-use crate::verilog::{assign, comment, lit, reg, set, wire, zext, Item, Module, Port, Stmt};
+use crate::verilog::{assign, comment, lit, reg, set, tree, wire, zext, Item, Module, Port, Stmt};
 use crate::Names;
 use golden::writer::{Writer, LATENCY};
 use golden::Align;
@@ -38,6 +38,17 @@ fn mem_ports(w: &Writer) -> Vec<Port> {
         Port::output("mem_data", 8 * p, &format!("{p} lanes of UQ8.0"), "lane i = pixel x mod P = i of the block").reg(),
         Port::output("mem_we", p, "bit per lane", "write enable of lane i (never all low)").vector().reg(),
     ]
+}
+
+/// `y * stride` as `y` shifted to each set bit of the constant stride, summed in a balanced
+/// tree: Yosys maps a `*` by a constant onto a hard multiplier (a MULT18X18D on the ECP5, an
+/// SB_MAC16 on the UP5K), whose fixed site the block address then routes to and from (the
+/// writer's `mem_addr`, 10.8 ns beside the chain on the 25F, docs/fpga.md); a stride has few
+/// set bits (640 / P: two), so the adders are few.
+fn row_times_stride(y: &str, stride: u32) -> String {
+    let terms: Vec<String> =
+        (0..32).filter(|i| stride >> i & 1 == 1).map(|i| if i == 0 { y.to_string() } else { format!("({y} << {i})") }).collect();
+    tree(&terms)
 }
 
 /// Span alignment needs the glue; at P = 1 every segment is one block and there is none.
@@ -78,8 +89,8 @@ pub fn module(w: &Writer, names: &Names) -> Module {
 
     let mut body = vec![
         wire("free", 1, "!mem_valid || mem_ready"),
-        comment("Row-major block address; the row stride is a constant."),
-        wire("row", aw, format!("{} * {}", zext("in_y", w.y_bits(), aw), lit(aw, b as u64))),
+        comment(format!("Row-major block address; the row stride {b} as shifts and adds of y (no multiplier).")),
+        wire("row", aw, row_times_stride(&zext("in_y", w.y_bits(), aw), b)),
     ];
     // P = 2^XW: one block a row, and x says nothing about the block.
     match w.block_bits() {
