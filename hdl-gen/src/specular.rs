@@ -11,7 +11,7 @@
 mod properties;
 
 use crate::rom;
-use crate::verilog::{assign, comment, lit, reg, set, tree, wire, zext, Item, Module, Param, Port, Stmt};
+use crate::verilog::{assign, comment, lit, reg, set, wire, zext, Item, Module, Param, Port, Stmt};
 use golden::rom::{BRDF_HEX, NK_HEX};
 use golden::specular::{SpecularPlan, SpecularUnit, C_FRAC, N_BITS, THETA_FRAC};
 use golden::Config;
@@ -64,6 +64,20 @@ fn rom_read(module: &str, name: &str, file_param: &str, addr: &str, data: &str) 
         name: name.into(),
         params: vec![conn("INIT_FILE", file_param)],
         conns: vec![conn("clk", "clk"), conn("en", "adv"), conn("addr", addr), conn("data", data)],
+    }
+}
+
+/// `a + b + ...` as a balanced tree of two-input adds, so a sum of partial products is log2(n)
+/// adders deep however Yosys maps it (the writer's row stride uses it too).
+pub(crate) fn tree(terms: &[String]) -> String {
+    match terms {
+        [] => "0".into(),
+        [one] => one.clone(),
+        _ => {
+            let (l, r) = terms.split_at(terms.len().div_ceil(2));
+            let paren = |t: &[String]| if t.len() > 1 { format!("({})", tree(t)) } else { tree(t) };
+            format!("{} + {}", paren(l), paren(r))
+        }
     }
 }
 

@@ -328,20 +328,6 @@ pub fn sext(x: &str, from: u32, to: u32) -> String {
     }
 }
 
-/// `a + b + ...` as a balanced tree of two-input adds, so a sum of partial products is log2(n)
-/// adders deep however Yosys maps it.
-pub fn tree(terms: &[String]) -> String {
-    match terms {
-        [] => "0".into(),
-        [one] => one.clone(),
-        _ => {
-            let (l, r) = terms.split_at(terms.len().div_ceil(2));
-            let paren = |t: &[String]| if t.len() > 1 { format!("({})", tree(t)) } else { tree(t) };
-            format!("{} + {}", paren(l), paren(r))
-        }
-    }
-}
-
 /// `{{n{1'b0}}, x}`: zero-extends.
 pub fn zext(x: &str, from: u32, to: u32) -> String {
     assert!(to >= from, "zext narrows {x} from {from} to {to}");

@@ -4,7 +4,8 @@
 
 mod properties;
 
-use crate::verilog::{assign, comment, lit, reg, set, tree, wire, zext, Item, Module, Port, Stmt};
+use crate::specular::tree;
+use crate::verilog::{assign, comment, lit, reg, set, wire, zext, Item, Module, Port, Stmt};
 use crate::Names;
 use golden::writer::{Writer, LATENCY};
 use golden::Align;
