@@ -266,3 +266,27 @@ pub fn top_module(hw: &crate::frontend::Hw, w: &Writer, names: &Names) -> Module
     body.push(Item::Instance { module: names.writer.clone(), name: "u_writer".into(), params: vec![], conns });
     Module { name: names.fb_top.clone(), header, params: vec![], ports, body }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::row_times_stride;
+
+    /// The row's terms are `y` at each set bit of the stride, each once: their weights sum to
+    /// the stride, for every stride a screen of up to 2^16 pixels makes at any P (odd ones too,
+    /// which the co-simulated screens do not).
+    #[test]
+    fn the_row_terms_weigh_the_stride() {
+        for stride in 1..=4096u32 {
+            let e = row_times_stride("y", stride);
+            let weight: u64 = e
+                .split(" + ")
+                .map(|t| {
+                    let t = t.trim_matches(|c| c == '(' || c == ')');
+                    t.split_once(" << ").map_or_else(|| 1, |(_, s)| 1u64 << s.parse::<u32>().expect("a shift"))
+                })
+                .sum();
+            assert_eq!(weight, stride as u64, "stride {stride}: {e}");
+            assert!(!e.contains('*'), "{e}");
+        }
+    }
+}
