@@ -29,8 +29,8 @@ module fb_writer_p8 (
   output reg  [7:0] mem_we     // bit per lane; write enable of lane i (never all low)
 );
   wire free = !mem_valid || mem_ready;
-  // Row-major block address; the row stride is a constant.
-  wire [15:0] row = {7'd0, in_y} * 16'd80;
+  // Row-major block address; the row stride 80 as shifts and adds of y (no multiplier).
+  wire [15:0] row = ({7'd0, in_y} << 4) + ({7'd0, in_y} << 6);
   wire [8:0] blk = in_x[11:3];
   wire [15:0] addr = row + {7'd0, blk};
   reg cont;

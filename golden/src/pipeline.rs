@@ -48,8 +48,8 @@ pub fn numbered(body: Vec<(&str, String, Vec<PipeReg>)>) -> Vec<PipeStage> {
 /// |--:|---|---|---|
 /// | 0 | as SPEC's seed: 2 stages | 5 stages | CALC in one clock |
 /// | 1 | + a span register; the BFPI's multiples and the last-segment flag registered | + both multiplies split into registered 4-bit partial products and their sum; the BRDF address registered before the ROM, both ROMs' words registered before any arithmetic: 10 stages | CALC in five clocks ([`SETUP_STAGES`]), overlapped with the dividers; the span path in eight ([`I0_STAGES`]) instead of two, behind the walker's row registered and its span's ends registered ([`Pipeline::row_stages`], the reciprocal `I0`) |
-/// | 2 | + the lane sums registered before round and clamp | as level 1 | as level 1 |
-/// | 3 | + no clock with two adders in a row: the BFPI's first adder level formed as the span enters its register, the rest when it starts; each lane's sum split at the binary point (high part and the fraction's carry registered, joined before the clamp) | as level 1 | as level 1 |
+/// | 2 | + the lane sums registered before round and clamp | as level 1, the partial products in shift-and-add logic instead of `*` (no multiplier; [`Pipeline::logic_products`]) | as level 1 |
+/// | 3 | + no clock with two adders in a row: the BFPI's first adder level formed as the span enters its register, the rest when it starts; each lane's sum split at the binary point (high part and the fraction's carry registered, joined before the clamp) | as level 2 | as level 1 |
 ///
 /// Level 0 is the default: the smallest circuit and the shortest latency, for the shader and
 /// the specular unit byte for byte the RTL every earlier release generated (the front-end's is
@@ -131,6 +131,16 @@ impl Pipeline {
     /// long).
     pub fn split_multiplies(self) -> bool {
         self.0 >= 1
+    }
+
+    /// Specular unit: each split multiply's partial products written as shifts and adds (a
+    /// balanced tree of the 4-bit slice's masked, shifted operands) instead of `*`, so that
+    /// synthesis builds them in logic and not on the device's multipliers. On the ECP5-25F
+    /// beside the chain, the level-1 form took 11 of the 28 MULT18X18D, and routing to the last
+    /// free ones stretched its partial products to 13.8 ns (docs/fpga.md); logic places next
+    /// to its registers. Same registers and latency as level 1.
+    pub fn logic_products(self) -> bool {
+        self.0 >= 2
     }
 
     /// Front-end: the set-up's CALC (area, orientation, rows, edge and plane terms, the
@@ -239,7 +249,15 @@ mod tests {
     #[test]
     fn each_level_adds_to_the_one_before() {
         let flags = |p: Pipeline| {
-            [p.span_stage(), p.sum_stage(), p.split_multiplies(), p.split_adds(), p.calc_clocks() > 1, p.row_stage(I0Form::Reciprocal)]
+            [
+                p.span_stage(),
+                p.sum_stage(),
+                p.split_multiplies(),
+                p.logic_products(),
+                p.split_adds(),
+                p.calc_clocks() > 1,
+                p.row_stage(I0Form::Reciprocal),
+            ]
         };
         let levels: Vec<_> = Pipeline::all().collect();
         for w in levels.windows(2) {

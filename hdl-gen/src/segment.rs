@@ -261,7 +261,10 @@ impl<'a> Seg<'a> {
                     format!("({} ? {shifted} : {})", bit(&src("in_lead"), log2p, b), lit(aw, 0))
                 })
                 .collect();
-            body.push(swire("lead_di", aw, terms.join(" + ")));
+            // A balanced tree: log2(log2 P) adders deep, not log2 P - 1 in a row (the start
+            // value into `cur_acc` was the level-2 shader's one path over 10 ns beside the
+            // chain on the 25F, docs/fpga.md).
+            body.push(swire("lead_di", aw, crate::specular::tree(&terms)));
             format!("{i0} + {half} - lead_di")
         } else {
             format!("{i0} + {half}")

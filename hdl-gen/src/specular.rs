@@ -68,8 +68,8 @@ fn rom_read(module: &str, name: &str, file_param: &str, addr: &str, data: &str) 
 }
 
 /// `a + b + ...` as a balanced tree of two-input adds, so a sum of partial products is log2(n)
-/// adders deep however Yosys maps it.
-fn tree(terms: &[String]) -> String {
+/// adders deep however Yosys maps it (the writer's row stride uses it too).
+pub(crate) fn tree(terms: &[String]) -> String {
     match terms {
         [] => "0".into(),
         [one] => one.clone(),
@@ -83,13 +83,15 @@ fn tree(terms: &[String]) -> String {
 
 /// A multiply `a * b` split for clock rate (`--pipeline`): `a` times each `k`-bit slice of `b`
 /// (wires `<product>_j`), registered (`<reg>_j`), and summed a stage later in a balanced tree.
-/// Operands are (name, width).
+/// Operands are (name, width). `logic`: each slice's product as shifts and adds
+/// ([`golden::pipeline::Pipeline::logic_products`]).
 struct SplitMul {
     a: (&'static str, u32),
     b: (&'static str, u32),
     k: u32,
     product: &'static str,
     reg: &'static str,
+    logic: bool,
 }
 
 impl SplitMul {
@@ -103,11 +105,20 @@ impl SplitMul {
         (0..self.slices())
             .flat_map(|j| {
                 let bits = k.min(bw - j * k);
-                let slice = zext(&format!("{b}[{}:{}]", j * k + bits - 1, j * k), bits, aw + k);
-                [
-                    reg(&format!("{}_{j}", self.reg), aw + k),
-                    wire(&format!("{}_{j}", self.product), aw + k, format!("{} * {slice}", zext(a, aw, aw + k))),
-                ]
+                let wide = zext(a, aw, aw + k);
+                let product = if self.logic {
+                    // Bit i of the slice selects `a << i`; the selected terms summed in a tree.
+                    let terms: Vec<String> = (0..bits)
+                        .map(|i| {
+                            let shifted = if i == 0 { wide.clone() } else { format!("({wide} << {i})") };
+                            format!("({{{}{{{b}[{}]}}}} & {shifted})", aw + k, j * k + i)
+                        })
+                        .collect();
+                    tree(&terms)
+                } else {
+                    format!("{wide} * {}", zext(&format!("{b}[{}:{}]", j * k + bits - 1, j * k), bits, aw + k))
+                };
+                [reg(&format!("{}_{j}", self.reg), aw + k), wire(&format!("{}_{j}", self.product), aw + k, product)]
             })
             .collect()
     }
@@ -210,10 +221,12 @@ fn header(unit: &SpecularUnit, names: &SpecNames) -> Vec<String> {
 
 /// Split multiplies (`--pipeline`): |theta| * M and C * w, by k-bit slices of M and of w.
 fn arg_mul(p: &SpecularPlan) -> SplitMul {
-    SplitMul { a: ("mag1q", p.mag_bits), b: ("m1", p.nk_mant_bits), k: SpecularPlan::MUL_CHUNK, product: "pp1", reg: "pp2a" }
+    let logic = p.pipeline.logic_products();
+    SplitMul { a: ("mag1q", p.mag_bits), b: ("m1", p.nk_mant_bits), k: SpecularPlan::MUL_CHUNK, product: "pp1", reg: "pp2a", logic }
 }
 fn c_mul(p: &SpecularPlan) -> SplitMul {
-    SplitMul { a: ("c3q", C_BITS), b: ("w3q", p.word_bits), k: SpecularPlan::MUL_CHUNK, product: "cp3", reg: "cp4a" }
+    let logic = p.pipeline.logic_products();
+    SplitMul { a: ("c3q", C_BITS), b: ("w3q", p.word_bits), k: SpecularPlan::MUL_CHUNK, product: "cp3", reg: "cp4a", logic }
 }
 
 /// Stages 0 and 1: the issue stage (the span's registers, theta of the pixel being issued),

@@ -4,6 +4,7 @@
 
 mod properties;
 
+use crate::specular::tree;
 use crate::verilog::{assign, comment, lit, reg, set, wire, zext, Item, Module, Port, Stmt};
 use crate::Names;
 use golden::writer::{Writer, LATENCY};
@@ -38,6 +39,17 @@ fn mem_ports(w: &Writer) -> Vec<Port> {
         Port::output("mem_data", 8 * p, &format!("{p} lanes of UQ8.0"), "lane i = pixel x mod P = i of the block").reg(),
         Port::output("mem_we", p, "bit per lane", "write enable of lane i (never all low)").vector().reg(),
     ]
+}
+
+/// `y * stride` as `y` shifted to each set bit of the constant stride, summed in a balanced
+/// tree: Yosys maps a `*` by a constant onto a hard multiplier (a MULT18X18D on the ECP5, an
+/// SB_MAC16 on the UP5K), whose fixed site the block address then routes to and from (the
+/// writer's `mem_addr`, 10.8 ns beside the chain on the 25F, docs/fpga.md); a stride has few
+/// set bits (640 / P: two), so the adders are few.
+fn row_times_stride(y: &str, stride: u32) -> String {
+    let terms: Vec<String> =
+        (0..32).filter(|i| stride >> i & 1 == 1).map(|i| if i == 0 { y.to_string() } else { format!("({y} << {i})") }).collect();
+    tree(&terms)
 }
 
 /// Span alignment needs the glue; at P = 1 every segment is one block and there is none.
@@ -78,8 +90,8 @@ pub fn module(w: &Writer, names: &Names) -> Module {
 
     let mut body = vec![
         wire("free", 1, "!mem_valid || mem_ready"),
-        comment("Row-major block address; the row stride is a constant."),
-        wire("row", aw, format!("{} * {}", zext("in_y", w.y_bits(), aw), lit(aw, b as u64))),
+        comment(format!("Row-major block address; the row stride {b} as shifts and adds of y (no multiplier).")),
+        wire("row", aw, row_times_stride(&zext("in_y", w.y_bits(), aw), b)),
     ];
     // P = 2^XW: one block a row, and x says nothing about the block.
     match w.block_bits() {
@@ -253,4 +265,28 @@ pub fn top_module(hw: &crate::frontend::Hw, w: &Writer, names: &Names) -> Module
     }
     body.push(Item::Instance { module: names.writer.clone(), name: "u_writer".into(), params: vec![], conns });
     Module { name: names.fb_top.clone(), header, params: vec![], ports, body }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::row_times_stride;
+
+    /// The row's terms are `y` at each set bit of the stride, each once: their weights sum to
+    /// the stride, for every stride a screen of up to 2^16 pixels makes at any P (odd ones too,
+    /// which the co-simulated screens do not).
+    #[test]
+    fn the_row_terms_weigh_the_stride() {
+        for stride in 1..=4096u32 {
+            let e = row_times_stride("y", stride);
+            let weight: u64 = e
+                .split(" + ")
+                .map(|t| {
+                    let t = t.trim_matches(|c| c == '(' || c == ')');
+                    t.split_once(" << ").map_or_else(|| 1, |(_, s)| 1u64 << s.parse::<u32>().expect("a shift"))
+                })
+                .sum();
+            assert_eq!(weight, stride as u64, "stride {stride}: {e}");
+            assert!(!e.contains('*'), "{e}");
+        }
+    }
 }

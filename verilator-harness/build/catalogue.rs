@@ -145,7 +145,8 @@ pub fn entries(all_chains: bool) -> Vec<(String, Kind, hdl_gen::Options)> {
     use hdl_gen::Options;
     let mut e: Vec<(String, Kind, Options)> = Vec::new();
     // The specular unit as SPEC's seed builds it, then split for clock rate (`--pipeline 1`;
-    // level 2 adds nothing to the unit).
+    // level 2's partial products in shifts and adds, the same registers, are built on demand in
+    // the slow tier: tests/specular.rs).
     e.push(("spec".into(), Kind::Specular, Options::default()));
     e.push(("spec_pl1".into(), Kind::Specular, Options { pipeline: Pipeline::at(1), ..Default::default() }));
     for p in BUILT_P {

@@ -152,3 +152,54 @@ fn a_golden_unit_of_another_table_set_is_caught() {
     let _ = sim.try_stream(&spans, &mut report);
     assert!(report.mismatch_count > 0, "the model passed against golden's k = {other_ks:?} unit (seed {seed})");
 }
+
+/// `--pipeline 2`'s unit, whose split multiplies' partial products are shifts and adds in logic
+/// (no multiplier; `golden::pipeline::Pipeline::logic_products`), built on first use: bit-exact
+/// on random spans under random gaps and backpressure, and a fault planted in each of its two
+/// shift-add multiplies caught on the same spans (an argument slice's bit at the wrong weight, a
+/// bit of the BRDF word read from its neighbour). Slow tier: three models to build, about a
+/// minute of CPU each on a cold cache, then seconds.
+#[test]
+#[ignore]
+fn logic_products_are_bit_exact_and_their_planted_faults_are_caught() {
+    if verilator_harness::registry::rtl_dir().is_some() {
+        eprintln!("specular logic products: skipped: COSIM_RTL_DIR provides the models");
+        return;
+    }
+    let opts = hdl_gen::Options { pipeline: golden::pipeline::Pipeline::at(2), ..Default::default() };
+    assert!(opts.pipeline.logic_products(), "level 2 is the shift-add form");
+    let base = verilator_harness::ondemand::describe(&opts, verilator_harness::models::Kind::Specular).unwrap_or_else(|e| panic!("{e}"));
+    let unit = &base.sources.iter().find(|(n, _)| n == "specular_unit.v").expect("the unit's file").1;
+    let code = |l: &&str| !l.trim_start().starts_with("//") && !l.contains("// ");
+    assert!(unit.lines().filter(code).all(|l| !l.contains(" * ")), "a multiply left in the level-2 unit");
+    let seed = verilator_harness::seed("specular logic products");
+    let mut rng = SeedRng::seed_from_u64(seed);
+    let max_len = base.cfg.max_len();
+    let spans: Vec<SpecularSpan> = (0..2000).map(|_| random_span(&mut rng, max_len)).collect();
+    let run = |m: &verilator_harness::models::Model| {
+        let info = verilator_harness::ondemand::load::<SpecIn, SpecOut>(m).unwrap_or_else(|e| panic!("{e}"));
+        let mut sim = SpecularCosim::new(info, specular_unit(), seed, Traffic::RANDOM);
+        let mut report = Report::default();
+        sim.try_stream(&spans, &mut report).expect("spans the ports carry");
+        report
+    };
+    let clean = run(&base);
+    assert_clean(&base.tag, seed, &clean);
+    assert!(clean.pixels > 100_000, "{} pixels compared", clean.pixels);
+    let line = |start: &str| unit.lines().find(|l| l.contains(start)).unwrap_or_else(|| panic!("no {start}")).to_string();
+    let (arg, cmul) = (line("pp1_1 = "), line("cp3_0 = "));
+    let faults = [
+        (arg.clone(), arg.replacen("<< 3)", "<< 2)", 1), "an argument slice's top bit at the next weight down"),
+        (cmul.clone(), cmul.replacen("w3q[1]", "w3q[0]", 1), "the BRDF word's bit 1 read from bit 0"),
+    ];
+    for (k, (from, to, what)) in faults.into_iter().enumerate() {
+        assert_ne!(from, to, "{what}: the fault does not apply");
+        let mut m = base.clone();
+        let text = m.sources.iter_mut().find(|(n, _)| n == "specular_unit.v").expect("the unit's file");
+        text.1 = text.1.replacen(&from, &to, 1);
+        m.tag = format!("{}_fault{k}", base.tag);
+        let report = run(&m);
+        eprintln!("{what}: {} mismatches of {} pixels", report.mismatch_count, report.pixels);
+        assert!(report.mismatch_count > 0, "planted fault not caught: {what} (seed {seed})");
+    }
+}

@@ -445,6 +445,7 @@ impl SpecularPlan {
             ),
         ];
         let (mc, cc) = (chunks(self.nk_mant_bits), chunks(w));
+        let how = if self.pipeline.logic_products() { " in shifts and adds" } else { "" };
         if split {
             body.push((
                 "nk_q",
@@ -453,7 +454,7 @@ impl SpecularPlan {
             ));
             body.push((
                 "arg_part",
-                format!("pp_k = mag * M[4k +: 4], k < {mc}; err = (M == 0)"),
+                format!("pp_k = mag * M[4k +: 4], k < {mc}{how}; err = (M == 0)"),
                 vec![
                     reg("pp", mc * (self.mag_bits + Self::MUL_CHUNK), &format!("{mc} x uint")),
                     reg("sel", self.sel_bits, "uint"),
@@ -493,7 +494,7 @@ impl SpecularPlan {
             ));
             body.push((
                 "c_part",
-                format!("cp_k = C * w[4k +: 4], k < {cc} (C * (w + 1) = C * w + C)"),
+                format!("cp_k = C * w[4k +: 4], k < {cc}{how} (C * (w + 1) = C * w + C)"),
                 vec![reg("cp", cc * (16 + Self::MUL_CHUNK), &format!("{cc} x uint")), reg("cut", 1, "flag"), reg("err", 1, "flag")],
             ));
         } else {
