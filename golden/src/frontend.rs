@@ -69,7 +69,9 @@
 //! needed modulo 2^(AW+2) only, doubled to the remainder's 2^(AW+3) (the partial products wholly
 //! above it are never built; at the defaults two tiles, the 2 top bits of `q~` and the corner of
 //! `An`'s top 6 bits against `q~`'s low 8 in logic). With `Gxn lo`'s three (54 x 12 bits, from
-//! `Gxn >> 8`: [`Widths::GXN_ZEROS`]) the span path takes 7 tiles a row. `t = AW - 1` would
+//! `Gxn >> 8`: [`Widths::GXN_ZEROS`]) the span path takes 7 tiles a row; on the ECP5-25F plan
+//! ([`engine::Plan::run_sums`]) `Gxn lo` comes from running sums stepped with the left edges'
+//! DDAs instead ([`sums`]), and the span path takes 4. `t = AW - 1` would
 //! need one compare but a 22-bit `H`, four tiles. A shift one further (`t = AW + 1`) lets the
 //! estimate fall three below, and a compare dropped leaves two-below uncorrected: the tests plant
 //! both.
@@ -88,7 +90,6 @@ pub mod incremental;
 pub mod sums;
 mod walk;
 
-pub use self::sums::{left_slots, LEFT_SLOTS};
 use crate::format::{Config, Span};
 use crate::setup::{is_top_left, snap, Screen, Snapped, Triangle, SUBPIXEL};
 use serde::{Deserialize, Serialize};
@@ -402,7 +403,7 @@ pub struct TriSetup {
     pub tn: u128,
     pub dyn_: u128,
     pub gxn: u128,
-    /// The running sums' start and step for the two left slots ([`left_slots`]; the engine
+    /// The running sums' start and step for the two left slots ([`sums::left_slots`]; the engine
     /// form's span path, when its plan has [`engine::Plan::run_sums`]): `(Gxn >> 8) g` and
     /// `(Gxn >> 8) Qs` of the slot's edge modulo 2^[`Widths::sum_bits`], so the walker steps
     /// `Gxn g` with that edge's DDA and the span path takes `Gxn lo` from the slot its left end

@@ -423,7 +423,7 @@ impl Outputs {
             // As the edge's own fields: a slot's sums are 0 where its edge is not an active left
             // edge (never a span's source), its step where the edge is never stepped (`canonical`).
             sums: self.sums.map(|s| {
-                let src = super::left_slots(&edges);
+                let src = super::sums::left_slots(&edges);
                 std::array::from_fn(|j| {
                     let (pg, pq) = s[j];
                     let e = &edges[src[j]];
@@ -452,7 +452,7 @@ fn stepped(e: &EdgeWalk) -> bool {
 /// A set-up with the steps the walker never takes zeroed: `setup` divides them exactly, a
 /// divider of the step's width does not need to (their quotient may not fit it).
 pub fn canonical(mut st: TriSetup) -> TriSetup {
-    let src = super::left_slots(&st.edges);
+    let src = super::sums::left_slots(&st.edges);
     if let Some(s) = &mut st.sums {
         for j in 0..2 {
             if !stepped(&st.edges[src[j]]) {

@@ -11,8 +11,8 @@
 //! `g`, hence equal `P`: which of them is taken does not matter.
 //!
 //! A triangle has at most two left edges (`dy < 0`), so two *slots* hold the sums, not three
-//! edges: slot 0 takes the first active left edge by index, slot 1 the last ([`LEFT_SLOTS`]);
-//! with one left edge both hold it. Four products a triangle instead of six keep the ECP5
+//! edges: slot a edge 0 if it is an active left edge, else edge 1; slot b edge 2 if it is one,
+//! else edge 1 ([`LEFT_SLOTS`]). Four products a triangle instead of six keep the ECP5
 //! plan's 8 tiles at II = 12 with every product on one tile (six rotated products over tiles
 //! across 6 triangles, docs/fpga.md).
 //!
@@ -20,14 +20,15 @@
 
 use super::{mask, EdgeWalk, FrontEnd, TriSetup, Widths};
 
-/// The order in which each left slot takes the first active left edge: slot 0 the lowest
-/// index, slot 1 the highest. Every active left edge is in a slot.
-pub const LEFT_SLOTS: [[usize; 3]; 2] = [[0, 1, 2], [2, 1, 0]];
+/// Each left slot's edges `(own, other)`: the slot holds its own edge if that is a left edge,
+/// else the other. Slot a is edge 0 or 1, slot b edge 2 or 1: a triangle has at most two left
+/// edges, so every active left edge is in a slot (edge 1 in a when edge 0 is not left, else in
+/// b, as edge 2 then is not), and each slot is a select of two.
+pub const LEFT_SLOTS: [(usize, usize); 2] = [(0, 1), (2, 1)];
 
-/// Each left slot's edge ([`LEFT_SLOTS`]): the first active left edge in the slot's order, else
-/// the order's last (never a span's source).
+/// Each left slot's edge ([`LEFT_SLOTS`]).
 pub fn left_slots(edges: &[EdgeWalk; 3]) -> [usize; 2] {
-    LEFT_SLOTS.map(|order| *order.iter().find(|&&k| edges[k].active && !edges[k].right).unwrap_or(&order[2]))
+    LEFT_SLOTS.map(|(own, other)| if edges[own].active && !edges[own].right { own } else { other })
 }
 
 /// A fault planted in the running sums: the tests' negative controls.

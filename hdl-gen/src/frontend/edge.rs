@@ -104,10 +104,16 @@ fn offset_to_signed(q: &str, w: u32) -> String {
 /// extra outputs `(port, width, signed, the edge's signal, tri_frontend's name of lane k)`: the
 /// walker's state and the held set-up result. None in the default form.
 pub(super) fn state_outputs(hw: &Hw) -> Vec<(&'static str, u32, bool, String, &'static str)> {
+    let e = EdgeWidths::new(hw);
+    if hw.run_sums() {
+        // The walker's left slots step their running sums with the edge's DDA: whether it
+        // steps on the next row and whether it carries.
+        let on = if e.tracked { "w_act && w_ge" } else { "w_act && row >= w_rs" };
+        return vec![("x_on", 1, false, on.into(), "e_on"), ("x_cy", 1, false, "cy".into(), "e_cy")];
+    }
     if !super::incremental::on(hw) {
         return Vec::new();
     }
-    let e = EdgeWidths::new(hw);
     let flip = |q: &str| offset_to_signed(q, e.bound_w);
     vec![
         ("x_in", 1, false, "in_rows".into(), "in"),
@@ -320,7 +326,13 @@ fn module_engine(hw: &Hw, names: &Names) -> Module {
         ports.push(if port == "g" || port == "qs" { p.signed() } else { p });
     }
     ports.extend(walker_ports(&e));
+    for (port, w, _, _, name) in state_outputs(hw) {
+        ports.push(Port::output(port, w, "", &format!("for the walker's running sums: the edge's {name}")));
+    }
     let mut body = dda(&e);
+    for (port, _, _, signal, _) in state_outputs(hw) {
+        body.push(Item::Assign(port.into(), signal));
+    }
     let mut load = ["act", "right", "rs", "re", "g", "rem", "qs", "rs256"].map(|p| set(format!("w_{p}"), p)).to_vec();
     load.extend([set("w_thr", "d - rs256"), set("w_qs1", format!("qs + {}", zext("1'b1", 1, bound_w)))]);
     body.push(walk(&e, load, ("rs", "re")));

@@ -81,6 +81,13 @@ impl Hw {
         self.fe.widths().k - 1
     }
 
+    /// Whether the span path takes `Gxn lo` from the walker's two left slots' running sums, not a
+    /// product a row (golden's `Plan::run_sums`, `golden::frontend::sums`): the engine form on
+    /// the ECP5-25F plan, `I0` by the reciprocal.
+    pub fn run_sums(&self) -> bool {
+        self.fe.setup.plan().is_some_and(|p| p.run_sums) && self.fe.i0 == I0Form::Reciprocal
+    }
+
     /// Whether the walker's row is registered before its span is decided
     /// ([`golden::pipeline::Pipeline::row_stage`]).
     pub fn row_stage(&self) -> bool {
