@@ -69,7 +69,9 @@
 //! needed modulo 2^(AW+2) only, doubled to the remainder's 2^(AW+3) (the partial products wholly
 //! above it are never built; at the defaults two tiles, the 2 top bits of `q~` and the corner of
 //! `An`'s top 6 bits against `q~`'s low 8 in logic). With `Gxn lo`'s three (54 x 12 bits, from
-//! `Gxn >> 8`: [`Widths::GXN_ZEROS`]) the span path takes 7 tiles a row. `t = AW - 1` would
+//! `Gxn >> 8`: [`Widths::GXN_ZEROS`]) the span path takes 7 tiles a row; on the ECP5-25F plan
+//! ([`engine::Plan::run_sums`]) `Gxn lo` comes from running sums stepped with the left edges'
+//! DDAs instead ([`sums`]), and the span path takes 4. `t = AW - 1` would
 //! need one compare but a 22-bit `H`, four tiles. A shift one further (`t = AW + 1`) lets the
 //! estimate fall three below, and a compare dropped leaves two-below uncorrected: the tests plant
 //! both.
@@ -85,6 +87,8 @@
 
 pub mod engine;
 pub mod incremental;
+pub mod sums;
+mod walk;
 
 use crate::format::{Config, Span};
 use crate::setup::{is_top_left, snap, Screen, Snapped, Triangle, SUBPIXEL};
@@ -261,6 +265,12 @@ impl Widths {
     /// narrower (at 640x480 52 x 10 bits, three tiles instead of four).
     pub const GXN_ZEROS: u32 = SUBPIXEL.trailing_zeros();
 
+    /// Bits of the running sums of `Gxn g` ([`TriSetup::sums`]): `Gxn lo` modulo 2^(K-2) without
+    /// its [`Widths::GXN_ZEROS`] zero bits.
+    pub fn sum_bits(&self) -> u32 {
+        self.k - 2 - Self::GXN_ZEROS
+    }
+
     /// `Gxn c` modulo 2^(K-2) as the span path forms it: `((Gxn >> z) c) << z` with `z` =
     /// [`Widths::GXN_ZEROS`]; the bits of `Gxn` below 2^z are not read (the tests plant z + 1).
     pub fn gx_lo(&self, gxn: u128, c: u32, zeros: u32) -> u128 {
@@ -364,13 +374,6 @@ pub struct EdgeWalk {
 }
 
 impl EdgeWalk {
-    /// After row `r` was emitted: one DDA step, if the edge has started.
-    fn step(&mut self, r: u32) {
-        if self.active && r >= self.rs {
-            self.step_carry();
-        }
-    }
-
     /// One DDA step; whether the remainder carried into the bound (`g` moved by `Qs + 1`).
     fn step_carry(&mut self) -> bool {
         self.rem += self.rs256;
@@ -400,6 +403,13 @@ pub struct TriSetup {
     pub tn: u128,
     pub dyn_: u128,
     pub gxn: u128,
+    /// The running sums' start and step for the two left slots ([`sums::left_slots`]; the engine
+    /// form's span path, when its plan has [`engine::Plan::run_sums`]): `(Gxn >> 8) g` and
+    /// `(Gxn >> 8) Qs` of the slot's edge modulo 2^[`Widths::sum_bits`], so the walker steps
+    /// `Gxn g` with that edge's DDA and the span path takes `Gxn lo` from the slot its left end
+    /// comes from ([`FrontEnd::walk`]), with no product a row. 0 where the slot's edge is not an
+    /// active left edge.
+    pub sums: Option<[(u128, u128); 2]>,
     /// Exact plane data, for self-checks: `I_0 A`, `Nx`, `Ny`, `x0`, `y0`, `A`.
     pub plane: Plane,
 }
@@ -585,9 +595,11 @@ impl FrontEnd {
             tn: norm(plane.s(0, first)),
             dyn_: norm(256 * ny),
             gxn: norm(256 * nx),
+            sums: None,
             plane,
         };
-        (Outcome::Walked, Some(setup))
+        let sums = self.setup.plan().is_some_and(|p| p.run_sums).then(|| self.running_sums(&setup));
+        (Outcome::Walked, Some(TriSetup { sums, ..setup }))
     }
 
     /// `round(x / a)`, half away from zero, saturated to DW signed bits: the set-up's divider.
@@ -608,52 +620,15 @@ impl FrontEnd {
     /// The walker's intensity for row `r`, first column `c`: `S2n = ((2S + A) << s) mod 2^(K-1)`
     /// from the running sum `tn` of the row, then the reciprocal and one correction.
     pub fn i0(&self, st: &TriSetup, tn: u128, c: u32) -> u32 {
-        let wd = self.widths();
         debug_assert_eq!(st.gxn & mask(Widths::GXN_ZEROS), 0, "Gxn's low bits, {st:?}");
-        let s2n = (2 * (tn + wd.gx_lo(st.gxn, c, Widths::GXN_ZEROS)) + st.an) & mask(wd.k - 1);
-        wd.reciprocal_quotient(s2n, st.an, st.rn)
+        self.i0_from(st, tn, self.widths().gx_lo(st.gxn, c, Widths::GXN_ZEROS))
     }
 
-    /// Walks a set-up triangle: `out(y, span)` for every covered row, top to bottom.
-    pub fn walk(&self, st: &TriSetup, mut out: impl FnMut(u32, Span)) {
+    /// [`FrontEnd::i0`] from `Gxn c` modulo 2^(K-2), however it was formed.
+    pub fn i0_from(&self, st: &TriSetup, tn: u128, gx: u128) -> u32 {
         let wd = self.widths();
-        let km = mask(wd.k);
-        let mut edges = st.edges;
-        let mut tn = st.tn;
-        for r in st.first..=st.last {
-            let (mut lo, mut hi) = (0i64, self.screen.width as i64 - 1);
-            for e in &edges {
-                if e.active && (e.rs..=e.re).contains(&r) {
-                    if e.right {
-                        hi = hi.min(e.g);
-                    } else {
-                        lo = lo.max(-e.g);
-                    }
-                }
-            }
-            if lo <= hi {
-                let i0 = self.i0(st, tn, lo as u32);
-                debug_assert_eq!(
-                    i0 as i128,
-                    (2 * st.plane.s(lo, r as i64) + st.plane.a) / (2 * st.plane.a),
-                    "I0 of row {r} at column {lo}, {st:?}"
-                );
-                let len = (hi - lo + 1) as u32;
-                let di = match self.di {
-                    DiMode::Triangle => st.di,
-                    DiMode::Scanline if len == 1 => 0,
-                    DiMode::Scanline => {
-                        let last = self.i0(st, tn, hi as u32);
-                        self.di(last as i128 - i0 as i128, (len - 1) as u128)
-                    }
-                };
-                out(r, Span { x0: lo as u32, len, i0, di });
-            }
-            for e in &mut edges {
-                e.step(r);
-            }
-            tn = (tn + st.dyn_) & km;
-        }
+        let s2n = (2 * (tn + gx) + st.an) & mask(wd.k - 1);
+        wd.reciprocal_quotient(s2n, st.an, st.rn)
     }
 
     /// Set-up and walk: the outcome, and `out(y, span)` for every span.

@@ -39,6 +39,7 @@ mod properties;
 mod setup;
 mod span;
 mod stager;
+mod sums;
 mod walker;
 
 pub use chain::top_module;

@@ -32,7 +32,7 @@ fn engine_planted_faults_are_caught() {
         engine.lines().find(|l| l.trim_start().starts_with("assign m") && l.contains("_sh[")).expect("a tile's weight shifts");
     let shift_line = engine
         .lines()
-        .find(|l| l.trim_start().starts_with("sh0_n <=") && l.contains("_1);"))
+        .find(|l| l.trim_start().starts_with("sh0_n <=") && l.contains("_1)"))
         .expect("a shift's amount read from a second copy");
     let epoch_line =
         engine.lines().find(|l| l.contains("<= (") && l.contains("_q[") && l.contains("ep[0]")).expect("a quotient captured by epoch");
@@ -44,7 +44,7 @@ fn engine_planted_faults_are_caught() {
             "a tile's passes at the wrong weights (no shift)",
         ),
         (epoch_line.to_string(), epoch_line.replacen("ep[0]", "ep[1]", 1), "a quotient from another epoch's divider"),
-        (shift_line.to_string(), shift_line.replacen("_1);", "_0);", 1), "a shared shift's amount from the next triangle's copy"),
+        (shift_line.to_string(), shift_line.replacen("_1)", "_0)", 1), "a shared shift's amount from the next triangle's copy"),
     ];
     assert_faults_caught(&base, "tri_fe_engine.v", "fault", faults, seed, &tris);
 }
@@ -118,4 +118,33 @@ fn span_path_planted_faults_are_caught() {
         (gx.clone(), gx.replacen(" + ({36'd0, gx_2} << 36)", "", 1), "Gxn lo's top tile dropped"),
     ];
     assert_faults_caught(&base, "tri_frontend.v", "i0fault", faults, seed, &tris);
+}
+
+/// Negative controls of the walker's running sums of `Gxn g` (`--target ecp5-25f`'s span path,
+/// golden's `frontend::sums`; the ECP5 plan at level 1, 37x23, each a model built on first use):
+/// slot a's sum stepped by `Gxn Qs` alone (its edge's carries not added), the span's source always
+/// slot a, the screen's clamp taking slot a's sum instead of 0 (golden's three planted faults).
+/// Caught on the triangles the clean model passes
+/// (`engine_spans_equal_golden_at_the_targets_pipeline_level`). Slow tier: three models.
+#[test]
+#[ignore]
+fn running_sums_planted_faults_are_caught() {
+    let Some(opts) = engine(golden::setup::Screen { width: 37, height: 23 }, golden::frontend::engine::SetupForm::Ecp5_25f) else { return };
+    let opts = hdl_gen::Options { pipeline: golden::pipeline::Pipeline::at(1), ..opts };
+    let base = verilator_harness::ondemand::describe(&opts, verilator_harness::models::Kind::Frontend).unwrap_or_else(|e| panic!("{e}"));
+    let seed = verilator_harness::seed("frontend running sums faults");
+    let fe = opts.frontend().unwrap().fe;
+    let tris = random_triangles(&mut SeedRng::seed_from_u64(seed), &fe, 3000);
+    let text = &base.sources.iter().find(|(n, _)| n == "tri_frontend.v").expect("the front-end's file").1;
+    let line =
+        |what: &str, f: &dyn Fn(&str) -> bool| text.lines().find(|l| f(l)).unwrap_or_else(|| panic!("no line for {what}")).to_string();
+    let step = line("slot a's carry", &|l| l.contains("w_ca <= w_ca + "));
+    let source = line("the span's source", &|l| l.contains("we_gxs <= "));
+    let clamp = source.split_once(" ? ").expect("the clamp's test").0.split_once("<= ").expect("the source's value").1.to_string();
+    let faults = [
+        (step.clone(), format!("{}w_ca <= w_ca;", step.split_once("w_ca").unwrap().0), "slot a's carry ignored"),
+        (source.clone(), source.replacen("? wr_pa : wr_pb", "? wr_pa : wr_pa", 1), "the span's source always slot a"),
+        (source.clone(), source.replacen(&format!("{clamp} ?"), "1'b1 ?", 1), "the clamp takes slot a's sum"),
+    ];
+    assert_faults_caught(&base, "tri_frontend.v", "sumfault", faults, seed, &tris);
 }

@@ -82,6 +82,11 @@ pub struct Plan {
     pub reciprocal: bool,
     /// The incremental `I0`'s per-source steps are part of the set-up.
     pub i0_steps: bool,
+    /// The span path's `Gxn lo` from per-edge running sums, not a product a row: the set-up
+    /// forms each edge's `(Gxn >> 8) g` and `(Gxn >> 8) Qs` ([`super::TriSetup::sums`]) as
+    /// `(Nx g) << s` and `(Nx Qs) << s` modulo 2^(K-10), six products and six shifts more.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub run_sums: bool,
     /// Shared barrel shifters for the normalising shifts by a value (`ShlBy`: `2A`, and the
     /// plane's terms by `s`); 0: each shift its own logic, as CALC's. Five 64-bit shifts by a
     /// 6-bit amount were about 1,560 of the ECP5 plan's engine LUT4 (docs/fpga.md).
@@ -115,6 +120,7 @@ impl Plan {
         div_form: DivForm::ShiftRemainder,
         reciprocal: true,
         i0_steps: false,
+        run_sums: true,
         shifters: 1,
     };
     /// For the iCE40 UP5K: 2 of its SB_MAC16 and one 1-bit divider, the smallest engine. 15-bit
@@ -127,6 +133,7 @@ impl Plan {
         div_form: DivForm::ShiftRemainder,
         reciprocal: true,
         i0_steps: false,
+        run_sums: false,
         shifters: 1,
     };
     /// For the iCE40 HX8K, which has no multiplier: one shift-add unit and one divider, a bit a clock.
@@ -138,6 +145,7 @@ impl Plan {
         div_form: DivForm::ShiftRemainder,
         reciprocal: false,
         i0_steps: false,
+        run_sums: false,
         shifters: 1,
     };
 }
@@ -267,6 +275,8 @@ pub struct Outputs {
     pub ny: V,
     pub a: V,
     pub steps: Option<(StepOut, [[StepOut; 2]; 3])>,
+    /// Per left slot `(Gxn >> 8) g` and `(Gxn >> 8) Qs` ([`Plan::run_sums`]).
+    pub sums: Option<[(V, V); 2]>,
 }
 
 impl Outputs {
@@ -281,6 +291,9 @@ impl Outputs {
             for s in std::iter::once(c0).chain(edge.iter().flatten()) {
                 v.extend([s.ok, s.q, s.rn]);
             }
+        }
+        for (pg, pq) in self.sums.iter().flatten() {
+            v.extend([*pg, *pq]);
         }
         v
     }
@@ -407,6 +420,20 @@ impl Outputs {
             tn: u(self.tn),
             dyn_: u(self.dyn_),
             gxn: u(self.gxn),
+            // As the edge's own fields: a slot's sums are 0 where its edge is not an active left
+            // edge (never a span's source), its step where the edge is never stepped (`canonical`).
+            sums: self.sums.map(|s| {
+                let src = super::sums::left_slots(&edges);
+                std::array::from_fn(|j| {
+                    let (pg, pq) = s[j];
+                    let e = &edges[src[j]];
+                    if e.active && !e.right {
+                        (u(pg), u(pq))
+                    } else {
+                        (0, 0)
+                    }
+                })
+            }),
             plane,
         };
         let steps = self.steps.map(|(c0, edge)| {
@@ -425,6 +452,14 @@ fn stepped(e: &EdgeWalk) -> bool {
 /// A set-up with the steps the walker never takes zeroed: `setup` divides them exactly, a
 /// divider of the step's width does not need to (their quotient may not fit it).
 pub fn canonical(mut st: TriSetup) -> TriSetup {
+    let src = super::sums::left_slots(&st.edges);
+    if let Some(s) = &mut st.sums {
+        for j in 0..2 {
+            if !stepped(&st.edges[src[j]]) {
+                s[j].1 = 0;
+            }
+        }
+    }
     for e in &mut st.edges {
         if !stepped(e) {
             (e.qs, e.rs256) = (0, 0);
@@ -443,11 +478,13 @@ pub fn canonical_steps(st: &TriSetup, mut s: Steps) -> Steps {
     s
 }
 
-/// `FrontEnd::setup` and its steps in the canonical form the engine is compared in.
-pub fn reference(fe: &FrontEnd, t: &super::FixedTriangle) -> (Outcome, Option<TriSetup>, Option<Steps>) {
+/// `FrontEnd::setup` and its steps in the canonical form the engine is compared in, with the
+/// running sums when `plan` forms them ([`Plan::run_sums`]).
+pub fn reference(fe: &FrontEnd, plan: &Plan, t: &super::FixedTriangle) -> (Outcome, Option<TriSetup>, Option<Steps>) {
     let (o, st) = fe.setup(t);
     match st {
         Some(st) => {
+            let st = TriSetup { sums: plan.run_sums.then(|| fe.running_sums(&st)), ..st };
             let steps = fe.i0_steps(&st);
             (o, Some(canonical(st)), Some(canonical_steps(&st, steps)))
         }

@@ -100,14 +100,21 @@ fn offset_to_signed(q: &str, w: u32) -> String {
     }
 }
 
-/// What the incremental I0 (`--fe-i0 incremental`, `super::incremental`) reads of each edge, as
-/// extra outputs `(port, width, signed, the edge's signal, tri_frontend's name of lane k)`: the
-/// walker's state and the held set-up result. None in the default form.
+/// What the incremental I0 (`--fe-i0 incremental`, `super::incremental`) or the left slots'
+/// running sums (`Hw::run_sums`, `super::sums`) read of each edge, as extra outputs `(port,
+/// width, signed, the edge's signal, tri_frontend's name of lane k)`: the walker's state and the
+/// held set-up result. None in the default form.
 pub(super) fn state_outputs(hw: &Hw) -> Vec<(&'static str, u32, bool, String, &'static str)> {
+    let e = EdgeWidths::new(hw);
+    if hw.run_sums() {
+        // The walker's left slots step their running sums with the edge's DDA: whether it
+        // steps on the next row and whether it carries.
+        let on = if e.tracked { "w_act && w_ge" } else { "w_act && row >= w_rs" };
+        return vec![("x_on", 1, false, on.into(), "e_on"), ("x_cy", 1, false, "cy".into(), "e_cy")];
+    }
     if !super::incremental::on(hw) {
         return Vec::new();
     }
-    let e = EdgeWidths::new(hw);
     let flip = |q: &str| offset_to_signed(q, e.bound_w);
     // Behind an engine the held set-up result is the queue head, the edge's inputs.
     let engine = hw.engine_form();
@@ -131,8 +138,9 @@ pub(super) fn state_outputs(hw: &Hw) -> Vec<(&'static str, u32, bool, String, &'
 
 /// The ports of [`state_outputs`].
 fn state_ports(hw: &Hw) -> Vec<Port> {
+    let reader = if hw.run_sums() { "walker's running sums" } else { "incremental I0" };
     let out = |(port, w, signed, _, name): (&str, u32, bool, String, &str)| {
-        let p = Port::output(port, w, if signed { "signed integer" } else { "" }, &format!("for the incremental I0: the edge's {name}"));
+        let p = Port::output(port, w, if signed { "signed integer" } else { "" }, &format!("for the {reader}: the edge's {name}"));
         if signed {
             p.signed()
         } else {

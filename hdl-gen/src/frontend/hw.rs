@@ -2,7 +2,7 @@
 //! rate, pipeline level) and its ports: the types every part of the generator shares.
 
 use crate::verilog::Port;
-use golden::frontend::{DiMode, FrontEnd, Widths};
+use golden::frontend::{DiMode, FrontEnd, I0Form, Widths};
 
 /// Quotient bits the set-up's dividers take per clock (`--fe-div-bits`): area against rate.
 pub const DIV_BITS: [u32; 3] = [1, 2, 4];
@@ -75,6 +75,13 @@ impl Hw {
     /// `Tn` and `Gxn lo` are read modulo 2^(K-2).
     pub fn s2n_bits(&self) -> u32 {
         self.fe.widths().k - 1
+    }
+
+    /// Whether the span path takes `Gxn lo` from the walker's two left slots' running sums, not a
+    /// product a row (golden's `Plan::run_sums`, `golden::frontend::sums`): the engine form on
+    /// the ECP5-25F plan, `I0` by the reciprocal.
+    pub fn run_sums(&self) -> bool {
+        self.fe.setup.plan().is_some_and(|p| p.run_sums) && self.fe.i0 == I0Form::Reciprocal
     }
 
     /// Whether the walker's row is registered before its span is decided

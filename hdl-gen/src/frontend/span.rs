@@ -170,24 +170,35 @@ pub(super) fn path(hw: &Hw, body: &mut Vec<Item>) -> Stager {
     i0_section(&mut sp);
     // The walker's row, or the row stage's ([`walker::row`]).
     let row = |n: &str| walker::row(hw, n);
+    // With the running sums (`Hw::run_sums`) the left end's `Gxn lo` is minus the sum the row
+    // stage chose (`gxs`, golden's `frontend::sums`): no product by the column.
+    let (sums, gxn) = (hw.run_sums(), walker::reads_gxn(hw));
     for (n, ww, src) in [
         ("y", row_w, row("w_row")),
         ("x", xw, "lo_u".into()),
         ("len", xw + 1, format!("len_w[{xw}:0]")),
         ("tn", s2_w - 1, format!("{}[{}:0]", row("w_tn"), s2_w - 2)),
         ("gxn", gx_w, format!("{}[{}:{zeros}]", row("w_gxn"), s2_w - 2)),
+        ("gxs", gx_w, row("w_gxs")),
         ("an", area_w, row("w_an")),
         ("rn", recip_w, row("w_rn")),
     ] {
-        sp.input_as(n, ww, false, &src);
+        if (n != "gxn" || gxn) && (n != "gxs" || sums) {
+            sp.input_as(n, ww, false, &src);
+        }
     }
     // The walker's sums are modulo 2^K; the span path reads their residues modulo 2^(K-2), and
     // Gxn's low bits are zero (golden's `Widths::GXN_ZEROS`).
     body.push(comment("verilator lint_off UNUSEDSIGNAL"));
-    body.push(wire("unused_sums_top", 4, format!("{{w_tn[{0}:{1}], w_gxn[{0}:{1}]}}", sum_w - 1, sum_w - 2)));
-    let gxn_low = format!("{}[{}:0]", row("w_gxn"), zeros - 1);
-    body.push(wire("unused_gxn_low", zeros, gxn_low));
+    if gxn {
+        body.push(wire("unused_sums_top", 4, format!("{{w_tn[{0}:{1}], w_gxn[{0}:{1}]}}", sum_w - 1, sum_w - 2)));
+        let gxn_low = format!("{}[{}:0]", row("w_gxn"), zeros - 1);
+        body.push(wire("unused_gxn_low", zeros, gxn_low));
+    } else {
+        body.push(wire("unused_sums_top", 2, format!("w_tn[{}:{}]", sum_w - 1, sum_w - 2)));
+    }
     body.push(comment("verilator lint_on UNUSEDSIGNAL"));
+    let by_product = |e: &End| !sums || e.x != head.x; // `Gxn lo` by a product by the column
     if scan {
         sp.input_as("xh", xw, false, &format!("hi3[{}:0]", xw - 1));
         body.push(comment("verilator lint_off UNUSEDSIGNAL"));
@@ -201,22 +212,24 @@ pub(super) fn path(hw: &Hw, body: &mut Vec<Item>) -> Stager {
     // Gxn lo modulo 2^(K-2): S2n's residue needs no more. Its partial products in one stage,
     // their sum in the next.
     let mut gx_partials = Vec::new();
-    for e in &ends {
+    for e in ends.iter().filter(|e| by_product(e)) {
         let (gxn, x) = (sp.at("gxn"), sp.at(e.x));
         gx_partials.push(partial_products(&mut sp, tile, e.gx, (&gxn, gx_w), (&x, xw), gx_w));
     }
     sp.cut();
     i0_section(&mut sp);
     sp.note(comment("verilator lint_off UNUSEDSIGNAL"));
-    for (e, terms) in ends.iter().zip(&gx_partials) {
+    for (e, terms) in ends.iter().filter(|e| by_product(e)).zip(&gx_partials) {
         sum_partials(&mut sp, e.gx, terms, gx_w);
     }
     sp.note(comment("verilator lint_on UNUSEDSIGNAL"));
     sp.cut();
     i0_section(&mut sp);
     for e in &ends {
-        let gx = format!("{{{}, {}}}", sp.at(e.gx), lit(zeros, 0));
-        let sum = format!("{} + {}", zext(&sp.at("tn"), s2_w - 1, s2_w), zext(&gx, s2_w - 1, s2_w));
+        // Gxn lo = -(sum << 8) from the running sums: subtracted.
+        let (gx, op) = if by_product(e) { (sp.at(e.gx), "+") } else { (sp.at("gxs"), "-") };
+        let gx = format!("{{{gx}, {}}}", lit(zeros, 0));
+        let sum = format!("{} {op} {}", zext(&sp.at("tn"), s2_w - 1, s2_w), zext(&gx, s2_w - 1, s2_w));
         sp.def(e.s2, s2_w, false, format!("(({sum}) << 1) + {}", zext(&sp.at("an"), area_w, s2_w)));
     }
     sp.cut();

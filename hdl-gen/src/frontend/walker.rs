@@ -50,11 +50,31 @@ fn row_values(hw: &Hw) -> Vec<(&'static str, u32)> {
     // The span path reads the sums modulo 2^(K-2) only ([`Hw::s2n_bits`]).
     let sums = hw.s2n_bits() - 1;
     let mut v = vec![("w_row", row_w), ("w_tn", sums), ("w_gxn", sums), ("w_an", area_w), ("w_rn", recip_w)];
+    if !reads_gxn(hw) {
+        v.retain(|(n, _)| *n != "w_gxn");
+    }
     // Per scanline the span's dI is its own division's: the triangle's is not read.
     if hw.fe.di == DiMode::Triangle {
         v.push(("w_di", hw.fe.cfg.dw()));
     }
     v
+}
+
+/// Whether the span path reads the row's `Gxn` (for a product by the column): not when the
+/// running sums give the left end's (`Hw::run_sums`), unless the scanline `dI`'s last pixel
+/// needs its own.
+pub(super) fn reads_gxn(hw: &Hw) -> bool {
+    !hw.run_sums() || hw.fe.di == DiMode::Scanline
+}
+
+/// The running sums' row-stage registers (`Hw::run_sums`): the slots' sums and slot a's edge
+/// with the row's bounds, then the span's source with its ends.
+fn sum_stage_registers(hw: &Hw) -> [Vec<(String, u32)>; 2] {
+    if !hw.run_sums() {
+        return [Vec::new(), Vec::new()];
+    }
+    let sb = hw.fe.widths().sum_bits();
+    [vec![("wr_pa".into(), sb), ("wr_pb".into(), sb), ("wr_sa".into(), 3)], vec![("we_gxs".into(), sb)]]
 }
 
 /// The row stages: the walked row (valid, each edge's bound, the span path's inputs)
@@ -89,6 +109,21 @@ fn row_stages(hw: &Hw, body: &mut Vec<Item>) {
     for (end, side) in [("mg", "wr_lg"), ("hi3", "wr_ha")] {
         body.push(swire(&format!("{end}_w"), end_w, least_of_three(side)));
     }
+    let [first, second] = sum_stage_registers(hw);
+    for (n, w) in first.iter().chain(&second) {
+        body.push(reg(n, *w));
+    }
+    for (n, _) in &first {
+        let v = match n.as_str() {
+            "wr_pa" => super::sums::slot_sum("a"),
+            "wr_pb" => super::sums::slot_sum("b"),
+            _ => n.replace("wr_", "w_"),
+        };
+        moves.push(set(n, v));
+    }
+    if !second.is_empty() {
+        moves.push(set("we_gxs", super::sums::source(hw, "wr_lg", ("wr_pa", "wr_pb", "wr_sa"), "mg_w")));
+    }
     body.push(reg(v2, 1));
     body.extend([sreg("we_mg", end_w), sreg("we_hi3", end_w)]);
     moves.extend([set(v2, v1), set("we_mg", "mg_w"), set("we_hi3", "hi3_w")]);
@@ -110,8 +145,11 @@ pub(super) fn row_registers(hw: &Hw) -> Vec<Vec<(String, u32, bool)>> {
     let mut first = vec![(row_valid(1).to_string(), 1, false)];
     first.extend(["lg", "ha"].iter().flat_map(|side| (0..3).map(move |k| (format!("wr_{side}{k}"), end_w, true))));
     first.extend(row_values(hw).into_iter().map(|(n, w)| (row_at(hw, n, 1), w, false)));
+    let [sums1, sums2] = sum_stage_registers(hw);
+    first.extend(sums1.into_iter().map(|(n, w)| (n, w, false)));
     let mut second = vec![(row_valid(2).to_string(), 1, false), ("we_mg".to_string(), end_w, true), ("we_hi3".to_string(), end_w, true)];
     second.extend(row_values(hw).into_iter().map(|(n, w)| (row_at(hw, n, 2), w, false)));
+    second.extend(sums2.into_iter().map(|(n, w)| (n, w, false)));
     vec![first, second]
 }
 
@@ -124,9 +162,10 @@ pub(super) fn emit(hw: &Hw, names: &Names, body: &mut Vec<Item>) {
     body.push(reg("w_valid", 1));
     body.push(reg("w_row", row_w));
     body.push(reg("w_last", row_w));
-    for (n, ww) in [("w_di", dw), ("w_an", area_w), ("w_rn", recip_w), ("w_tn", sum_w), ("w_gxn", sum_w), ("w_dyn", sum_w)] {
-        body.push(reg(n, ww));
-    }
+    let regs = [("w_di", dw), ("w_an", area_w), ("w_rn", recip_w), ("w_tn", sum_w), ("w_gxn", sum_w), ("w_dyn", sum_w)];
+    body.extend(regs.iter().filter(|(n, _)| *n != "w_gxn" || reads_gxn(hw)).map(|(n, ww)| reg(n, *ww)));
+    let (sum_decls, sum_load, sum_step) = if hw.run_sums() { super::sums::walker(hw) } else { Default::default() };
+    body.extend(sum_decls);
     if fe.di == DiMode::Scanline {
         let (_, sd_cnt_w) = scanline_divider(hw);
         body.push(comment("Per-scanline dI (the comparison option): a restoring divider, busy for each span of m >= 2."));
@@ -175,7 +214,7 @@ pub(super) fn emit(hw: &Hw, names: &Names, body: &mut Vec<Item>) {
     }
     body.push(edge::instances(hw, names, &edge::input_buses(hw)));
     // The incremental I0 reads each edge's state by its own names, lane k of the edges' buses.
-    for (port, w, signed, _, name) in &state {
+    for (port, w, signed, _, name) in state.iter().filter(|_| inc) {
         for k in 0..3 {
             let lane = if *w == 1 { format!("e_{port}[{k}]") } else { format!("e_{port}[{}:{}]", (k + 1) * w - 1, k * w) };
             let alias = format!("{name}{k}");
@@ -211,6 +250,13 @@ pub(super) fn emit(hw: &Hw, names: &Names, body: &mut Vec<Item>) {
             body.push(swire(end, end_w, least_of_three(side)));
         }
     }
+    if hw.run_sums() && !hw.row_stage() {
+        body.push(wire(
+            "w_gxs",
+            hw.fe.widths().sum_bits(),
+            super::sums::source(hw, "lg", (&super::sums::slot_sum("a"), &super::sums::slot_sum("b"), "w_sa"), "mg"),
+        ));
+    }
     body.push(comment("verilator lint_off UNUSEDSIGNAL"));
     body.push(swire("lo3", end_w, "-mg"));
     body.push(swire("room", end_w + 1, format!("{} + {}", sext("hi3", end_w, end_w + 1), sext("mg", end_w, end_w + 1))));
@@ -234,7 +280,10 @@ pub(super) fn emit(hw: &Hw, names: &Names, body: &mut Vec<Item>) {
         set("w_gxn", "s_gxn"),
         set("w_dyn", "s_dyn"),
     ]);
-    let step = vec![set("w_row", format!("w_row + {}", lit(row_w, 1))), set("w_tn", "w_tn + w_dyn")];
+    load.retain(|st| reads_gxn(hw) || !matches!(st, Stmt::Set(l, _) if l == "w_gxn"));
+    load.extend(sum_load);
+    let mut step = vec![set("w_row", format!("w_row + {}", lit(row_w, 1))), set("w_tn", "w_tn + w_dyn")];
+    step.extend(sum_step);
     let walked = vec![Stmt::If("w_end".into(), vec![set("w_valid", "1'b0")], step)];
     let moves = if tracked {
         // As the edges: the stall gates the enables, the registers choose the load or the step.

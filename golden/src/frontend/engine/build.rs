@@ -255,6 +255,7 @@ impl Program {
         let dyn_ = b.op("dyn", Kind::ShlBy(t, s), kw, false);
         let t = b.shl("nx8", nx, 8, nx_w + 8, true);
         let gxn = b.op("gxn", Kind::ShlBy(t, s), kw, false);
+        let sums = plan.run_sums.then(|| running_sums(&mut b, &wd, &edges, nx, s));
         let steps = plan.i0_steps.then(|| i0_steps(&mut b, &wd, iw, &by_a, aabs, nx, ny, &edges));
         let out = Outputs {
             guard_ok,
@@ -274,9 +275,42 @@ impl Program {
             ny,
             a: aabs,
             steps,
+            sums,
         };
         Program { ops: b.ops, out }
     }
+}
+
+/// The running sums' start and step (`Plan::run_sums`) for the two left edges' slots
+/// ([`crate::frontend::sums::left_slots`]): (Gxn >> 8) v = (Nx v) << s modulo 2^(K-10), the
+/// product of Nx (narrower than Gxn >> 8: fewer tile passes) shifted on the shared
+/// shifter. Two slots, not three edges: four products (12 tile passes) keep the 8 tiles'
+/// static binding at II = 12, six (18) made it rotate over 6 triangles (docs/fpga.md).
+fn running_sums(b: &mut B, wd: &Widths, edges: &[EdgeOut], nx: V, s: V) -> [(V, V); 2] {
+    let sb = wd.sum_bits();
+    let left: Vec<V> = edges
+        .iter()
+        .map(|e| {
+            let l = b.not(e.right);
+            b.and(e.active, l)
+        })
+        .collect();
+    // Slot a is edge 0 if it is a left edge, else edge 1; slot b edge 2 if it is one, else
+    // edge 1 (`crate::frontend::sums::left_slots`): each value a select of two.
+    let slot = |b: &mut B, n: &str, (own, other): (usize, usize)| {
+        let pick = |b: &mut B, what: &str, f: fn(&EdgeOut) -> V| {
+            let w = b.w(f(&edges[own]));
+            b.sel(&format!("{what}_{n}"), left[own], f(&edges[own]), f(&edges[other]), w, true)
+        };
+        let (g, qs) = (pick(b, "g", |e| e.g), pick(b, "qs", |e| e.qs));
+        let sum = |b: &mut B, what: &str, v: V| {
+            let p = b.mul(&format!("m_{what}{n}"), nx, v, sb, false);
+            b.op(format!("{what}{n}"), Kind::ShlBy(p, s), sb, false)
+        };
+        (sum(b, "pg", g), sum(b, "pq", qs))
+    };
+    let [a, b_] = crate::frontend::sums::LEFT_SLOTS;
+    [slot(b, "a", a), slot(b, "b", b_)]
 }
 
 /// The incremental `I0`'s steps (`FrontEnd::i0_steps`): `divmod(X, 2A)` of `X = 512 Ny` and,

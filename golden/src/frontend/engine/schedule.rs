@@ -474,6 +474,7 @@ pub fn today_pw() -> u32 {
         div_form: DivForm::ShiftDivisor,
         reciprocal: false,
         i0_steps: false,
+        run_sums: false,
         shifters: 0,
     };
     Program::setup(&fe, &plan).ops.iter().map(|o| if let Kind::Div { pw, .. } = o.kind { pw } else { 0 }).sum()

@@ -10,7 +10,17 @@ use crate::stimulus::random_fixed_triangles;
 use rand::SeedableRng;
 
 fn plan(mults: u32, dividers: u32, div_bits: u32, reciprocal: bool) -> Plan {
-    Plan { mults, mul: Plan::TILE18, dividers, div_bits, div_form: DivForm::ShiftRemainder, reciprocal, i0_steps: true, shifters: 0 }
+    Plan {
+        mults,
+        mul: Plan::TILE18,
+        dividers,
+        div_bits,
+        div_form: DivForm::ShiftRemainder,
+        reciprocal,
+        i0_steps: true,
+        run_sums: false,
+        shifters: 0,
+    }
 }
 
 /// The screens of the equivalence: the default, a small one at F = 4 and the widest (2^16).
@@ -39,7 +49,7 @@ fn plans() -> Vec<Plan> {
 fn first_mismatch(fe: &FrontEnd, s: &Schedule, tris: &[crate::frontend::FixedTriangle]) -> Option<String> {
     let got = s.run(tris);
     tris.iter().zip(got).find_map(|(t, g)| {
-        let mut want: Result3 = reference(fe, t);
+        let mut want: Result3 = reference(fe, &s.plan, t);
         if !s.plan.i0_steps {
             want.2 = want.2.and(None);
             if want.1.is_some() {
@@ -91,7 +101,7 @@ fn engine_equals_setup() {
     let prog = Program::setup(&fe, &plan(1, 1, 1, true));
     let mut rng = SeedRng::seed_from_u64(seed);
     for t in random_fixed_triangles(&mut rng, &fe, 2_000) {
-        assert_eq!(prog.eval(&t), reference(&fe, &t), "{t:?}");
+        assert_eq!(prog.eval(&t), reference(&fe, &plan(1, 1, 1, true), &t), "{t:?}");
     }
 }
 
@@ -239,6 +249,7 @@ fn engine_grid() {
         div_form: DivForm::ShiftDivisor,
         reciprocal: false,
         i0_steps: false,
+        run_sums: false,
         shifters: 0,
     };
     println!("{} (today)", row(&today.schedule(&fe).unwrap()));
@@ -258,7 +269,17 @@ fn engine_grid() {
                         for (div_bits, div_form) in
                             [1, 2, 4].into_iter().flat_map(|b| [(b, DivForm::ShiftRemainder), (b, DivForm::ShiftDivisor)])
                         {
-                            let p = Plan { mults, mul, dividers, div_bits, div_form, reciprocal, i0_steps: steps, shifters: 1 };
+                            let p = Plan {
+                                mults,
+                                mul,
+                                dividers,
+                                div_bits,
+                                div_form,
+                                reciprocal,
+                                i0_steps: steps,
+                                run_sums: false,
+                                shifters: 1,
+                            };
                             let s = p.schedule(&fe).unwrap();
                             let r = row(&s);
                             if r.contains(&filter) {

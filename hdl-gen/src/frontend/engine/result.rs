@@ -35,6 +35,12 @@ pub(crate) fn fields(hw: &Hw, s: &Schedule) -> Vec<Field> {
         let (nx_w, ny_w) = hw.plane_widths();
         v.extend([f("nx", o.nx, nx_w), f("ny", o.ny, ny_w), f("a", o.a, aw)]);
     }
+    // The left slots' running sums' starts and steps (`Hw::run_sums`), the walker's `s_pga`...
+    if let (Some(sums), true) = (o.sums, hw.run_sums()) {
+        for (slot, (pg, pq)) in ["a", "b"].iter().zip(sums) {
+            v.extend([f(&format!("pg{slot}"), pg, hw.fe.widths().sum_bits()), f(&format!("pq{slot}"), pq, hw.fe.widths().sum_bits())]);
+        }
+    }
     for (j, e) in o.edges.iter().enumerate() {
         for (n, x, w) in [
             ("act", e.active, 1),

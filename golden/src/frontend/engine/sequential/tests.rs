@@ -12,7 +12,7 @@ use rand::SeedableRng;
 /// incremental steps, so those are left out).
 fn first_mismatch(fe: &FrontEnd, s: &SeqSchedule, tris: &[FixedTriangle]) -> Option<String> {
     tris.iter().zip(s.run(tris)).find_map(|(t, g)| {
-        let want = reference(fe, t);
+        let want = reference(fe, &Plan::ICE40_HX8K, t);
         ((g.0, g.1) != (want.0, want.1)).then(|| format!("{t:?}\n sequential {:?}\n setup {:?}", g.1, want.1))
     })
 }

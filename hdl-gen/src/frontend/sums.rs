@@ -1,0 +1,68 @@
+//! The walker's running sums of `Gxn g` (`Hw::run_sums`, golden's `frontend::sums`): two left
+//! slots, each the sum of one left edge, stepped with that edge's DDA; the span's `Gxn lo` is
+//! minus the sum of the slot its left end comes from, or 0 at the screen's clamp. No product a
+//! row: the span path's `Gxn lo` tiles go.
+
+use super::hw::Hw;
+use crate::verilog::{comment, lit, reg, set, wire, Item, Stmt};
+use golden::frontend::sums::LEFT_SLOTS;
+use golden::frontend::Widths;
+
+/// The slots: each has its edge (one-hot), its sum in two parts and its step.
+const SLOTS: [&str; 2] = ["a", "b"];
+
+/// Slot `slot`'s sum on the walked row: its two parts added.
+pub(super) fn slot_sum(slot: &str) -> String {
+    format!("(w_p{slot} + w_c{slot})")
+}
+
+fn onehot(k: usize) -> String {
+    lit(3, 1 << k)
+}
+
+/// The walker's declarations, its load (from the queue head) and its step (on the walker's
+/// next row, each slot as its edge steps).
+pub(super) fn walker(hw: &Hw) -> (Vec<Item>, Vec<Stmt>, Vec<Stmt>) {
+    let wd = hw.fe.widths();
+    let sb = wd.sum_bits();
+    let z = Widths::GXN_ZEROS;
+    let mut decls = vec![
+        comment("Running sums of Gxn g (Gxn >> 8 units, modulo 2^(K-10)) of the two left slots: slot a edge 0 if it is an active"),
+        comment("left edge, else edge 1; slot b edge 2 if it is one, else edge 1 (w_sa, w_sb one-hot). A slot's sum is w_p + w_c:"),
+        comment("w_p steps by Gxn qs as its edge steps, w_c by Gxn (w_g8) as its edge carries."),
+        reg("w_g8", sb),
+    ];
+    let mut load = vec![set("w_g8", format!("s_gxn[{}:{z}]", z + sb - 1))];
+    let mut step = Vec::new();
+    let left = |k: usize| format!("(e_act[{k}] && !e_right[{k}])");
+    for (slot, (own, other)) in SLOTS.iter().zip(LEFT_SLOTS) {
+        let (s, p, q, c) = (format!("w_s{slot}"), format!("w_p{slot}"), format!("w_q{slot}"), format!("w_c{slot}"));
+        decls.push(reg(&s, 3));
+        decls.extend([&p, &q, &c].map(|n| reg(n, sb)));
+        load.push(set(&s, format!("{} ? {} : {}", left(own), onehot(own), onehot(other))));
+        load.push(set(&p, format!("s_pg{slot}")));
+        load.push(set(&q, format!("s_pq{slot}")));
+        load.push(set(&c, lit(sb, 0)));
+        // The carry's Gxn in a sum of its own, not a select of the step before one add: its
+        // enable is the carry, and the two sums meet in an add into the row stage (carry chains,
+        // where the select was a LUT4 a bit).
+        let carry = Stmt::If(format!("|(e_x_cy & {s})"), vec![set(&c, format!("{c} + w_g8"))], vec![]);
+        step.push(Stmt::If(format!("|(e_x_on & {s})"), vec![set(&p, format!("{p} + {q}")), carry], vec![]));
+    }
+    // The queue head's Gxn is read for its steps only, modulo 2^(K-2) and above its zero bits.
+    decls.push(comment("verilator lint_off UNUSEDSIGNAL"));
+    decls.push(wire("unused_s_gxn", 2 + z, format!("{{s_gxn[{}:{}], s_gxn[{}:0]}}", wd.k - 1, wd.k - 2, z - 1)));
+    decls.push(comment("verilator lint_on UNUSEDSIGNAL"));
+    (decls, load, step)
+}
+
+/// The span's `Gxn lo` source (`sb` bits, a sum to negate): the slot whose edge wins the left
+/// end's least-of-three (`side0..2`, the edges' bounds on the row), 0 when the end is the clamp
+/// (`mg`'s sign clear: every bound is at most 0, `lo = -mg`). Edges that tie have equal sums.
+pub(super) fn source(hw: &Hw, side: &str, (pa, pb, sa): (&str, &str, &str), mg: &str) -> String {
+    let wd = hw.fe.widths();
+    let end_w = super::edge::end_width(hw);
+    let c = |i: u32, j: u32| format!("{side}{i} <= {side}{j}");
+    let win = format!("(({} && {}) ? {} : ({}) ? {} : {})", c(0, 1), c(0, 2), onehot(0), c(1, 2), onehot(1), onehot(2));
+    format!("{mg}[{}] ? ((|({win} & {sa})) ? {pa} : {pb}) : {}", end_w - 1, lit(wd.sum_bits(), 0))
+}
