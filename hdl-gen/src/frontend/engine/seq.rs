@@ -16,7 +16,7 @@ mod tile;
 use super::result::{fields, ports, Field};
 use super::units::bits_for;
 use crate::frontend::hw::Hw;
-use crate::verilog::{comment, reg, set, sreg, wire, Item, Module, Param, Stmt};
+use crate::verilog::{comment, reg, set, sreg, wire, Item, Module, Param, Port, Stmt};
 use golden::frontend::engine::schedule::Class;
 use golden::frontend::engine::sequential::{Exec, Loc, SeqSchedule, ALU_LAT, READ};
 use golden::frontend::engine::{Kind, MulUnit, V};
@@ -173,7 +173,9 @@ pub fn module(hw: &Hw, s: &SeqSchedule, name: &str) -> SeqEngine {
     let consts: Vec<String> = s.preload.iter().map(|&(_, v)| format!("{w}'h{:x}", (v as u128) & mask)).collect();
 
     let res_w: u32 = fields.iter().map(|f| f.w).sum();
-    let ports = ports(hw, res_w);
+    let mut ports = ports(hw, res_w);
+    ports.push(Port::output("res_we", fields.len() as u32, "", "per field of res: write it into the queue's tail this clock"));
+    ports.push(Port::output("res_wr", 1, "", "a field of res is due this clock (whether or not en)"));
     let params: Vec<Param> = Vec::new();
     let header = vec![
         format!("{name} — the sequential set-up engine (issue 27; docs/design.md): golden's microprogram on one ALU."),
@@ -644,43 +646,50 @@ fn write_bus(cx: &Cx, widths: &[u32], b: &mut Vec<Item>) {
     b.push(Item::Blank);
 }
 
-/// The result fields, each loaded as its value is written.
+/// The result: each field written into the queue's tail entry as its value is written
+/// (`res_we`, a bit a field, for a valid period's triangle and not while frozen; `res_wr`: a
+/// field is due this clock), so the engine keeps no copy of it; the guard-band check and the
+/// cull, which the front-end reads as the result is pushed, loaded here.
 fn results(cx: &Cx, fields: &[Field], groups: &[V], b: &mut Vec<Item>) {
-    let (ops, out) = (&cx.s.prog.ops, &cx.s.prog.out);
+    let (ops, out, s) = (&cx.s.prog.ops, &cx.s.prog.out, cx.s);
     let cb = bits_for(groups.len() as u32);
-    b.push(comment("The result: each field loads as its value is written."));
-    let mut loads = Vec::new();
-    let name_of = |v: V| -> Option<String> {
-        if v == out.guard_ok {
-            return Some("c_guard".into());
-        }
-        if v == out.cull {
-            return Some("c_cull".into());
-        }
-        None
-    };
+    b.push(comment("The result: each field written into the queue's tail as its value is written (res_we), the guard-band"));
+    b.push(comment("check and the cull loaded here. The tail becomes an entry at res_v, the next period's clock 0, which"));
+    b.push(comment("writes no field."));
+    let cap = |v: V| format!("u_cap == {cb}'d{}", groups.iter().position(|&x| x == v).unwrap() + 1);
+    // The fields' groups come first in `groups` (then the checks'): res_wr is a range of them.
+    let nf = groups.iter().take_while(|v| fields.iter().any(|f| f.v == **v)).count();
+    assert!(nf > 0 && groups[nf..].iter().all(|v| fields.iter().all(|f| f.v != *v)), "the fields' groups first");
+    for &v in &groups[..nf] {
+        assert!(s.slots[v.0 as usize].write > 0, "{}: a field written at clock 0, the push's", ops[v.0 as usize].name);
+    }
+    let first = fields.iter().find(|f| !matches!(ops[f.v.0 as usize].kind, Kind::Const(_))).expect("a computed field").v;
     let mut parts = Vec::new();
+    let mut we = Vec::new();
     for f in fields {
-        let n = format!("c_{}", f.name);
         match ops[f.v.0 as usize].kind {
-            Kind::Const(k) => parts.push(format!("{}'d{}", f.w, k)),
+            // A constant rides with the first computed field's write.
+            Kind::Const(k) => {
+                parts.push(format!("{}'d{}", f.w, k));
+                we.push(format!("en && vld[0] && {}", cap(first)));
+            }
             _ => {
-                b.push(reg(&n, f.w));
-                let g = groups.iter().position(|&v| v == f.v).unwrap() + 1;
-                loads.push(Stmt::If(format!("u_cap == {cb}'d{g}"), vec![set(&n, format!("bus[{}:0]", f.w - 1))], vec![]));
-                parts.push(n);
+                parts.push(if f.w == 1 { "bus[0]".to_string() } else { format!("bus[{}:0]", f.w - 1) });
+                we.push(format!("en && vld[0] && {}", cap(f.v)));
             }
         }
     }
-    for v in [out.guard_ok, out.cull] {
-        let n = name_of(v).unwrap();
-        b.push(reg(&n, 1));
-        let g = groups.iter().position(|&x| x == v).unwrap() + 1;
-        loads.push(Stmt::If(format!("u_cap == {cb}'d{g}"), vec![set(&n, "bus[0]")], vec![]));
+    let mut loads = Vec::new();
+    for (v, n) in [(out.guard_ok, "c_guard"), (out.cull, "c_cull")] {
+        b.push(reg(n, 1));
+        loads.push(Stmt::If(cap(v), vec![set(n, "bus[0]")], vec![]));
     }
     b.push(Item::Always(vec![Stmt::If("en".into(), loads, vec![])]));
     parts.reverse();
+    we.reverse();
     b.push(Item::Assign("res".into(), format!("{{{}}}", parts.join(", "))));
+    b.push(Item::Assign("res_we".into(), format!("{{{}}}", we.join(",\n    "))));
+    b.push(Item::Assign("res_wr".into(), format!("vld[0] && u_cap != {cb}'d0 && u_cap <= {cb}'d{nf}")));
     b.push(Item::Assign("res_guard".into(), "c_guard".into()));
     b.push(Item::Assign("res_cull".into(), "c_cull".into()));
 }

@@ -130,13 +130,13 @@ impl<'a> Tiles<'a> {
             b.push(Item::Always(vec![Stmt::If(
                 "en".into(),
                 vec![
-                    Stmt::If(uf("ld"), vec![set(&m("a"), "x0"), set(&m("b"), "x1")], vec![]),
-                    set(&m("ra"), m("ca")),
-                    set(&m("rb"), m("cb")),
-                    set(&m("f1"), uf("ld")),
-                    set(&m("s1"), uf("s")),
-                    set(&m("pr"), format!("{} * {}", m("ra"), m("rb"))),
-                    set(&m("acc"), m("held")),
+                    Stmt::If(uf("ld"), vec![set(m("a"), "x0"), set(m("b"), "x1")], vec![]),
+                    set(m("ra"), m("ca")),
+                    set(m("rb"), m("cb")),
+                    set(m("f1"), uf("ld")),
+                    set(m("s1"), uf("s")),
+                    set(m("pr"), format!("{} * {}", m("ra"), m("rb"))),
+                    set(m("acc"), m("held")),
                 ],
                 vec![],
             )]));
