@@ -194,7 +194,7 @@ pub fn module(hw: &Hw, s: &SeqSchedule, name: &str) -> SeqEngine {
     memories(&cx, &l, &micro, &consts, &mut b);
     alu(&cx, &mut b);
     match tile::Tiles::new(s) {
-        Some(t) => t.units(&cx, &mut b),
+        Some(t) => t.units(w, &mut b),
         None => shift_add(&cx, &mut b),
     }
     divider(&cx, &mut b);
@@ -262,7 +262,9 @@ fn microprogram(cx: &Cx, fields: &[Field]) -> Micro {
             let e = t + READ;
             match (exec, op.kind) {
                 (Exec::Unit(Class::Mul, u), _) if tiles.is_some() => {
-                    tiles.as_ref().expect("tiles").passes(o, u, &mut mw);
+                    for (t, k, v) in tiles.as_ref().expect("tiles").passes(o, u) {
+                        mw[t as usize].set(k, v, t);
+                    }
                 }
                 (Exec::Unit(Class::Mul, _), _) => {
                     let nb = ops[args[1].0 as usize].w;

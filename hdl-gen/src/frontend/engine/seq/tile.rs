@@ -13,13 +13,12 @@
 //!   and whether the sum shifts, are microword fields of the pass's clock (per unit: the
 //!   units run at once), so the unit has no sequencer of its own.
 
-use super::{Cx, Word};
 use crate::verilog::{comment, reg, set, sreg, wire, Item, Stmt};
 use golden::frontend::engine::schedule::MUL_PIPE;
 use golden::frontend::engine::sequential::{Exec, SeqSchedule, READ};
 use golden::frontend::engine::{Kind, MulUnit};
 
-use super::bits_for;
+use super::super::units::bits_for;
 
 /// Per unit, its microword fields: load (the first pass), chunk of a, chunk of b, a's chunk
 /// signed (its top one, of a signed operand), b's, the sum shifted a chunk up.
@@ -48,8 +47,8 @@ impl<'a> Tiles<'a> {
         (0..self.mults as usize).flat_map(|u| FIELDS[u].iter().zip([1, self.cbw, self.cbw, 1, 1, 1]).map(|(n, w)| (*n, w))).collect()
     }
 
-    /// Product `o` on unit `u`: its passes' fields in the microwords from its load on.
-    pub(super) fn passes(&self, o: usize, u: u32, mw: &mut [Word]) {
+    /// Product `o` on unit `u`: its passes' fields, `(clock, field, value)`, from its load on.
+    pub(super) fn passes(&self, o: usize, u: u32) -> Vec<(u32, &'static str, u64)> {
         let ops = &self.s.prog.ops;
         let sl = self.s.slots[o];
         let Kind::Mul(a, b) = ops[o].kind else { unreachable!("a product on a multiplier") };
@@ -63,21 +62,25 @@ impl<'a> Tiles<'a> {
         assert_eq!(sl.exec, Exec::Unit(golden::frontend::engine::schedule::Class::Mul, u));
         assert_eq!(sl.write, l + p.len() as u32 + MUL_PIPE, "{}: golden's passes", ops[o].name);
         let f = &FIELDS[u as usize];
+        let mut set = Vec::new();
         for (k, &(i, j)) in p.iter().enumerate() {
             let t = l + k as u32;
-            let x = &mut mw[t as usize];
-            x.set(f[0], (k == 0) as u64, t);
-            x.set(f[1], i as u64, t);
-            x.set(f[2], j as u64, t);
-            x.set(f[3], (i + 1 == ca && a.signed) as u64, t);
-            x.set(f[4], (j + 1 == cb && b.signed) as u64, t);
-            x.set(f[5], (k > 0 && i + j < p[k - 1].0 + p[k - 1].1) as u64, t);
+            set.extend([
+                (t, f[0], (k == 0) as u64),
+                (t, f[1], i as u64),
+                (t, f[2], j as u64),
+                (t, f[3], (i + 1 == ca && a.signed) as u64),
+                (t, f[4], (j + 1 == cb && b.signed) as u64),
+                (t, f[5], (k > 0 && i + j < p[k - 1].0 + p[k - 1].1) as u64),
+            ]);
         }
+        set
     }
 
     /// The units: per unit the held operands, the chunk selection, the tile and the sum.
-    pub(super) fn units(&self, cx: &Cx, b: &mut Vec<Item>) {
-        let (w, bits, n) = (cx.w, self.bits, self.chunks);
+    /// `w`: the register file's word.
+    pub(super) fn units(&self, w: u32, b: &mut Vec<Item>) {
+        let (bits, n) = (self.bits, self.chunks);
         // The operands sign-extended past their top chunk's sign bit (a register-file word holds
         // its value sign- or zero-extended to W: unsigned values have a zero bit on top).
         let ew = n * bits + 1;
