@@ -657,7 +657,9 @@ fn results(cx: &Cx, fields: &[Field], groups: &[V], b: &mut Vec<Item>) {
     let cb = bits_for(groups.len() as u32);
     b.push(comment("The result: each field written into the queue's tail as its value is written (res_we), the guard-band"));
     b.push(comment("check and the cull loaded here. The tail becomes an entry at res_v, the next period's clock 0, which"));
-    b.push(comment("writes no field."));
+    b.push(comment("writes no field (cap_ok: gated by the clock, not only by the microprogram, so that the proof's induction,"));
+    b.push(comment("whose microword register is free, sees it too)."));
+    b.push(wire("cap_ok", 1, format!("en && vld[0] && pc != {}'d0", cx.cw)));
     let cap = |v: V| format!("u_cap == {cb}'d{}", groups.iter().position(|&x| x == v).unwrap() + 1);
     // The fields' groups come first in `groups` (then the checks'): res_wr is a range of them.
     let nf = groups.iter().take_while(|v| fields.iter().any(|f| f.v == **v)).count();
@@ -673,11 +675,11 @@ fn results(cx: &Cx, fields: &[Field], groups: &[V], b: &mut Vec<Item>) {
             // A constant rides with the first computed field's write.
             Kind::Const(k) => {
                 parts.push(format!("{}'d{}", f.w, k));
-                we.push(format!("en && vld[0] && {}", cap(first)));
+                we.push(format!("cap_ok && {}", cap(first)));
             }
             _ => {
                 parts.push(if f.w == 1 { "bus[0]".to_string() } else { format!("bus[{}:0]", f.w - 1) });
-                we.push(format!("en && vld[0] && {}", cap(f.v)));
+                we.push(format!("cap_ok && {}", cap(f.v)));
             }
         }
     }
