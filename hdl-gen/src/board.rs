@@ -13,6 +13,7 @@ pub use parts::{DRAW, QUEUE_BITS};
 pub use uart_draw::draw_module as draw_module_uart;
 
 use crate::verilog::{assign, comment, lit, net, reg, set, wire, Item, Module, Param, Port, Stmt};
+use crate::widths::bits_for;
 use crate::Names;
 use golden::frontend::{FixedTriangle, FrontEnd};
 use golden::writer::Writer;
@@ -89,10 +90,6 @@ pub fn rom_image(fe: &FrontEnd, tris: &[FixedTriangle]) -> Result<String, BoardE
         out.push('\n');
     }
     Ok(out)
-}
-
-fn bits_for(n: u64) -> u32 {
-    (64 - n.leading_zeros()).max(1)
 }
 
 /// `board_draw`: on the drawing clock, clears the frame buffer, then streams the ROM's

@@ -29,7 +29,7 @@ pub enum ArgsError {
     TreeUnpipelined,
     #[error("--fe-i0 incremental takes --fe-di triangle: the per-scanline dI needs the reciprocal's I0 at every span's last pixel")]
     IncrementalScanline,
-    #[error("--fe-setup {0} takes --fe-di triangle and --fe-i0 reciprocal: its engine computes the per-triangle set-up only")]
+    #[error("--fe-setup {0} takes --fe-di triangle and --fe-i0 reciprocal (only ice40-hx8k also takes incremental): its engine computes the per-triangle set-up only")]
     EngineForm(&'static str),
     #[error("--width/--height: {0}")]
     Screen(#[from] golden::frontend::FrontEndError),
@@ -141,7 +141,7 @@ pub struct VariantArgs {
     /// eight dividers, the default) or the shared set-up engine on a device's plan, `ecp5-25f`,
     /// `ice40-up5k` or `ice40-hx8k` (golden's `Plan`: a few shared multipliers and dividers
     /// sequenced over several clocks a triangle, behind a set-up result queue; docs/design.md).
-    /// Same spans bit for bit. The engine forms take `--fe-di triangle --fe-i0 reciprocal`.
+    /// Same spans bit for bit. The engine forms take `--fe-di triangle --fe-i0 reciprocal` (`ice40-hx8k` also `--fe-i0 incremental`).
     /// Default: `parallel`, or the target's choice.
     #[arg(long = "fe-setup", value_enum)]
     pub fe_setup: Option<SetupForm>,
@@ -183,7 +183,9 @@ impl VariantArgs {
         if fe_i0 == I0Form::Incremental && self.fe_di == DiMode::Scanline {
             return Err(ArgsError::IncrementalScanline);
         }
-        if fe_setup != SetupForm::Parallel && (fe_i0 != I0Form::Reciprocal || self.fe_di != DiMode::Triangle) {
+        // The HX8K's sequential engine takes the incremental I0 too (its span path has no product).
+        let i0_ok = fe_i0 == I0Form::Reciprocal || fe_setup == SetupForm::Ice40Hx8k;
+        if fe_setup != SetupForm::Parallel && (!i0_ok || self.fe_di != DiMode::Triangle) {
             return Err(ArgsError::EngineForm(fe_setup.name()));
         }
         let opts = Options {
@@ -287,5 +289,18 @@ mod tests {
             );
         }
         assert!(Cli::try_parse_from(["t", "--target", "ecp5-85f"]).is_err());
+    }
+
+    /// The HX8K's sequential engine takes the incremental I0 (its span path without a product);
+    /// the other engines refuse it with one message.
+    #[test]
+    fn only_the_hx8k_engine_takes_the_incremental_i0() {
+        let hx = options(&["--target", "ice40-hx8k", "--fe-i0", "incremental"]);
+        assert_eq!((hx.fe_setup, hx.fe_i0), (SetupForm::Ice40Hx8k, I0Form::Incremental));
+        for plan in ["ecp5-25f", "ice40-up5k"] {
+            let cli = Cli::try_parse_from(["t", "--fe-setup", plan, "--fe-i0", "incremental"]).expect("the flags parse");
+            let err = cli.model.options(None).expect_err("a pipelined engine with the incremental I0");
+            assert!(matches!(err, ArgsError::EngineForm(p) if p == plan), "{plan}: {err}");
+        }
     }
 }

@@ -109,8 +109,8 @@ fn build(hw: &Hw, names: &Names) -> (Module, Vec<golden::pipeline::PipeStage>) {
     let mut body = Vec::new();
     if engine::on(hw) {
         assert!(
-            fe.di == DiMode::Triangle && !incremental::on(hw),
-            "the shared set-up engine takes --fe-di triangle --fe-i0 reciprocal (hdl_gen::cli refuses the others)"
+            fe.di == DiMode::Triangle && (!incremental::on(hw) || hw.sequential().is_some()),
+            "the shared set-up engine takes --fe-di triangle, and --fe-i0 incremental on the sequential engine only (hdl_gen::cli refuses the others)"
         );
         engine::setup(hw, names, &mut body);
         walker::emit(hw, names, &mut body);

@@ -18,6 +18,7 @@ pub mod specular;
 mod target;
 pub mod tools;
 pub mod verilog;
+pub mod widths;
 pub mod writer;
 
 pub use axis::Bus;

@@ -411,7 +411,8 @@ pub(crate) fn engine(screen: golden::setup::Screen, form: golden::frontend::engi
 fn engine_spans_of(opts: hdl_gen::Options, n: usize) {
     let m = verilator_harness::registry::frontend(&opts).unwrap_or_else(|e| panic!("{e}"));
     let seed = verilator_harness::seed("frontend engine");
-    let fe = frontend(m);
+    // Golden's spans are the same in both I0 forms; the incremental form's are its own model's.
+    let fe = frontend(m).with_i0(opts.fe_i0);
     let hw = opts.frontend().unwrap();
     assert_eq!(fe.with_setup(opts.fe_setup), hw.fe, "the model's front-end is the plan's");
     assert_eq!(hw.latency(), m.latency, "the manifest's latency is the engine's");
@@ -521,6 +522,58 @@ fn sequential_engine_spans_equal_golden() {
         };
         assert_faults_caught(&base, "tri_fe_engine.v", "seqfault", [fault], seed, &tris);
     }
+}
+
+/// A fault planted in one line of a front-end's file: in `file`'s first line holding `line`,
+/// `from` made `to`.
+struct LineFault {
+    file: &'static str,
+    line: &'static str,
+    from: &'static str,
+    to: &'static str,
+}
+
+impl LineFault {
+    /// The model of `opts` with this fault (tagged `<base><suffix>0`) is caught on 1,000
+    /// random triangles (the seed named `seed_name`).
+    fn caught(&self, opts: &hdl_gen::Options, seed_name: &str, suffix: &str, what: &'static str) {
+        let base = verilator_harness::ondemand::describe(opts, verilator_harness::models::Kind::Frontend).unwrap_or_else(|e| panic!("{e}"));
+        let seed = verilator_harness::seed(seed_name);
+        let fe = opts.frontend().unwrap().fe;
+        let tris = random_triangles(&mut SeedRng::seed_from_u64(seed), &fe, 1000);
+        let text = &base.sources.iter().find(|(n, _)| n == self.file).unwrap_or_else(|| panic!("no {}", self.file)).1;
+        let line = text.lines().find(|l| l.contains(self.line)).unwrap_or_else(|| panic!("{what}: no line with {}", self.line));
+        let faults = [(line.to_string(), line.replacen(self.from, self.to, 1), what)];
+        assert_faults_caught(&base, self.file, suffix, faults, seed, &tris);
+    }
+}
+
+/// The HX8K's span path without a product (`--target ice40-hx8k --fe-i0 incremental`, issue
+/// 27): the sequential engine's set-up, the incremental I0 with its starts on a shift-add
+/// multiplier (RW clocks a product), at 37x23 and 640x480, levels 0 and 1, 1,000 triangles
+/// each, bit for bit golden's spans; a fault planted in the shift-add (a partial product from
+/// the wrong bit) is caught. Slow tier: `cargo nextest run -p verilator-harness --run-ignored
+/// only -E 'test(/sequential_incremental/)'`.
+#[test]
+#[ignore]
+fn sequential_incremental_i0_spans_equal_golden() {
+    use golden::frontend::engine::SetupForm;
+    use golden::frontend::I0Form;
+    let small = golden::setup::Screen { width: 37, height: 23 };
+    let form = |screen, level| {
+        engine(screen, SetupForm::Ice40Hx8k).map(|o| hdl_gen::Options {
+            fe_i0: I0Form::Incremental,
+            pipeline: golden::pipeline::Pipeline::at(level),
+            ..o
+        })
+    };
+    for (screen, level) in [(small, 0), (golden::setup::Screen::default(), 1), (small, 1)] {
+        let Some(opts) = form(screen, level) else { return };
+        engine_spans_of(opts, 1000);
+    }
+    let Some(opts) = form(small, 0) else { return };
+    let fault = LineFault { file: "tri_frontend.v", line: "ie_p <= ie_p + (ie_sb[0]", from: "ie_sb[0]", to: "ie_sb[1]" };
+    fault.caught(&opts, "frontend sequential incremental fault", "seqincfault", "the shift-add's partial product from the wrong bit");
 }
 
 /// The shared-edge mesh through `tri_fb_p8` with the engine's front-end: every pixel of the

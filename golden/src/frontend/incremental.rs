@@ -18,7 +18,7 @@
 //! Everything the hardware would hold is modelled: normalised remainders (`<< s`, against
 //! `2 An`) and quotients modulo 2^IW.
 
-use super::{mask, FrontEnd, TriSetup};
+use super::{mask, FrontEnd, I0Form, SetupForm, TriSetup};
 use crate::format::Span;
 
 /// One source's step per row: quotient (modulo 2^IW) and normalised remainder of `X / 2A`, or
@@ -54,7 +54,38 @@ pub struct Cost {
     pub most_starts: u32,
 }
 
+/// Products the start engine's program forms before its last step, which writes the source
+/// (the RTL's `tri_frontend`, `--fe-i0 incremental`; docs/design.md): at an edge `Gxn lo`,
+/// `|Nx Qs|`, `S2n Rn`, `q~ 2An`, `Gxn |Qs|`, the step's `X0 Rn`, `q~ 2An`, `X1 Rn`, `q~ 2An`;
+/// column 0 has one step and stops two products earlier.
+pub const EDGE_PRODUCTS: u32 = 9;
+pub const COL0_PRODUCTS: u32 = 7;
+
 impl FrontEnd {
+    /// Clocks each of the start engine's products takes: one on a K x RW multiplier, or RW (one
+    /// bit of the narrower operand a clock) on a shift-add one, which the HX8K's form takes: the
+    /// HX8K has no multiplier, and at its sequential set-up's few hundred clocks a triangle the
+    /// starts' clocks are cheaper than a K x RW product in logic.
+    pub fn start_product_clocks(&self) -> u32 {
+        match self.setup {
+            SetupForm::Ice40Hx8k => self.widths().rw,
+            _ => 1,
+        }
+    }
+
+    /// Clocks a start takes, `(at an edge, at column 0)`, from the clock it begins to the one
+    /// that writes the source; `(0, 0)` in the reciprocal form, which has none. A walker's
+    /// start holds the walker as long; a triangle's first row is started while it is held.
+    pub fn start_clocks(&self) -> (u32, u32) {
+        match self.i0 {
+            I0Form::Reciprocal => (0, 0),
+            I0Form::Incremental => {
+                let m = self.start_product_clocks();
+                (EDGE_PRODUCTS * m + 1, COL0_PRODUCTS * m + 1)
+            }
+        }
+    }
+
     /// Set-up's steps for a walked triangle: `divmod(X, 2A)` of each source's constant.
     pub fn i0_steps(&self, st: &TriSetup) -> Steps {
         let p = &st.plane;

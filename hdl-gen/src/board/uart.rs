@@ -10,6 +10,7 @@
 //! is found at whatever byte it starts.
 
 use crate::verilog::{lit, reg, set, wire, Item, Module, Port, Stmt};
+use crate::widths::bits_for;
 use golden::frontend::FixedTriangle;
 
 pub const LEN: usize = 32;
@@ -239,10 +240,6 @@ pub fn check_equations() -> (Vec<u128>, Vec<u128>, u16) {
 /// The byte receiver's and the status sender's module names.
 pub const RX: &str = "board_uart_rx";
 pub const TX: &str = "board_uart_tx";
-
-fn bits_for(n: u64) -> u32 {
-    (64 - n.leading_zeros()).max(1)
-}
 
 /// `board_uart_rx`: 8N1 bytes at `div` clocks a bit, sampled at each bit's middle. A stop bit
 /// found low is a framing error (`ferr`), after which the line must be seen high before the next

@@ -109,6 +109,9 @@ pub(super) fn state_outputs(hw: &Hw) -> Vec<(&'static str, u32, bool, String, &'
     }
     let e = EdgeWidths::new(hw);
     let flip = |q: &str| offset_to_signed(q, e.bound_w);
+    // Behind an engine the held set-up result is the queue head, the edge's inputs.
+    let engine = hw.engine_form();
+    let held = |parallel: String, input: &str| if engine { input.to_string() } else { parallel };
     vec![
         ("x_in", 1, false, "in_rows".into(), "in"),
         ("x_right", 1, false, "w_right".into(), "w_right"),
@@ -117,13 +120,26 @@ pub(super) fn state_outputs(hw: &Hw) -> Vec<(&'static str, u32, bool, String, &'
         ("x_rs", e.row_w, false, "w_rs".into(), "w_rs"),
         ("x_qs", e.bound_w, true, "w_qs".into(), "w_qs"),
         ("x_cy", 1, false, "cy".into(), "cy"),
-        ("x_sact", 1, false, "s_act".into(), "s_act"),
-        ("x_sright", 1, false, "s_right".into(), "s_right"),
-        ("x_srs", e.row_w, false, "s_rs".into(), "s_rs"),
-        ("x_sre", e.row_w, false, "s_re".into(), "s_re"),
-        ("x_rg", e.bound_w, true, flip("ei_q"), "r_g"),
-        ("x_rqs", e.bound_w, true, flip("es_q"), "r_qs"),
+        ("x_sact", 1, false, held("s_act".into(), "act"), "s_act"),
+        ("x_sright", 1, false, held("s_right".into(), "right"), "s_right"),
+        ("x_srs", e.row_w, false, held("s_rs".into(), "rs"), "s_rs"),
+        ("x_sre", e.row_w, false, held("s_re".into(), "re"), "s_re"),
+        ("x_rg", e.bound_w, true, held(flip("ei_q"), "g"), "r_g"),
+        ("x_rqs", e.bound_w, true, held(flip("es_q"), "qs"), "r_qs"),
     ]
+}
+
+/// The ports of [`state_outputs`].
+fn state_ports(hw: &Hw) -> Vec<Port> {
+    let out = |(port, w, signed, _, name): (&str, u32, bool, String, &str)| {
+        let p = Port::output(port, w, if signed { "signed integer" } else { "" }, &format!("for the incremental I0: the edge's {name}"));
+        if signed {
+            p.signed()
+        } else {
+            p
+        }
+    };
+    state_outputs(hw).into_iter().map(out).collect()
 }
 
 /// The `generate` loop of the three edges in `tri_frontend`: each lane of the input buses into
@@ -193,10 +209,7 @@ pub(super) fn module(hw: &Hw, names: &Names) -> Module {
         Port::input("re", row_w, "unsigned integer", "last row"),
     ];
     ports.extend(walker_ports(&e));
-    for (port, w, signed, _, name) in state_outputs(hw) {
-        let p = Port::output(port, w, if signed { "signed integer" } else { "" }, &format!("for the incremental I0: the edge's {name}"));
-        ports.push(if signed { p.signed() } else { p });
-    }
+    ports.extend(state_ports(hw));
     let mut body = vec![comment("Set-up: the edge's rows, side and divisor, held until the walker takes them.")];
     body.extend([reg("s_act", 1), reg("s_right", 1), reg("s_rs", row_w), reg("s_re", row_w), reg("s_d", ediv_w)]);
     body.push(Item::Always(vec![Stmt::If(
@@ -228,9 +241,7 @@ pub(super) fn module(hw: &Hw, names: &Names) -> Module {
         set("w_rs256", rs256),
     ];
     body.push(walk(&e, load, ("s_rs", "s_re")));
-    for (port, _, _, signal, _) in state_outputs(hw) {
-        body.push(Item::Assign(port.into(), signal));
-    }
+    body.extend(state_outputs(hw).into_iter().map(|(port, _, _, signal, _)| Item::Assign(port.into(), signal)));
     Module { name: names.fe_edge.clone(), header, params: vec![], ports, body }
 }
 
@@ -320,10 +331,12 @@ fn module_engine(hw: &Hw, names: &Names) -> Module {
         ports.push(if port == "g" || port == "qs" { p.signed() } else { p });
     }
     ports.extend(walker_ports(&e));
+    ports.extend(state_ports(hw));
     let mut body = dda(&e);
     let mut load = ["act", "right", "rs", "re", "g", "rem", "qs", "rs256"].map(|p| set(format!("w_{p}"), p)).to_vec();
     load.extend([set("w_thr", "d - rs256"), set("w_qs1", format!("qs + {}", zext("1'b1", 1, bound_w)))]);
     body.push(walk(&e, load, ("rs", "re")));
+    body.extend(state_outputs(hw).into_iter().map(|(port, _, _, signal, _)| Item::Assign(port.into(), signal)));
     Module { name: names.fe_edge.clone(), header, params: vec![], ports, body }
 }
 

@@ -2,12 +2,8 @@
 //! rate, pipeline level) and its ports: the types every part of the generator shares.
 
 use crate::verilog::Port;
-use golden::frontend::{DiMode, FrontEnd, I0Form, Widths};
+use golden::frontend::{DiMode, FrontEnd, Widths};
 
-/// The incremental I0's start engine (`super::incremental`): clocks a start takes, and a start at
-/// column 0, which has one step.
-pub const START_CLOCKS: u32 = 10;
-pub const COL0_CLOCKS: u32 = 8;
 /// Quotient bits the set-up's dividers take per clock (`--fe-div-bits`): area against rate.
 pub const DIV_BITS: [u32; 3] = [1, 2, 4];
 pub const DEFAULT_DIV_BITS: u32 = 4;
@@ -108,7 +104,7 @@ impl Hw {
     /// figure is the worst case of the slot's wait.
     pub fn latency(&self) -> u32 {
         if let Some((ii, latency, _)) = self.engine_timing() {
-            return ii + latency + 3 + self.i0_stages();
+            return ii + latency + 3 + self.i0_stages() + self.start_clocks();
         }
         self.calc_clocks() + self.div_clocks() + 2 + self.i0_stages() + self.span_div_clocks() + self.start_clocks()
     }
@@ -119,10 +115,21 @@ impl Hw {
     /// these clocks more; a later start (an edge taking over the left end) holds the walker
     /// as long.
     pub fn start_clocks(&self) -> u32 {
-        match self.fe.i0 {
-            I0Form::Reciprocal => 0,
-            I0Form::Incremental => START_CLOCKS,
-        }
+        self.fe.start_clocks().0
+    }
+
+    /// The incremental I0's shift-add start (`FrontEnd::start_product_clocks` above 1): the
+    /// width of its clock count within a product, `ie_k` (0 .. clocks - 1).
+    pub fn start_count_bits(&self) -> u32 {
+        (32 - (self.fe.start_product_clocks() - 1).leading_zeros()).max(1)
+    }
+
+    /// The exact plane's widths, CALC's oriented `Nx` and `Ny` (signed), as the incremental I0's
+    /// range checks read them.
+    pub fn plane_widths(&self) -> (u32, u32) {
+        let Widths { cx, cy, .. } = self.fe.widths();
+        let iw = self.fe.cfg.iw();
+        (iw + cy + 3, iw + cx + 3)
     }
 
     /// Clocks from a triangle's transfer to the first segment out of `tri_shader_p<P>` when idle:

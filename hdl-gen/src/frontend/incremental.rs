@@ -4,7 +4,7 @@
 //! row (`golden::frontend::incremental`, the model this is bit for bit).
 //!
 //! A source is *started* at the first row where it gives the left end of a span with pixels:
-//! there one shared engine (one multiplier, [`START_CLOCKS`] clocks) evaluates today's
+//! there one shared engine (one multiplier, `FrontEnd::start_clocks` clocks) evaluates today's
 //! reciprocal formula at that pixel, which is covered, so in range and exact, and divides the
 //! source's row steps by `2A` with the same reciprocal (only when their quotient is within
 //! `[-2^IW, 2^IW)`: a step it cannot take leaves the source unstarted, to start again at its
@@ -16,12 +16,14 @@ use super::stager::Stager;
 use crate::verilog::{assign, comment, lit, reg, set, sext, sreg, swire, wire, zext, Item, Stmt};
 use golden::frontend::{I0Form, Widths};
 
-/// Clocks of a start at an edge, from the clock it begins (t0) to the one that writes the
-/// source (t9), one product a clock: to the pixel, the exact step product, the modular one, and
-/// three reciprocal evaluations (the start, the step without and with the DDA's carry) of two
-/// products each, chained where their operands allow. Column 0 has one step and takes
-/// [`COL0_CLOCKS`]. A walker's start holds the walker these clocks.
-pub use super::hw::{COL0_CLOCKS, START_CLOCKS};
+// A start at an edge runs from the clock it begins (t0) to the one that writes the source
+// (t9), one product a step (golden's `incremental::EDGE_PRODUCTS`): to the pixel, the exact
+// step product, the modular one, and three reciprocal evaluations (the start, the step without
+// and with the DDA's carry) of two products each, chained where their operands allow. Column 0
+// has one step (`COL0_PRODUCTS`). A product takes one clock on the K x RW multiplier, RW on the
+// HX8K's shift-add one (`FrontEnd::start_product_clocks`); a walker's start holds the walker
+// for `FrontEnd::start_clocks`.
+use golden::frontend::incremental::{COL0_PRODUCTS, EDGE_PRODUCTS};
 
 pub(super) fn on(hw: &Hw) -> bool {
     hw.fe.i0 == I0Form::Incremental
@@ -29,9 +31,7 @@ pub(super) fn on(hw: &Hw) -> bool {
 
 /// Exact plane widths: CALC's oriented `Nx` and `Ny` (signed).
 fn plane_widths(hw: &Hw) -> (u32, u32) {
-    let Widths { cx, cy, .. } = hw.fe.widths();
-    let iw = hw.fe.cfg.iw();
-    (iw + cy + 3, iw + cx + 3)
+    hw.plane_widths()
 }
 
 /// The set-up result's extra registers: the exact plane, for the steps' range checks.
@@ -44,6 +44,15 @@ pub(super) fn setup_regs(hw: &Hw, body: &mut Vec<Item>) {
 /// CALC's last clock loads them with the rest of the set-up result.
 pub(super) fn setup_load(st: &Stager) -> Vec<Stmt> {
     vec![set("s_nx", st.at("onx")), set("s_ny", st.at("ony")), set("s_a", st.at("aabs"))]
+}
+
+/// A set-up result is held for the walker: the parallel set-up's `HOLD`, an engine's queue head.
+fn held(hw: &Hw) -> &'static str {
+    if hw.engine_form() {
+        "q_ne"
+    } else {
+        "st == HOLD"
+    }
 }
 
 /// The smallest of three signed signals, compared side by side (the walker's form).
@@ -92,7 +101,7 @@ pub(super) fn select(hw: &Hw, body: &mut Vec<Item>) {
     body.push(wire("ie_wait", 1, "px && !(ie_sc0 || ie_sc1 || ie_sc2 || ie_sc3)"));
     body.push(wire("ie_i0", iw, "ie_sel == 2'd0 ? ie_q0 : ie_sel == 2'd1 ? ie_q1 : ie_sel == 2'd2 ? ie_q2 : ie_q3"));
     body.push(comment("The next triangle is taken once its first row's start is made (ie_pv)."));
-    body.push(assign("take", "st == HOLD && ie_pv && adv && !ie_wait && (!w_valid || w_end)"));
+    body.push(assign("take", format!("{} && ie_pv && adv && !ie_wait && (!w_valid || w_end)", held(hw))));
 }
 
 /// The widths the start engine works in.
@@ -138,14 +147,23 @@ impl Ew {
 pub(super) fn engine(hw: &Hw, body: &mut Vec<Item>) {
     let ew = Ew::new(hw);
     let Ew { aw, bound_w, sum_w, xw, iw, nx_w, a_w, b_w, p_w, e_w, c_w, .. } = ew;
+    let (start, col0) = hw.fe.start_clocks();
+    let m = hw.fe.start_product_clocks();
     assert!(
         xw <= b_w && bound_w <= b_w && iw < b_w && nx_w <= a_w && c_w <= a_w && e_w - 1 <= p_w,
         "the engine's operands fit its multiplier"
     );
     body.push(Item::Blank);
-    body.push(comment(format!(
-        "Incremental I0: the start engine, one {a_w} x {b_w} multiplier, {START_CLOCKS} clocks a start ({COL0_CLOCKS} at column 0):"
-    )));
+    if m == 1 {
+        body.push(comment(format!(
+            "Incremental I0: the start engine, one {a_w} x {b_w} multiplier, {start} clocks a start ({col0} at column 0):"
+        )));
+    } else {
+        body.push(comment(format!(
+            "Incremental I0: the start engine, one shift-add multiplier ({a_w} x {b_w}, {m} clocks a product), {start} clocks a start ({col0} at column 0):"
+        )));
+        body.push(comment("each step below is its product's first clock (ie_k == 0), the product is ready at the next step's."));
+    }
     body.push(comment("t0 Gxn lo; t1 S2n, |Nx Qs|; t2 S2n Rn; t3 q~ 2An; t4 I0 and its remainder, Gxn |Qs|; t5 the"));
     body.push(comment("step's numerator X0 = ((512 (Ny - Nx Qs)) << s) + (2An << IW), its range, X0 Rn; t6 q~ 2An; t7 the"));
     body.push(comment("step, X1 = X0 - 2 Gxn, X1 Rn; t8 q~ 2An; t9 X1's step (edges only). It serves the walker's start"));
@@ -167,26 +185,53 @@ pub(super) fn engine(hw: &Hw, body: &mut Vec<Item>) {
         reg("ie_ok0", 1),
         reg("ie_ok1", 1),
     ]);
-    first_row(&ew, body);
+    if m > 1 {
+        body.push(comment("The shift-add multiplier: the multiplicand shifted up and the multiplier down a bit a clock."));
+        body.extend([reg("ie_k", hw.start_count_bits()), reg("ie_sa", p_w), reg("ie_sb", b_w)]);
+    }
+    first_row(hw, &ew, body);
     body.push(comment("The walker's start goes first: it takes the engine from a first-row start, which starts again."));
     body.push(wire("ie_go", 1, "ie_wait ? (!ie_busy || ie_pre) : (!ie_busy && ie_pneed)"));
     body.push(wire("ie_tt", 4, format!("ie_go ? {} : ie_t", lit(4, 0))));
-    operands(&ew, body);
+    operands(hw, &ew, body);
     let prog = program(&ew);
     let walk = source_steps(&ew, body);
     let load = first_row_load();
-    let go = vec![
-        set("ie_busy", "1'b1"),
-        set("ie_pre", "!ie_wait"),
-        set("ie_t", lit(4, 1)),
-        set("ie_src", "ie_wait ? ie_sel : ie_psel"),
-        set("ie_p", format!("{} * {}", zext("ie_ma", a_w, p_w), zext("ie_mb", b_w, p_w))),
-    ];
-    let mut busy = vec![set("ie_p", format!("{} * {}", zext("ie_ma", a_w, p_w), zext("ie_mb", b_w, p_w)))];
+    // A product's first clock: the whole product, or the shift-add's first partial product.
+    let issue = if m == 1 {
+        vec![set("ie_p", format!("{} * {}", zext("ie_ma", a_w, p_w), zext("ie_mb", b_w, p_w)))]
+    } else {
+        vec![
+            set("ie_p", format!("ie_mb[0] ? {} : {}", zext("ie_ma", a_w, p_w), lit(p_w, 0))),
+            set("ie_sa", format!("{} << 1", zext("ie_ma", a_w, p_w))),
+            set("ie_sb", "ie_mb >> 1"),
+            set("ie_k", lit(hw.start_count_bits(), 1)),
+        ]
+    };
+    let mut go =
+        vec![set("ie_busy", "1'b1"), set("ie_pre", "!ie_wait"), set("ie_t", lit(4, 1)), set("ie_src", "ie_wait ? ie_sel : ie_psel")];
+    go.extend(issue.clone());
+    let mut busy = issue;
     busy.extend(prog);
+    if m > 1 {
+        let kw = hw.start_count_bits();
+        // The last step issues no product: the engine idles with its clock count at 0.
+        busy.push(Stmt::If("ie_last".into(), vec![set("ie_k", lit(kw, 0))], vec![]));
+        let add = vec![
+            set("ie_p", format!("ie_p + (ie_sb[0] ? ie_sa : {})", lit(p_w, 0))),
+            set("ie_sa", "ie_sa << 1"),
+            set("ie_sb", "ie_sb >> 1"),
+            set("ie_k", format!("ie_k == {} ? {} : ie_k + {}", lit(kw, (m - 1) as u64), lit(kw, 0), lit(kw, 1))),
+        ];
+        busy = vec![Stmt::If(format!("ie_k != {}", lit(kw, 0)), add, busy)];
+    }
+    let mut reset = vec![set("ie_busy", "1'b0"), set("ie_t", lit(4, 0)), set("ie_pv", "1'b0")];
+    if m > 1 {
+        reset.push(set("ie_k", lit(hw.start_count_bits(), 0)));
+    }
     body.push(Item::Always(vec![Stmt::If(
         "rst".into(),
-        vec![set("ie_busy", "1'b0"), set("ie_t", lit(4, 0)), set("ie_pv", "1'b0")],
+        reset,
         vec![
             Stmt::If("ie_go".into(), go, vec![Stmt::If("ie_busy".into(), busy, vec![])]),
             Stmt::If("take".into(), load, vec![Stmt::If("adv && w_valid && !ie_wait".into(), walk, vec![])]),
@@ -196,7 +241,7 @@ pub(super) fn engine(hw: &Hw, body: &mut Vec<Item>) {
 }
 
 /// The held triangle's first row: its left end and the source giving it.
-fn first_row(ew: &Ew, body: &mut Vec<Item>) {
+fn first_row(hw: &Hw, ew: &Ew, body: &mut Vec<Item>) {
     let Ew { bound_w, end_w, .. } = *ew;
     body.push(comment("The held triangle's first row: its left end and the source giving it (none started yet)."));
     for k in 0..3 {
@@ -214,11 +259,11 @@ fn first_row(ew: &Ew, body: &mut Vec<Item>) {
         body.push(wire(&format!("ie_pc{}", k + 1), 1, format!("pin{k} && !s_right{k} && pgg{k} == pmg")));
     }
     body.push(wire("ie_psel", 2, "ie_pc0 ? 2'd0 : ie_pc1 ? 2'd1 : ie_pc2 ? 2'd2 : 2'd3"));
-    body.push(wire("ie_pneed", 1, "st == HOLD && !ie_pv"));
+    body.push(wire("ie_pneed", 1, format!("{} && !ie_pv", held(hw))));
 }
 
 /// The engine's operands and its arithmetic around the one product.
-fn operands(ew: &Ew, body: &mut Vec<Item>) {
+fn operands(hw: &Hw, ew: &Ew, body: &mut Vec<Item>) {
     let Ew { aw, bound_w, sum_w, recip_w, xw, iw, frac, nx_w, ny_w, a_w, b_w, e_w, y_w, cmp_w, c_w, .. } = *ew;
     body.push(comment("Operands: the set-up's result for a first-row start, the walker's otherwise."));
     body.push(wire("ie_su", 1, "ie_go ? !ie_wait : ie_pre"));
@@ -236,7 +281,7 @@ fn operands(ew: &Ew, body: &mut Vec<Item>) {
         x("x_tn", sum_w, "s_tn", "w_tn", false),
         x("x_dyn", sum_w, "s_dyn", "w_dyn", false),
         x("x_an", aw, "s_an", "w_an", false),
-        x("x_rn", recip_w, "drn_q", "w_rn", false),
+        x("x_rn", recip_w, if hw.engine_form() { "r_rn" } else { "drn_q" }, "w_rn", false),
         x("x_nx", nx_w, "s_nx", "w_nx", true),
         x("x_ny", ny_w, "s_ny", "w_ny", true),
         x("x_a", aw, "s_a", "w_a", false),
@@ -301,7 +346,7 @@ fn operands(ew: &Ew, body: &mut Vec<Item>) {
     body.push(wire(
         "ie_last",
         1,
-        format!("ie_t == {} || (ie_src == 2'd0 && ie_t == {})", lit(4, START_CLOCKS as u64 - 1), lit(4, COL0_CLOCKS as u64 - 1)),
+        format!("ie_t == {} || (ie_src == 2'd0 && ie_t == {})", lit(4, EDGE_PRODUCTS as u64), lit(4, COL0_PRODUCTS as u64)),
     ));
     let cq = format!("ie_cq[{}:0]", iw - 1);
     let cr = format!("ie_cr[{}:0]", aw);

@@ -44,7 +44,7 @@ pub(super) fn emit(hw: &Hw, set_up: Setup, sp: &Stager) -> Item {
             cull,
         }),
     );
-    shape.starts = super::incremental::on(hw).then_some(super::incremental::START_CLOCKS);
+    shape.starts = super::incremental::on(hw).then_some(hw.fe.start_product_clocks());
     frontend_properties(&shape)
 }
 
@@ -65,7 +65,9 @@ pub(super) fn emit_engine(hw: &Hw, sp: &Stager) -> Item {
         binary_phase: hw.sequential().is_some(),
         capture: hw.sequential().is_some(),
     };
-    frontend_properties(&shape(hw, sp, SetupShape::Engine(engine)))
+    let mut shape = shape(hw, sp, SetupShape::Engine(engine));
+    shape.starts = super::incremental::on(hw).then_some(hw.fe.start_product_clocks());
+    frontend_properties(&shape)
 }
 
 /// Row stage `j` (1, 2): where it holds the row, and what holds of its registers as the
@@ -262,7 +264,8 @@ impl Reference<'_> {
         b.push(wire("f_adv", 1, "!out_valid || out_ready"));
         b.push(wire("f_wend", 1, "f_wrow == f_wlast"));
         let take = match (&self.s.setup, self.s.starts) {
-            (SetupShape::Engine(e), _) => format!("f_qn != {} && f_adv && (!f_wv || f_wend)", lit(e.qw(), 0)),
+            (SetupShape::Engine(e), None) => format!("f_qn != {} && f_adv && (!f_wv || f_wend)", lit(e.qw(), 0)),
+            (SetupShape::Engine(e), Some(_)) => format!("f_qn != {} && ie_pv && f_adv && !ie_wait && (!f_wv || f_wend)", lit(e.qw(), 0)),
             (_, Some(_)) => "f_sb && f_sh && ie_pv && f_adv && !ie_wait && (!f_wv || f_wend)".into(),
             (_, None) => "f_sb && f_sh && f_adv && (!f_wv || f_wend)".into(),
         };
@@ -466,8 +469,8 @@ impl Reference<'_> {
             ));
         }
         b.push(Item::Always(vec![when("f_past && !$past(rst)", rate)]));
-        if let Some(clocks) = self.s.starts {
-            b.extend(starts(clocks));
+        if let Some(m) = self.s.starts {
+            b.extend(starts(m, waiting));
         }
         let in_flight = match &self.s.setup {
             SetupShape::Parallel(p) => {
@@ -563,28 +566,36 @@ impl Reference<'_> {
 
 /// The incremental I0's start engine (`--fe-i0 incremental`): what bounds the walker's waits
 /// and the held triangle's. A walker's start runs at once, taking the engine from a held
-/// triangle's start; the engine's job counts its clocks and ends within `clocks`, and then the
-/// source is started (the walker goes on); a held triangle's start runs whenever the walker
-/// needs no start, and a held start belongs to the held triangle.
-fn starts(clocks: u32) -> Vec<Item> {
+/// triangle's start; the engine's job counts its steps (and, `m` clocks a product, each step's
+/// clocks) and ends within its program, and then the source is started (the walker goes on); a
+/// held triangle's start runs whenever the walker needs none, and a held start belongs to the
+/// held triangle (`held`: the set-up result is held for the walker).
+fn starts(m: u32, held: &str) -> Vec<Item> {
     let t = |v: u32| lit(4, v as u64);
+    let mut engine = vec![assert(format!(
+        "ie_busy ? (ie_t >= {} && ie_t <= {}) : ie_t == {}",
+        t(1),
+        t(golden::frontend::incremental::EDGE_PRODUCTS),
+        t(0)
+    ))];
+    if m > 1 {
+        let kw = bits_for(m - 1);
+        engine.push(assert(format!("ie_busy ? ie_k <= {} : ie_k == {}", lit(kw, (m - 1) as u64), lit(kw, 0))));
+    }
+    engine.extend([
+        when("ie_busy && !ie_pre", vec![assert("ie_wait"), assert("ie_src == ie_sel")]),
+        when("ie_busy && ie_pre", vec![assert(held), assert("!ie_pv")]),
+        when("ie_pv", vec![assert(held)]),
+    ]);
     vec![
         comment("Starts (incremental I0): the walker's start runs at once and ends within the engine's clocks,"),
         comment("then the walker goes on; the held triangle's start runs when the walker needs none."),
-        Item::Comb(vec![when(
-            "f_past",
-            vec![
-                assert(format!("ie_busy ? (ie_t >= {} && ie_t <= {}) : ie_t == {}", t(1), t(clocks - 1), t(0))),
-                when("ie_busy && !ie_pre", vec![assert("ie_wait"), assert("ie_src == ie_sel")]),
-                when("ie_busy && ie_pre", vec![assert("st == HOLD"), assert("!ie_pv")]),
-                when("ie_pv", vec![assert("st == HOLD")]),
-            ],
-        )]),
+        Item::Comb(vec![when("f_past", engine)]),
         Item::Always(vec![when(
             "f_past && !$past(rst)",
             vec![
                 when("$past(ie_wait) && ie_wait", vec![assert("ie_busy && !ie_pre")]),
-                when("$past(st == HOLD && !ie_pv && !ie_wait && !ie_busy)", vec![assert("ie_busy && ie_pre")]),
+                when(format!("$past({held} && !ie_pv && !ie_wait && !ie_busy)"), vec![assert("ie_busy && ie_pre")]),
             ],
         )]),
     ]

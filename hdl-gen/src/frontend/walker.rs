@@ -138,7 +138,7 @@ pub(super) fn emit(hw: &Hw, names: &Names, body: &mut Vec<Item>) {
     body.push(wire("w_end", 1, "w_row == w_last"));
     let inc = super::incremental::on(hw);
     let engine = hw.engine_form();
-    if engine {
+    if engine && !inc {
         body.push(assign("take", "q_ne && adv && (!w_valid || w_end)"));
     } else if !inc {
         body.push(assign("take", "st == HOLD && adv && (!w_valid || w_end)"));

@@ -30,6 +30,11 @@ pub(crate) fn fields(hw: &Hw, s: &Schedule) -> Vec<Field> {
         f("dyn", o.dyn_, k),
         f("gxn", o.gxn, k),
     ];
+    if hw.fe.i0 == golden::frontend::I0Form::Incremental {
+        // The incremental I0's starts check their steps' range on the exact plane.
+        let (nx_w, ny_w) = hw.plane_widths();
+        v.extend([f("nx", o.nx, nx_w), f("ny", o.ny, ny_w), f("a", o.a, aw)]);
+    }
     for (j, e) in o.edges.iter().enumerate() {
         for (n, x, w) in [
             ("act", e.active, 1),

@@ -19,6 +19,7 @@
 use super::sequencer::Seq;
 use super::values::{Src, Values};
 use crate::verilog::{comment, reg, set, sreg, wire, Item, Stmt};
+pub(super) use crate::widths::bits_for;
 use golden::frontend::engine::schedule::Class;
 use golden::frontend::engine::{Kind, MulUnit};
 
@@ -42,11 +43,6 @@ fn or(conds: &[String]) -> String {
     } else {
         conds.join(" || ")
     }
-}
-
-/// Bits to hold `max` (at least 1): a shift amount's, an address's or a counter's width.
-pub(super) fn bits_for(max: u32) -> u32 {
-    (32 - max.leading_zeros()).max(1)
 }
 
 /// A unit output a value register captures: (register load clock, epoch) -> Verilog.

@@ -5,6 +5,7 @@
 
 use crate::formal::{assert, when};
 use crate::verilog::{lit, zext, Stmt};
+pub(super) use crate::widths::bits_for;
 
 /// What the front-end's proof needs from its generator: widths, screen, its set-up's shape.
 pub struct FrontendShape {
@@ -27,7 +28,8 @@ pub struct FrontendShape {
     pub row_stages: Vec<RowStage>,
     /// The span path's register stages between the walker (or the row stage) and the output, in order.
     pub span_stages: Vec<SpanStage>,
-    /// The incremental I0 (`--fe-i0 incremental`): its start engine's clocks. The walker then
+    /// The incremental I0 (`--fe-i0 incremental`): its start engine's clocks a product (1, or
+    /// the HX8K's shift-add's RW, counted by `ie_k`). The walker then
     /// waits while a source starts (`ie_wait`, a data decision taken as given, like a row's
     /// coverage) and the held triangle is taken once its first row is started (`ie_pv`); the
     /// engine's own properties bound both waits.
@@ -166,10 +168,6 @@ pub(super) fn f_mv(j: usize, last: usize) -> String {
 }
 pub(super) fn one(w: u32) -> String {
     lit(w, 1)
-}
-/// Bits to hold `n` (at least 1).
-pub(super) fn bits_for(n: u32) -> u32 {
-    (32 - n.leading_zeros()).max(1)
 }
 /// A valid span (`v`) is on the screen with at least one pixel.
 pub(super) fn on_screen(v: &str, x: &str, len: &str, xw: u32, width: u64) -> Stmt {
