@@ -43,8 +43,8 @@ impl Target {
     /// parallel set-up on every device measured (ECP5, `--pipeline 1`: 5,015 LUT4 and 15
     /// MULT18X18D since stop 30, placed on the 25F at 82.0 MHz, against 9,134 LUT4 and 83
     /// MULT18X18D at 47.5 MHz on the 85F for the parallel form's best, which no 25F holds; iCE40:
-    /// 11,120 SB_LUT4 on the HX8K's sequential engine against 38,337 without DSPs, 14 SB_MAC16
-    /// against 81 with them) and
+    /// 11,120 SB_LUT4 on the HX8K's sequential engine against 38,337 without DSPs; 6,609 SB_LUT4
+    /// and 12 SB_MAC16 on the UP5K's sequential engine against 8,719 and 81 with them) and
     /// sets a triangle up in fewer clocks than the parallel form at the same clock (12 against
     /// 13); `--pipeline 1` (the span path in stages: the parallel form's 18.2 MHz at level 0
     /// became 47-48 MHz); the reciprocal `I0`, which the engine forms take.

@@ -121,6 +121,7 @@ fn synth_and_check_rtl_dir_show_the_generators_message() {
         (&["--chain", "16", "--chain-specular", "7", "--out", o], &["--chain-specular 7", "'7'"]),
         (&["--chain"], &["--chain needs a value"]),
         (&["--family", "vhdl"], &["unknown family 'vhdl'"]),
+        (&["--device", "25k", "--out", o], &["--device takes hx8k or up5k with --family ice40", "'25k'"]),
         (&["--seeds"], &["--seeds needs a value"]),
     ];
     for (args, needles) in cases {

@@ -470,8 +470,8 @@ fn engine_spans_equal_golden_at_the_targets_pipeline_level() {
     engine_spans_of(hdl_gen::Options { pipeline: golden::pipeline::Pipeline::at(1), ..opts }, 3000);
 }
 
-/// The slow tier (`--ignored`): the ECP5 plan at 640x480, the iCE40 plans at 37x23 (II = 120 and
-/// 270 clocks a triangle: 3,000 triangles are about a million clocks each); each builds a model
+/// The slow tier (`--ignored`): the ECP5 plan at 640x480, the iCE40 plans at 37x23 (their
+/// sequential engines, about 340 clocks a triangle: 3,000 triangles are about a million clocks each); each builds a model
 /// on first use. `cargo nextest run -p verilator-harness --run-ignored only -E 'test(/engine_/)'`.
 #[test]
 #[ignore]
@@ -486,29 +486,42 @@ fn engine_spans_equal_golden_at_640x480_and_on_the_ice40_plans() {
     }
 }
 
-/// The sequential engine (`--fe-setup ice40-hx8k`, issue 27: golden's microprogram on one ALU,
-/// the values in a block-RAM register file) at 37x23 and 640x480, levels 0 and 1 (the target's),
-/// 1,000 triangles each (about 330 clocks a triangle); a fault planted in its ALU (the subtract
-/// made an add) is caught. Slow tier: `cargo nextest run -p verilator-harness --run-ignored only
-/// -E 'test(/sequential_engine/)'`.
+/// The sequential engines (issue 27: golden's microprogram on one ALU, the values in a
+/// block-RAM register file): the HX8K's (`--fe-setup ice40-hx8k`, a shift-add multiplier) at
+/// 37x23 and 640x480, levels 0 and 1 (the target's), the UP5K's (`ice40-up5k`, its products as
+/// SB_MAC16 tile passes) at 37x23 level 0 and 640x480 level 1 (its target's); 1,000 triangles
+/// each (about 340 clocks a triangle); a fault planted in the HX8K's ALU (the subtract made an
+/// add) and one in the UP5K's tiles (the sum not shifted a chunk up where the pass's weight
+/// drops) are caught. Slow tier: `cargo nextest run -p verilator-harness --run-ignored only -E
+/// 'test(/sequential_engine/)'`.
 #[test]
 #[ignore]
 fn sequential_engine_spans_equal_golden() {
     use golden::frontend::engine::SetupForm;
     let small = golden::setup::Screen { width: 37, height: 23 };
-    for (screen, level) in [(small, 0), (golden::setup::Screen::default(), 0), (small, 1)] {
-        let Some(opts) = engine(screen, SetupForm::Ice40Hx8k) else { return };
+    let big = golden::setup::Screen::default();
+    let runs = [(SetupForm::Ice40Hx8k, small, 0), (SetupForm::Ice40Hx8k, big, 0), (SetupForm::Ice40Hx8k, small, 1)];
+    for (form, screen, level) in runs.into_iter().chain([(SetupForm::Ice40Up5k, small, 0), (SetupForm::Ice40Up5k, big, 1)]) {
+        let Some(opts) = engine(screen, form) else { return };
         engine_spans_of(hdl_gen::Options { pipeline: golden::pipeline::Pipeline::at(level), ..opts }, 1000);
     }
-    let Some(opts) = engine(small, SetupForm::Ice40Hx8k) else { return };
-    let base = verilator_harness::ondemand::describe(&opts, verilator_harness::models::Kind::Frontend).unwrap_or_else(|e| panic!("{e}"));
-    let seed = verilator_harness::seed("frontend sequential engine fault");
-    let fe = opts.frontend().unwrap().fe;
-    let tris = random_triangles(&mut SeedRng::seed_from_u64(seed), &fe, 1000);
-    let engine = &base.sources.iter().find(|(n, _)| n == "tri_fe_engine.v").expect("the engine's file").1;
-    let sub = engine.lines().find(|l| l.contains(" sub = ")).expect("the ALU's subtract select");
-    let faults = [(sub.to_string(), sub.replacen(" sub = u_fn == 4'd2 || ", " sub = ", 1), "the ALU's subtract made an add")];
-    assert_faults_caught(&base, "tri_fe_engine.v", "seqfault", faults, seed, &tris);
+    for form in [SetupForm::Ice40Hx8k, SetupForm::Ice40Up5k] {
+        let Some(opts) = engine(small, form) else { return };
+        let base =
+            verilator_harness::ondemand::describe(&opts, verilator_harness::models::Kind::Frontend).unwrap_or_else(|e| panic!("{e}"));
+        let seed = verilator_harness::seed("frontend sequential engine fault");
+        let fe = opts.frontend().unwrap().fe;
+        let tris = random_triangles(&mut SeedRng::seed_from_u64(seed), &fe, 1000);
+        let engine = &base.sources.iter().find(|(n, _)| n == "tri_fe_engine.v").expect("the engine's file").1;
+        let fault = if form == SetupForm::Ice40Up5k {
+            let held = engine.lines().find(|l| l.contains(" m0held = ")).expect("the first tile's sum");
+            (held.to_string(), held.replacen(" m0s1 ? ", " 1'b0 ? ", 1), "the tile's sum not shifted where the weight drops")
+        } else {
+            let sub = engine.lines().find(|l| l.contains(" sub = ")).expect("the ALU's subtract select");
+            (sub.to_string(), sub.replacen(" sub = u_fn == 4'd2 || ", " sub = ", 1), "the ALU's subtract made an add")
+        };
+        assert_faults_caught(&base, "tri_fe_engine.v", "seqfault", [fault], seed, &tris);
+    }
 }
 
 /// A fault planted in one line of a front-end's file: in `file`'s first line holding `line`,

@@ -48,7 +48,8 @@ pub(super) fn entry_bits(hw: &Hw, s: &Schedule) -> u32 {
 /// The set-up result queue module of this configuration.
 pub(super) fn result_queue(hw: &Hw, names: &Names) -> Module {
     let s = hw.engine().expect("the engine form");
-    queue_module(names, entry_bits(hw, &s), super::QUEUE_DEPTH)
+    let widths: Vec<u32> = fields(hw, &s).iter().map(|f| f.w).collect();
+    queue_module(names, entry_bits(hw, &s), super::QUEUE_DEPTH, hw.sequential().is_some().then_some(&widths[..]))
 }
 
 fn plan_text(s: &Schedule) -> String {
@@ -218,7 +219,17 @@ pub(super) fn setup(hw: &Hw, names: &Names, body: &mut Vec<Item>) {
     }
     body.push(crate::verilog::net("take", 1));
     body.push(crate::verilog::wire("q_push", 1, "res_v && res_guard && !res_cull"));
-    body.push(Item::Assign("en".into(), "!(q_push && q_full)".into()));
+    // The sequential engine writes the result's fields into the queue's tail as it produces
+    // them (res_we, res_wr: some field this clock), so it also freezes while the queue is full
+    // and it has a field to write.
+    let capture = hw.sequential().is_some();
+    if capture {
+        body.push(crate::verilog::net("res_we", fields.len() as u32));
+        body.push(crate::verilog::net("res_wr", 1));
+        body.push(Item::Assign("en".into(), "!(q_full && (q_push || res_wr))".into()));
+    } else {
+        body.push(Item::Assign("en".into(), "!(q_push && q_full)".into()));
+    }
     body.push(crate::verilog::wire("q_in", 1, "q_push && !q_full"));
     let mut conns: Vec<(String, String)> =
         ["clk", "rst", "en", "in_valid", "in_ready"].iter().map(|p| (p.to_string(), p.to_string())).collect();
@@ -228,8 +239,11 @@ pub(super) fn setup(hw: &Hw, names: &Names, body: &mut Vec<Item>) {
         }
     }
     conns.extend(["res_v", "res_guard", "res_cull", "res"].map(|p| (p.to_string(), p.to_string())));
+    if capture {
+        conns.extend(["res_we", "res_wr"].map(|p| (p.to_string(), p.to_string())));
+    }
     body.push(Item::Instance { module: names.fe_engine.clone(), name: "u_engine".into(), params: vec![], conns });
-    let qc = [
+    let mut qc = vec![
         ("clk", "clk"),
         ("rst", "rst"),
         ("push", "q_in"),
@@ -239,11 +253,14 @@ pub(super) fn setup(hw: &Hw, names: &Names, body: &mut Vec<Item>) {
         ("nonempty", "q_ne"),
         ("full", "q_full"),
     ];
+    if capture {
+        qc.insert(4, ("we", "res_we"));
+    }
     body.push(Item::Instance {
         module: names.fe_queue.clone(),
         name: "u_queue".into(),
         params: vec![("W".into(), res_w.to_string()), ("DEPTH".into(), super::QUEUE_DEPTH.to_string())],
-        conns: qc.map(|(a, b)| (a.to_string(), b.to_string())).to_vec(),
+        conns: qc.into_iter().map(|(a, b)| (a.to_string(), b.to_string())).collect(),
     });
     body.push(Item::Always(vec![Stmt::If("rst".into(), vec![set("err", "1'b0")], vec![set("err", "res_v && !res_guard")])]));
     body.push(comment("The queue head's fields: the set-up result the walker loads."));

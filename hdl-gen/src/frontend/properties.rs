@@ -63,6 +63,7 @@ pub(super) fn emit_engine(hw: &Hw, sp: &Stager) -> Item {
         depth: super::QUEUE_DEPTH,
         entry_w: super::engine::entry_bits(hw, &s),
         binary_phase: hw.sequential().is_some(),
+        capture: hw.sequential().is_some(),
     };
     let mut shape = shape(hw, sp, SetupShape::Engine(engine));
     shape.starts = super::incremental::on(hw).then_some(hw.fe.start_product_clocks());
@@ -286,8 +287,14 @@ impl Reference<'_> {
                 b.push(comment("The design's data decisions, taken as given: the result's guard-band check and cull."));
                 b.push(wire("f_push", 1, "f_due && res_guard && !res_cull"));
                 b.push(wire("f_full", 1, format!("f_qn == {}", lit(qw, e.depth as u64))));
-                b.push(comment("The engine freezes exactly while a result for the queue is due and the queue is full."));
-                b.push(wire("f_en", 1, "!(f_push && f_full)"));
+                if e.capture {
+                    b.push(comment("The engine freezes exactly while the queue is full and a result for it is due or the engine"));
+                    b.push(comment("has a field of one to write into its tail (res_wr, taken as given)."));
+                    b.push(wire("f_en", 1, "!(f_full && (f_push || res_wr))"));
+                } else {
+                    b.push(comment("The engine freezes exactly while a result for the queue is due and the queue is full."));
+                    b.push(wire("f_en", 1, "!(f_push && f_full)"));
+                }
                 b.push(wire("f_qin", 1, "f_push && !f_full"));
                 b.push(wire("f_enter", 1, format!("f_en && f_ph == {}", lit(phw, (e.ii - 1) as u64))));
                 b.push(wire("f_rdy", 1, "!f_vf || f_enter"));

@@ -30,7 +30,7 @@
 //!   an EBR does, so a wrong address, a read before its write or a value overwritten while live
 //!   gives a wrong set-up, which the tests compare with [`FrontEnd::setup`].
 //!
-//! Not in RTL yet: docs/design.md, *A sequential engine for the iCE40 plans*.
+//! The RTL: `hdl-gen`'s `frontend/engine/seq.rs`; docs/design.md, *A sequential engine for the iCE40 HX8K*.
 
 use super::placement::{ceil, class, timing, Class};
 use super::schedule::{lut_per_bit_step, Result3};
@@ -68,14 +68,15 @@ impl SeqPlan {
     /// The UP5K: 2 of its SB_MAC16 and one divider.
     pub const ICE40_UP5K: SeqPlan = SeqPlan { units: Plan::ICE40_UP5K, read_ports: 2, bank_bits: 16, bank_depth: 256 };
 
-    /// The form whose engine is sequential: the HX8K's (`--fe-setup ice40-hx8k`). The UP5K's
-    /// keeps the pipelined engine until the RTL's multiplier runs its SB_MAC16 passes (golden
-    /// sequences [`SeqPlan::ICE40_UP5K`] and its tests check it); the ECP5 and the parallel
-    /// set-up keep theirs.
+    /// The forms whose engine is sequential: the iCE40s' (`--fe-setup ice40-hx8k`, whose
+    /// multiplier is shift-add, and `ice40-up5k`, whose products are SB_MAC16 passes: the
+    /// pipelined UP5K engine's registers alone were more than the device's 5,280 cells,
+    /// docs/fpga.md); the ECP5 and the parallel set-up keep theirs.
     pub fn for_form(form: SetupForm) -> Option<SeqPlan> {
         match form {
             SetupForm::Ice40Hx8k => Some(SeqPlan::ICE40_HX8K),
-            SetupForm::Ice40Up5k | SetupForm::Parallel | SetupForm::Ecp5_25f => None,
+            SetupForm::Ice40Up5k => Some(SeqPlan::ICE40_UP5K),
+            SetupForm::Parallel | SetupForm::Ecp5_25f => None,
         }
     }
 

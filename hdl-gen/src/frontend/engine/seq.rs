@@ -1,19 +1,22 @@
 //! The sequential set-up engine (issue 27, the iCE40 plans): golden's microprogram
 //! ([`golden::frontend::engine::sequential::SeqSchedule`]) printed as a machine: a microcode
 //! ROM of one word a clock, a register file of two block-RAM copies (a read port each, one
-//! write port), a flag file, one ALU, the plan's shift-add multiplier and restoring divider,
-//! and the result fields captured as their values are written. Its ports and its contract are
+//! write port), a flag file, one ALU, the plan's multipliers (the HX8K's shift-add unit, the
+//! UP5K's SB_MAC16 tiles: [`tile`]) and restoring divider, and the result fields captured as
+//! their values are written. Its ports and its contract are
 //! `tri_fe_engine`'s: a triangle (or a bubble) enters every `clocks` clocks, its result is due
 //! `clocks` clocks later, `en` low freezes every register.
 //!
-//! `--fe-setup ice40-hx8k` (and `--target ice40-hx8k`) takes it in place of the pipelined
+//! `--fe-setup ice40-hx8k|ice40-up5k` (and their `--target`s) take it in place of the pipelined
 //! engine; co-simulated in `verilator-harness/tests/frontend.rs` (`sequential_engine_*`, slow
 //! tier). docs/design.md, *A sequential engine for the iCE40 HX8K*.
+
+mod tile;
 
 use super::result::{fields, ports, Field};
 use super::units::bits_for;
 use crate::frontend::hw::Hw;
-use crate::verilog::{comment, reg, set, sreg, wire, Item, Module, Param, Stmt};
+use crate::verilog::{comment, reg, set, sreg, wire, Item, Module, Param, Port, Stmt};
 use golden::frontend::engine::schedule::Class;
 use golden::frontend::engine::sequential::{Exec, Loc, SeqSchedule, ALU_LAT, READ};
 use golden::frontend::engine::{Kind, MulUnit, V};
@@ -39,6 +42,8 @@ const SRC_MUL: u64 = 1;
 const SRC_DIVQ: u64 = 2;
 const SRC_DIVR: u64 = 3;
 const SRC_IN: u64 = 4;
+/// The second multiplier's product (the UP5K's two tiles; after the nine inputs).
+const SRC_MUL1: u64 = 13;
 
 /// The microword's fields, least significant first: name and width.
 struct Layout {
@@ -46,8 +51,9 @@ struct Layout {
 }
 
 impl Layout {
-    fn new(aw: u32, fb: u32, sw: u32, cb: u32, wb: u32) -> Layout {
-        let fields = vec![
+    /// `tiles`: the tile multipliers' fields ([`tile::fields`]) in place of the shift-add unit's.
+    fn new(aw: u32, fb: u32, sw: u32, cb: u32, wb: u32, tiles: Option<Vec<(&'static str, u32)>>) -> Layout {
+        let mut fields = vec![
             ("ra", aw),
             ("rb", aw),
             ("fn", 4),
@@ -75,6 +81,10 @@ impl Layout {
             ("wsg", 1),
             ("cap", cb),
         ];
+        if let Some(t) = tiles {
+            let at = fields.iter().position(|f| f.0 == "mld").expect("the multiplier's fields");
+            fields.splice(at..at + 3, t);
+        }
         Layout { fields }
     }
     fn width(&self) -> u32 {
@@ -143,7 +153,10 @@ struct Micro {
 /// `name`: the sequential engine of `hw` (an iCE40 form), with `s` golden's microprogram.
 pub fn module(hw: &Hw, s: &SeqSchedule, name: &str) -> SeqEngine {
     s.verify().unwrap_or_else(|e| panic!("golden's microprogram: {e}"));
-    assert!(matches!(s.plan.units.mul, MulUnit::ShiftAdd { bits: 1 }), "the RTL's multiplier is shift-add, a bit a clock");
+    assert!(
+        matches!(s.plan.units.mul, MulUnit::ShiftAdd { bits: 1 } | MulUnit::Tile { .. }),
+        "the RTL's multiplier is shift-add a bit a clock, or tiles"
+    );
     assert_eq!(s.plan.units.div_bits, 1, "the RTL's divider takes a bit a clock");
     let pipe = hw.engine().expect("an engine form");
     let fields: Vec<Field> = fields(hw, &pipe);
@@ -160,7 +173,9 @@ pub fn module(hw: &Hw, s: &SeqSchedule, name: &str) -> SeqEngine {
     let consts: Vec<String> = s.preload.iter().map(|&(_, v)| format!("{w}'h{:x}", (v as u128) & mask)).collect();
 
     let res_w: u32 = fields.iter().map(|f| f.w).sum();
-    let ports = ports(hw, res_w);
+    let mut ports = ports(hw, res_w);
+    ports.push(Port::output("res_we", fields.len() as u32, "", "per field of res: write it into the queue's tail this clock"));
+    ports.push(Port::output("res_wr", 1, "", "a field of res is due this clock (whether or not en)"));
     let params: Vec<Param> = Vec::new();
     let header = vec![
         format!("{name} — the sequential set-up engine (issue 27; docs/design.md): golden's microprogram on one ALU."),
@@ -178,7 +193,11 @@ pub fn module(hw: &Hw, s: &SeqSchedule, name: &str) -> SeqEngine {
     sequencer(&cx, &mut b);
     memories(&cx, &l, &micro, &consts, &mut b);
     alu(&cx, &mut b);
-    units(&cx, &mut b);
+    match tile::Tiles::new(s) {
+        Some(t) => t.units(w, &mut b),
+        None => shift_add(&cx, &mut b),
+    }
+    divider(&cx, &mut b);
     write_bus(&cx, &widths, &mut b);
     results(&cx, &fields, &groups, &mut b);
     SeqEngine { module: Module { name: name.into(), header, params, ports, body: b } }
@@ -204,7 +223,8 @@ fn microprogram(cx: &Cx, fields: &[Field]) -> Micro {
     let mut widths: Vec<u32> = (0..ops.len()).filter(|&o| !matches!(s.slots[o].exec, Exec::Dead | Exec::Const)).map(|o| ops[o].w).collect();
     widths.sort();
     widths.dedup();
-    let l = Layout::new(aw, fb, sw, cb, bits_for(widths.len() as u32 - 1));
+    let tiles = tile::Tiles::new(s);
+    let l = Layout::new(aw, fb, sw, cb, bits_for(widths.len() as u32 - 1), tiles.as_ref().map(tile::Tiles::fields));
     let mut mw = vec![Word::default(); c as usize + 2];
     let addr = |v: V| match s.slots[v.0 as usize].loc {
         Loc::Ram(a) => a,
@@ -215,7 +235,7 @@ fn microprogram(cx: &Cx, fields: &[Field]) -> Micro {
         let t = sl.issue;
         // Operands: the wide ones on ports A then B, the flags from the flag file.
         let mut args = op.kind.args();
-        if let Kind::Mul(a, b) = op.kind {
+        if let (Kind::Mul(a, b), None) = (op.kind, &tiles) {
             // The shift-add unit steps through its second operand: the narrower.
             if ops[a.0 as usize].w < ops[b.0 as usize].w {
                 args = vec![b, a];
@@ -241,6 +261,11 @@ fn microprogram(cx: &Cx, fields: &[Field]) -> Micro {
             let x = &mut mw[(t + READ) as usize];
             let e = t + READ;
             match (exec, op.kind) {
+                (Exec::Unit(Class::Mul, u), _) if tiles.is_some() => {
+                    for (t, k, v) in tiles.as_ref().expect("tiles").passes(o, u) {
+                        mw[t as usize].set(k, v, t);
+                    }
+                }
                 (Exec::Unit(Class::Mul, _), _) => {
                     let nb = ops[args[1].0 as usize].w;
                     x.set("mld", 1, e);
@@ -281,6 +306,7 @@ fn microprogram(cx: &Cx, fields: &[Field]) -> Micro {
         }
         let src = match (exec, op.kind) {
             (Exec::Alu, _) => SRC_ALU,
+            (Exec::Unit(Class::Mul, 1), _) => SRC_MUL1,
             (Exec::Unit(Class::Mul, _), _) => SRC_MUL,
             (Exec::Unit(Class::Div, _), _) => SRC_DIVQ,
             (Exec::Rem, _) => SRC_DIVR,
@@ -501,9 +527,9 @@ fn alu(cx: &Cx, b: &mut Vec<Item>) {
     b.push(Item::Blank);
 }
 
-/// The shift-add multiplier and the restoring divider.
-fn units(cx: &Cx, b: &mut Vec<Item>) {
-    let (w, sw, ops) = (cx.w, cx.sw, &cx.s.prog.ops);
+/// The shift-add multiplier.
+fn shift_add(cx: &Cx, b: &mut Vec<Item>) {
+    let (w, sw) = (cx.w, cx.sw);
     b.push(comment(
         "The shift-add multiplier: the product modulo 2^W, a bit of the second operand a clock (its sign bit's weight negative).",
     ));
@@ -529,6 +555,11 @@ fn units(cx: &Cx, b: &mut Vec<Item>) {
         vec![],
     )]));
     b.push(Item::Blank);
+}
+
+/// The restoring divider.
+fn divider(cx: &Cx, b: &mut Vec<Item>) {
+    let (w, sw, ops) = (cx.w, cx.sw, &cx.s.prog.ops);
     b.push(comment("The restoring divider: the remainder shifted past the divisor, the dividend's low qb bits shifted in, a bit a clock."));
     let mut qbs: Vec<u32> = ops.iter().filter_map(|o| if let Kind::Div { qb, .. } = o.kind { Some(qb) } else { None }).collect();
     qbs.sort();
@@ -579,7 +610,11 @@ fn write_bus(cx: &Cx, widths: &[u32], b: &mut Vec<Item>) {
     let (wd, iw, w) = (cx.hw.fe.widths(), cx.hw.fe.cfg.iw(), cx.w);
     b.push(comment("The write bus: the source the microword names, wrapped to the value's width and sign."));
     let ins = ["nx0", "nx1", "nx2", "ny0", "ny1", "ny2", "ni0", "ni1", "ni2"];
-    let mut srcs: Vec<(u64, String)> = vec![(SRC_MUL, "macc".into()), (SRC_DIVQ, "dq".into()), (SRC_DIVR, "dr".into())];
+    let mut srcs: Vec<(u64, String)> = match cx.s.plan.units.mul {
+        MulUnit::Tile { .. } => (0..cx.s.plan.units.mults).map(|u| ([SRC_MUL, SRC_MUL1][u as usize], format!("m{u}acc"))).collect(),
+        MulUnit::ShiftAdd { .. } => vec![(SRC_MUL, "macc".into())],
+    };
+    srcs.extend([(SRC_DIVQ, "dq".into()), (SRC_DIVR, "dr".into())]);
     for (k, n) in ins.iter().enumerate() {
         let (wv, sg) = if k < 3 {
             (wd.cx, true)
@@ -613,43 +648,52 @@ fn write_bus(cx: &Cx, widths: &[u32], b: &mut Vec<Item>) {
     b.push(Item::Blank);
 }
 
-/// The result fields, each loaded as its value is written.
+/// The result: each field written into the queue's tail entry as its value is written
+/// (`res_we`, a bit a field, for a valid period's triangle and not while frozen; `res_wr`: a
+/// field is due this clock), so the engine keeps no copy of it; the guard-band check and the
+/// cull, which the front-end reads as the result is pushed, loaded here.
 fn results(cx: &Cx, fields: &[Field], groups: &[V], b: &mut Vec<Item>) {
-    let (ops, out) = (&cx.s.prog.ops, &cx.s.prog.out);
+    let (ops, out, s) = (&cx.s.prog.ops, &cx.s.prog.out, cx.s);
     let cb = bits_for(groups.len() as u32);
-    b.push(comment("The result: each field loads as its value is written."));
-    let mut loads = Vec::new();
-    let name_of = |v: V| -> Option<String> {
-        if v == out.guard_ok {
-            return Some("c_guard".into());
-        }
-        if v == out.cull {
-            return Some("c_cull".into());
-        }
-        None
-    };
+    b.push(comment("The result: each field written into the queue's tail as its value is written (res_we), the guard-band"));
+    b.push(comment("check and the cull loaded here. The tail becomes an entry at res_v, the next period's clock 0, which"));
+    b.push(comment("writes no field (cap_ok: gated by the clock, not only by the microprogram, so that the proof's induction,"));
+    b.push(comment("whose microword register is free, sees it too)."));
+    b.push(wire("cap_ok", 1, format!("en && vld[0] && pc != {}'d0", cx.cw)));
+    let cap = |v: V| format!("u_cap == {cb}'d{}", groups.iter().position(|&x| x == v).unwrap() + 1);
+    // The fields' groups come first in `groups` (then the checks'): res_wr is a range of them.
+    let nf = groups.iter().take_while(|v| fields.iter().any(|f| f.v == **v)).count();
+    assert!(nf > 0 && groups[nf..].iter().all(|v| fields.iter().all(|f| f.v != *v)), "the fields' groups first");
+    for &v in &groups[..nf] {
+        assert!(s.slots[v.0 as usize].write > 0, "{}: a field written at clock 0, the push's", ops[v.0 as usize].name);
+    }
+    let first = fields.iter().find(|f| !matches!(ops[f.v.0 as usize].kind, Kind::Const(_))).expect("a computed field").v;
     let mut parts = Vec::new();
+    let mut we = Vec::new();
     for f in fields {
-        let n = format!("c_{}", f.name);
         match ops[f.v.0 as usize].kind {
-            Kind::Const(k) => parts.push(format!("{}'d{}", f.w, k)),
+            // A constant rides with the first computed field's write.
+            Kind::Const(k) => {
+                parts.push(format!("{}'d{}", f.w, k));
+                we.push(format!("cap_ok && {}", cap(first)));
+            }
             _ => {
-                b.push(reg(&n, f.w));
-                let g = groups.iter().position(|&v| v == f.v).unwrap() + 1;
-                loads.push(Stmt::If(format!("u_cap == {cb}'d{g}"), vec![set(&n, format!("bus[{}:0]", f.w - 1))], vec![]));
-                parts.push(n);
+                parts.push(if f.w == 1 { "bus[0]".to_string() } else { format!("bus[{}:0]", f.w - 1) });
+                we.push(format!("cap_ok && {}", cap(f.v)));
             }
         }
     }
-    for v in [out.guard_ok, out.cull] {
-        let n = name_of(v).unwrap();
-        b.push(reg(&n, 1));
-        let g = groups.iter().position(|&x| x == v).unwrap() + 1;
-        loads.push(Stmt::If(format!("u_cap == {cb}'d{g}"), vec![set(&n, "bus[0]")], vec![]));
+    let mut loads = Vec::new();
+    for (v, n) in [(out.guard_ok, "c_guard"), (out.cull, "c_cull")] {
+        b.push(reg(n, 1));
+        loads.push(Stmt::If(cap(v), vec![set(n, "bus[0]")], vec![]));
     }
     b.push(Item::Always(vec![Stmt::If("en".into(), loads, vec![])]));
     parts.reverse();
+    we.reverse();
     b.push(Item::Assign("res".into(), format!("{{{}}}", parts.join(", "))));
+    b.push(Item::Assign("res_we".into(), format!("{{{}}}", we.join(",\n    "))));
+    b.push(Item::Assign("res_wr".into(), format!("vld[0] && u_cap != {cb}'d0 && u_cap <= {cb}'d{nf}")));
     b.push(Item::Assign("res_guard".into(), "c_guard".into()));
     b.push(Item::Assign("res_cull".into(), "c_cull".into()));
 }

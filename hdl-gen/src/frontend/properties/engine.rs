@@ -66,11 +66,19 @@ impl Reference<'_> {
             ),
             when("f_take", (1..e.depth).map(|i| set(format!("f_q{}", i - 1), format!("f_q{i}"))).collect()),
         ];
-        // The slot the pushed result lands in: behind the entries that stay.
+        // The slot the pushed result lands in: behind the entries that stay. With the capture,
+        // the result is the tail entry as the engine wrote it (the queue's word at wr), so a
+        // field written over an entry still held breaks the queue's links.
+        let pushed = if e.capture {
+            let pw = bits_for(e.depth - 1);
+            (0..e.depth).rev().fold(format!("{}'d0", e.entry_w), |acc, k| format!("(f_q_wr == {}) ? f_q_mem{k} : {acc}", lit(pw, k as u64)))
+        } else {
+            "res".to_string()
+        };
         for i in 0..e.depth {
             st.push(when(
                 format!("f_qin && f_qn - {} == {}", zext("f_take", 1, qw), lit(qw, i as u64)),
-                vec![set(format!("f_q{i}"), "res")],
+                vec![set(format!("f_q{i}"), pushed.clone())],
             ));
         }
         st.push(set("f_qn", format!("f_qn + {} - {}", zext("f_qin", 1, qw), zext("f_take", 1, qw))));
@@ -111,6 +119,10 @@ impl Reference<'_> {
             hold.push(assert("f_e_ep == $past(f_e_ep)"));
         }
         b.push(Item::Comb(vec![when("f_past && !en", vec![assert("!q_in")])]));
+        if e.capture {
+            b.push(comment("The capture: no field is written into the tail while the queue is full (the tail is its oldest entry)."));
+            b.push(Item::Comb(vec![when("f_past && q_full", vec![assert("res_we == 0")])]));
+        }
         b.push(Item::Always(vec![when("f_past && !$past(rst) && !$past(en)", hold)]));
         b
     }

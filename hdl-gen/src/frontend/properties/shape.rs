@@ -75,6 +75,9 @@ pub struct EngineShape {
     pub entry_w: u32,
     /// The engine's phase is a binary counter (`pc`, the sequential engine's), not a one-hot ring.
     pub binary_phase: bool,
+    /// The engine writes the result's fields into the queue's tail as it produces them (the
+    /// sequential engine's `res_we`, taken as given), and the push makes the tail an entry.
+    pub capture: bool,
 }
 
 /// A register stage of the front-end's span path: where it holds a span's valid, row, columns

@@ -1,0 +1,149 @@
+//! The sequential engine's tile multipliers (`MulUnit::Tile`, the UP5K's SB_MAC16): a product
+//! of two register-file words as golden's chunk passes, one a clock, on a `bits + 1`-bit signed
+//! multiplier with registered inputs and output (so `synth_ice40 -dsp` maps it onto one
+//! SB_MAC16), accumulated as the pipelined engine's tiles are ([`super::super::units`]):
+//! heaviest chunk pair first, the sum shifted one chunk up where the pair's weight drops.
+//!
+//! - **Timing** (golden's `timing`: `p` passes, then `MUL_PIPE`): the unit loads at its issue's
+//!   read clock `L`, where the operands are on the read ports, and runs its first pass on them
+//!   there; the operands are held for the other passes (`L + 1 ..`). A pass's chunks are
+//!   registered, their product the clock after, the sum the clock after that: the product is
+//!   in the accumulator at `L + p + 2`, the clock golden writes it.
+//! - **Control**: every pass's chunk indices, whether each is its operand's signed top chunk
+//!   and whether the sum shifts, are microword fields of the pass's clock (per unit: the
+//!   units run at once), so the unit has no sequencer of its own.
+
+use crate::verilog::{comment, reg, set, sreg, wire, Item, Stmt};
+use golden::frontend::engine::schedule::MUL_PIPE;
+use golden::frontend::engine::sequential::{Exec, SeqSchedule, READ};
+use golden::frontend::engine::{Kind, MulUnit};
+
+use super::super::units::bits_for;
+
+/// Per unit, its microword fields: load (the first pass), chunk of a, chunk of b, a's chunk
+/// signed (its top one, of a signed operand), b's, the sum shifted a chunk up.
+const FIELDS: [[&str; 6]; 2] = [["m0ld", "m0ca", "m0cb", "m0ta", "m0tb", "m0s"], ["m1ld", "m1ca", "m1cb", "m1ta", "m1tb", "m1s"]];
+
+/// The tile units of a sequential schedule whose plan has them.
+pub(super) struct Tiles<'a> {
+    s: &'a SeqSchedule,
+    bits: u32,
+    mults: u32,
+    /// Chunks of the widest operand, and the chunk index's bits.
+    chunks: u32,
+    cbw: u32,
+}
+
+impl<'a> Tiles<'a> {
+    pub(super) fn new(s: &'a SeqSchedule) -> Option<Tiles<'a>> {
+        let MulUnit::Tile { bits } = s.plan.units.mul else { return None };
+        let mults = s.plan.units.mults;
+        assert!((1..=FIELDS.len() as u32).contains(&mults), "{mults} tile multipliers (the RTL has fields for 1 or 2)");
+        let chunks = s.cost.ram_width.div_ceil(bits);
+        Some(Tiles { s, bits, mults, chunks, cbw: bits_for(chunks - 1) })
+    }
+
+    pub(super) fn fields(&self) -> Vec<(&'static str, u32)> {
+        (0..self.mults as usize).flat_map(|u| FIELDS[u].iter().zip([1, self.cbw, self.cbw, 1, 1, 1]).map(|(n, w)| (*n, w))).collect()
+    }
+
+    /// Product `o` on unit `u`: its passes' fields, `(clock, field, value)`, from its load on.
+    pub(super) fn passes(&self, o: usize, u: u32) -> Vec<(u32, &'static str, u64)> {
+        let ops = &self.s.prog.ops;
+        let sl = self.s.slots[o];
+        let Kind::Mul(a, b) = ops[o].kind else { unreachable!("a product on a multiplier") };
+        let (a, b) = (&ops[a.0 as usize], &ops[b.0 as usize]);
+        let (ca, cb) = (a.w.div_ceil(self.bits), b.w.div_ceil(self.bits));
+        // Golden's pairs (those wholly above the kept bits left out), heaviest first (Horner).
+        let mut p: Vec<(u32, u32)> =
+            (0..ca).flat_map(|i| (0..cb).map(move |j| (i, j))).filter(|&(i, j)| (i + j) * self.bits < ops[o].w).collect();
+        p.sort_by_key(|&(i, j)| std::cmp::Reverse(i + j));
+        let l = sl.issue + READ;
+        assert_eq!(sl.exec, Exec::Unit(golden::frontend::engine::schedule::Class::Mul, u));
+        assert_eq!(sl.write, l + p.len() as u32 + MUL_PIPE, "{}: golden's passes", ops[o].name);
+        let f = &FIELDS[u as usize];
+        let mut set = Vec::new();
+        for (k, &(i, j)) in p.iter().enumerate() {
+            let t = l + k as u32;
+            set.extend([
+                (t, f[0], (k == 0) as u64),
+                (t, f[1], i as u64),
+                (t, f[2], j as u64),
+                (t, f[3], (i + 1 == ca && a.signed) as u64),
+                (t, f[4], (j + 1 == cb && b.signed) as u64),
+                (t, f[5], (k > 0 && i + j < p[k - 1].0 + p[k - 1].1) as u64),
+            ]);
+        }
+        set
+    }
+
+    /// The units: per unit the held operands, the chunk selection, the tile and the sum.
+    /// `w`: the register file's word.
+    pub(super) fn units(&self, w: u32, b: &mut Vec<Item>) {
+        let (bits, n) = (self.bits, self.chunks);
+        // The operands sign-extended past their top chunk's sign bit (a register-file word holds
+        // its value sign- or zero-extended to W: unsigned values have a zero bit on top).
+        let ew = n * bits + 1;
+        let (pw, cbw) = (2 * bits + 2, self.cbw);
+        b.push(comment(format!(
+            "The tile multipliers: a product as golden's passes of {bits}-bit chunks on a {0} x {0} signed multiplier (SB_MAC16),",
+            bits + 1
+        )));
+        b.push(comment("the first pass at the load on the read ports' operands, the others on the operands held (m*a, m*b); the"));
+        b.push(comment("sum cleared for the first pass and shifted a chunk up where the weight drops, modulo W."));
+        for u in 0..self.mults {
+            let m = |x: &str| format!("m{u}{x}");
+            let uf = |x: &str| format!("u_m{u}{x}");
+            b.extend([reg(&m("a"), w), reg(&m("b"), w)]);
+            for (o, x) in [("a", "x0"), ("b", "x1")] {
+                let src = m(&format!("x{o}"));
+                b.push(wire(&src, w, format!("{} ? {x} : {}", uf("ld"), m(o))));
+                b.push(wire(&m(&format!("e{o}")), ew, crate::verilog::sext(&src, w, ew)));
+                // The chunk the microword names, its sign bit the operand's where it is the
+                // signed top chunk.
+                let c = m(&format!("c{o}"));
+                b.push(reg(&c, bits + 1));
+                let e = m(&format!("e{o}"));
+                let top = uf(&format!("t{o}"));
+                let arms = (0..n)
+                    .map(|i| {
+                        let x = format!("{{{top} & {e}[{}], {e}[{}:{}]}}", (i + 1) * bits, (i + 1) * bits - 1, i * bits);
+                        (format!("{cbw}'d{i}"), vec![Stmt::Blocking(c.clone(), x)])
+                    })
+                    .collect();
+                b.push(Item::Comb(vec![Stmt::Case {
+                    sel: uf(&format!("c{o}")),
+                    arms,
+                    default: vec![Stmt::Blocking(c.clone(), format!("{}'d0", bits + 1))],
+                }]));
+            }
+            b.extend([sreg(&m("ra"), bits + 1), sreg(&m("rb"), bits + 1), reg(&m("f1"), 1), reg(&m("s1"), 1)]);
+            if w < pw {
+                b.push(comment("verilator lint_off UNUSEDSIGNAL"));
+                b.push(sreg(&m("pr"), pw));
+                b.push(comment("verilator lint_on UNUSEDSIGNAL"));
+            } else {
+                b.push(sreg(&m("pr"), pw));
+            }
+            b.push(reg(&m("acc"), w));
+            let pe = if w > pw { crate::verilog::sext(&m("pr"), pw, w) } else { format!("{}[{}:0]", m("pr"), w - 1) };
+            b.push(wire(&m("accn"), w, format!("{} + {pe}", m("acc"))));
+            let up = if w > bits { format!("{{{}[{}:0], {bits}'d0}}", m("accn"), w - bits - 1) } else { format!("{w}'d0") };
+            b.push(wire(&m("held"), w, format!("{} ? {w}'d0 : {} ? {up} : {}", m("f1"), m("s1"), m("accn"))));
+            b.push(Item::Always(vec![Stmt::If(
+                "en".into(),
+                vec![
+                    Stmt::If(uf("ld"), vec![set(m("a"), "x0"), set(m("b"), "x1")], vec![]),
+                    set(m("ra"), m("ca")),
+                    set(m("rb"), m("cb")),
+                    set(m("f1"), uf("ld")),
+                    set(m("s1"), uf("s")),
+                    set(m("pr"), format!("{} * {}", m("ra"), m("rb"))),
+                    set(m("acc"), m("held")),
+                ],
+                vec![],
+            )]));
+        }
+        b.push(Item::Blank);
+    }
+}
