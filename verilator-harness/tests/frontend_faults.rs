@@ -13,7 +13,8 @@ use verilator_harness::frontend::random_triangles;
 /// one logic operation reading its operand's copy of the next triangle (a copy off by one
 /// period), a tile's passes added at the wrong weights (its accumulator never shifted), a division's quotient taken from the
 /// divider of another epoch (a binding rotated), the shared shifter's amount read from the next
-/// triangle's copy. Slow tier.
+/// triangle's copy; and in `tri_frontend.v`, a triangle taken with no queue entry reserved for its
+/// result (the credits ignored: the queue overflows under backpressure). Slow tier.
 #[test]
 #[ignore]
 fn engine_planted_faults_are_caught() {
@@ -47,6 +48,10 @@ fn engine_planted_faults_are_caught() {
         (shift_line.to_string(), shift_line.replacen("_1);", "_0);", 1), "a shared shift's amount from the next triangle's copy"),
     ];
     assert_faults_caught(&base, "tri_fe_engine.v", "fault", faults, seed, &tris);
+    let top = &base.sources.iter().find(|(n, _)| n == "tri_frontend.v").expect("the front-end's file").1;
+    let room = top.lines().find(|l| l.contains("wire q_room = cr != 0;")).expect("the credits' room").to_string();
+    let fault = (room.clone(), room.replacen("cr != 0", "1'b1", 1), "a triangle taken with no queue entry for its result");
+    assert_faults_caught(&base, "tri_frontend.v", "cfault", [fault], seed, &tris);
 }
 
 /// Negative controls of the walker behind the row stages (`--pipeline 1`, the ECP5 plan at
