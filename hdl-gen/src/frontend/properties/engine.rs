@@ -153,6 +153,11 @@ impl Reference<'_> {
         // from the head is its memory word (rd + i) mod depth.
         let rd = "{1'b0, f_q_rd}";
         let wrap = |x: String, k: u32| format!("({x} == {} || {x} == {})", lit(pw + 1, k as u64), lit(pw + 1, (k + e.depth) as u64));
+        if !e.depth.is_power_of_two() {
+            // The pointers stay below the depth (a word past it is no entry).
+            let last = lit(pw, (e.depth - 1) as u64);
+            link.extend([assert(format!("f_q_rd <= {last}")), assert(format!("f_q_wr <= {last}"))]);
+        }
         link.extend([
             assert(format!("f_q_cnt == {}", zext("f_qn", qw, pw + 1))),
             assert(format!("{rd} + f_q_cnt == {{1'b0, f_q_wr}} || {rd} + f_q_cnt == {{1'b0, f_q_wr}} + {}", lit(pw + 1, e.depth as u64))),
