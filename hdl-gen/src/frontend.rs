@@ -183,7 +183,7 @@ fn header(hw: &Hw, names: &Names) -> Vec<String> {
                 fe.setup.name(),
                 hw.engine_timing().map_or(s.ii, |t| t.0),
                 hw.engine_timing().map_or(s.latency, |t| t.1),
-                QUEUE_DEPTH
+                hw.queue_depth()
             ),
             format!("{} clocks per triangle, walked or dropped; the next triangles' set-up overlaps the walk.", hw.setup_clocks().0),
             format!("Latency: first span valid at most {} clocks after the triangle's transfer when the walker is idle.", hw.latency()),

@@ -406,7 +406,7 @@ pub fn render(opts: &Options, names: &Names, modules: &[Module], unit: &Specular
                 ii,
                 latency,
                 epochs,
-                queue_depth: crate::frontend::QUEUE_DEPTH,
+                queue_depth: hw.queue_depth(),
             }),
             span_div_clocks: hw.span_div_clocks(),
             latency: hw.latency(),

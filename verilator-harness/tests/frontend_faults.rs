@@ -6,14 +6,18 @@
 use crate::frontend::{assert_faults_caught, engine};
 use golden::rng::SeedRng;
 use rand::SeedableRng;
-use verilator_harness::frontend::random_triangles;
+use verilator_harness::ffi::{FeOut, TriIn};
+use verilator_harness::frontend::{random_triangles, run_frontend};
+use verilator_harness::segment::{Stress, Traffic};
 
 /// Negative controls of the engine's co-simulation: a fault planted in the generated engine
 /// (each a model built on first use, 37x23) is caught on the triangles the clean model passes:
 /// one logic operation reading its operand's copy of the next triangle (a copy off by one
 /// period), a tile's passes added at the wrong weights (its accumulator never shifted), a division's quotient taken from the
 /// divider of another epoch (a binding rotated), the shared shifter's amount read from the next
-/// triangle's copy. Slow tier.
+/// triangle's copy; and in `tri_frontend.v`, a triangle taken with no queue entry reserved for its
+/// result (the credits ignored), under backpressure heavy enough to fill the queue, which the
+/// clean model passes. Slow tier.
 #[test]
 #[ignore]
 fn engine_planted_faults_are_caught() {
@@ -47,6 +51,22 @@ fn engine_planted_faults_are_caught() {
         (shift_line.to_string(), shift_line.replacen("_1)", "_0)", 1), "a shared shift's amount from the next triangle's copy"),
     ];
     assert_faults_caught(&base, "tri_fe_engine.v", "fault", faults, seed, &tris);
+    // The credits: with out_ready high a clock in ten, triangles arrive faster than they are
+    // walked and the queue fills (under Traffic::RANDOM it never does at this depth).
+    let heavy = Traffic { valid: 1.0, ready: 0.1 };
+    let run = |m: &verilator_harness::models::Model| {
+        let info = verilator_harness::ondemand::load::<TriIn, FeOut>(m).unwrap_or_else(|e| panic!("{e}"));
+        run_frontend(info, seed, heavy, Stress::NONE, &tris)
+    };
+    assert!(run(&base).ok(), "the clean model under heavy backpressure");
+    let mut m = base.clone();
+    let top = &mut m.sources.iter_mut().find(|(n, _)| n == "tri_frontend.v").expect("the front-end's file").1;
+    let room = top.lines().find(|l| l.contains("wire q_room = cr != 0;")).expect("the credits' room").to_string();
+    *top = top.replacen(&room, &room.replacen("cr != 0", "1'b1", 1), 1);
+    m.tag = format!("{}_cfault", base.tag);
+    let report = run(&m);
+    eprintln!("a triangle taken with no queue entry for its result: {} mismatches", report.mismatch_count);
+    assert!(!report.ok(), "planted fault not caught: a triangle taken with no queue entry for its result");
 }
 
 /// Negative controls of the walker behind the row stages (`--pipeline 1`, the ECP5 plan at

@@ -12,9 +12,10 @@
 //! - [`result`]: the set-up result's fields and the engine's ports, which both forms share.
 //! - [`seq`]: the HX8K's sequential engine (golden's microprogram), on the same ports.
 //!
-//! One enable, `en`, freezes the whole engine (every register of it) while a result is due and
-//! the queue is full: simple, and its fan-out (every engine register's clock enable) is the
-//! path to watch for timing.
+//! The pipelined engine never freezes: `tri_frontend` takes a triangle only with a queue entry
+//! reserved for its result (a credit, [`setup`]), so a result always finds room and no engine
+//! register has an enable beyond its phase (a freeze's fan-out into every register was the
+//! 25F's critical path). The sequential engine ([`seq`]) keeps its freeze, `en`.
 
 mod queue;
 mod result;
@@ -49,7 +50,7 @@ pub(super) fn entry_bits(hw: &Hw, s: &Schedule) -> u32 {
 pub(super) fn result_queue(hw: &Hw, names: &Names) -> Module {
     let s = hw.engine().expect("the engine form");
     let widths: Vec<u32> = fields(hw, &s).iter().map(|f| f.w).collect();
-    queue_module(names, entry_bits(hw, &s), super::QUEUE_DEPTH, hw.sequential().is_some().then_some(&widths[..]))
+    queue_module(names, entry_bits(hw, &s), hw.queue_depth(), hw.sequential().is_some().then_some(&widths[..]))
 }
 
 fn plan_text(s: &Schedule) -> String {
@@ -112,12 +113,12 @@ pub(super) fn module(hw: &Hw, names: &Names) -> Module {
         "program as v<op>_<name>_<copy> (a register, or a wire for wiring), copy k the triangle k periods older, shifted".into(),
         "when the next triangle's value is written; each logic operation's result t<op>; per unit the operand multiplexers".into(),
         "(mu_* for the multipliers, du_* for the dividers, sh<k>_a/_n for the shifters), selected by phase and epoch; the units as generate loops".into(),
-        "(g_mul, g_div); the result at the latency (res). en low freezes every register of the engine.".into(),
+        "(g_mul, g_div); the result at the latency (res). It never freezes: tri_frontend takes a triangle only with a queue entry for its result.".into(),
         String::new(),
         "The units' operations (clock from the entry, unit, operation, clocks busy), golden's listing:".into(),
     ];
     header.extend(s.listing().lines().map(|l| format!("  {l}")));
-    let ports = ports(hw, res_w);
+    let ports = ports(hw, res_w).into_iter().filter(|p| p.name != "en").collect();
     let mut body = Vec::new();
     sequencer::emit(&seq, &wd, iw, s.latency, &mut body);
     // Values: many copies and wiring nets are read only in part or by some readers.
@@ -168,7 +169,7 @@ pub(super) fn module(hw: &Hw, names: &Names) -> Module {
     body.push(comment("Every value register's load at its phase (the copies shift with it)."));
     let phases: Vec<Stmt> =
         loads.into_iter().enumerate().filter(|(_, l)| !l.is_empty()).map(|(p, l)| Stmt::If(seq.phase(p as u32), l, vec![])).collect();
-    body.push(Item::Always(vec![Stmt::If("en".into(), phases, vec![])]));
+    body.push(Item::Always(phases));
     body.push(Item::Blank);
     body.push(comment(format!("The result, at clock {} of its triangle.", s.latency)));
     let at = |x: V, w: u32| v.at(x, s.latency).ext(w);
@@ -202,37 +203,72 @@ pub(super) fn setup(hw: &Hw, names: &Names, body: &mut Vec<Item>) {
     let fields = fields(hw, &s);
     let res_w: u32 = fields.iter().map(|f| f.w).sum();
     let (ii, latency, _) = hw.engine_timing().expect("the engine form");
+    let (depth, credit) = (hw.queue_depth(), hw.queue_credit());
+    let capture = hw.sequential().is_some();
     body.push(comment(format!(
-        "Set-up: the {} engine ({}, II = {ii} clocks a triangle, latency {latency}), then its result queue ({}, {} entries).",
+        "Set-up: the {} engine ({}, II = {ii} clocks a triangle, latency {latency}), then its result queue ({}, {depth} entries).",
         if hw.sequential().is_some() { "sequential" } else { "shared" },
         names.fe_engine,
         names.fe_queue,
-        super::QUEUE_DEPTH
     )));
-    body.push(comment(
-        "A result due while the queue is full freezes the engine (en); a guard-band drop pulses err; a culled triangle is dropped.",
-    ));
-    for (n, w) in
-        [("en", 1), ("res_v", 1), ("res_guard", 1), ("res_cull", 1), ("res", res_w), ("q_head", res_w), ("q_ne", 1), ("q_full", 1)]
-    {
+    body.push(comment(if credit {
+        "A triangle is taken only with a queue entry for its result (cr counts those neither held nor reserved): the engine never freezes; a guard-band drop pulses err; a culled triangle is dropped."
+    } else {
+        "A result due while the queue is full freezes the engine (en); a guard-band drop pulses err; a culled triangle is dropped."
+    }));
+    let mut nets = vec![("res_v", 1), ("res_guard", 1), ("res_cull", 1), ("res", res_w), ("q_head", res_w), ("q_ne", 1)];
+    nets.insert(0, if credit { ("e_ready", 1) } else { ("en", 1) });
+    for (n, w) in nets {
         body.push(crate::verilog::net(n, w));
+    }
+    if credit {
+        // With credits the queue is never full when a result is due: only the proof reads it.
+        body.extend([
+            comment("verilator lint_off UNUSEDSIGNAL"),
+            crate::verilog::net("q_full", 1),
+            comment("verilator lint_on UNUSEDSIGNAL"),
+        ]);
+    } else {
+        body.push(crate::verilog::net("q_full", 1));
     }
     body.push(crate::verilog::net("take", 1));
     body.push(crate::verilog::wire("q_push", 1, "res_v && res_guard && !res_cull"));
-    // The sequential engine writes the result's fields into the queue's tail as it produces
-    // them (res_we, res_wr: some field this clock), so it also freezes while the queue is full
-    // and it has a field to write.
-    let capture = hw.sequential().is_some();
-    if capture {
-        body.push(crate::verilog::net("res_we", fields.len() as u32));
-        body.push(crate::verilog::net("res_wr", 1));
-        body.push(Item::Assign("en".into(), "!(q_full && (q_push || res_wr))".into()));
+    let (valid, ready) = if credit {
+        // The credits: taken with a triangle, given back when its result leaves the queue or is
+        // not pushed. A registered count, so the engine's entry and the vertex register's load
+        // read no queue or walker logic.
+        let cw = units::bits_for(depth);
+        body.push(reg("cr", cw));
+        body.push(crate::verilog::wire("q_room", 1, "cr != 0"));
+        body.push(crate::verilog::wire("e_valid", 1, "in_valid && q_room"));
+        body.push(Item::Assign("in_ready".into(), "e_ready && q_room".into()));
+        body.push(crate::verilog::wire("q_in", 1, "q_push"));
+        let back = |x: &str| crate::verilog::zext(x, 1, cw);
+        body.push(Item::Always(vec![Stmt::If(
+            "rst".into(),
+            vec![set("cr", crate::verilog::lit(cw, depth as u64))],
+            vec![set("cr", format!("cr + {} + {} - {}", back("take"), back("(res_v && !q_push)"), back("(in_valid && in_ready)")))],
+        )]));
+        ("e_valid", "e_ready")
     } else {
-        body.push(Item::Assign("en".into(), "!(q_push && q_full)".into()));
+        if capture {
+            // The sequential engine writes the result's fields into the queue's tail as it
+            // produces them (res_we, res_wr: some field this clock), so it also freezes while
+            // the queue is full and it has a field to write.
+            body.push(crate::verilog::net("res_we", fields.len() as u32));
+            body.push(crate::verilog::net("res_wr", 1));
+            body.push(Item::Assign("en".into(), "!(q_full && (q_push || res_wr))".into()));
+        } else {
+            body.push(Item::Assign("en".into(), "!(q_push && q_full)".into()));
+        }
+        body.push(crate::verilog::wire("q_in", 1, "q_push && !q_full"));
+        ("in_valid", "in_ready")
+    };
+    let mut conns: Vec<(String, String)> = ["clk", "rst"].iter().map(|p| (p.to_string(), p.to_string())).collect();
+    if !credit {
+        conns.push(("en".into(), "en".into()));
     }
-    body.push(crate::verilog::wire("q_in", 1, "q_push && !q_full"));
-    let mut conns: Vec<(String, String)> =
-        ["clk", "rst", "en", "in_valid", "in_ready"].iter().map(|p| (p.to_string(), p.to_string())).collect();
+    conns.extend([("in_valid".to_string(), valid.to_string()), ("in_ready".to_string(), ready.to_string())]);
     for k in 0..3 {
         for p in ["in_x", "in_y", "in_i"] {
             conns.push((format!("{p}{k}"), format!("{p}{k}")));
@@ -259,7 +295,7 @@ pub(super) fn setup(hw: &Hw, names: &Names, body: &mut Vec<Item>) {
     body.push(Item::Instance {
         module: names.fe_queue.clone(),
         name: "u_queue".into(),
-        params: vec![("W".into(), res_w.to_string()), ("DEPTH".into(), super::QUEUE_DEPTH.to_string())],
+        params: vec![("W".into(), res_w.to_string()), ("DEPTH".into(), depth.to_string())],
         conns: qc.into_iter().map(|(a, b)| (a.to_string(), b.to_string())).collect(),
     });
     body.push(Item::Always(vec![Stmt::If("rst".into(), vec![set("err", "1'b0")], vec![set("err", "res_v && !res_guard")])]));

@@ -18,9 +18,9 @@ pub struct Hw {
     pub pipeline: golden::pipeline::Pipeline,
 }
 
-/// Entries of the set-up result queue behind the shared engine (`--fe-setup` not `parallel`):
+/// Entries of the set-up result queue behind the sequential engine (`--fe-setup ice40-hx8k`):
 /// two, so the next triangle's set-up waits behind the one being walked without freezing the
-/// engine.
+/// engine. The pipelined engine's queue is deeper ([`Hw::queue_depth`]).
 pub const QUEUE_DEPTH: u32 = 2;
 
 impl Hw {
@@ -49,6 +49,23 @@ impl Hw {
             return Some((s.clocks, s.clocks, 1));
         }
         self.engine().map(|s| (s.ii, s.latency, s.epochs().expect("a periodic binding (golden's tests)")))
+    }
+
+    /// Whether the engine never freezes (the pipelined engine): the front-end takes a triangle
+    /// only with a queue entry reserved for its result (a credit), so no register of the engine
+    /// has a clock enable wider than its phase (a freeze's fan-out was the 25F's critical path).
+    pub fn queue_credit(&self) -> bool {
+        self.engine_form() && self.sequential().is_none()
+    }
+
+    /// The set-up result queue's entries: [`QUEUE_DEPTH`] behind the sequential engine; behind
+    /// the pipelined one, with credits, as many as the freeze held (the two entries, a triangle
+    /// per period in flight and the vertex register's), so the rate is kept.
+    pub fn queue_depth(&self) -> u32 {
+        match self.engine_timing() {
+            Some((ii, latency, _)) if self.queue_credit() => QUEUE_DEPTH + latency / ii + 2,
+            _ => QUEUE_DEPTH,
+        }
     }
 
     /// Clocks the dividers run: the reciprocal's RW quotient bits, `div_bits` a clock.

@@ -60,7 +60,8 @@ pub(super) fn emit_engine(hw: &Hw, sp: &Stager) -> Item {
         ii,
         latency,
         epochs,
-        depth: super::QUEUE_DEPTH,
+        depth: hw.queue_depth(),
+        credit: hw.queue_credit(),
         entry_w: super::engine::entry_bits(hw, &s),
         binary_phase: hw.sequential().is_some(),
         capture: hw.sequential().is_some(),
@@ -287,17 +288,28 @@ impl Reference<'_> {
                 b.push(comment("The design's data decisions, taken as given: the result's guard-band check and cull."));
                 b.push(wire("f_push", 1, "f_due && res_guard && !res_cull"));
                 b.push(wire("f_full", 1, format!("f_qn == {}", lit(qw, e.depth as u64))));
-                if e.capture {
-                    b.push(comment("The engine freezes exactly while the queue is full and a result for it is due or the engine"));
-                    b.push(comment("has a field of one to write into its tail (res_wr, taken as given)."));
-                    b.push(wire("f_en", 1, "!(f_full && (f_push || res_wr))"));
+                if e.credit {
+                    b.push(comment("The engine never freezes; a triangle is taken only while the queue has an entry neither"));
+                    b.push(comment("held nor reserved for the triangle in the vertex register or one in flight."));
+                    b.push(wire("f_en", 1, "1'b1"));
+                    b.push(wire("f_qin", 1, "f_push"));
+                    let held = format!("{} + {}", zext("f_vf", 1, qw + 1), engine::held(e, qw + 1));
+                    b.push(wire("f_held", qw + 1, held));
+                    b.push(wire("f_room", 1, format!("f_held < {}", lit(qw + 1, e.depth as u64))));
                 } else {
-                    b.push(comment("The engine freezes exactly while a result for the queue is due and the queue is full."));
-                    b.push(wire("f_en", 1, "!(f_push && f_full)"));
+                    if e.capture {
+                        b.push(comment("The engine freezes exactly while the queue is full and a result for it is due or the engine"));
+                        b.push(comment("has a field of one to write into its tail (res_wr, taken as given)."));
+                        b.push(wire("f_en", 1, "!(f_full && (f_push || res_wr))"));
+                    } else {
+                        b.push(comment("The engine freezes exactly while a result for the queue is due and the queue is full."));
+                        b.push(wire("f_en", 1, "!(f_push && f_full)"));
+                    }
+                    b.push(wire("f_qin", 1, "f_push && !f_full"));
+                    b.push(wire("f_room", 1, "1'b1"));
                 }
-                b.push(wire("f_qin", 1, "f_push && !f_full"));
                 b.push(wire("f_enter", 1, format!("f_en && f_ph == {}", lit(phw, (e.ii - 1) as u64))));
-                b.push(wire("f_rdy", 1, "!f_vf || f_enter"));
+                b.push(wire("f_rdy", 1, "(!f_vf || f_enter) && f_room"));
             }
         }
         b.push(wire("f_acc", 1, "in_valid && f_rdy"));
@@ -479,16 +491,7 @@ impl Reference<'_> {
             }
             SetupShape::Engine(e) => {
                 b.extend(self.engine_ports(e));
-                // A period's triangle is in flight until its result is taken: every period before
-                // the result's, and the result's up to its phase.
-                let q = e.latency / e.ii;
-                let n = e.periods();
-                let mut s = format!(" + {}", zext("f_qn", e.qw(), cw));
-                s += &(0..q).map(|j| format!(" + {}", zext(&bit("f_vld", n, j), 1, cw))).collect::<String>();
-                s + &format!(
-                    " + {}",
-                    zext(&format!("({} && f_ph <= {})", bit("f_vld", n, q), lit(e.phw(), (e.latency % e.ii) as u64)), 1, cw)
-                )
+                format!(" + {}", engine::held(e, cw))
             }
         };
         b.push(comment("Nothing lost or invented: every accepted triangle was flagged, culled or walked, or is"));

@@ -22,8 +22,8 @@ pub(crate) fn module(names: &Names, w: u32, depth: u32, capture: Option<&[u32]>)
     ];
     match capture {
         None => header.extend([
-            "push takes din at the tail (never when full: the engine freezes instead); pop drops the head; dout is the head".into(),
-            "while nonempty. Both in one clock are allowed.".into(),
+            "push takes din at the tail (never when full: the engine freezes, or the front-end's credits hold a triangle back);".into(),
+            "pop drops the head; dout is the head while nonempty. Both in one clock are allowed.".into(),
         ]),
         Some(f) => header.extend([
             format!("we[k] writes field k of din into the tail entry ({} fields, W fixed by them); push makes the tail an", f.len()),

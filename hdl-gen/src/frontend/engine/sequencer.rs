@@ -52,9 +52,10 @@ impl Seq {
     }
 
     /// The entry: the last phase, a triangle (or a bubble) moves from the vertex registers into
-    /// the program's inputs.
+    /// the program's inputs (the engine never freezes: the front-end's credits keep the queue
+    /// from overflowing).
     pub fn entry(&self) -> String {
-        format!("en && {}", self.phase(self.ii - 1))
+        self.phase(self.ii - 1)
     }
 }
 
@@ -105,13 +106,7 @@ pub(super) fn emit(seq: &Seq, wd: &Widths, iw: u32, latency: u32, body: &mut Vec
     if r > 1 {
         reset.push(set("ep", one_hot(r)));
     }
-    body.push(Item::Always(vec![Stmt::If(
-        "rst".into(),
-        reset,
-        vec![
-            Stmt::If("in_valid && in_ready".into(), take, vec![Stmt::If("enter".into(), vec![set("v_full", "1'b0")], vec![])]),
-            Stmt::If("en".into(), run, vec![]),
-        ],
-    )]));
+    run.insert(0, Stmt::If("in_valid && in_ready".into(), take, vec![Stmt::If("enter".into(), vec![set("v_full", "1'b0")], vec![])]));
+    body.push(Item::Always(vec![Stmt::If("rst".into(), reset, run)]));
     body.push(Item::Blank);
 }

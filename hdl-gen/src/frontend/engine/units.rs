@@ -284,18 +284,14 @@ fn multiplier(mul: MulUnit, acc_w: u32, (lane_a, lane_b, sh_w): (u32, u32, u32),
             let up = if acc_w > bits { format!("{{accn[{}:0], {bits}'d0}}", acc_w - bits - 1) } else { format!("{acc_w}'d0") };
             g.push(wire("accn", acc_w, "acc + pe"));
             g.push(wire("held", acc_w, format!("f1 ? {acc_w}'d0 : s1 ? {up} : accn")));
-            g.push(Item::Always(vec![Stmt::If(
-                "en".into(),
-                vec![
-                    Stmt::If(lane("la", 1), vec![set("ra", lane("a", lane_a))], vec![]),
-                    Stmt::If(lane("lb", 1), vec![set("rb", lane("b", lane_b))], vec![]),
-                    set("f1", lane("f", 1)),
-                    set("s1", lane("sh", sh_w)),
-                    set("pr", "ra * rb"),
-                    set("acc", "held"),
-                ],
-                vec![],
-            )]));
+            g.push(Item::Always(vec![
+                Stmt::If(lane("la", 1), vec![set("ra", lane("a", lane_a))], vec![]),
+                Stmt::If(lane("lb", 1), vec![set("rb", lane("b", lane_b))], vec![]),
+                set("f1", lane("f", 1)),
+                set("s1", lane("sh", sh_w)),
+                set("pr", "ra * rb"),
+                set("acc", "held"),
+            ]));
         }
         MulUnit::ShiftAdd { bits } => {
             g.extend([reg("pp", acc_w), reg("f2", 1), reg("acc", acc_w)]);
@@ -305,11 +301,7 @@ fn multiplier(mul: MulUnit, acc_w: u32, (lane_a, lane_b, sh_w): (u32, u32, u32),
             g.push(wire("pw", acc_w, prod));
             g.push(wire("accn", acc_w, format!("(f2 ? {acc_w}'d0 : acc) + pp")));
             let shift = if bits == 1 { lane("sh", sh_w) } else { format!("({} * {bits})", lane("sh", sh_w)) };
-            g.push(Item::Always(vec![Stmt::If(
-                "en".into(),
-                vec![set("pp", format!("pw << {shift}")), set("f2", lane("f", 1)), set("acc", "accn")],
-                vec![],
-            )]));
+            g.push(Item::Always(vec![set("pp", format!("pw << {shift}")), set("f2", lane("f", 1)), set("acc", "accn")]));
         }
     }
     g
@@ -421,13 +413,9 @@ pub(super) fn dividers(v: &Values, seq: &Seq, body: &mut Vec<Item>) -> Vec<Captu
         g.push(Item::Assign(lane("q", qm), lo.clone()));
         g.push(Item::Assign(lane("r", wd), rm.clone()));
         g.push(Item::Always(vec![Stmt::If(
-            "en".into(),
-            vec![Stmt::If(
-                lane("ld", 1),
-                vec![set("dv", lane("d", wd)), set("rm", lane("n", wd)), set("lo", lane("lo", qm))],
-                vec![set("rm", rm), set("lo", lo)],
-            )],
-            vec![],
+            lane("ld", 1),
+            vec![set("dv", lane("d", wd)), set("rm", lane("n", wd)), set("lo", lane("lo", qm))],
+            vec![set("rm", rm), set("lo", lo)],
         )]));
         body.push(Item::ForGenerate { var: k, count: n, label: format!("g_div{gi}"), body: g });
     }
@@ -484,11 +472,7 @@ pub(super) fn shifters(v: &Values, seq: &Seq, body: &mut Vec<Item>) -> Vec<Captu
         let (ra, rk) = (format!("sh{u}_a"), format!("sh{u}_n"));
         body.push(reg(&ra, *w));
         body.push(reg(&rk, *wk));
-        body.push(Item::Always(vec![Stmt::If(
-            "en".into(),
-            vec![set(&ra, and_or(&merged(&sr[0]), *w)), set(&rk, and_or(&merged(&sr[1]), *wk))],
-            vec![],
-        )]));
+        body.push(Item::Always(vec![set(&ra, and_or(&merged(&sr[0]), *w)), set(&rk, and_or(&merged(&sr[1]), *wk))]));
         body.push(comment("verilator lint_off UNUSEDSIGNAL"));
         body.push(wire(&format!("sh{u}_y"), *w, format!("{ra} << {rk}")));
         body.push(comment("verilator lint_on UNUSEDSIGNAL"));

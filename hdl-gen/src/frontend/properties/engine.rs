@@ -30,6 +30,16 @@ pub(super) fn engine_probes(e: &EngineShape) -> Vec<(String, String, u32)> {
     v
 }
 
+/// The triangles the queue holds or will, at `w` bits: its entries, and each period's triangle in
+/// flight until its result is due (every period before the result's, the result's up to its
+/// phase).
+pub(super) fn held(e: &EngineShape, w: u32) -> String {
+    let (q, n) = (e.latency / e.ii, e.periods());
+    let mut s = zext("f_qn", e.qw(), w);
+    s += &(0..q).map(|j| format!(" + {}", zext(&bit("f_vld", n, j), 1, w))).collect::<String>();
+    s + &format!(" + {}", zext(&format!("({} && f_ph <= {})", bit("f_vld", n, q), lit(e.phw(), (e.latency % e.ii) as u64)), 1, w))
+}
+
 impl Reference<'_> {
     /// The engine's reference registers: the vertex register, the phase and the valid bits of
     /// the periods in flight, and the queue (its count and entries, in order).
@@ -91,8 +101,15 @@ impl Reference<'_> {
     pub(super) fn engine_ports(&self, e: &EngineShape) -> Vec<Item> {
         let (depth, none) = (lit(e.qw(), e.depth as u64), lit(e.qw(), 0));
         let mut b = vec![comment("The engine: a result is due exactly at its schedule's latency after its entry plus the clocks")];
-        b.push(comment("frozen; the engine freezes exactly while that result finds the queue full."));
-        b.push(Item::Comb(vec![when("f_past", vec![assert("res_v == f_due"), assert("en == f_en")])]));
+        if e.credit {
+            b.push(comment("frozen (none: it never freezes, and the queue never holds more than its entries and those"));
+            b.push(comment("reserved, so a due result always finds room)."));
+            let all = lit(e.qw() + 1, e.depth as u64);
+            b.push(Item::Comb(vec![when("f_past", vec![assert("res_v == f_due"), assert(format!("f_held <= {all}"))])]));
+        } else {
+            b.push(comment("frozen; the engine freezes exactly while that result finds the queue full."));
+            b.push(Item::Comb(vec![when("f_past", vec![assert("res_v == f_due"), assert("en == f_en")])]));
+        }
         b.push(comment("The queue: never written when full, never read when empty, written exactly when a result"));
         b.push(comment("for it is due and it has room, read exactly when the walker takes; its head is the oldest"));
         b.push(comment("entry not yet taken (entries leave in the order they came, none lost or repeated)."));
@@ -109,21 +126,23 @@ impl Reference<'_> {
                 when(format!("f_qn != {none}"), vec![assert("q_head == f_q0")]),
             ],
         )]));
-        b.push(comment("The freeze: while en is low the phase ring, the valid bits of the periods in flight and"));
-        b.push(comment("the epoch ring hold, and the queue is not written."));
-        let mut hold = vec![assert("f_e_vld == $past(f_e_vld)")];
-        if e.ii > 1 {
-            hold.push(assert("f_e_ph == $past(f_e_ph)"));
+        if !e.credit {
+            b.push(comment("The freeze: while en is low the phase ring, the valid bits of the periods in flight and"));
+            b.push(comment("the epoch ring hold, and the queue is not written."));
+            let mut hold = vec![assert("f_e_vld == $past(f_e_vld)")];
+            if e.ii > 1 {
+                hold.push(assert("f_e_ph == $past(f_e_ph)"));
+            }
+            if e.epochs > 1 {
+                hold.push(assert("f_e_ep == $past(f_e_ep)"));
+            }
+            b.push(Item::Comb(vec![when("f_past && !en", vec![assert("!q_in")])]));
+            b.push(Item::Always(vec![when("f_past && !$past(rst) && !$past(en)", hold)]));
         }
-        if e.epochs > 1 {
-            hold.push(assert("f_e_ep == $past(f_e_ep)"));
-        }
-        b.push(Item::Comb(vec![when("f_past && !en", vec![assert("!q_in")])]));
         if e.capture {
             b.push(comment("The capture: no field is written into the tail while the queue is full (the tail is its oldest entry)."));
             b.push(Item::Comb(vec![when("f_past && q_full", vec![assert("res_we == 0")])]));
         }
-        b.push(Item::Always(vec![when("f_past && !$past(rst) && !$past(en)", hold)]));
         b
     }
 
@@ -146,6 +165,11 @@ impl Reference<'_> {
         // from the head is its memory word (rd + i) mod depth.
         let rd = "{1'b0, f_q_rd}";
         let wrap = |x: String, k: u32| format!("({x} == {} || {x} == {})", lit(pw + 1, k as u64), lit(pw + 1, (k + e.depth) as u64));
+        if !e.depth.is_power_of_two() {
+            // The pointers stay below the depth (a word past it is no entry).
+            let last = lit(pw, (e.depth - 1) as u64);
+            link.extend([assert(format!("f_q_rd <= {last}")), assert(format!("f_q_wr <= {last}"))]);
+        }
         link.extend([
             assert(format!("f_q_cnt == {}", zext("f_qn", qw, pw + 1))),
             assert(format!("{rd} + f_q_cnt == {{1'b0, f_q_wr}} || {rd} + f_q_cnt == {{1'b0, f_q_wr}} + {}", lit(pw + 1, e.depth as u64))),
@@ -157,6 +181,11 @@ impl Reference<'_> {
                     vec![assert(format!("f_q_mem{k} == f_q{i}"))],
                 ));
             }
+        }
+        if e.credit {
+            // The credits: the entries neither held nor reserved.
+            let w = e.qw() + 1;
+            link.push(assert(format!("{} == {} - f_held", zext("cr", bits_for(e.depth), w), lit(w, e.depth as u64))));
         }
         link.extend([assert("w_valid == f_wv"), when("f_wv", vec![assert("w_row == f_wrow"), assert("w_last == f_wlast")])]);
         link

@@ -73,6 +73,9 @@ pub struct EngineShape {
     /// The queue's entries and an entry's bits.
     pub depth: u32,
     pub entry_w: u32,
+    /// The front-end takes a triangle only with a queue entry for its result (`cr`), and the
+    /// engine never freezes (the pipelined engine's); else a due result freezes it (`en`).
+    pub credit: bool,
     /// The engine's phase is a binary counter (`pc`, the sequential engine's), not a one-hot ring.
     pub binary_phase: bool,
     /// The engine writes the result's fields into the queue's tail as it produces them (the
