@@ -10,6 +10,24 @@ use verilator_harness::ffi::{FeOut, TriIn};
 use verilator_harness::frontend::{random_triangles, run_frontend};
 use verilator_harness::segment::{Stress, Traffic};
 
+/// The line of `text` that `f` picks, for a fault to replace; panics naming `what` if the
+/// generated text has none (a renamed signal must fail the test, not skip the fault).
+fn line(text: &str, what: &str, f: &dyn Fn(&str) -> bool) -> String {
+    text.lines().find(|l| f(l)).unwrap_or_else(|| panic!("no line for {what}")).to_string()
+}
+
+/// The walker's faults' base: the ECP5 plan's front-end at 37x23, level 1 (the row stages), its
+/// seed for `label` and 3,000 random triangles; `None` where `engine` skips (COSIM_RTL_DIR).
+fn row_stage_base(label: &str) -> Option<(verilator_harness::models::Model, u64, Vec<golden::frontend::FixedTriangle>)> {
+    let opts = engine(golden::setup::Screen { width: 37, height: 23 }, golden::frontend::engine::SetupForm::Ecp5_25f)?;
+    let opts = hdl_gen::Options { pipeline: golden::pipeline::Pipeline::at(1), ..opts };
+    let base = verilator_harness::ondemand::describe(&opts, verilator_harness::models::Kind::Frontend).unwrap_or_else(|e| panic!("{e}"));
+    let seed = verilator_harness::seed(label);
+    let fe = opts.frontend().unwrap().fe;
+    let tris = random_triangles(&mut SeedRng::seed_from_u64(seed), &fe, 3000);
+    Some((base, seed, tris))
+}
+
 /// Negative controls of the engine's co-simulation: a fault planted in the generated engine
 /// (each a model built on first use, 37x23) is caught on the triangles the clean model passes:
 /// one logic operation reading its operand's copy of the next triangle (a copy off by one
@@ -79,16 +97,8 @@ fn engine_planted_faults_are_caught() {
 #[test]
 #[ignore]
 fn walker_planted_faults_are_caught() {
-    let Some(opts) = engine(golden::setup::Screen { width: 37, height: 23 }, golden::frontend::engine::SetupForm::Ecp5_25f) else { return };
-    let opts = hdl_gen::Options { pipeline: golden::pipeline::Pipeline::at(1), ..opts };
-    let base = verilator_harness::ondemand::describe(&opts, verilator_harness::models::Kind::Frontend).unwrap_or_else(|e| panic!("{e}"));
-    let seed = verilator_harness::seed("frontend walker faults");
-    let fe = opts.frontend().unwrap().fe;
-    let tris = random_triangles(&mut SeedRng::seed_from_u64(seed), &fe, 3000);
+    let Some((base, seed, tris)) = row_stage_base("frontend walker faults") else { return };
     let text = |file: &str| base.sources.iter().find(|(n, _)| n == file).unwrap_or_else(|| panic!("no {file}")).1.clone();
-    let line = |text: &str, what: &str, f: &dyn Fn(&str) -> bool| {
-        text.lines().find(|l| f(l)).unwrap_or_else(|| panic!("no line for {what}")).to_string()
-    };
     let edge = text("tri_fe_edge.v");
     let step = line(&edge, "the row's place moved against rs", &|l| l.contains("w_ge <= w_ge ||"));
     let load = line(&edge, "the row's place loaded against rs", &|l| l.contains("w_ge <= first >= rs;"));
@@ -125,12 +135,10 @@ fn span_path_planted_faults_are_caught() {
     let fe = opts.frontend().unwrap().fe;
     let tris = random_triangles(&mut SeedRng::seed_from_u64(seed), &fe, 3000);
     let text = &base.sources.iter().find(|(n, _)| n == "tri_frontend.v").expect("the front-end's file").1;
-    let line =
-        |what: &str, f: &dyn Fn(&str) -> bool| text.lines().find(|l| f(l)).unwrap_or_else(|| panic!("no line for {what}")).to_string();
-    let up = line("the correction's select", &|l| l.contains(" i0 = ") && l.contains("i0_ge4"));
-    let prod = line("the estimate's sum", &|l| l.contains(" prod = ") && l.contains("prod_2"));
-    let m = line("the correction's sum", &|l| l.contains(" m_an = ") && l.contains("m_an_2"));
-    let gx = line("Gxn lo's sum", &|l| l.contains(" gx = ") && l.contains("gx_2"));
+    let up = line(text, "the correction's select", &|l| l.contains(" i0 = ") && l.contains("i0_ge4"));
+    let prod = line(text, "the estimate's sum", &|l| l.contains(" prod = ") && l.contains("prod_2"));
+    let m = line(text, "the correction's sum", &|l| l.contains(" m_an = ") && l.contains("m_an_2"));
+    let gx = line(text, "Gxn lo's sum", &|l| l.contains(" gx = ") && l.contains("gx_2"));
     let faults = [
         (up.clone(), up.replacen("i0_ge4 ? qt2 : ", "", 1), "the second compare dropped"),
         (prod.clone(), prod.replacen(" + ({18'd0, prod_2} << 18)", "", 1), "the estimate's partial product in logic dropped"),
@@ -149,17 +157,10 @@ fn span_path_planted_faults_are_caught() {
 #[test]
 #[ignore]
 fn running_sums_planted_faults_are_caught() {
-    let Some(opts) = engine(golden::setup::Screen { width: 37, height: 23 }, golden::frontend::engine::SetupForm::Ecp5_25f) else { return };
-    let opts = hdl_gen::Options { pipeline: golden::pipeline::Pipeline::at(1), ..opts };
-    let base = verilator_harness::ondemand::describe(&opts, verilator_harness::models::Kind::Frontend).unwrap_or_else(|e| panic!("{e}"));
-    let seed = verilator_harness::seed("frontend running sums faults");
-    let fe = opts.frontend().unwrap().fe;
-    let tris = random_triangles(&mut SeedRng::seed_from_u64(seed), &fe, 3000);
+    let Some((base, seed, tris)) = row_stage_base("frontend running sums faults") else { return };
     let text = &base.sources.iter().find(|(n, _)| n == "tri_frontend.v").expect("the front-end's file").1;
-    let line =
-        |what: &str, f: &dyn Fn(&str) -> bool| text.lines().find(|l| f(l)).unwrap_or_else(|| panic!("no line for {what}")).to_string();
-    let step = line("slot a's carry", &|l| l.contains("w_ca <= w_ca + "));
-    let source = line("the span's source", &|l| l.contains("we_gxs <= "));
+    let step = line(text, "slot a's carry", &|l| l.contains("w_ca <= w_ca + "));
+    let source = line(text, "the span's source", &|l| l.contains("we_gxs <= "));
     let clamp = source.split_once(" ? ").expect("the clamp's test").0.split_once("<= ").expect("the source's value").1.to_string();
     let faults = [
         (step.clone(), format!("{}w_ca <= w_ca;", step.split_once("w_ca").unwrap().0), "slot a's carry ignored"),
