@@ -46,11 +46,13 @@ impl Reference<'_> {
     pub(super) fn engine_declarations(&self, e: &EngineShape) -> Vec<Item> {
         let mut b = vec![
             comment("The reference. The vertex register, the engine's phase (0 .. II - 1) and the valid bits of the"),
-            comment("periods in flight (a triangle or a bubble enters at the last phase), the queue: its count and"),
-            comment("its entries, the head first, each as the engine offered it (the result's bits, taken as given)."),
+            comment("periods in flight (a triangle or a bubble enters at the last phase), the queue's count, and one"),
+            comment("tracked entry: a result the solver picks freely as it enters the queue (f_pick), kept as the"),
+            comment("engine offered it (the result's bits, taken as given) with its place from the head. Whatever"),
+            comment("holds of it holds of every entry, so one entry's bits stand for the queue's."),
         ];
         b.extend([reg("f_vf", 1), reg("f_ph", e.phw()), reg("f_vld", e.periods()), reg("f_qn", e.qw())]);
-        b.extend((0..e.depth).map(|i| reg(&format!("f_q{i}"), e.entry_w)));
+        b.extend([wire("f_pick", 1, "$anyseq"), reg("f_tin", 1), reg("f_tp", bits_for(e.depth - 1)), reg("f_tv", e.entry_w)]);
         b
     }
 
@@ -74,7 +76,6 @@ impl Reference<'_> {
                     vec![set("f_ph", format!("f_ph + {}", one(phw)))],
                 )],
             ),
-            when("f_take", (1..e.depth).map(|i| set(format!("f_q{}", i - 1), format!("f_q{i}"))).collect()),
         ];
         // The slot the pushed result lands in: behind the entries that stay. With the capture,
         // the result is the tail entry as the engine wrote it (the queue's word at wr), so a
@@ -85,14 +86,19 @@ impl Reference<'_> {
         } else {
             "res".to_string()
         };
-        for i in 0..e.depth {
-            st.push(when(
-                format!("f_qin && f_qn - {} == {}", zext("f_take", 1, qw), lit(qw, i as u64)),
-                vec![set(format!("f_q{i}"), pushed.clone())],
-            ));
-        }
+        // The tracked entry moves up a place on each take and leaves from the head; a result is
+        // picked only while none is tracked, behind the entries that stay.
+        let pw = bits_for(e.depth - 1);
+        st.push(when(
+            "f_tin && f_take",
+            vec![Stmt::If(format!("f_tp == {}", lit(pw, 0)), vec![set("f_tin", "1'b0")], vec![set("f_tp", format!("f_tp - {}", one(pw)))])],
+        ));
+        // Its place, below the depth (a result enters only with room), so within the pointer's bits.
+        let place = format!("f_qn - {}", zext("f_take", 1, qw));
+        st.push(when("f_qin && !f_tin && f_pick", vec![set("f_tin", "1'b1"), set("f_tv", pushed), set("f_tp", place)]));
         st.push(set("f_qn", format!("f_qn + {} - {}", zext("f_qin", 1, qw), zext("f_take", 1, qw))));
-        let reset = vec![set("f_vf", "1'b0"), set("f_ph", lit(phw, 0)), set("f_vld", lit(n, 0)), set("f_qn", lit(qw, 0))];
+        let reset =
+            vec![set("f_vf", "1'b0"), set("f_ph", lit(phw, 0)), set("f_vld", lit(n, 0)), set("f_qn", lit(qw, 0)), set("f_tin", "1'b0")];
         (reset, st)
     }
 
@@ -123,7 +129,7 @@ impl Reference<'_> {
                 assert("take == f_take"),
                 assert(format!("q_ne == (f_qn != {none})")),
                 assert(format!("q_full == (f_qn == {depth})")),
-                when(format!("f_qn != {none}"), vec![assert("q_head == f_q0")]),
+                when(format!("f_tin && f_tp == {}", lit(bits_for(e.depth - 1), 0)), vec![assert("q_head == f_tv")]),
             ],
         )]));
         if !e.credit {
@@ -174,13 +180,10 @@ impl Reference<'_> {
             assert(format!("f_q_cnt == {}", zext("f_qn", qw, pw + 1))),
             assert(format!("{rd} + f_q_cnt == {{1'b0, f_q_wr}} || {rd} + f_q_cnt == {{1'b0, f_q_wr}} + {}", lit(pw + 1, e.depth as u64))),
         ]);
-        for i in 0..e.depth {
-            for k in 0..e.depth {
-                link.push(when(
-                    format!("f_qn > {} && {}", lit(qw, i as u64), wrap(format!("{rd} + {}", lit(pw + 1, i as u64)), k)),
-                    vec![assert(format!("f_q_mem{k} == f_q{i}"))],
-                ));
-            }
+        // The tracked entry is one the queue holds, in its memory word (rd + place) mod depth.
+        link.push(when("f_tin", vec![assert(format!("{} < f_qn", zext("f_tp", pw, qw)))]));
+        for k in 0..e.depth {
+            link.push(when(format!("f_tin && {}", wrap(format!("{rd} + {{1'b0, f_tp}}"), k)), vec![assert(format!("f_q_mem{k} == f_tv"))]));
         }
         if e.credit {
             // The credits: the entries neither held nor reserved.
