@@ -110,7 +110,11 @@ fn walker_planted_faults_are_caught() {
     assert_faults_caught(&base, "tri_fe_edge.v", "wfault", faults, seed, &tris);
     let fe_text = text("tri_frontend.v");
     let mg = line(&fe_text, "the span's left end", &|l| l.contains("we_mg <= mg_w;"));
-    let faults = [(mg.clone(), mg.replacen("mg_w", "wr_lg0", 1), "the span's left end from one edge alone")];
+    let end = line(&fe_text, "the walk's end stepped", &|l| l.contains("w_end <= w_row + ") && l.contains(" == w_last;"));
+    let faults = [
+        (mg.clone(), mg.replacen("mg_w", "wr_lg0", 1), "the span's left end from one edge alone"),
+        (end.clone(), end.replacen("'d1 == w_last", "'d2 == w_last", 1), "the walk's registered end a row early"),
+    ];
     assert_faults_caught(&base, "tri_frontend.v", "wsfault", faults, seed, &tris);
 }
 
@@ -160,12 +164,13 @@ fn running_sums_planted_faults_are_caught() {
     let Some((base, seed, tris)) = row_stage_base("frontend running sums faults") else { return };
     let text = &base.sources.iter().find(|(n, _)| n == "tri_frontend.v").expect("the front-end's file").1;
     let step = line(text, "slot a's carry", &|l| l.contains("w_ca <= w_ca + "));
-    let source = line(text, "the span's source", &|l| l.contains("we_gxs <= "));
-    let clamp = source.split_once(" ? ").expect("the clamp's test").0.split_once("<= ").expect("the source's value").1.to_string();
+    let source = line(text, "the span's source", &|l| l.contains(" we_gxs = "));
+    let clamp = source.split_once(" ? ").expect("the clamp's test").0.split_once("= ").expect("the source's value").1.to_string();
     let faults = [
         (step.clone(), format!("{}w_ca <= w_ca;", step.split_once("w_ca").unwrap().0), "slot a's carry ignored"),
-        (source.clone(), source.replacen("? wr_pa : wr_pb", "? wr_pa : wr_pa", 1), "the span's source always slot a"),
+        (source.clone(), source.replacen("? we_pa : we_pb", "? we_pa : we_pa", 1), "the span's source always slot a"),
         (source.clone(), source.replacen(&format!("{clamp} ?"), "1'b1 ?", 1), "the clamp takes slot a's sum"),
+        (source.clone(), source.replacen("? we_pa : we_pb", "? wr_pa : wr_pb", 1), "the source's sums a row stage early"),
     ];
     assert_faults_caught(&base, "tri_frontend.v", "sumfault", faults, seed, &tris);
 }
