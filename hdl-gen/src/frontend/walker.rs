@@ -173,20 +173,13 @@ pub(super) fn row_registers(hw: &Hw) -> Vec<Vec<(String, u32, bool)>> {
     vec![first, second]
 }
 
-pub(super) fn emit(hw: &Hw, names: &Names, body: &mut Vec<Item>) {
-    let fe = &hw.fe;
-    let Widths { yw: row_w, aw: area_w, k: sum_w, rw: recip_w, .. } = fe.widths();
-    let (xw, dw) = (fe.cfg.xbits, fe.cfg.dw());
-    let w = fe.screen.width as i64;
-    body.push(comment("Walker: the triangle being walked, one row per clock (each edge's DDA in g_edge[k].u_edge)."));
-    body.push(reg("w_valid", 1));
-    body.push(reg("w_row", row_w));
-    body.push(reg("w_last", row_w));
-    let regs = [("w_di", dw), ("w_an", area_w), ("w_rn", recip_w), ("w_tn", sum_w), ("w_gxn", sum_w), ("w_dyn", sum_w)];
-    body.extend(regs.iter().filter(|(n, _)| *n != "w_gxn" || reads_gxn(hw)).map(|(n, ww)| reg(n, *ww)));
-    let (sum_decls, sum_load, sum_step) = if hw.run_sums() { super::sums::walker(hw) } else { Default::default() };
-    body.extend(sum_decls);
-    if fe.di == DiMode::Scanline {
+/// When the walker steps (outside the row stages' form): not loading, not stalled, a row after
+/// this one.
+const STEP_WHEN: &str = "!rst && !take && adv && w_valid && !w_end";
+
+/// The walker's stall (`adv`), its end of walk, its take and its load or step.
+fn control(hw: &Hw, body: &mut Vec<Item>) {
+    if hw.fe.di == DiMode::Scanline {
         let (_, sd_cnt_w) = scanline_divider(hw);
         body.push(comment("Per-scanline dI (the comparison option): a restoring divider, busy for each span of m >= 2."));
         body.extend([reg("sd_busy", 1), reg("sd_cnt", sd_cnt_w), reg("sd_neg", 1)]);
@@ -216,10 +209,9 @@ pub(super) fn emit(hw: &Hw, names: &Names, body: &mut Vec<Item>) {
     }
     let end_w = edge::end_width(hw);
     body.push(swire("lo0", end_w, slit(end_w, 0)));
-    body.push(swire("hi0", end_w, slit(end_w, w - 1)));
+    body.push(swire("hi0", end_w, slit(end_w, hw.fe.screen.width as i64 - 1)));
     body.push(comment("The edges: loaded with the set-up result, stepped a row; each one's bound on the row."));
     // The incremental I0's walker also waits for its start engine (`ie_wait`, declared below).
-    let step_when = "!rst && !take && adv && w_valid && !w_end";
     // Behind the row stages the walker's load and step are chosen from its registers (w_next,
     // w_more) and its stall gates the registers' enables alone (`adv`, the edges' `go`): `take`,
     // the two together, fanned out to every walker and edge register was a long path
@@ -233,9 +225,26 @@ pub(super) fn emit(hw: &Hw, names: &Names, body: &mut Vec<Item>) {
         if inc {
             body.push(net("w_step", 1));
         } else {
-            body.push(wire("w_step", 1, step_when));
+            body.push(wire("w_step", 1, STEP_WHEN));
         }
     }
+}
+
+pub(super) fn emit(hw: &Hw, names: &Names, body: &mut Vec<Item>) {
+    let fe = &hw.fe;
+    let Widths { yw: row_w, aw: area_w, k: sum_w, rw: recip_w, .. } = fe.widths();
+    let (xw, dw) = (fe.cfg.xbits, fe.cfg.dw());
+    body.push(comment("Walker: the triangle being walked, one row per clock (each edge's DDA in g_edge[k].u_edge)."));
+    body.push(reg("w_valid", 1));
+    body.push(reg("w_row", row_w));
+    body.push(reg("w_last", row_w));
+    let regs = [("w_di", dw), ("w_an", area_w), ("w_rn", recip_w), ("w_tn", sum_w), ("w_gxn", sum_w), ("w_dyn", sum_w)];
+    body.extend(regs.iter().filter(|(n, _)| *n != "w_gxn" || reads_gxn(hw)).map(|(n, ww)| reg(n, *ww)));
+    let (sum_decls, sum_load, sum_step) = if hw.run_sums() { super::sums::walker(hw) } else { Default::default() };
+    body.extend(sum_decls);
+    control(hw, body);
+    let (inc, engine, tracked) = (super::incremental::on(hw), hw.engine_form(), hw.row_stage());
+    let end_w = edge::end_width(hw);
     body.push(net("e_lg", 3 * end_w));
     body.push(net("e_ha", 3 * end_w));
     let state = edge::state_outputs(hw);
@@ -300,7 +309,7 @@ pub(super) fn emit(hw: &Hw, names: &Names, body: &mut Vec<Item>) {
         body.push(wire("px", 1, format!("w_valid && !room[{end_w}]")));
         super::incremental::select(hw, body);
         body.push(wire("emit", 1, "px && !ie_wait"));
-        body.push(assign("w_step", format!("{step_when} && !ie_wait")));
+        body.push(assign("w_step", format!("{STEP_WHEN} && !ie_wait")));
     } else {
         body.push(wire("emit", 1, format!("{row_valid} && !room[{end_w}]")));
     }
