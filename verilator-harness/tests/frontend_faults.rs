@@ -89,11 +89,12 @@ fn engine_planted_faults_are_caught() {
 
 /// Negative controls of the walker behind the row stages (`--pipeline 1`, the ECP5 plan at
 /// 37x23, each a model built on first use): an edge's place among its rows moved onto its first
-/// row a row late, an edge starting at the walk's first row never entered, and the span's left
-/// end taken from one edge alone in the row stages (12,188, 17,523 and 14,763 mismatches). Caught on the triangles the clean model passes
+/// row a row late, an edge starting at the walk's first row never entered, the span's left
+/// end taken from one edge alone in the row stages, and the walk's registered end made a row
+/// early (11,950, 17,349, 14,712 and 13,301 mismatches). Caught on the triangles the clean model passes
 /// (`engine_spans_equal_golden_at_the_targets_pipeline_level`). (The place not moved past an
 /// edge's last row is no fault: beyond its end vertex an edge's line lies outside the triangle,
-/// so its bound never wins.) Slow tier: three models, about a minute of CPU each to build.
+/// so its bound never wins.) Slow tier: four models, about a minute of CPU each to build.
 #[test]
 #[ignore]
 fn walker_planted_faults_are_caught() {
@@ -110,7 +111,11 @@ fn walker_planted_faults_are_caught() {
     assert_faults_caught(&base, "tri_fe_edge.v", "wfault", faults, seed, &tris);
     let fe_text = text("tri_frontend.v");
     let mg = line(&fe_text, "the span's left end", &|l| l.contains("we_mg <= mg_w;"));
-    let faults = [(mg.clone(), mg.replacen("mg_w", "wr_lg0", 1), "the span's left end from one edge alone")];
+    let end = line(&fe_text, "the walk's end stepped", &|l| l.contains("w_end <= w_row + ") && l.contains(" == w_last;"));
+    let faults = [
+        (mg.clone(), mg.replacen("mg_w", "wr_lg0", 1), "the span's left end from one edge alone"),
+        (end.clone(), end.replacen("'d1 == w_last", "'d2 == w_last", 1), "the walk's registered end a row early"),
+    ];
     assert_faults_caught(&base, "tri_frontend.v", "wsfault", faults, seed, &tris);
 }
 
@@ -151,21 +156,24 @@ fn span_path_planted_faults_are_caught() {
 /// Negative controls of the walker's running sums of `Gxn g` (`--target ecp5-25f`'s span path,
 /// golden's `frontend::sums`; the ECP5 plan at level 1, 37x23, each a model built on first use):
 /// slot a's sum stepped by `Gxn Qs` alone (its edge's carries not added), the span's source always
-/// slot a, the screen's clamp taking slot a's sum instead of 0 (golden's three planted faults).
+/// slot a, the screen's clamp taking slot a's sum instead of 0 (golden's three planted faults;
+/// 4,406, 2,317 and 3,215 mismatches), and the source selected from the first row stage's sums
+/// (a row ahead's) instead of the second's (5,236).
 /// Caught on the triangles the clean model passes
-/// (`engine_spans_equal_golden_at_the_targets_pipeline_level`). Slow tier: three models.
+/// (`engine_spans_equal_golden_at_the_targets_pipeline_level`). Slow tier: four models.
 #[test]
 #[ignore]
 fn running_sums_planted_faults_are_caught() {
     let Some((base, seed, tris)) = row_stage_base("frontend running sums faults") else { return };
     let text = &base.sources.iter().find(|(n, _)| n == "tri_frontend.v").expect("the front-end's file").1;
     let step = line(text, "slot a's carry", &|l| l.contains("w_ca <= w_ca + "));
-    let source = line(text, "the span's source", &|l| l.contains("we_gxs <= "));
-    let clamp = source.split_once(" ? ").expect("the clamp's test").0.split_once("<= ").expect("the source's value").1.to_string();
+    let source = line(text, "the span's source", &|l| l.contains(" we_gxs = "));
+    let clamp = source.split_once(" ? ").expect("the clamp's test").0.split_once("= ").expect("the source's value").1.to_string();
     let faults = [
         (step.clone(), format!("{}w_ca <= w_ca;", step.split_once("w_ca").unwrap().0), "slot a's carry ignored"),
-        (source.clone(), source.replacen("? wr_pa : wr_pb", "? wr_pa : wr_pa", 1), "the span's source always slot a"),
+        (source.clone(), source.replacen("? we_pa : we_pb", "? we_pa : we_pa", 1), "the span's source always slot a"),
         (source.clone(), source.replacen(&format!("{clamp} ?"), "1'b1 ?", 1), "the clamp takes slot a's sum"),
+        (source.clone(), source.replacen("? we_pa : we_pb", "? wr_pa : wr_pb", 1), "the source's sums a row stage early"),
     ];
     assert_faults_caught(&base, "tri_frontend.v", "sumfault", faults, seed, &tris);
 }

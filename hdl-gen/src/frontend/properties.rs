@@ -558,6 +558,9 @@ impl Reference<'_> {
         if let Some(r) = rows.first() {
             // A walked row after its triangle's first has that triangle's row ahead of it.
             link.push(when("f_wv && !f_wnew", vec![assert("f_r1v"), assert(format!("w_di == {}", r.di))]));
+            // Behind the row stages the walk's end is a register: its row's compare, set while
+            // no row is walked.
+            link.push(assert("w_end == (!f_wv || f_wend)"));
         }
         for sp in span_stages {
             link.push(on_screen(&sp.valid, &sp.x, &sp.len, xw, width));

@@ -56,13 +56,19 @@ pub(super) fn walker(hw: &Hw) -> (Vec<Item>, Vec<Stmt>, Vec<Stmt>) {
     (decls, load, step)
 }
 
-/// The span's `Gxn lo` source (`sb` bits, a sum to negate): the slot whose edge wins the left
-/// end's least-of-three (`side0..2`, the edges' bounds on the row), 0 when the end is the clamp
-/// (`mg`'s sign clear: every bound is at most 0, `lo = -mg`). Edges that tie have equal sums.
-pub(super) fn source(hw: &Hw, side: &str, (pa, pb, sa): (&str, &str, &str), mg: &str) -> String {
-    let wd = hw.fe.widths();
-    let end_w = super::edge::end_width(hw);
+/// Whether the left end's source is slot a (`sa` one-hot: slot a's edge): the edge that wins the
+/// left end's least-of-three (`side0..2`, the edges' bounds on the row) is slot a's. Edges that
+/// tie have equal sums, so either slot is right for them.
+pub(super) fn slot_a_wins(side: &str, sa: &str) -> String {
     let c = |i: u32, j: u32| format!("{side}{i} <= {side}{j}");
     let win = format!("(({} && {}) ? {} : ({}) ? {} : {})", c(0, 1), c(0, 2), onehot(0), c(1, 2), onehot(1), onehot(2));
-    format!("{mg}[{}] ? ((|({win} & {sa})) ? {pa} : {pb}) : {}", end_w - 1, lit(wd.sum_bits(), 0))
+    format!("|({win} & {sa})")
+}
+
+/// The span's `Gxn lo` source (`sb` bits, a sum to negate): slot a's sum when `a_wins`
+/// ([`slot_a_wins`]), else slot b's; 0 when the end is the clamp (`mg`'s sign clear: every bound
+/// is at most 0, `lo = -mg`).
+pub(super) fn source(hw: &Hw, (pa, pb, a_wins): (&str, &str, &str), mg: &str) -> String {
+    let end_w = super::edge::end_width(hw);
+    format!("{mg}[{}] ? (({a_wins}) ? {pa} : {pb}) : {}", end_w - 1, lit(hw.fe.widths().sum_bits(), 0))
 }

@@ -68,13 +68,28 @@ pub(super) fn reads_gxn(hw: &Hw) -> bool {
 }
 
 /// The running sums' row-stage registers (`Hw::run_sums`): the slots' sums and slot a's edge
-/// with the row's bounds, then the span's source with its ends.
+/// with the row's bounds, then the two sums again with the left end's choice (`we_ga`: slot a's
+/// edge wins) beside the span's ends. The source is selected from these registers
+/// ([`sum_source`]): the compares, the choice and a 54-bit select in one clock into `we_gxs`
+/// were the merged front-end's critical path (docs/fpga.md).
 fn sum_stage_registers(hw: &Hw) -> [Vec<(String, u32)>; 2] {
     if !hw.run_sums() {
         return [Vec::new(), Vec::new()];
     }
     let sb = hw.fe.widths().sum_bits();
-    [vec![("wr_pa".into(), sb), ("wr_pb".into(), sb), ("wr_sa".into(), 3)], vec![("we_gxs".into(), sb)]]
+    [
+        vec![("wr_pa".into(), sb), ("wr_pb".into(), sb), ("wr_sa".into(), 3)],
+        vec![("we_pa".into(), sb), ("we_pb".into(), sb), ("we_ga".into(), 1)],
+    ]
+}
+
+/// The span's `Gxn lo` source in the second row stage, `we_gxs`: selected from its registers, so
+/// the span path's first register (`p1_gxs`) is one select away from them.
+fn sum_source(hw: &Hw, body: &mut Vec<Item>) {
+    if hw.run_sums() {
+        body.push(comment("The span's Gxn lo source: the winning slot's sum, or 0 at the screen's clamp."));
+        body.push(wire("we_gxs", hw.fe.widths().sum_bits(), super::sums::source(hw, ("we_pa", "we_pb", "we_ga"), "we_mg")));
+    }
 }
 
 /// The row stages: the walked row (valid, each edge's bound, the span path's inputs)
@@ -121,8 +136,12 @@ fn row_stages(hw: &Hw, body: &mut Vec<Item>) {
         };
         moves.push(set(n, v));
     }
-    if !second.is_empty() {
-        moves.push(set("we_gxs", super::sums::source(hw, "wr_lg", ("wr_pa", "wr_pb", "wr_sa"), "mg_w")));
+    for (n, _) in &second {
+        let v = match n.as_str() {
+            "we_ga" => super::sums::slot_a_wins("wr_lg", "wr_sa"),
+            _ => n.replace("we_", "wr_"),
+        };
+        moves.push(set(n, v));
     }
     body.push(reg(v2, 1));
     body.extend([sreg("we_mg", end_w), sreg("we_hi3", end_w)]);
@@ -133,6 +152,7 @@ fn row_stages(hw: &Hw, body: &mut Vec<Item>) {
     }
     let reset = vec![set(v1, "1'b0"), set(v2, "1'b0")];
     body.push(Item::Always(vec![Stmt::If("rst".into(), reset, vec![Stmt::If("adv".into(), moves, vec![])])]));
+    sum_source(hw, body);
 }
 
 /// The row stages' registers for the manifest, one list a stage: `(name, bits, signed)`; none
@@ -153,11 +173,67 @@ pub(super) fn row_registers(hw: &Hw) -> Vec<Vec<(String, u32, bool)>> {
     vec![first, second]
 }
 
+/// When the walker steps (outside the row stages' form): not loading, not stalled, a row after
+/// this one.
+const STEP_WHEN: &str = "!rst && !take && adv && w_valid && !w_end";
+
+/// The walker's stall (`adv`), its end of walk, its take and its load or step.
+fn control(hw: &Hw, body: &mut Vec<Item>) {
+    if hw.fe.di == DiMode::Scanline {
+        let (_, sd_cnt_w) = scanline_divider(hw);
+        body.push(comment("Per-scanline dI (the comparison option): a restoring divider, busy for each span of m >= 2."));
+        body.extend([reg("sd_busy", 1), reg("sd_cnt", sd_cnt_w), reg("sd_neg", 1)]);
+        body.push(wire("adv", 1, "(!out_valid || out_ready) && !sd_busy"));
+    } else {
+        body.push(wire("adv", 1, "!out_valid || out_ready"));
+    }
+    // Behind the row stages the walk's end is a register, `!w_valid || w_row == w_last` made as
+    // the row is loaded or stepped (set in a reset and kept while no row is walked): compared in
+    // the clock it is read, it led the take and the walker's loads (`w_row == w_last`, then
+    // `w_next` into every walker and edge register's enable) on the merged front-end's critical
+    // path (docs/fpga.md). Now the take and the loads' enable are one LUT4 of registers.
+    let tracked = hw.row_stage();
+    let free = if tracked {
+        body.push(comment("w_end: no row after the walked one (its triangle's last row, or none walked)."));
+        body.push(reg("w_end", 1));
+        "w_end"
+    } else {
+        body.push(wire("w_end", 1, "w_row == w_last"));
+        "(!w_valid || w_end)"
+    };
+    let inc = super::incremental::on(hw);
+    let engine = hw.engine_form();
+    let waiting = if engine { "q_ne" } else { "st == HOLD" };
+    if !inc {
+        body.push(assign("take", format!("{waiting} && adv && {free}")));
+    }
+    let end_w = edge::end_width(hw);
+    body.push(swire("lo0", end_w, slit(end_w, 0)));
+    body.push(swire("hi0", end_w, slit(end_w, hw.fe.screen.width as i64 - 1)));
+    body.push(comment("The edges: loaded with the set-up result, stepped a row; each one's bound on the row."));
+    // The incremental I0's walker also waits for its start engine (`ie_wait`, declared below).
+    // Behind the row stages the walker's load and step are chosen from its registers (w_next,
+    // w_more) and its stall gates the registers' enables alone (`adv`, the edges' `go`): `take`,
+    // the two together, fanned out to every walker and edge register was a long path
+    // (docs/fpga.md). The edges' enables leave out the reset: an edge's state matters only under
+    // the walker's valid, which the reset clears, and its next load sets all of it.
+    if tracked {
+        body.push(wire("w_next", 1, format!("{waiting} && {free}")));
+        body.push(wire("w_more", 1, "!w_end"));
+    } else {
+        body.push(wire("w_load", 1, "!rst && take"));
+        if inc {
+            body.push(net("w_step", 1));
+        } else {
+            body.push(wire("w_step", 1, STEP_WHEN));
+        }
+    }
+}
+
 pub(super) fn emit(hw: &Hw, names: &Names, body: &mut Vec<Item>) {
     let fe = &hw.fe;
     let Widths { yw: row_w, aw: area_w, k: sum_w, rw: recip_w, .. } = fe.widths();
     let (xw, dw) = (fe.cfg.xbits, fe.cfg.dw());
-    let w = fe.screen.width as i64;
     body.push(comment("Walker: the triangle being walked, one row per clock (each edge's DDA in g_edge[k].u_edge)."));
     body.push(reg("w_valid", 1));
     body.push(reg("w_row", row_w));
@@ -166,46 +242,9 @@ pub(super) fn emit(hw: &Hw, names: &Names, body: &mut Vec<Item>) {
     body.extend(regs.iter().filter(|(n, _)| *n != "w_gxn" || reads_gxn(hw)).map(|(n, ww)| reg(n, *ww)));
     let (sum_decls, sum_load, sum_step) = if hw.run_sums() { super::sums::walker(hw) } else { Default::default() };
     body.extend(sum_decls);
-    if fe.di == DiMode::Scanline {
-        let (_, sd_cnt_w) = scanline_divider(hw);
-        body.push(comment("Per-scanline dI (the comparison option): a restoring divider, busy for each span of m >= 2."));
-        body.extend([reg("sd_busy", 1), reg("sd_cnt", sd_cnt_w), reg("sd_neg", 1)]);
-        body.push(wire("adv", 1, "(!out_valid || out_ready) && !sd_busy"));
-    } else {
-        body.push(wire("adv", 1, "!out_valid || out_ready"));
-    }
-    body.push(wire("w_end", 1, "w_row == w_last"));
-    let inc = super::incremental::on(hw);
-    let engine = hw.engine_form();
-    if engine && !inc {
-        body.push(assign("take", "q_ne && adv && (!w_valid || w_end)"));
-    } else if !inc {
-        body.push(assign("take", "st == HOLD && adv && (!w_valid || w_end)"));
-    }
+    control(hw, body);
+    let (inc, engine, tracked) = (super::incremental::on(hw), hw.engine_form(), hw.row_stage());
     let end_w = edge::end_width(hw);
-    body.push(swire("lo0", end_w, slit(end_w, 0)));
-    body.push(swire("hi0", end_w, slit(end_w, w - 1)));
-    body.push(comment("The edges: loaded with the set-up result, stepped a row; each one's bound on the row."));
-    // The incremental I0's walker also waits for its start engine (`ie_wait`, declared below).
-    let step_when = "!rst && !take && adv && w_valid && !w_end";
-    // Behind the row stages the walker's load and step are chosen from its registers (w_next,
-    // w_more) and its stall gates the registers' enables alone (`adv`, the edges' `go`): `take`,
-    // the two together, fanned out to every walker and edge register was a long path
-    // (docs/fpga.md). The edges' enables leave out the reset: an edge's state matters only under
-    // the walker's valid, which the reset clears, and its next load sets all of it.
-    let tracked = hw.row_stage();
-    if tracked {
-        let next = if engine { "q_ne && (!w_valid || w_end)" } else { "st == HOLD && (!w_valid || w_end)" };
-        body.push(wire("w_next", 1, next));
-        body.push(wire("w_more", 1, "w_valid && !w_end"));
-    } else {
-        body.push(wire("w_load", 1, "!rst && take"));
-        if inc {
-            body.push(net("w_step", 1));
-        } else {
-            body.push(wire("w_step", 1, step_when));
-        }
-    }
     body.push(net("e_lg", 3 * end_w));
     body.push(net("e_ha", 3 * end_w));
     let state = edge::state_outputs(hw);
@@ -254,7 +293,11 @@ pub(super) fn emit(hw: &Hw, names: &Names, body: &mut Vec<Item>) {
         body.push(wire(
             "w_gxs",
             hw.fe.widths().sum_bits(),
-            super::sums::source(hw, "lg", (&super::sums::slot_sum("a"), &super::sums::slot_sum("b"), "w_sa"), "mg"),
+            super::sums::source(
+                hw,
+                (&super::sums::slot_sum("a"), &super::sums::slot_sum("b"), &super::sums::slot_a_wins("lg", "w_sa")),
+                "mg",
+            ),
         ));
     }
     body.push(comment("verilator lint_off UNUSEDSIGNAL"));
@@ -266,7 +309,7 @@ pub(super) fn emit(hw: &Hw, names: &Names, body: &mut Vec<Item>) {
         body.push(wire("px", 1, format!("w_valid && !room[{end_w}]")));
         super::incremental::select(hw, body);
         body.push(wire("emit", 1, "px && !ie_wait"));
-        body.push(assign("w_step", format!("{step_when} && !ie_wait")));
+        body.push(assign("w_step", format!("{STEP_WHEN} && !ie_wait")));
     } else {
         body.push(wire("emit", 1, format!("{row_valid} && !room[{end_w}]")));
     }
@@ -283,6 +326,10 @@ pub(super) fn emit(hw: &Hw, names: &Names, body: &mut Vec<Item>) {
     load.retain(|st| reads_gxn(hw) || !matches!(st, Stmt::Set(l, _) if l == "w_gxn"));
     load.extend(sum_load);
     let mut step = vec![set("w_row", format!("w_row + {}", lit(row_w, 1))), set("w_tn", "w_tn + w_dyn")];
+    if tracked {
+        load.push(set("w_end", "s_first == s_last"));
+        step.push(set("w_end", format!("w_row + {} == w_last", lit(row_w, 1))));
+    }
     step.extend(sum_step);
     let walked = vec![Stmt::If("w_end".into(), vec![set("w_valid", "1'b0")], step)];
     let moves = if tracked {
@@ -295,7 +342,11 @@ pub(super) fn emit(hw: &Hw, names: &Names, body: &mut Vec<Item>) {
             vec![Stmt::If(if inc { "adv && w_valid && !ie_wait" } else { "adv && w_valid" }.into(), walked, vec![])],
         )]
     };
-    body.push(Item::Always(vec![Stmt::If("rst".into(), vec![set("w_valid", "1'b0")], moves)]));
+    let mut reset = vec![set("w_valid", "1'b0")];
+    if tracked {
+        reset.push(set("w_end", "1'b1"));
+    }
+    body.push(Item::Always(vec![Stmt::If("rst".into(), reset, moves)]));
     body.push(Item::Blank);
     if inc {
         super::incremental::engine(hw, body);

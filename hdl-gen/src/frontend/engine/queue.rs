@@ -7,7 +7,7 @@
 //! `push` then makes the tail an entry; the engine freezes while the queue is full and it has a
 //! field to write. The engine then holds no copy of the result (689 flip-flops at 640x480).
 
-use crate::verilog::{comment, set, sized, wire, Item, Kind, Module, Param, Port, Stmt};
+use crate::verilog::{comment, reg, set, sized, wire, Item, Kind, Module, Param, Port, Stmt};
 use crate::Names;
 
 /// The queue module, its parameters' defaults `w` bits and `depth` entries; with `capture`
@@ -55,15 +55,18 @@ pub(crate) fn module(names: &Names, w: u32, depth: u32, capture: Option<&[u32]>)
     body.push(sized(Kind::Reg, "rd", "PW", None));
     body.push(sized(Kind::Reg, "wr", "PW", None));
     body.push(sized(Kind::Reg, "cnt", "PW+1", None));
+    // Nonempty as a register (`cnt != 0`, kept with the count): the walker's take and its loads'
+    // enable read it, and `|cnt` before them was on the 25F's path into the read pointer.
+    body.push(reg("ne", 1));
     // The parameters narrowed to the pointers' widths (they fit: PW holds DEPTH - 1).
     body.push(comment("verilator lint_off WIDTH"));
     body.push(sized(Kind::Localparam, "LAST", "PW", Some("DEPTH - 1".into())));
     body.push(sized(Kind::Localparam, "ALL", "PW+1", Some("DEPTH".into())));
     body.push(comment("verilator lint_on WIDTH"));
     body.push(Item::Assign("dout".into(), "mem[rd]".into()));
-    body.push(Item::Assign("nonempty".into(), "|cnt".into()));
+    body.push(Item::Assign("nonempty".into(), "ne".into()));
     body.push(Item::Assign("full".into(), "cnt == ALL".into()));
-    body.push(wire("do_pop", 1, "pop && |cnt"));
+    body.push(wire("do_pop", 1, "pop && ne"));
     let next = |p: &str| format!("({p} == LAST) ? {{PW{{1'b0}}}} : {p} + 1'b1");
     let write = match capture {
         None => vec![Stmt::If("push".into(), vec![set("mem[wr]", "din")], vec![])],
@@ -82,8 +85,10 @@ pub(crate) fn module(names: &Names, w: u32, depth: u32, capture: Option<&[u32]>)
     let mut st = write;
     st.push(Stmt::If(
         "rst".into(),
-        vec![set("rd", "{PW{1'b0}}"), set("wr", "{PW{1'b0}}"), set("cnt", "{(PW+1){1'b0}}")],
+        vec![set("rd", "{PW{1'b0}}"), set("wr", "{PW{1'b0}}"), set("cnt", "{(PW+1){1'b0}}"), set("ne", "1'b0")],
         vec![
+            // Nonempty after this clock: an entry in, two or more held, or the one held kept.
+            set("ne", "push || |cnt[PW:1] || (ne && !do_pop)"),
             Stmt::If("push".into(), vec![set("wr", next("wr"))], vec![]),
             Stmt::If("do_pop".into(), vec![set("rd", next("rd"))], vec![]),
             Stmt::If(
