@@ -87,12 +87,14 @@
 
 pub mod engine;
 pub mod incremental;
+pub mod span_seq;
 pub mod sums;
 mod walk;
 
 use crate::format::{Config, Span};
 use crate::setup::{is_top_left, snap, Screen, Snapped, Triangle, SUBPIXEL};
 use serde::{Deserialize, Serialize};
+pub use span_seq::SpanForm;
 
 const HALF: i64 = SUBPIXEL / 2;
 
@@ -224,6 +226,9 @@ pub struct FrontEnd {
     /// How the set-up is built (issue 27): the spans do not depend on it, its clocks do.
     #[serde(default, skip_serializing_if = "SetupForm::is_default")]
     pub setup: SetupForm,
+    /// How the span path forms a row's `I0` (issue 27, the iCE40s): its rate and latency.
+    #[serde(default, skip_serializing_if = "SpanForm::is_default")]
+    pub span: SpanForm,
 }
 
 /// Every width of the front-end, derived once from the configuration: the generator declares
@@ -466,7 +471,7 @@ impl FrontEnd {
         if screen.height == 0 || screen.height > 1 << 16 {
             return Err(FrontEndError::Height { height: screen.height });
         }
-        Ok(FrontEnd { cfg, screen, di: DiMode::Triangle, i0: I0Form::Reciprocal, setup: SetupForm::Parallel })
+        Ok(FrontEnd { cfg, screen, di: DiMode::Triangle, i0: I0Form::Reciprocal, setup: SetupForm::Parallel, span: SpanForm::Parallel })
     }
 
     /// The same front-end with `dI` from `di`.
@@ -482,6 +487,11 @@ impl FrontEnd {
     /// The same front-end with its set-up built as `setup` says.
     pub fn with_setup(self, setup: SetupForm) -> FrontEnd {
         FrontEnd { setup, ..self }
+    }
+
+    /// The same front-end with its span path in the form `span` says.
+    pub fn with_span(self, span: SpanForm) -> FrontEnd {
+        FrontEnd { span, ..self }
     }
 
     pub fn widths(&self) -> Widths {
