@@ -4,7 +4,7 @@
 //! other option keeps its own default. The choices are the measured best for each device
 //! (docs/design.md, "Targets"; figures in docs/fpga.md), so they change when a measurement does.
 
-use golden::frontend::{I0Form, SetupForm};
+use golden::frontend::{I0Form, SetupForm, SpanForm};
 use serde::{Deserialize, Serialize};
 
 /// A device family and size the generated chain is meant to fit.
@@ -35,6 +35,8 @@ pub struct Choice {
     pub fe_i0: I0Form,
     /// `--fe-setup`.
     pub fe_setup: SetupForm,
+    /// `--fe-span`.
+    pub fe_span: SpanForm,
 }
 
 impl Target {
@@ -54,7 +56,13 @@ impl Target {
             Target::Ice40Hx8k => SetupForm::Ice40Hx8k,
             Target::Ice40Up5k => SetupForm::Ice40Up5k,
         };
-        Choice { pipeline: 1, fe_div_bits: None, fe_i0: I0Form::Reciprocal, fe_setup }
+        // The iCE40s walk a covered row every few dozen clocks: their span path's products on one
+        // shift-add unit, not in parallel logic (most of their front-end's LUTs, docs/fpga.md).
+        let fe_span = match self {
+            Target::Ecp5_25f => SpanForm::Parallel,
+            Target::Ice40Hx8k | Target::Ice40Up5k => SpanForm::Sequential,
+        };
+        Choice { pipeline: 1, fe_div_bits: None, fe_i0: I0Form::Reciprocal, fe_setup, fe_span }
     }
 
     /// The name `--target` takes.

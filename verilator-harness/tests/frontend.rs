@@ -414,7 +414,7 @@ fn engine_spans_of(opts: hdl_gen::Options, n: usize) {
     // Golden's spans are the same in both I0 forms; the incremental form's are its own model's.
     let fe = frontend(m).with_i0(opts.fe_i0);
     let hw = opts.frontend().unwrap();
-    assert_eq!(fe.with_setup(opts.fe_setup), hw.fe, "the model's front-end is the plan's");
+    assert_eq!(fe.with_setup(opts.fe_setup).with_span(opts.fe_span), hw.fe, "the model's front-end is the plan's");
     assert_eq!(hw.latency(), m.latency, "the manifest's latency is the engine's");
     let tris = random_triangles(&mut SeedRng::seed_from_u64(seed), &fe, n);
     let exp = Expected::new(fe, &tris);
@@ -574,6 +574,31 @@ fn sequential_incremental_i0_spans_equal_golden() {
     let Some(opts) = form(small, 0) else { return };
     let fault = LineFault { file: "tri_frontend.v", line: "ie_p <= ie_p + (ie_sb[0]", from: "ie_sb[0]", to: "ie_sb[1]" };
     fault.caught(&opts, "frontend sequential incremental fault", "seqincfault", "the shift-add's partial product from the wrong bit");
+}
+
+/// The sequential span path (`--fe-span sequential`, the iCE40 targets' choice) behind both
+/// iCE40 engines, 1,000 triangles each (37x23 and 640x480, levels 0 and 1), as
+/// [`engine_spans_of`]; a fault (the correction's `q~ + 1` made `q~`) is caught. Slow tier:
+/// `cargo nextest run -p verilator-harness --run-ignored only -E 'test(/sequential_span/)'`.
+#[test]
+#[ignore]
+fn sequential_span_path_spans_equal_golden() {
+    use golden::frontend::{engine::SetupForm::*, SpanForm};
+    let (small, big) = (golden::setup::Screen { width: 37, height: 23 }, golden::setup::Screen::default());
+    let form = |screen, setup, level| {
+        engine(screen, setup).map(|o| hdl_gen::Options {
+            fe_span: SpanForm::Sequential,
+            pipeline: golden::pipeline::Pipeline::at(level),
+            ..o
+        })
+    };
+    for (screen, setup, level) in [(small, Ice40Hx8k, 0), (big, Ice40Hx8k, 1), (small, Ice40Up5k, 1), (big, Ice40Up5k, 1)] {
+        let Some(opts) = form(screen, setup, level) else { return };
+        engine_spans_of(opts, 1000);
+    }
+    let Some(opts) = form(small, Ice40Hx8k, 1) else { return };
+    let fault = LineFault { file: "tri_frontend.v", line: "sq_qt_now} + ", from: "} + ", to: "} - " };
+    fault.caught(&opts, "frontend sequential span fault", "seqspanfault", "the correction's q~ + 1 made q~ - 1");
 }
 
 /// The shared-edge mesh through `tri_fb_p8` with the engine's front-end: every pixel of the

@@ -116,6 +116,10 @@ impl Hw {
     /// and above the row stages and 8 ([`golden::pipeline::i0_registers`]; 8 alone with the
     /// incremental `I0`).
     pub fn i0_stages(&self) -> u32 {
+        // The sequential span path: its clocks from a covered row's accept to the output write.
+        if let Some(q) = self.fe.span_seq() {
+            return q.row_clocks() + self.row_stages();
+        }
         golden::pipeline::i0_registers(self.pipeline).iter().filter(|&&r| r).count() as u32 + self.row_stages()
     }
 

@@ -171,6 +171,8 @@ pub(super) fn emit(hw: &Hw, names: &Names, body: &mut Vec<Item>) {
         body.push(comment("Per-scanline dI (the comparison option): a restoring divider, busy for each span of m >= 2."));
         body.extend([reg("sd_busy", 1), reg("sd_cnt", sd_cnt_w), reg("sd_neg", 1)]);
         body.push(wire("adv", 1, "(!out_valid || out_ready) && !sd_busy"));
+    } else if super::span_seq::unit(hw).is_some() {
+        super::span_seq::handshake(hw, body);
     } else {
         body.push(wire("adv", 1, "!out_valid || out_ready"));
     }
