@@ -64,6 +64,10 @@ impl Hw {
     pub fn queue_depth(&self) -> u32 {
         match self.engine_timing() {
             Some((ii, latency, _)) if self.queue_credit() => QUEUE_DEPTH + latency / ii + 2,
+            // Behind the sequential span path one entry: the walker copies it as it takes it, and
+            // a second entry (its read multiplexer and 689 flip-flops at 640x480) was about a
+            // fifth of the HX8K's logic cells (docs/fpga.md).
+            _ if self.fe.span_seq().is_some() => 1,
             _ => QUEUE_DEPTH,
         }
     }

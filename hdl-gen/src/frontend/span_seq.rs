@@ -58,21 +58,22 @@ pub(super) fn emit(hw: &Hw, body: &mut Vec<Item>) -> Stager {
     body.push(wire("unused_sums_top", 4, format!("{{w_tn[{0}:{1}], w_gxn[{0}:{1}]}}", sum_w - 1, sum_w - 2)));
     body.push(wire("unused_gxn_low", zeros, format!("{}[{}:0]", row("w_gxn"), zeros - 1)));
     body.push(comment("verilator lint_on UNUSEDSIGNAL"));
-    let held = [
-        ("sq_y", row_w),
-        ("sq_x", xw),
-        ("sq_len", xw + 1),
-        ("sq_di", dw),
-        ("sq_gxn", gx_w),
-        ("sq_an", area_w),
-        ("sq_rn", recip_w),
-        ("sq_l", area_w + 2),
-        ("sq_qt", iw),
-        ("sq_ge2", 1),
-        ("sq_acc", w),
-        ("sq_mc", w),
-        ("sq_mp", mp_w),
-    ];
+    // The triangle's values: without row stages the walker's own registers, which hold while
+    // the unit is busy (`adv` is low, and the walker takes the next triangle only once it is
+    // idle, `walker::emit`); behind row stages, which hold the rows after it, copies.
+    let copies = hw.row_stage();
+    let tri = |n: &str| -> String {
+        match (copies, n) {
+            (true, _) => format!("sq_{n}"),
+            (false, "gxn") => format!("w_gxn[{}:{zeros}]", s2_w - 2),
+            (false, _) => format!("w_{n}"),
+        }
+    };
+    let mut held = vec![("sq_y", row_w), ("sq_x", xw), ("sq_len", xw + 1)];
+    if copies {
+        held.extend([("sq_di", dw), ("sq_gxn", gx_w), ("sq_an", area_w), ("sq_rn", recip_w)]);
+    }
+    held.extend([("sq_l", area_w + 2), ("sq_qt", iw), ("sq_ge2", 1), ("sq_acc", w), ("sq_mc", w), ("sq_mp", mp_w)]);
     body.extend(held.iter().map(|(n, ww)| reg(n, *ww)));
     body.push(wire("accept", 1, "adv && emit"));
     // One step: the accumulator plus the multiplicand times the multiplier's low B bits, as B
@@ -96,14 +97,14 @@ pub(super) fn emit(hw: &Hw, body: &mut Vec<Item>) -> Stager {
     };
     let mc_load = |m: Multiplicand, accept: bool| match m {
         Multiplicand::An if accept => zext(&row("w_an"), area_w, w),
-        Multiplicand::An => zext("sq_an", area_w, w),
-        Multiplicand::Gx => format!("{{sq_gxn, {}}}", lit(zeros + 1, 0)),
+        Multiplicand::An => zext(&tri("an"), area_w, w),
+        Multiplicand::Gx => format!("{{{}, {}}}", tri("gxn"), lit(zeros + 1, 0)),
         Multiplicand::H => zext(&format!("sq_acc[{}:{t}]", w - 1), w - t, w),
     };
     let mp_load = |m: Multiplier| match m {
         Multiplier::One => lit(mp_w, 1),
         Multiplier::Lo => zext("sq_x", xw, mp_w),
-        Multiplier::Rn => zext("sq_rn", recip_w, mp_w),
+        Multiplier::Rn => zext(&tri("rn"), recip_w, mp_w),
         Multiplier::Qt1 => zext(&format!("{} + {}", zext("sq_qt_now", iw, iw + 1), lit(iw + 1, 1)), iw + 1, mp_w),
     };
     let load = |k: usize, accept: bool| -> Vec<Stmt> {
@@ -124,15 +125,15 @@ pub(super) fn emit(hw: &Hw, body: &mut Vec<Item>) -> Stager {
     };
     let mut on_accept = vec![set("sq_busy", "1'b1")];
     on_accept.extend(load(0, true));
-    on_accept.extend([
-        set("sq_y", row("w_row")),
-        set("sq_x", "lo_u"),
-        set("sq_len", format!("len_w[{xw}:0]")),
-        set("sq_di", row("w_di")),
-        set("sq_gxn", format!("{}[{}:{zeros}]", row("w_gxn"), s2_w - 2)),
-        set("sq_an", row("w_an")),
-        set("sq_rn", row("w_rn")),
-    ]);
+    on_accept.extend([set("sq_y", row("w_row")), set("sq_x", "lo_u"), set("sq_len", format!("len_w[{xw}:0]"))]);
+    if copies {
+        on_accept.extend([
+            set("sq_di", row("w_di")),
+            set("sq_gxn", format!("{}[{}:{zeros}]", row("w_gxn"), s2_w - 2)),
+            set("sq_an", row("w_an")),
+            set("sq_rn", row("w_rn")),
+        ]);
+    }
     let step = vec![
         set("sq_acc", "sq_sum"),
         set("sq_mc", format!("sq_mc << {b}")),
@@ -156,7 +157,8 @@ pub(super) fn emit(hw: &Hw, body: &mut Vec<Item>) -> Stager {
         )],
     )]));
     body.push(comment("The output register: the unit's result, written when it is done and the output is free."));
-    let write = vec![set("out_y", "sq_y"), set("out_x", "sq_x"), set("out_len", "sq_len"), set("out_i0", "sq_i0"), set("out_di", "sq_di")];
+    let write =
+        vec![set("out_y", "sq_y"), set("out_x", "sq_x"), set("out_len", "sq_len"), set("out_i0", "sq_i0"), set("out_di", tri("di"))];
     body.push(Item::Always(vec![Stmt::If(
         "rst".into(),
         vec![set("out_valid", "1'b0")],

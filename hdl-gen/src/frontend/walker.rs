@@ -179,7 +179,12 @@ pub(super) fn emit(hw: &Hw, names: &Names, body: &mut Vec<Item>) {
     body.push(wire("w_end", 1, "w_row == w_last"));
     let inc = super::incremental::on(hw);
     let engine = hw.engine_form();
-    if engine && !inc {
+    // Without row stages the sequential span path reads the triangle's values from the walker's
+    // registers while it is busy: the next triangle is taken once the last row has left.
+    let seq_direct = super::span_seq::unit(hw).is_some() && !hw.row_stage();
+    if engine && seq_direct {
+        body.push(assign("take", "q_ne && adv && !w_valid"));
+    } else if engine && !inc {
         body.push(assign("take", "q_ne && adv && (!w_valid || w_end)"));
     } else if !inc {
         body.push(assign("take", "st == HOLD && adv && (!w_valid || w_end)"));
