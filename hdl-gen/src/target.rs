@@ -62,7 +62,15 @@ impl Target {
             Target::Ecp5_25f => SpanForm::Parallel,
             Target::Ice40Hx8k | Target::Ice40Up5k => SpanForm::Sequential,
         };
-        Choice { pipeline: 1, fe_div_bits: None, fe_i0: I0Form::Reciprocal, fe_setup, fe_span }
+        // Level 0 on the iCE40s: their span path is sequential, so level 1's span stages are gone
+        // and its two row stages only cost flip-flops (HX8K tri_fb_p4 in its harness: 9,920 logic
+        // cells at level 0 against 10,445 at level 1, docs/fpga.md); their p = 4 shader runs at
+        // 85 MHz on the HX8K at level 0.
+        let pipeline = match self {
+            Target::Ecp5_25f => 1,
+            Target::Ice40Hx8k | Target::Ice40Up5k => 0,
+        };
+        Choice { pipeline, fe_div_bits: None, fe_i0: I0Form::Reciprocal, fe_setup, fe_span }
     }
 
     /// The name `--target` takes.
