@@ -49,7 +49,8 @@ impl Target {
     /// and 12 SB_MAC16 on the UP5K's sequential engine against 8,719 and 81 with them) and
     /// sets a triangle up in fewer clocks than the parallel form at the same clock (12 against
     /// 13); `--pipeline 1` (the span path in stages: the parallel form's 18.2 MHz at level 0
-    /// became 47-48 MHz); the reciprocal `I0`, which the engine forms take.
+    /// became 47-48 MHz) on the ECP5, 0 on the iCE40s with their sequential span path; the
+    /// reciprocal `I0`, which the engine forms take.
     pub fn choice(self) -> Choice {
         let fe_setup = match self {
             Target::Ecp5_25f => SetupForm::Ecp5_25f,
