@@ -141,6 +141,14 @@ mod tests {
         for (id, other) in cases {
             assert_ne!(decided(id, &m), decided(id, other), "{id}");
         }
+        let span = hdl_gen::Options {
+            fe_setup: golden::frontend::SetupForm::Ice40Up5k,
+            fe_span: golden::frontend::SpanForm::Sequential,
+            ..Default::default()
+        };
+        for id in ["fe_span", "target"] {
+            assert_ne!(decided(id, &engine), decided(id, &manifest(&span)), "{id}");
+        }
         assert!(decided("no_such_flag", &m).is_err());
     }
 }
