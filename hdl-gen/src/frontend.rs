@@ -117,9 +117,9 @@ fn build(hw: &Hw, names: &Names) -> (Module, Vec<golden::pipeline::PipeStage>) {
         engine::setup(hw, names, &mut body);
         walker::emit(hw, names, &mut body);
         if span_seq::unit(hw).is_some() {
-            // Its handshake has no properties yet (scripts/prove proves the parallel span path's).
             let sp = span_seq::emit(hw, &mut body);
             let stages = if hw.calc_clocks() > 1 { span_stage_list(hw, &sp) } else { Vec::new() };
+            body.push(properties::emit_engine(hw, &sp));
             return (top(hw, names, body), stages);
         }
         let sp = span::path(hw, &mut body);

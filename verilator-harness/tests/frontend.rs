@@ -134,14 +134,18 @@ fn set_up_costs(m: &'static verilator_harness::ffi::ModelInfo<verilator_harness:
     // The model's set-up form and divider rate, from the latency the build recorded for it (a
     // COSIM_RTL_DIR folder's may be an engine form or the incremental I0, which the model's
     // description does not name).
-    use golden::frontend::{I0Form, SetupForm};
+    use golden::frontend::{I0Form, SetupForm, SpanForm};
+    let seq = |setup, i0| matches!(setup, SetupForm::Ice40Hx8k | SetupForm::Ice40Up5k) && i0 == I0Form::Reciprocal;
     let hw = SetupForm::ALL
         .iter()
         .flat_map(|&setup| I0Form::ALL.map(move |i0| (setup, i0)))
         .filter(|&(setup, i0)| setup == SetupForm::Parallel || i0 == I0Form::Reciprocal)
         .flat_map(|(setup, i0)| {
+            SpanForm::ALL.into_iter().filter(move |&s| s == SpanForm::Parallel || seq(setup, i0)).map(move |s| (setup, i0, s))
+        })
+        .flat_map(|(setup, i0, span)| {
             hdl_gen::frontend::DIV_BITS.map(|div_bits| hdl_gen::frontend::Hw {
-                fe: frontend(m).with_setup(setup).with_i0(i0),
+                fe: frontend(m).with_setup(setup).with_i0(i0).with_span(span),
                 div_bits,
                 pipeline: m.pipeline,
             })

@@ -4,6 +4,7 @@
 //! busy: `adv`, their one stall, is the unit's readiness instead of the output register's.
 
 use super::hw::Hw;
+use super::properties::{SpanStage, SpanUnit};
 use super::stager::Stager;
 use super::walker;
 use crate::verilog::{comment, lit, reg, set, wire, zext, Item, Stmt};
@@ -13,6 +14,35 @@ use golden::frontend::Widths;
 /// The unit of a front-end whose span form is sequential.
 pub(super) fn unit(hw: &Hw) -> Option<SpanSeq> {
     hw.fe.span_seq()
+}
+
+/// The unit as the properties' one span stage: busy while it holds a row.
+pub(super) fn stage(hw: &Hw) -> SpanStage {
+    let di = if hw.row_stage() { "sq_di" } else { "w_di" };
+    SpanStage { valid: "sq_busy".into(), y: "sq_y".into(), x: "sq_x".into(), len: "sq_len".into(), di: di.into() }
+}
+
+/// The unit's shape for the properties: its clocks, the clocks left from its phase and count
+/// (each phase's steps, then a load clock and the steps of each phase after it), and whether the
+/// walker takes a triangle only when empty (the unit reads its registers, `walker::emit`).
+pub(super) fn shape(hw: &Hw) -> Option<SpanUnit> {
+    let q = unit(hw)?;
+    let (n, cnt_w) = (SpanSeq::PHASES.len(), count_bits(&q));
+    let phase_w = 32 - (n as u32 - 1).leading_zeros();
+    let sw = 32 - q.row_clocks().leading_zeros();
+    let after = |k: usize| -> u32 { SpanSeq::PHASES[k + 1..].iter().map(|p| 1 + q.steps(p)).sum() };
+    let left = (0..n - 1)
+        .rev()
+        .fold(lit(sw, after(n - 1) as u64), |acc, k| format!("sq_ph == {} ? {} : {acc}", lit(phase_w, k as u64), lit(sw, after(k) as u64)));
+    let steps = (0..n - 1).rev().fold(lit(cnt_w, q.steps(&SpanSeq::PHASES[n - 1]) as u64), |acc, k| {
+        format!("sq_ph == {} ? {} : {acc}", lit(phase_w, k as u64), lit(cnt_w, q.steps(&SpanSeq::PHASES[k]) as u64))
+    });
+    Some(SpanUnit {
+        row_clocks: q.row_clocks(),
+        left: format!("{} + ({left})", zext("sq_cnt", cnt_w, sw)),
+        bounds: vec![format!("sq_ph <= {}", lit(phase_w, n as u64 - 1)), format!("sq_cnt <= ({steps})")],
+        take_when_empty: !hw.row_stage(),
+    })
 }
 
 /// Width of the unit's step count: the most steps a phase takes.

@@ -14,7 +14,8 @@ use crate::Names;
 /// (the entry's fields' widths, least significant first) the tail is written a field at a time.
 pub(crate) fn module(names: &Names, w: u32, depth: u32, capture: Option<&[u32]>) -> Module {
     // One entry only behind a sequential engine that captures into it (the sequential span
-    // path's form, `Hw::queue_depth`): the walker copies the head as it takes it.
+    // path's form, `Hw::queue_depth`): the walker copies the head as it takes it. Its pointers
+    // then stay 0 (synthesis drops them and the read multiplexer).
     assert!(
         depth >= 2 || (depth == 1 && capture.is_some()),
         "a set-up result queue of {depth} entries (2 or more, so set-up overlaps the walk)"
@@ -54,9 +55,6 @@ pub(crate) fn module(names: &Names, w: u32, depth: u32, capture: Option<&[u32]>)
     if let Some(f) = capture {
         assert_eq!(f.iter().sum::<u32>(), w, "the fields fill the entry");
         ports.insert(4, Port::input("we", f.len() as u32, "", "per field: its bits of din into the tail entry"));
-    }
-    if depth == 1 {
-        return Module { name: names.fe_queue.clone(), header, params: params[..2].to_vec(), ports, body: single(capture.unwrap_or(&[w])) };
     }
     let mut body = vec![comment("Storage, pointers and the count.")];
     body.push(sized(Kind::Reg, "mem [0:DEPTH-1]", "W", None));
@@ -108,23 +106,4 @@ fn field_writes(fields: &[u32], into: &str) -> Vec<Stmt> {
             Stmt::If(format!("we[{k}]"), vec![set(format!("{into}{r}"), format!("din{r}"))], vec![])
         })
         .collect()
-}
-
-/// The one-entry queue's body: the entry and whether it holds a result. The engine writes no
-/// field while it is full, so the entry the walker reads is never written under it.
-fn single(fields: &[u32]) -> Vec<Item> {
-    let mut body = vec![comment("The entry and whether it is held.")];
-    body.push(sized(Kind::Reg, "mem", "W", None));
-    body.push(crate::verilog::reg("held", 1));
-    body.push(Item::Assign("dout".into(), "mem".into()));
-    body.push(Item::Assign("nonempty".into(), "held".into()));
-    body.push(Item::Assign("full".into(), "{31'd0, held} == DEPTH".into()));
-    let mut st = field_writes(fields, "mem");
-    st.push(Stmt::If(
-        "rst".into(),
-        vec![set("held", "1'b0")],
-        vec![Stmt::If("push".into(), vec![set("held", "1'b1")], vec![Stmt::If("pop".into(), vec![set("held", "1'b0")], vec![])])],
-    ));
-    body.push(Item::Always(st));
-    body
 }
