@@ -105,7 +105,6 @@ pub(super) fn emit(hw: &Hw, body: &mut Vec<Item>) -> Stager {
     }
     held.extend([("sq_l", area_w + 2), ("sq_qt", iw), ("sq_ge2", 1), ("sq_acc", w), ("sq_mc", w), ("sq_mp", mp_w)]);
     body.extend(held.iter().map(|(n, ww)| reg(n, *ww)));
-    body.push(wire("accept", 1, "adv && emit"));
     // One step: the accumulator plus the multiplicand times the multiplier's low B bits, as B
     // shifted adds (an iCE40 LUT4 and carry a bit each).
     let terms: Vec<String> = (0..b)
@@ -153,7 +152,10 @@ pub(super) fn emit(hw: &Hw, body: &mut Vec<Item>) -> Stager {
         }
         v
     };
-    let mut on_accept = vec![set("sq_busy", "1'b1")];
+    // Whenever the walker moves the unit loads its row (busy only when the row has a pixel): its
+    // ~300 registers' enable is then `adv` alone, where with the walker's pixel test in it that
+    // test's fan-out was the HX8K's critical path at level 0 (docs/fpga.md).
+    let mut on_accept = vec![set("sq_busy", "emit")];
     on_accept.extend(load(0, true));
     on_accept.extend([set("sq_y", row("w_row")), set("sq_x", "lo_u"), set("sq_len", format!("len_w[{xw}:0]"))]);
     if copies {
@@ -180,11 +182,7 @@ pub(super) fn emit(hw: &Hw, body: &mut Vec<Item>) -> Stager {
     body.push(Item::Always(vec![Stmt::If(
         "rst".into(),
         vec![set("sq_busy", "1'b0")],
-        vec![Stmt::If(
-            "accept".into(),
-            on_accept,
-            vec![Stmt::If("sq_fin".into(), vec![set("sq_busy", "1'b0")], vec![Stmt::If("sq_busy".into(), busy, vec![])])],
-        )],
+        vec![Stmt::If("adv".into(), on_accept, vec![Stmt::If("sq_busy".into(), busy, vec![])])],
     )]));
     body.push(comment("The output register: the unit's result, written when it is done and the output is free."));
     let write =
