@@ -94,7 +94,6 @@ mod walk;
 use crate::format::{Config, Span};
 use crate::setup::{is_top_left, snap, Screen, Snapped, Triangle, SUBPIXEL};
 use serde::{Deserialize, Serialize};
-pub use span_seq::SpanForm;
 
 const HALF: i64 = SUBPIXEL / 2;
 
@@ -210,6 +209,35 @@ impl SetupForm {
     /// Whether this is the default (serialised plans leave it out, so theirs stay as they were).
     pub fn is_default(&self) -> bool {
         *self == SetupForm::default()
+    }
+}
+
+/// How the span path forms a covered row's `I0` (`generate --fe-span`): the products in
+/// parallel logic or tiles, a row a clock (the default), or one after another on one shift-add
+/// unit ([`span_seq::SpanSeq`]). The spans are the same bit for bit; the walker's rate and the latency
+/// differ.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
+#[serde(rename_all = "kebab-case")]
+pub enum SpanForm {
+    #[default]
+    Parallel,
+    Sequential,
+}
+
+impl SpanForm {
+    pub const ALL: [SpanForm; 2] = [SpanForm::Parallel, SpanForm::Sequential];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            SpanForm::Parallel => "parallel",
+            SpanForm::Sequential => "sequential",
+        }
+    }
+
+    /// Whether this is the default (serialised plans leave it out, so theirs stay as they were).
+    pub fn is_default(&self) -> bool {
+        *self == SpanForm::default()
     }
 }
 

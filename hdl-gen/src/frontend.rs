@@ -115,6 +115,9 @@ fn build(hw: &Hw, names: &Names) -> (Module, Vec<golden::pipeline::PipeStage>) {
             "the shared set-up engine takes --fe-di triangle, and --fe-i0 incremental on the sequential engine only (hdl_gen::cli refuses the others)"
         );
         engine::setup(hw, names, &mut body);
+        if span_seq::unit(hw).is_some() {
+            span_seq::handshake(hw, &mut body);
+        }
         walker::emit(hw, names, &mut body);
         if span_seq::unit(hw).is_some() {
             let sp = span_seq::emit(hw, &mut body);

@@ -417,13 +417,7 @@ pub fn render(opts: &Options, names: &Names, modules: &[Module], unit: &Specular
             setup_clocks_walked: hw.setup_clocks().0,
             setup_clocks_dropped: hw.setup_clocks().1,
             span: hw.fe.span,
-            walker: match hw.fe.span_seq() {
-                None => "one clock per row from the first to the last row of the bounding box on screen".into(),
-                Some(q) => format!(
-                    "one clock per row from the first to the last row of the bounding box on screen, {} per covered row (the sequential span path's)",
-                    q.row_clocks()
-                ),
-            },
+            walker: walker_clocks(&hw),
         }),
         writer: wr.map(|w| WriterEntry {
             module: names.writer.clone(),
@@ -527,4 +521,14 @@ pub fn core_file(opts: &Options, names: &Names, modules: &[Module], wrappers: &[
 
 fn is_zero(v: &u32) -> bool {
     *v == 0
+}
+
+/// The manifest's walker clocks: a row a clock, or with the sequential span path its clocks a
+/// covered row.
+fn walker_clocks(hw: &crate::frontend::Hw) -> String {
+    let rows = "one clock per row from the first to the last row of the bounding box on screen";
+    match hw.fe.span_seq() {
+        None => rows.into(),
+        Some(q) => format!("{rows}, {} per covered row (the sequential span path's)", q.row_clocks()),
+    }
 }

@@ -24,37 +24,7 @@
 //! bit of the accumulator is the complement of the sign: the compare itself, with no subtractor
 //! beside the unit.
 
-use super::{mask, FrontEnd, Widths};
-use serde::{Deserialize, Serialize};
-
-/// How the span path forms a covered row's `I0` (`generate --fe-span`): the products in
-/// parallel logic or tiles, a row a clock (the default), or one after another on one shift-add
-/// unit ([`SpanSeq`]). The spans are the same bit for bit; the walker's rate and the latency
-/// differ.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
-#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
-#[serde(rename_all = "kebab-case")]
-pub enum SpanForm {
-    #[default]
-    Parallel,
-    Sequential,
-}
-
-impl SpanForm {
-    pub const ALL: [SpanForm; 2] = [SpanForm::Parallel, SpanForm::Sequential];
-
-    pub fn name(self) -> &'static str {
-        match self {
-            SpanForm::Parallel => "parallel",
-            SpanForm::Sequential => "sequential",
-        }
-    }
-
-    /// Whether this is the default (serialised plans leave it out, so theirs stay as they were).
-    pub fn is_default(&self) -> bool {
-        *self == SpanForm::default()
-    }
-}
+use super::{mask, FrontEnd, SpanForm, Widths};
 
 /// What a phase loads into the accumulator.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

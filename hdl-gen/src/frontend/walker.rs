@@ -171,21 +171,16 @@ pub(super) fn emit(hw: &Hw, names: &Names, body: &mut Vec<Item>) {
         body.push(comment("Per-scanline dI (the comparison option): a restoring divider, busy for each span of m >= 2."));
         body.extend([reg("sd_busy", 1), reg("sd_cnt", sd_cnt_w), reg("sd_neg", 1)]);
         body.push(wire("adv", 1, "(!out_valid || out_ready) && !sd_busy"));
-    } else if super::span_seq::unit(hw).is_some() {
-        super::span_seq::handshake(hw, body);
-    } else {
+    } else if hw.fe.span_seq().is_none() {
         body.push(wire("adv", 1, "!out_valid || out_ready"));
     }
     body.push(wire("w_end", 1, "w_row == w_last"));
     let inc = super::incremental::on(hw);
     let engine = hw.engine_form();
-    // Without row stages the sequential span path reads the triangle's values from the walker's
-    // registers while it is busy: the next triangle is taken once the last row has left.
-    let seq_direct = super::span_seq::unit(hw).is_some() && !hw.row_stage();
-    if engine && seq_direct {
-        body.push(assign("take", "q_ne && adv && !w_valid"));
-    } else if engine && !inc {
-        body.push(assign("take", "q_ne && adv && (!w_valid || w_end)"));
+    // The sequential span path (its own `adv`) reads these registers without row stages: take after the last row.
+    if engine && !inc {
+        let free = if hw.fe.span_seq().is_some() && !hw.row_stage() { "!w_valid" } else { "(!w_valid || w_end)" };
+        body.push(assign("take", format!("q_ne && adv && {free}")));
     } else if !inc {
         body.push(assign("take", "st == HOLD && adv && (!w_valid || w_end)"));
     }
