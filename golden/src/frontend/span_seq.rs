@@ -227,11 +227,11 @@ mod tests {
     use crate::setup::Screen;
     use crate::Config;
 
-    /// Every span of `scale` times 2,000 + 1,000 + 1,000 random triangles: the unit's `I0` is the
+    /// Every span of `quarters` / 4 times 2,000 + 1,000 + 1,000 random triangles: the unit's `I0` is the
     /// parallel path's (which the walk checks against the exact plane), at the default formats
     /// and at small ones; a fault (the column's multiplicand not shifted once) is caught on more
     /// than a quarter of them. Returns the spans compared.
-    fn unit_against_parallel(scale: usize) -> u64 {
+    fn unit_against_parallel(quarters: usize) -> u64 {
         let mut total = 0;
         for (cfg, screen, n) in [
             (Config::default(), Screen { width: 640, height: 480 }, 2_000),
@@ -243,7 +243,7 @@ mod tests {
             let q = seq.span_seq().expect("sequential");
             let mut rng = Rng(0x5eed_5ca1);
             let (mut spans, mut caught) = (0u64, 0u64);
-            for _ in 0..n * scale {
+            for _ in 0..n * quarters / 4 {
                 let t = random_tri(&mut rng, &fe);
                 let list = fe.span_list(&t);
                 assert_eq!(list, seq.span_list(&t), "{t:?}");
@@ -259,14 +259,14 @@ mod tests {
                     tn = (tn + st.dyn_) & mask(fe.widths().k);
                 }
             }
-            assert!(spans > 500, "{spans} spans at {screen:?}");
+            assert!(spans > 100, "{spans} spans at {screen:?}");
             assert!(caught * 4 > spans, "the unshifted column is caught on {caught} of {spans} spans");
             total += spans;
         }
         total
     }
 
-    /// [`unit_against_parallel`] once: about 2 s.
+    /// [`unit_against_parallel`] on 1,000 triangles: about half a second (the suite's time budget).
     #[test]
     fn the_sequential_unit_gives_the_parallel_i0_on_every_span() {
         unit_against_parallel(1);
@@ -276,7 +276,7 @@ mod tests {
     #[test]
     #[ignore]
     fn the_sequential_unit_gives_the_parallel_i0_on_a_million_spans() {
-        let spans = unit_against_parallel(10);
+        let spans = unit_against_parallel(40);
         println!("{spans} spans");
         assert!(spans > 1_000_000, "{spans}");
     }
