@@ -87,6 +87,7 @@
 
 pub mod engine;
 pub mod incremental;
+pub mod span_seq;
 pub mod sums;
 mod walk;
 
@@ -211,6 +212,35 @@ impl SetupForm {
     }
 }
 
+/// How the span path forms a covered row's `I0` (`generate --fe-span`): the products in
+/// parallel logic or tiles, a row a clock (the default), or one after another on one shift-add
+/// unit ([`span_seq::SpanSeq`]). The spans are the same bit for bit; the walker's rate and the latency
+/// differ.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
+#[serde(rename_all = "kebab-case")]
+pub enum SpanForm {
+    #[default]
+    Parallel,
+    Sequential,
+}
+
+impl SpanForm {
+    pub const ALL: [SpanForm; 2] = [SpanForm::Parallel, SpanForm::Sequential];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            SpanForm::Parallel => "parallel",
+            SpanForm::Sequential => "sequential",
+        }
+    }
+
+    /// Whether this is the default (serialised plans leave it out, so theirs stay as they were).
+    pub fn is_default(&self) -> bool {
+        *self == SpanForm::default()
+    }
+}
+
 /// A front-end configuration: the shader's formats, the screen it draws on, where `dI` comes
 /// from and how `I0` is formed.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
@@ -224,6 +254,9 @@ pub struct FrontEnd {
     /// How the set-up is built (issue 27): the spans do not depend on it, its clocks do.
     #[serde(default, skip_serializing_if = "SetupForm::is_default")]
     pub setup: SetupForm,
+    /// How the span path forms a row's `I0` (issue 27, the iCE40s): its rate and latency.
+    #[serde(default, skip_serializing_if = "SpanForm::is_default")]
+    pub span: SpanForm,
 }
 
 /// Every width of the front-end, derived once from the configuration: the generator declares
@@ -466,7 +499,7 @@ impl FrontEnd {
         if screen.height == 0 || screen.height > 1 << 16 {
             return Err(FrontEndError::Height { height: screen.height });
         }
-        Ok(FrontEnd { cfg, screen, di: DiMode::Triangle, i0: I0Form::Reciprocal, setup: SetupForm::Parallel })
+        Ok(FrontEnd { cfg, screen, di: DiMode::Triangle, i0: I0Form::Reciprocal, setup: SetupForm::Parallel, span: SpanForm::Parallel })
     }
 
     /// The same front-end with `dI` from `di`.
@@ -482,6 +515,11 @@ impl FrontEnd {
     /// The same front-end with its set-up built as `setup` says.
     pub fn with_setup(self, setup: SetupForm) -> FrontEnd {
         FrontEnd { setup, ..self }
+    }
+
+    /// The same front-end with its span path in the form `span` says.
+    pub fn with_span(self, span: SpanForm) -> FrontEnd {
+        FrontEnd { span, ..self }
     }
 
     pub fn widths(&self) -> Widths {

@@ -9,7 +9,7 @@ use crate::{check_prefix, BfpiArch, Bus, Options, Target};
 use clap::builder::{StringValueParser, TypedValueParser};
 use clap::Args;
 use golden::frontend::engine::SetupForm;
-use golden::frontend::{DiMode, I0Form};
+use golden::frontend::{DiMode, I0Form, SpanForm};
 use golden::pipeline::Pipeline;
 use golden::setup::Screen;
 use golden::specular::{parse_rel_error, BrdfK, PlanError, SpecularPlan};
@@ -31,6 +31,8 @@ pub enum ArgsError {
     IncrementalScanline,
     #[error("--fe-setup {0} takes --fe-di triangle and --fe-i0 reciprocal (only ice40-hx8k also takes incremental): its engine computes the per-triangle set-up only")]
     EngineForm(&'static str),
+    #[error("--fe-span sequential takes --fe-setup ice40-hx8k or ice40-up5k and --fe-i0 reciprocal: its unit serves the reciprocal I0 behind a sequential set-up engine")]
+    SequentialSpan,
     #[error("--width/--height: {0}")]
     Screen(#[from] golden::frontend::FrontEndError),
 }
@@ -145,6 +147,13 @@ pub struct VariantArgs {
     /// Default: `parallel`, or the target's choice.
     #[arg(long = "fe-setup", value_enum)]
     pub fe_setup: Option<SetupForm>,
+    /// How the front-end's span path forms a covered row's three I0 products: `parallel` (a
+    /// row a clock, the products in tiles or logic) or `sequential` (one shift-add unit, a few
+    /// dozen clocks a covered row, the walker waiting; the iCE40s' choice, with their
+    /// sequential engines and `--fe-i0 reciprocal`). Same spans bit for bit. Default:
+    /// `parallel`, or the target's choice.
+    #[arg(long = "fe-span", value_enum)]
+    pub fe_span: Option<SpanForm>,
     /// Register stages added for clock rate, 0..3 (golden::pipeline): 1 registers the span and
     /// the shader's increments, splits the specular unit's multiplies, and stages the
     /// front-end (CALC in five clocks, its span path in eight), 2 also the shader's lane sums, 3 cuts the shader's adders
@@ -188,6 +197,15 @@ impl VariantArgs {
         if fe_setup != SetupForm::Parallel && (!i0_ok || self.fe_di != DiMode::Triangle) {
             return Err(ArgsError::EngineForm(fe_setup.name()));
         }
+        // The sequential span path serves the reciprocal I0 behind a sequential engine: a target's
+        // choice of it gives way where a flag chose another set-up or I0; a flag asking for it there
+        // is refused.
+        let seq_ok = matches!(fe_setup, SetupForm::Ice40Hx8k | SetupForm::Ice40Up5k) && fe_i0 == I0Form::Reciprocal;
+        let fe_span = match self.fe_span {
+            Some(SpanForm::Sequential) if !seq_ok => return Err(ArgsError::SequentialSpan),
+            Some(s) => s,
+            None => choice.map(|c| c.fe_span).filter(|_| seq_ok).unwrap_or_default(),
+        };
         let opts = Options {
             bfpi_arch: self.bfpi_arch,
             screen,
@@ -195,6 +213,7 @@ impl VariantArgs {
             fe_di: self.fe_di,
             fe_i0,
             fe_setup,
+            fe_span,
             pipeline,
             bus: self.bus,
             target: self.target,
@@ -267,8 +286,8 @@ mod tests {
             let chosen = options(&["--target", t.name()]);
             assert_eq!(chosen.target, Some(t));
             assert_eq!(
-                (chosen.pipeline.level(), chosen.fe_div_bits, chosen.fe_i0, chosen.fe_setup),
-                (c.pipeline, c.fe_div_bits, c.fe_i0, c.fe_setup)
+                (chosen.pipeline.level(), chosen.fe_div_bits, chosen.fe_i0, chosen.fe_setup, chosen.fe_span),
+                (c.pipeline, c.fe_div_bits, c.fe_i0, c.fe_setup, c.fe_span)
             );
             let over = options(&[
                 "--target",
@@ -289,6 +308,24 @@ mod tests {
             );
         }
         assert!(Cli::try_parse_from(["t", "--target", "ecp5-85f"]).is_err());
+    }
+
+    /// The iCE40 targets choose the sequential span path; `--fe-span parallel` overrides it, and
+    /// it gives way to a flag's other set-up or I0; asked for where it cannot serve, one message.
+    #[test]
+    fn the_ice40_targets_choose_the_sequential_span_path() {
+        for t in ["ice40-hx8k", "ice40-up5k"] {
+            assert_eq!(options(&["--target", t]).fe_span, SpanForm::Sequential, "{t}");
+            assert_eq!(options(&["--target", t, "--fe-span", "parallel"]).fe_span, SpanForm::Parallel, "{t}");
+            assert_eq!(options(&["--target", t, "--fe-setup", "parallel"]).fe_span, SpanForm::Parallel, "{t}");
+        }
+        assert_eq!(options(&["--target", "ice40-hx8k", "--fe-i0", "incremental"]).fe_span, SpanForm::Parallel);
+        assert_eq!(options(&["--target", "ecp5-25f"]).fe_span, SpanForm::Parallel);
+        assert_eq!(options(&["--fe-setup", "ice40-up5k", "--fe-span", "sequential"]).fe_span, SpanForm::Sequential);
+        for bad in [&["--fe-span", "sequential"][..], &["--target", "ecp5-25f", "--fe-span", "sequential"]] {
+            let cli = Cli::try_parse_from(std::iter::once("t").chain(bad.iter().copied())).expect("the flags parse");
+            assert!(matches!(cli.model.options(None), Err(ArgsError::SequentialSpan)), "{bad:?}");
+        }
     }
 
     /// The HX8K's sequential engine takes the incremental I0 (its span path without a product);

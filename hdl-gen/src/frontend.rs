@@ -38,6 +38,7 @@ mod incremental;
 mod properties;
 mod setup;
 mod span;
+mod span_seq;
 mod stager;
 mod sums;
 mod walker;
@@ -114,7 +115,16 @@ fn build(hw: &Hw, names: &Names) -> (Module, Vec<golden::pipeline::PipeStage>) {
             "the shared set-up engine takes --fe-di triangle, and --fe-i0 incremental on the sequential engine only (hdl_gen::cli refuses the others)"
         );
         engine::setup(hw, names, &mut body);
+        if span_seq::unit(hw).is_some() {
+            span_seq::handshake(hw, &mut body);
+        }
         walker::emit(hw, names, &mut body);
+        if span_seq::unit(hw).is_some() {
+            let sp = span_seq::emit(hw, &mut body);
+            let stages = if hw.calc_clocks() > 1 { span_stage_list(hw, &sp) } else { Vec::new() };
+            body.push(properties::emit_engine(hw, &sp));
+            return (top(hw, names, body), stages);
+        }
         let sp = span::path(hw, &mut body);
         let sp = span::output(hw, names, sp, &mut body);
         let stages = if hw.calc_clocks() > 1 { span_stage_list(hw, &sp) } else { Vec::new() };
@@ -187,7 +197,14 @@ fn header(hw: &Hw, names: &Names) -> Vec<String> {
             ),
             format!("{} clocks per triangle, walked or dropped; the next triangles' set-up overlaps the walk.", hw.setup_clocks().0),
             format!("Latency: first span valid at most {} clocks after the triangle's transfer when the walker is idle.", hw.latency()),
-            format!("Spans: the walker, then {} register stages to the output register (I0's path).", hw.i0_stages()),
+            match hw.fe.span_seq() {
+                None => format!("Spans: the walker, then {} register stages to the output register (I0's path).", hw.i0_stages()),
+                Some(q) => format!(
+                    "Spans: the walker, {} row stages, then one shift-add unit for I0's products: {} clocks a covered row, the walker waiting.",
+                    hw.row_stages(),
+                    q.row_clocks()
+                ),
+            },
             String::new(),
             format!(
                 "Structure, in this file's order: the engine (u_engine: {}) and its queue (u_queue: {}), the head's fields; the",

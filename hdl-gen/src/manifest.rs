@@ -94,6 +94,10 @@ pub struct Frontend {
     /// How the set-up is built (`--fe-setup`); left out for the default, `parallel`.
     #[serde(default, skip_serializing_if = "golden::frontend::engine::SetupForm::is_default")]
     pub setup: golden::frontend::engine::SetupForm,
+    /// How the span path forms a row's products (`--fe-span`); left out for the default,
+    /// `parallel`.
+    #[serde(default, skip_serializing_if = "golden::frontend::SpanForm::is_default")]
+    pub span: golden::frontend::SpanForm,
     /// The shared set-up engine's plan and schedule (`--fe-setup` not `parallel`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub engine: Option<Engine>,
@@ -412,7 +416,8 @@ pub fn render(opts: &Options, names: &Names, modules: &[Module], unit: &Specular
             latency: hw.latency(),
             setup_clocks_walked: hw.setup_clocks().0,
             setup_clocks_dropped: hw.setup_clocks().1,
-            walker: "one clock per row from the first to the last row of the bounding box on screen".into(),
+            span: hw.fe.span,
+            walker: walker_clocks(&hw),
         }),
         writer: wr.map(|w| WriterEntry {
             module: names.writer.clone(),
@@ -516,4 +521,14 @@ pub fn core_file(opts: &Options, names: &Names, modules: &[Module], wrappers: &[
 
 fn is_zero(v: &u32) -> bool {
     *v == 0
+}
+
+/// The manifest's walker clocks: a row a clock, or with the sequential span path its clocks a
+/// covered row.
+fn walker_clocks(hw: &crate::frontend::Hw) -> String {
+    let rows = "one clock per row from the first to the last row of the bounding box on screen";
+    match hw.fe.span_seq() {
+        None => rows.into(),
+        Some(q) => format!("{rows}, {} per covered row (the sequential span path's)", q.row_clocks()),
+    }
 }

@@ -29,6 +29,9 @@ pub struct Options {
     /// How the front-end sets a triangle up (`--fe-setup`); the default is today's parallel CALC
     /// and dividers.
     pub fe_setup: golden::frontend::engine::SetupForm,
+    /// How the front-end's span path forms a row's products (`--fe-span`); the default is a row
+    /// a clock in parallel.
+    pub fe_span: golden::frontend::SpanForm,
     /// Register stages added for clock rate (`--pipeline`); level 0 is SPEC's seed structure.
     pub pipeline: golden::pipeline::Pipeline,
     /// `--bus`: SPEC's ports only, or AXI4-Stream wrappers of the streaming tops as well.
@@ -50,7 +53,8 @@ impl Options {
         let fe = golden::frontend::FrontEnd::new(self.cfg, self.screen.unwrap_or_else(|| Options::default_screen(&self.cfg)))?
             .with_di(self.fe_di)
             .with_i0(self.fe_i0)
-            .with_setup(self.fe_setup);
+            .with_setup(self.fe_setup)
+            .with_span(self.fe_span);
         Ok(frontend::Hw { fe, div_bits: self.fe_div_bits.unwrap_or(frontend::DEFAULT_DIV_BITS), pipeline: self.pipeline })
     }
 

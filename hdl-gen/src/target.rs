@@ -4,7 +4,7 @@
 //! other option keeps its own default. The choices are the measured best for each device
 //! (docs/design.md, "Targets"; figures in docs/fpga.md), so they change when a measurement does.
 
-use golden::frontend::{I0Form, SetupForm};
+use golden::frontend::{I0Form, SetupForm, SpanForm};
 use serde::{Deserialize, Serialize};
 
 /// A device family and size the generated chain is meant to fit.
@@ -35,6 +35,8 @@ pub struct Choice {
     pub fe_i0: I0Form,
     /// `--fe-setup`.
     pub fe_setup: SetupForm,
+    /// `--fe-span`.
+    pub fe_span: SpanForm,
 }
 
 impl Target {
@@ -47,14 +49,29 @@ impl Target {
     /// and 12 SB_MAC16 on the UP5K's sequential engine against 8,719 and 81 with them) and
     /// sets a triangle up in fewer clocks than the parallel form at the same clock (12 against
     /// 13); `--pipeline 1` (the span path in stages: the parallel form's 18.2 MHz at level 0
-    /// became 47-48 MHz); the reciprocal `I0`, which the engine forms take.
+    /// became 47-48 MHz) on the ECP5, 0 on the iCE40s with their sequential span path; the
+    /// reciprocal `I0`, which the engine forms take.
     pub fn choice(self) -> Choice {
         let fe_setup = match self {
             Target::Ecp5_25f => SetupForm::Ecp5_25f,
             Target::Ice40Hx8k => SetupForm::Ice40Hx8k,
             Target::Ice40Up5k => SetupForm::Ice40Up5k,
         };
-        Choice { pipeline: 1, fe_div_bits: None, fe_i0: I0Form::Reciprocal, fe_setup }
+        // The iCE40s walk a covered row every few dozen clocks: their span path's products on one
+        // shift-add unit, not in parallel logic (most of their front-end's LUTs, docs/fpga.md).
+        let fe_span = match self {
+            Target::Ecp5_25f => SpanForm::Parallel,
+            Target::Ice40Hx8k | Target::Ice40Up5k => SpanForm::Sequential,
+        };
+        // Level 0 on the iCE40s: their span path is sequential, so level 1's span stages are gone
+        // and its two row stages only cost flip-flops (HX8K tri_fb_p4 in its harness: 9,920 logic
+        // cells at level 0 against 10,445 at level 1, docs/fpga.md); their p = 4 shader runs at
+        // 85 MHz on the HX8K at level 0.
+        let pipeline = match self {
+            Target::Ecp5_25f => 1,
+            Target::Ice40Hx8k | Target::Ice40Up5k => 0,
+        };
+        Choice { pipeline, fe_div_bits: None, fe_i0: I0Form::Reciprocal, fe_setup, fe_span }
     }
 
     /// The name `--target` takes.

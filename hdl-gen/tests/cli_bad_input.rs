@@ -78,6 +78,7 @@ fn generate_bad_flags() {
         (&["generate", "--out", d, "--fe-setup", "ecp5-85f"], "--fe-setup"),
         (&["generate", "--out", d, "--fe-setup", "ecp5-25f", "--fe-i0", "incremental"], "--fe-setup ecp5-25f takes --fe-di triangle"),
         (&["generate", "--out", d, "--fe-setup", "ice40-hx8k", "--fe-di", "scanline"], "--fe-setup ice40-hx8k takes --fe-di triangle"),
+        (&["generate", "--out", d, "--fe-span", "sequential"], "--fe-span sequential takes --fe-setup ice40-hx8k or ice40-up5k"),
     ];
     for (args, needle) in cases {
         assert_rejected(args, needle, &dir);

@@ -379,22 +379,33 @@ fn the_set_up_engine_lints_clean_and_holds_no_latch() {
     lint_engine(golden::frontend::engine::SetupForm::Ecp5_25f);
 }
 
+/// With their parallel span path, and with the sequential one (`--fe-span sequential`, the
+/// targets' choice) at levels 0 and 1.
 #[test]
 #[ignore]
 fn the_ice40_set_up_engines_lint_clean_and_hold_no_latch() {
-    lint_engine(golden::frontend::engine::SetupForm::Ice40Up5k);
-    lint_engine(golden::frontend::engine::SetupForm::Ice40Hx8k);
+    use golden::frontend::{engine::SetupForm::*, SpanForm};
+    let (par, seq) = (SpanForm::Parallel, SpanForm::Sequential);
+    for (form, span, level) in [(Ice40Up5k, par, 0), (Ice40Hx8k, par, 0), (Ice40Hx8k, seq, 0), (Ice40Up5k, seq, 1)] {
+        lint_engine_at(form, span, level);
+    }
 }
 
 fn lint_engine(form: golden::frontend::engine::SetupForm) {
+    lint_engine_at(form, golden::frontend::SpanForm::Parallel, 0);
+}
+
+fn lint_engine_at(form: golden::frontend::engine::SetupForm, span: golden::frontend::SpanForm, level: u32) {
     {
-        let opts = Options { fe_setup: form, screen: Some(golden::setup::Screen { width: 37, height: 23 }), ..Default::default() };
-        let dir = std::env::temp_dir().join(format!("hdl-gen-lint-engine-{}-{}", std::process::id(), form.name()));
+        let screen = Some(golden::setup::Screen { width: 37, height: 23 });
+        let opts = Options { fe_setup: form, fe_span: span, pipeline: golden::pipeline::Pipeline::at(level), screen, ..Default::default() };
+        let tag = format!("{}-{}-{level}", form.name(), span.name());
+        let dir = std::env::temp_dir().join(format!("hdl-gen-lint-engine-{}-{tag}", std::process::id()));
         let _ = std::fs::remove_dir_all(&dir);
         let files = generate(&opts);
         // Linted clean before, byte for byte with the same tools and this test: not again (as the
         // sweep's configurations; a cold run pays the few seconds).
-        let what = format!("set-up engine {}", form.name());
+        let what = format!("set-up engine {tag}");
         let marker = Path::new(env!("CARGO_TARGET_TMPDIR")).join("lint-cache").join(cache_key(&files, &what, true, false));
         if marker.exists() {
             return;

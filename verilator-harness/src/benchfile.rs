@@ -125,6 +125,7 @@ impl StimModel {
         generate.extend(v.pipeline.map(|l| format!("--pipeline={l}")));
         generate.extend(v.target.map(|t| format!("--target={}", choice(&t))));
         generate.extend(v.fe_setup.map(|f| format!("--fe-setup={}", choice(&f))));
+        generate.extend(v.fe_span.map(|f| format!("--fe-span={}", choice(&f))));
         generate.extend(v.fe_div_bits.map(|b| format!("--fe-div-bits={b}")));
         match &v.brdf.brdf_k {
             None => {}

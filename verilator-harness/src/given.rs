@@ -18,11 +18,12 @@ pub fn decided(id: &str, m: &Manifest) -> Result<Option<String>, String> {
         format!("{v:?}")
     }
     let fe = |f: &dyn Fn(&hdl_gen::manifest::Frontend) -> String| m.frontend.as_ref().map_or("(no front-end)".to_string(), f);
-    let (pipeline, div_bits, i0, setup) = (
+    let (pipeline, div_bits, i0, setup, span) = (
         m.parameters.pipeline.to_string(),
         fe(&|f| f.div_bits.to_string()),
         fe(&|f| f.i0.name().to_string()),
         fe(&|f| f.setup.name().to_string()),
+        fe(&|f| f.span.name().to_string()),
     );
     let v = match id {
         "p" | "align" => return Ok(None),
@@ -36,9 +37,10 @@ pub fn decided(id: &str, m: &Manifest) -> Result<Option<String>, String> {
         "fe_di" => fe(&|f| f.di.name().to_string()),
         "fe_i0" => i0,
         "fe_setup" => setup,
+        "fe_span" => span,
         // A target decides what it chooses: a folder generated with the same choices by flags
         // is the same circuit.
-        "target" => format!("--pipeline {pipeline} --fe-div-bits {div_bits} --fe-i0 {i0} --fe-setup {setup}"),
+        "target" => format!("--pipeline {pipeline} --fe-div-bits {div_bits} --fe-i0 {i0} --fe-setup {setup} --fe-span {span}"),
         "brdf_k" | "max_rel_error" => {
             let g = &m.specular.geometry;
             format!("k {:?}, n ranges {}, tables {}", g.ks, text(&g.k_ranges), text(&g.tables))
@@ -138,6 +140,14 @@ mod tests {
             [("pipeline", &pl1), ("target", &pl1), ("fe_div_bits", &div1), ("target", &div1), ("fe_setup", &engine), ("target", &engine)];
         for (id, other) in cases {
             assert_ne!(decided(id, &m), decided(id, other), "{id}");
+        }
+        let span = hdl_gen::Options {
+            fe_setup: golden::frontend::SetupForm::Ice40Up5k,
+            fe_span: golden::frontend::SpanForm::Sequential,
+            ..Default::default()
+        };
+        for id in ["fe_span", "target"] {
+            assert_ne!(decided(id, &engine), decided(id, &manifest(&span)), "{id}");
         }
         assert!(decided("no_such_flag", &m).is_err());
     }

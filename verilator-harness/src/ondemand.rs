@@ -467,6 +467,9 @@ pub fn tag_suffix(opts: &hdl_gen::Options) -> String {
     if !opts.fe_setup.is_default() {
         s += &format!("_{}", opts.fe_setup.name().replace('-', ""));
     }
+    if !opts.fe_span.is_default() {
+        s += "_seqspan";
+    }
     if opts.bfpi_arch != hdl_gen::BfpiArch::ShiftAdd {
         s += &format!("_{:?}", opts.bfpi_arch).to_lowercase();
     }

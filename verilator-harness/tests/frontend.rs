@@ -134,14 +134,18 @@ fn set_up_costs(m: &'static verilator_harness::ffi::ModelInfo<verilator_harness:
     // The model's set-up form and divider rate, from the latency the build recorded for it (a
     // COSIM_RTL_DIR folder's may be an engine form or the incremental I0, which the model's
     // description does not name).
-    use golden::frontend::{I0Form, SetupForm};
+    use golden::frontend::{I0Form, SetupForm, SpanForm};
+    let seq = |setup, i0| matches!(setup, SetupForm::Ice40Hx8k | SetupForm::Ice40Up5k) && i0 == I0Form::Reciprocal;
     let hw = SetupForm::ALL
         .iter()
         .flat_map(|&setup| I0Form::ALL.map(move |i0| (setup, i0)))
         .filter(|&(setup, i0)| setup == SetupForm::Parallel || i0 == I0Form::Reciprocal)
         .flat_map(|(setup, i0)| {
+            SpanForm::ALL.into_iter().filter(move |&s| s == SpanForm::Parallel || seq(setup, i0)).map(move |s| (setup, i0, s))
+        })
+        .flat_map(|(setup, i0, span)| {
             hdl_gen::frontend::DIV_BITS.map(|div_bits| hdl_gen::frontend::Hw {
-                fe: frontend(m).with_setup(setup).with_i0(i0),
+                fe: frontend(m).with_setup(setup).with_i0(i0).with_span(span),
                 div_bits,
                 pipeline: m.pipeline,
             })
@@ -414,7 +418,7 @@ fn engine_spans_of(opts: hdl_gen::Options, n: usize) {
     // Golden's spans are the same in both I0 forms; the incremental form's are its own model's.
     let fe = frontend(m).with_i0(opts.fe_i0);
     let hw = opts.frontend().unwrap();
-    assert_eq!(fe.with_setup(opts.fe_setup), hw.fe, "the model's front-end is the plan's");
+    assert_eq!(fe.with_setup(opts.fe_setup).with_span(opts.fe_span), hw.fe, "the model's front-end is the plan's");
     assert_eq!(hw.latency(), m.latency, "the manifest's latency is the engine's");
     let tris = random_triangles(&mut SeedRng::seed_from_u64(seed), &fe, n);
     let exp = Expected::new(fe, &tris);
@@ -574,6 +578,31 @@ fn sequential_incremental_i0_spans_equal_golden() {
     let Some(opts) = form(small, 0) else { return };
     let fault = LineFault { file: "tri_frontend.v", line: "ie_p <= ie_p + (ie_sb[0]", from: "ie_sb[0]", to: "ie_sb[1]" };
     fault.caught(&opts, "frontend sequential incremental fault", "seqincfault", "the shift-add's partial product from the wrong bit");
+}
+
+/// The sequential span path (`--fe-span sequential`, the iCE40 targets' choice) behind both
+/// iCE40 engines, 1,000 triangles each (37x23 and 640x480, levels 0 and 1), as
+/// [`engine_spans_of`]; a fault (the correction's `q~ + 1` made `q~`) is caught. Slow tier:
+/// `cargo nextest run -p verilator-harness --run-ignored only -E 'test(/sequential_span/)'`.
+#[test]
+#[ignore]
+fn sequential_span_path_spans_equal_golden() {
+    use golden::frontend::{engine::SetupForm::*, SpanForm};
+    let (small, big) = (golden::setup::Screen { width: 37, height: 23 }, golden::setup::Screen::default());
+    let form = |screen, setup, level| {
+        engine(screen, setup).map(|o| hdl_gen::Options {
+            fe_span: SpanForm::Sequential,
+            pipeline: golden::pipeline::Pipeline::at(level),
+            ..o
+        })
+    };
+    for (screen, setup, level) in [(small, Ice40Hx8k, 0), (big, Ice40Hx8k, 1), (small, Ice40Up5k, 1), (big, Ice40Up5k, 1)] {
+        let Some(opts) = form(screen, setup, level) else { return };
+        engine_spans_of(opts, 1000);
+    }
+    let Some(opts) = form(small, Ice40Hx8k, 1) else { return };
+    let fault = LineFault { file: "tri_frontend.v", line: "sq_qt_now} + ", from: "} + ", to: "} - " };
+    fault.caught(&opts, "frontend sequential span fault", "seqspanfault", "the correction's q~ + 1 made q~ - 1");
 }
 
 /// The shared-edge mesh through `tri_fb_p8` with the engine's front-end: every pixel of the

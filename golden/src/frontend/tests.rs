@@ -6,7 +6,7 @@ use crate::setup::Vertex;
 use crate::Align;
 
 /// xorshift64*: a small, stable generator (the test's sequence never changes with a crate).
-struct Rng(u64);
+pub(super) struct Rng(pub(super) u64);
 impl Rng {
     fn next(&mut self) -> u64 {
         self.0 ^= self.0 >> 12;
@@ -21,7 +21,7 @@ impl Rng {
 
 /// A random port-level triangle of one of several kinds: anywhere in the guard band, small,
 /// slivers, vertices on centres, shared y (horizontal edges), at the band's edges.
-fn random_tri(rng: &mut Rng, fe: &FrontEnd) -> FixedTriangle {
+pub(super) fn random_tri(rng: &mut Rng, fe: &FrontEnd) -> FixedTriangle {
     let kind = rng.range(0, 6) as usize;
     random_tri_of(rng, fe, kind)
 }

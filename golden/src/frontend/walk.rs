@@ -37,7 +37,10 @@ impl FrontEnd {
                 }
                 let i0 = match gx {
                     Some(gx) => self.i0_from(st, tn, gx),
-                    None => self.i0(st, tn, lo as u32),
+                    None => match self.span_seq() {
+                        Some(q) => q.i0(tn, st.gxn, st.an, st.rn, lo as u32),
+                        None => self.i0(st, tn, lo as u32),
+                    },
                 };
                 debug_assert!(
                     fault != SumFault::None || i0 as i128 == (2 * st.plane.s(lo, r as i64) + st.plane.a) / (2 * st.plane.a),

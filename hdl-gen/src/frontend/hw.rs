@@ -64,6 +64,10 @@ impl Hw {
     pub fn queue_depth(&self) -> u32 {
         match self.engine_timing() {
             Some((ii, latency, _)) if self.queue_credit() => QUEUE_DEPTH + latency / ii + 2,
+            // Behind the sequential span path one entry: the walker copies it as it takes it, and
+            // a second entry (its read multiplexer and 689 flip-flops at 640x480) was about a
+            // fifth of the HX8K's logic cells (docs/fpga.md).
+            _ if self.fe.span_seq().is_some() => 1,
             _ => QUEUE_DEPTH,
         }
     }
@@ -116,6 +120,10 @@ impl Hw {
     /// and above the row stages and 8 ([`golden::pipeline::i0_registers`]; 8 alone with the
     /// incremental `I0`).
     pub fn i0_stages(&self) -> u32 {
+        // The sequential span path: its clocks from a covered row's accept to the output write.
+        if let Some(q) = self.fe.span_seq() {
+            return q.row_clocks() + self.row_stages();
+        }
         golden::pipeline::i0_registers(self.pipeline).iter().filter(|&&r| r).count() as u32 + self.row_stages()
     }
 

@@ -7,7 +7,7 @@ mod parallel;
 mod shape;
 
 use shape::*;
-pub use shape::{CalcStage, EngineShape, FrontendShape, ParallelSetup, RowStage, SetupShape, SpanStage};
+pub use shape::{CalcStage, EngineShape, FrontendShape, ParallelSetup, RowStage, SetupShape, SpanStage, SpanUnit};
 
 use super::hw::Hw;
 use super::setup::{self, Setup};
@@ -117,13 +117,17 @@ fn shape(hw: &Hw, sp: &Stager, setup: SetupShape) -> FrontendShape {
         latency: hw.latency(),
         setup,
         row_stages: (1..=hw.row_stages()).map(|j| row_stage(hw, j)).collect(),
-        span_stages: (1..=sp.stage())
-            .map(|j| {
-                let held = |n: &str| sp.held(n, j).expect("a span's fields reach the output");
-                SpanStage { valid: span::valid(j), y: held("y"), x: held("x"), len: held("len"), di: held("di") }
-            })
-            .collect(),
+        span_stages: match super::span_seq::unit(hw) {
+            Some(_) => vec![super::span_seq::stage(hw)],
+            None => (1..=sp.stage())
+                .map(|j| {
+                    let held = |n: &str| sp.held(n, j).expect("a span's fields reach the output");
+                    SpanStage { valid: span::valid(j), y: held("y"), x: held("x"), len: held("len"), di: held("di") }
+                })
+                .collect(),
+        },
         starts: None,
+        span_unit: super::span_seq::shape(hw),
     }
 }
 
@@ -210,6 +214,7 @@ impl Reference<'_> {
                     b.push(comment(format!("{CUT_TAG}connect -set {w} {r}")));
                     b.push(net(&w, n));
                 }
+                b.extend(engine::constant_probes(e));
                 b
             }
         };
@@ -262,9 +267,19 @@ impl Reference<'_> {
         b.extend([reg("f_errp", 1), reg("f_nacc", cw), reg("f_nerr", cw), reg("f_ncull", cw), reg("f_nwalk", cw)]);
         b.extend([reg("f_nrow", cw), reg("f_nout", cw)]);
 
-        b.push(wire("f_adv", 1, "!out_valid || out_ready"));
+        if let Some(u) = &self.s.span_unit {
+            b.push(comment("The sequential span path: busy (f_1v) for its clocks (f_sc left to its result), the walker"));
+            b.push(comment("moving while it is idle or writing its result to a free output."));
+            b.push(reg("f_sc", bits_for(u.row_clocks)));
+            b.push(wire("f_sdone", 1, format!("f_1v && f_sc == {}", lit(bits_for(u.row_clocks), 0))));
+            b.push(wire("f_adv", 1, "!f_1v || (f_sdone && (!out_valid || out_ready))"));
+        } else {
+            b.push(wire("f_adv", 1, "!out_valid || out_ready"));
+        }
         b.push(wire("f_wend", 1, "f_wrow == f_wlast"));
+        let empty = self.s.span_unit.as_ref().is_some_and(|u| u.take_when_empty);
         let take = match (&self.s.setup, self.s.starts) {
+            (SetupShape::Engine(e), None) if empty => format!("f_qn != {} && f_adv && !f_wv", lit(e.qw(), 0)),
             (SetupShape::Engine(e), None) => format!("f_qn != {} && f_adv && (!f_wv || f_wend)", lit(e.qw(), 0)),
             (SetupShape::Engine(e), Some(_)) => format!("f_qn != {} && ie_pv && f_adv && !ie_wait && (!f_wv || f_wend)", lit(e.qw(), 0)),
             (_, Some(_)) => "f_sb && f_sh && ie_pv && f_adv && !ie_wait && (!f_wv || f_wend)".into(),
@@ -378,14 +393,32 @@ impl Reference<'_> {
         } else {
             vec![set("f_1v", row), set("f_1y", "f_wrow"), set("f_1n", "f_wnew")]
         };
-        let spans = when(
-            "f_adv",
-            into_spans
-                .into_iter()
-                .chain((2..=nsp).flat_map(|i| ["v", "y", "n"].map(|f| set(format!("f_{i}{f}"), format!("f_{}{f}", i - 1)))))
-                .chain(["v", "y", "n"].map(|f| set(format!("f_o{f}"), format!("f_{nsp}{f}"))))
-                .collect(),
-        );
+        let spans = match &self.s.span_unit {
+            // The unit takes a row when the walker moves, and writes its result when done and the
+            // output is free.
+            Some(u) => {
+                let sw = bits_for(u.row_clocks);
+                let count = Stmt::If(
+                    "f_adv".into(),
+                    vec![set("f_sc", lit(sw, (u.row_clocks - 1) as u64))],
+                    vec![when(format!("f_1v && f_sc != {}", lit(sw, 0)), vec![set("f_sc", format!("f_sc - {}", one(sw)))])],
+                );
+                let out = ["y", "n"].map(|f| set(format!("f_o{f}"), format!("f_1{f}")));
+                vec![
+                    when("!out_valid || out_ready", std::iter::once(set("f_ov", "f_sdone")).chain(out).collect()),
+                    count,
+                    when("f_adv", into_spans),
+                ]
+            }
+            None => vec![when(
+                "f_adv",
+                into_spans
+                    .into_iter()
+                    .chain((2..=nsp).flat_map(|i| ["v", "y", "n"].map(|f| set(format!("f_{i}{f}"), format!("f_{}{f}", i - 1)))))
+                    .chain(["v", "y", "n"].map(|f| set(format!("f_o{f}"), format!("f_{nsp}{f}"))))
+                    .collect(),
+            )],
+        };
         let (reset, front) = match &self.s.setup {
             SetupShape::Parallel(p) => self.parallel_update(p),
             SetupShape::Engine(e) => self.engine_update(e),
@@ -418,7 +451,8 @@ impl Reference<'_> {
             ]
             .into_iter()
             .chain(front)
-            .chain([walker, spans])
+            .chain([walker])
+            .chain(spans)
             .collect(),
         )])
     }
@@ -461,10 +495,15 @@ impl Reference<'_> {
                 format!("$past(w_valid && adv && !w_end{go})"),
                 vec![assert("w_valid"), assert(format!("w_row == $past(w_row) + {}", one(yw)))],
             ),
-            when(
-                format!("$past(w_valid && adv && w_end && {waiting}{held}{go})"),
-                vec![assert("w_valid"), assert("w_row == $past(s_first)")],
-            ),
+            if self.s.span_unit.as_ref().is_some_and(|u| u.take_when_empty) {
+                // The next triangle is taken once the last row has left the walker.
+                when(format!("$past(!w_valid && adv && {waiting})"), vec![assert("w_valid"), assert("w_row == $past(s_first)")])
+            } else {
+                when(
+                    format!("$past(w_valid && adv && w_end && {waiting}{held}{go})"),
+                    vec![assert("w_valid"), assert("w_row == $past(s_first)")],
+                )
+            },
         ];
         if let SetupShape::Parallel(p) = &self.s.setup {
             let last = p.calc_stages.len();
@@ -564,6 +603,10 @@ impl Reference<'_> {
         }
         for sp in span_stages {
             link.push(on_screen(&sp.valid, &sp.x, &sp.len, xw, width));
+        }
+        if let Some(u) = &self.s.span_unit {
+            link.push(Stmt::Comment("The unit's clocks left are the reference's; its phase and count within bounds.".into()));
+            link.push(when("f_1v", u.bounds.iter().map(assert).chain([assert(format!("f_sc == {}", u.left))]).collect()));
         }
         b.push(Item::Comb(vec![when("f_past", link)]));
         b

@@ -184,7 +184,7 @@ fn control(hw: &Hw, body: &mut Vec<Item>) {
         body.push(comment("Per-scanline dI (the comparison option): a restoring divider, busy for each span of m >= 2."));
         body.extend([reg("sd_busy", 1), reg("sd_cnt", sd_cnt_w), reg("sd_neg", 1)]);
         body.push(wire("adv", 1, "(!out_valid || out_ready) && !sd_busy"));
-    } else {
+    } else if hw.fe.span_seq().is_none() {
         body.push(wire("adv", 1, "!out_valid || out_ready"));
     }
     // Behind the row stages the walk's end is a register, `!w_valid || w_row == w_last` made as
@@ -199,7 +199,9 @@ fn control(hw: &Hw, body: &mut Vec<Item>) {
         "w_end"
     } else {
         body.push(wire("w_end", 1, "w_row == w_last"));
-        "(!w_valid || w_end)"
+        // The sequential span path (its own `adv`) reads the walker's registers without row
+        // stages: the next triangle is taken once the last row has left.
+        if hw.fe.span_seq().is_some() && hw.engine_form() { "!w_valid" } else { "(!w_valid || w_end)" }
     };
     let inc = super::incremental::on(hw);
     let engine = hw.engine_form();

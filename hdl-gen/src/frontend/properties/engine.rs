@@ -21,13 +21,21 @@ pub(super) fn engine_probes(e: &EngineShape) -> Vec<(String, String, u32)> {
     if e.epochs > 1 {
         v.push(("f_e_ep".into(), "u_engine.ep".into(), e.epochs));
     }
-    v.extend([
-        ("f_q_cnt".into(), "u_queue.cnt".into(), pw + 1),
-        ("f_q_rd".into(), "u_queue.rd".into(), pw),
-        ("f_q_wr".into(), "u_queue.wr".into(), pw),
-    ]);
+    v.push(("f_q_cnt".into(), "u_queue.cnt".into(), pw + 1));
+    // A one-entry queue's pointers stay 0 and synthesis drops them: [`constant_probes`].
+    if e.depth > 1 {
+        v.extend([("f_q_rd".into(), "u_queue.rd".into(), pw), ("f_q_wr".into(), "u_queue.wr".into(), pw)]);
+    }
     v.extend((0..e.depth).map(|k| (format!("f_q_mem{k}"), format!("u_queue.mem[{k}]"), e.entry_w)));
     v
+}
+
+/// The probes a one-entry queue has no register for: its pointers, always 0.
+pub(super) fn constant_probes(e: &EngineShape) -> Vec<Item> {
+    if e.depth > 1 {
+        return Vec::new();
+    }
+    vec![wire("f_q_rd", 1, "1'b0"), wire("f_q_wr", 1, "1'b0")]
 }
 
 /// The triangles the queue holds or will, at `w` bits: its entries, and each period's triangle in

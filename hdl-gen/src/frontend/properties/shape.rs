@@ -34,6 +34,20 @@ pub struct FrontendShape {
     /// coverage) and the held triangle is taken once its first row is started (`ie_pv`); the
     /// engine's own properties bound both waits.
     pub starts: Option<u32>,
+    /// The sequential span path (`--fe-span sequential`): its one stage (`span_stages`' only)
+    /// holds a covered row for its clocks, and the walker moves while it is idle or writing its
+    /// result.
+    pub span_unit: Option<SpanUnit>,
+}
+
+/// The sequential span path's shape: its clocks from an accept to its result's write, where the
+/// design counts them (the clocks left, from its phase and step count), and whether the walker
+/// takes the next triangle only once its last row has left (the unit reads the walker's registers).
+pub struct SpanUnit {
+    pub row_clocks: u32,
+    pub left: String,
+    pub bounds: Vec<String>,
+    pub take_when_empty: bool,
 }
 
 /// The set-up the reference follows in front of the walker.
