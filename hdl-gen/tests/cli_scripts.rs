@@ -123,6 +123,9 @@ fn synth_and_check_rtl_dir_show_the_generators_message() {
         (&["--family", "vhdl"], &["unknown family 'vhdl'"]),
         (&["--device", "25k", "--out", o], &["--device takes hx8k or up5k with --family ice40", "'25k'"]),
         (&["--seeds"], &["--seeds needs a value"]),
+        (&["--abc-depth", "7", "--out", o], &["--abc-depth is for --family ecp5 only"]),
+        (&["--family", "ecp5", "--abc-depth", "x", "--out", o], &["--abc-depth takes", "'x'"]),
+        (&["--abc-depth"], &["--abc-depth needs a value"]),
     ];
     for (args, needles) in cases {
         assert_refused("synth", args, needles, &dir);

@@ -143,6 +143,9 @@ pub(super) fn module(hw: &Hw, names: &Names) -> Module {
     for &o in &roots {
         let op = v.op(o);
         if s.slots[o].class == Class::Logic {
+            for (name, w, e) in v.logic_nets(o) {
+                body.push(crate::verilog::wire(&name, w, e));
+            }
             let (e, w) = v.logic(o);
             let t = format!("t{o}");
             body.push(crate::verilog::wire(&t, w, e));

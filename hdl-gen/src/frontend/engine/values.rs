@@ -185,6 +185,26 @@ impl<'a> Values<'a> {
         }
     }
 
+    /// The nets a logic operation's result reads besides its operands (name, width, value).
+    ///
+    /// The leading-zero count's: its operand reversed above a one, `r`, and `r`'s lowest one,
+    /// `r & (~r + 1)`, an add that maps to the carry chain (CCU2C on the ECP5). Its index is
+    /// the count (`n` for zero). As a chain of selects the count was the engine's deepest
+    /// logic (43 selects, 11-12.5 ns on the 25F); here it is the carry and an OR of the one-hot.
+    /// ABC then maps the rest of the block under a smaller depth, in more LUT4, unless given the
+    /// chain's depth as its target (`scripts/synth --abc-depth 7`, docs/fpga.md).
+    pub fn logic_nets(&self, o: usize) -> Vec<(String, u32, String)> {
+        let op = self.op(o);
+        let Kind::Lzc(a, n) = op.kind else { return vec![] };
+        let v = self.at(a, self.s.slots[o].start);
+        let r = format!("t{o}_r");
+        let rev: Vec<String> = (0..n).map(|i| v.bits(i, 1)).collect();
+        vec![
+            (r.clone(), n + 1, format!("{{1'b1, {}}}", rev.join(", "))),
+            (format!("t{o}_h"), n + 1, format!("{r} & (~{r} + {}'d1)", n + 1)),
+        ]
+    }
+
     /// A logic operation's result from its operands read at its start, and the result's width.
     pub fn logic(&self, o: usize) -> (String, u32) {
         let op = self.op(o);
@@ -200,13 +220,14 @@ impl<'a> Values<'a> {
             Kind::Or(a, b) => (format!("(|{}) || (|{})", x(a).ext(self.op(a.0 as usize).w), x(b).ext(self.op(b.0 as usize).w)), 1),
             Kind::Sel(c, a, b) => (format!("(|{}) ? {} : {}", x(c).ext(self.op(c.0 as usize).w), x(a).ext(op.w), x(b).ext(op.w)), op.w),
             Kind::ShlBy(a, s) => (format!("{} << {}", x(a).ext(op.w), x(s).ext(self.op(s.0 as usize).w)), op.w),
-            Kind::Lzc(a, n) => {
-                let v = x(a);
-                let mut e = format!("{}'d{n}", op.w);
-                for i in 0..n {
-                    e = format!("{} ? {}'d{} : ({e})", v.bits(i, 1), op.w, n - 1 - i);
-                }
-                (e, op.w)
+            // Each bit of the count ORs the one-hot's positions that have that bit (`logic_nets`).
+            Kind::Lzc(_, n) => {
+                let h = format!("t{o}_h");
+                let bit = |b: u32| {
+                    let m: u128 = (0..=n).filter(|i| i >> b & 1 == 1).map(|i| 1u128 << i).sum();
+                    format!("|({h} & {}'h{m:x})", n + 1)
+                };
+                (format!("{{{}}}", (0..op.w).rev().map(bit).collect::<Vec<_>>().join(", ")), op.w)
             }
             _ => unreachable!("{} is not logic", op.name),
         }
