@@ -11,6 +11,7 @@
 //! engine; co-simulated in `verilator-harness/tests/frontend.rs` (`sequential_engine_*`, slow
 //! tier). docs/design.md, *A sequential engine for the iCE40 HX8K*.
 
+mod alu;
 mod tile;
 
 use super::result::{fields, ports, Field};
@@ -18,7 +19,7 @@ use super::units::bits_for;
 use crate::frontend::hw::Hw;
 use crate::verilog::{comment, reg, set, sreg, wire, Item, Module, Param, Port, Stmt};
 use golden::frontend::engine::schedule::Class;
-use golden::frontend::engine::sequential::{Exec, Loc, SeqSchedule, ALU_LAT, READ};
+use golden::frontend::engine::sequential::{Exec, Loc, SeqSchedule, READ};
 use golden::frontend::engine::{Kind, MulUnit, V};
 
 /// The ALU's functions (the microword's `fn` field).
@@ -192,7 +193,7 @@ pub fn module(hw: &Hw, s: &SeqSchedule, name: &str) -> SeqEngine {
     let mut b: Vec<Item> = Vec::new();
     sequencer(&cx, &mut b);
     memories(&cx, &l, &micro, &consts, &mut b);
-    alu(&cx, &mut b);
+    alu::alu(&cx, &mut b);
     match tile::Tiles::new(s) {
         Some(t) => t.units(w, &mut b),
         None => shift_add(&cx, &mut b),
@@ -296,7 +297,8 @@ fn microprogram(cx: &Cx, fields: &[Field]) -> Micro {
                     assert!(imm <= w, "shift or count {imm} beyond the word");
                     x.set("fn", f, e);
                     x.set("imm", imm as u64, e);
-                    assert_eq!(sl.write, t + READ + ALU_LAT, "the ALU's result is written the clock after");
+                    let lat = s.plan.alu_lat + s.plan.bus_lat;
+                    assert_eq!(sl.write, t + READ + lat, "the ALU's result is written alu_lat + bus_lat clocks after its operands");
                 }
                 other => panic!("{other:?} issued"),
             }
@@ -314,10 +316,13 @@ fn microprogram(cx: &Cx, fields: &[Field]) -> Micro {
             other => panic!("{other:?} writes"),
         };
         let wt = sl.write;
+        // A registered bus selects its source two clocks before the write ([`write_bus`]).
+        let st = wt - 2 * s.plan.bus_lat;
+        let x = &mut mw[st as usize];
+        x.set("src", src, st);
+        x.set("wc", widths.iter().position(|&k| k == op.w).unwrap() as u64, st);
+        x.set("wsg", op.signed as u64, st);
         let x = &mut mw[wt as usize];
-        x.set("src", src, wt);
-        x.set("wc", widths.iter().position(|&k| k == op.w).unwrap() as u64, wt);
-        x.set("wsg", op.signed as u64, wt);
         match sl.loc {
             Loc::Ram(a) => {
                 x.set("we", 1, wt);
@@ -439,94 +444,6 @@ fn memories(cx: &Cx, l: &Layout, micro: &[String], consts: &[String], b: &mut Ve
     b.push(Item::Blank);
 }
 
-/// The operands and the ALU.
-fn alu(cx: &Cx, b: &mut Vec<Item>) {
-    let (w, sw, ops) = (cx.w, cx.sw, &cx.s.prog.ops);
-    b.push(comment("Operands: a flag from the flag file, else the port the microword names."));
-    for j in 0..3 {
-        b.push(wire(&format!("x{j}"), w, format!("u_fl{j} ? {{{{{}{{1'b0}}}}, fl[u_fa{j}]}} : (u_pb{j} ? db : da)", w - 1)));
-    }
-    b.push(comment("The ALU, its result registered (written the clock after)."));
-    b.push(reg("ar", w));
-    // Leading zeros of x0's low n bits (the program's counts: one width at the named screens),
-    // halving: the top half zero or not, a bit of the count each, below it ones so that zero
-    // counts n. Log depth, where a bit-serial chain would set the clock.
-    let mut lzn: Vec<u32> = ops.iter().filter_map(|o| if let Kind::Lzc(_, n) = o.kind { Some(n) } else { None }).collect();
-    lzn.sort();
-    lzn.dedup();
-    b.push(reg("lz", sw));
-    // The last stage reads only the top bit of its pair.
-    b.push(comment("verilator lint_off UNUSEDSIGNAL"));
-    let mut sel = Vec::new();
-    for &n in &lzn {
-        let p = (n + 1).next_power_of_two();
-        let lb = p.trailing_zeros();
-        let mut st = vec![Stmt::Blocking(format!("lz{n}_v{lb}"), format!("{{x0[{}:0], {{{}{{1'b1}}}}}}", n - 1, p - n))];
-        b.push(reg(&format!("lz{n}_v{lb}"), p));
-        b.push(reg(&format!("lz{n}"), lb));
-        for k in (0..lb).rev() {
-            let h = 1u32 << k;
-            let (v, nv) = (format!("lz{n}_v{}", k + 1), format!("lz{n}_v{k}"));
-            if k > 0 {
-                b.push(reg(&nv, h));
-            }
-            st.push(Stmt::Blocking(format!("lz{n}[{k}]"), format!("{v}[{}:{h}] == {h}'d0", 2 * h - 1)));
-            if k > 0 {
-                st.push(Stmt::Blocking(nv, format!("lz{n}[{k}] ? {v}[{}:0] : {v}[{}:{h}]", h - 1, 2 * h - 1)));
-            }
-        }
-        b.push(Item::Comb(st));
-        b.push(comment("verilator lint_on UNUSEDSIGNAL"));
-        sel.push((n, format!("{{{{{}{{1'b0}}}}, lz{n}}}", sw - lb)));
-    }
-    let mut e = format!("{sw}'d0");
-    for (n, x) in sel.iter().rev() {
-        e = format!("(u_imm == {sw}'d{n}) ? {x} : {e}");
-    }
-    b.push(Item::Comb(vec![Stmt::Blocking("lz".into(), e)]));
-    let one = |e: &str| format!("{{{{{}{{1'b0}}}}, {e}}}", w - 1);
-    // One adder for add, subtract and the signed compare (the difference's sign, corrected
-    // where the operands' signs differ); one left shifter for shifts by a constant and by the
-    // value on x1 (all out at W or more).
-    b.push(wire("sub", 1, format!("u_fn == 4'd{FN_SUB} || u_fn == 4'd{FN_LT}")));
-    b.push(comment("verilator lint_off UNUSEDSIGNAL"));
-    b.push(wire("as1", w + 1, format!("{{x0, 1'b1}} + {{x1 ^ {{{w}{{sub}}}}, sub}}")));
-    b.push(comment("verilator lint_on UNUSEDSIGNAL"));
-    b.push(wire("addsub", w, format!("as1[{w}:1]")));
-    b.push(wire("lt", 1, format!("(x0[{0}] != x1[{0}]) ? x0[{0}] : addsub[{0}]", w - 1)));
-    b.push(wire("shl_by", 1, format!("u_fn == 4'd{FN_SHLV}")));
-    b.push(wire("shl_amt", sw, format!("shl_by ? x1[{}:0] : u_imm", sw - 1)));
-    b.push(wire("shl", w, format!("(shl_by && x1 >= {w}) ? {w}'d0 : x0 << shl_amt")));
-    // Right shifts are by constants, and few (one at the named screens): a multiplexer over them.
-    let mut shrs: Vec<u32> = ops.iter().filter_map(|o| if let Kind::Shr(_, n) = o.kind { Some(n) } else { None }).collect();
-    shrs.sort();
-    shrs.dedup();
-    b.push(reg("shr", w));
-    let arms = shrs.iter().map(|n| (format!("{sw}'d{n}"), vec![Stmt::Blocking("shr".into(), format!("$signed(x0) >>> {n}"))])).collect();
-    b.push(Item::Comb(vec![Stmt::Case { sel: "u_imm".into(), arms, default: vec![Stmt::Blocking("shr".into(), "x0".into())] }]));
-    let alu = [
-        (vec![FN_ADD, FN_SUB], "addsub".to_string()),
-        (vec![FN_LT], one("lt")),
-        (vec![FN_EQ], one("x0 == x1")),
-        (vec![FN_AND], one("|x0 && |x1")),
-        (vec![FN_OR], one("|x0 || |x1")),
-        (vec![FN_NOT], one("~|x0")),
-        (vec![FN_SEL], "|x0 ? x1 : x2".to_string()),
-        (vec![FN_LZC], format!("{{{{{}{{1'b0}}}}, lz}}", w - sw)),
-        (vec![FN_SHL, FN_SHLV], "shl".to_string()),
-        (vec![FN_SHR], "shr".to_string()),
-    ];
-    // A parallel case: Yosys builds one multiplexer per bit, not a chain of twelve.
-    b.push(reg("alu", w));
-    let arms = alu
-        .iter()
-        .map(|(fs, x)| (fs.iter().map(|f| format!("4'd{f}")).collect::<Vec<_>>().join(", "), vec![Stmt::Blocking("alu".into(), x.clone())]))
-        .collect();
-    b.push(Item::Comb(vec![Stmt::Case { sel: "u_fn".into(), arms, default: vec![Stmt::Blocking("alu".into(), "x0".into())] }]));
-    b.push(Item::Always(vec![Stmt::If("en".into(), vec![set("ar", "alu")], vec![])]));
-    b.push(Item::Blank);
-}
-
 /// The shift-add multiplier.
 fn shift_add(cx: &Cx, b: &mut Vec<Item>) {
     let (w, sw) = (cx.w, cx.sw);
@@ -557,29 +474,43 @@ fn shift_add(cx: &Cx, b: &mut Vec<Item>) {
     b.push(Item::Blank);
 }
 
-/// The restoring divider.
+/// The restoring divider, as wide as the widest divisor (`wd`, as the pipelined engine's
+/// shift-remainder dividers): the partial remainder stays below the divisor, so it fits `wd`
+/// bits after each step, and the quotient's `qm` bits (the widest) share a register with the
+/// dividend's low bits they replace. Where a quotient does not fit its bits the result is
+/// golden's "unspecified", which the program never reads.
 fn divider(cx: &Cx, b: &mut Vec<Item>) {
-    let (w, sw, ops) = (cx.w, cx.sw, &cx.s.prog.ops);
-    b.push(comment("The restoring divider: the remainder shifted past the divisor, the dividend's low qb bits shifted in, a bit a clock."));
-    let mut qbs: Vec<u32> = ops.iter().filter_map(|o| if let Kind::Div { qb, .. } = o.kind { Some(qb) } else { None }).collect();
-    qbs.sort();
-    qbs.dedup();
-    for (n, wn) in [("dr", w), ("dd", w), ("dn", w), ("dq", w), ("dcnt", sw), ("dr0", w), ("dn0", w)] {
+    let (sw, w) = (cx.sw, cx.w);
+    let (wd, qm, qbs) = div_widths(cx.s);
+    b.push(comment(format!(
+        "The restoring divider ({wd}-bit divisors, {qm} quotient bits): the remainder shifted past the divisor, the dividend's"
+    )));
+    b.push(comment(
+        "low qb bits shifted in from dl as the quotient's bits enter it, a bit a clock; one subtractor, its borrow the compare.",
+    ));
+    for (n, wn) in [("dr", wd), ("dd", wd), ("dl", qm), ("dcnt", sw), ("dr0", wd), ("dl0", qm)] {
         b.push(reg(n, wn));
     }
-    b.push(wire("dt", w + 1, format!("{{dr, dn[{}]}}", w - 1)));
-    // The partial remainder stays below the divisor: it fits W bits after each step.
-    b.push(wire("dge", 1, "dt >= {1'b0, dd}"));
-    // Its top bit is zero wherever it is taken.
+    b.push(wire("dt", wd + 1, format!("{{dr, dl[{}]}}", qm - 1)));
+    // Its bit wd is zero wherever it is taken.
     b.push(comment("verilator lint_off UNUSEDSIGNAL"));
-    b.push(wire("dsub", w + 1, "dt - {1'b0, dd}"));
+    b.push(wire("dsub", wd + 2, "{1'b0, dt} - {2'b0, dd}"));
     b.push(comment("verilator lint_on UNUSEDSIGNAL"));
+    b.push(wire("dge", 1, format!("!dsub[{}]", wd + 1)));
     // The quotient widths are few: a multiplexer over them, not a barrel shifter.
-    let mut top = vec![Stmt::Blocking("dr0".into(), "x0".into()), Stmt::Blocking("dn0".into(), "x0".into())];
-    for q in qbs.iter().rev() {
+    let high = |q: u32| {
+        if q + wd <= w {
+            format!("x0[{}:{q}]", q + wd - 1)
+        } else {
+            crate::verilog::zext(&format!("x0[{}:{q}]", w - 1), w - q, wd)
+        }
+    };
+    let low = |q: u32| if q < qm { format!("{{x0[{}:0], {}'d0}}", q - 1, qm - q) } else { format!("x0[{}:0]", q - 1) };
+    let mut top = vec![Stmt::Blocking("dr0".into(), format!("x0[{}:0]", wd - 1)), Stmt::Blocking("dl0".into(), format!("{qm}'d0"))];
+    for &q in qbs.iter().rev() {
         top = vec![Stmt::If(
             format!("u_dqb == {sw}'d{q}"),
-            vec![Stmt::Blocking("dr0".into(), format!("x0 >> {q}")), Stmt::Blocking("dn0".into(), format!("x0 << {}", w - q))],
+            vec![Stmt::Blocking("dr0".into(), high(q)), Stmt::Blocking("dl0".into(), low(q))],
             top,
         )];
     }
@@ -588,13 +519,12 @@ fn divider(cx: &Cx, b: &mut Vec<Item>) {
         "en".into(),
         vec![Stmt::If(
             "u_dld".into(),
-            vec![set("dr", "dr0"), set("dn", "dn0"), set("dd", "x1"), set("dq", format!("{w}'d0")), set("dcnt", "u_dqb")],
+            vec![set("dr", "dr0"), set("dl", "dl0"), set("dd", format!("x1[{}:0]", wd - 1)), set("dcnt", "u_dqb")],
             vec![Stmt::If(
                 format!("dcnt != {sw}'d0"),
                 vec![
-                    set("dr", format!("dge ? dsub[{0}:0] : dt[{0}:0]", w - 1)),
-                    set("dq", format!("{{dq[{}:0], dge}}", w - 2)),
-                    set("dn", "dn << 1"),
+                    set("dr", format!("dge ? dsub[{0}:0] : dt[{0}:0]", wd - 1)),
+                    set("dl", if qm > 1 { format!("{{dl[{}:0], dge}}", qm - 2) } else { "dge".into() }),
                     set("dcnt", format!("dcnt - {sw}'d1")),
                 ],
                 vec![],
@@ -603,6 +533,19 @@ fn divider(cx: &Cx, b: &mut Vec<Item>) {
         vec![],
     )]));
     b.push(Item::Blank);
+}
+
+/// The divider's widths: the widest divisor, the widest quotient and the quotient widths.
+fn div_widths(s: &SeqSchedule) -> (u32, u32, Vec<u32>) {
+    let ops = &s.prog.ops;
+    let divs: Vec<(u32, u32)> = (0..ops.len())
+        .filter(|&o| s.slots[o].exec != Exec::Dead)
+        .filter_map(|o| if let Kind::Div { d, qb, .. } = ops[o].kind { Some((ops[d.0 as usize].w, qb)) } else { None })
+        .collect();
+    let mut qbs: Vec<u32> = divs.iter().map(|d| d.1).collect();
+    qbs.sort();
+    qbs.dedup();
+    (divs.iter().map(|d| d.0).max().expect("a division"), *qbs.last().expect("a division"), qbs)
 }
 
 /// The write bus: its source, wrapped to the value's width and sign.
@@ -614,7 +557,8 @@ fn write_bus(cx: &Cx, widths: &[u32], b: &mut Vec<Item>) {
         MulUnit::Tile { .. } => (0..cx.s.plan.units.mults).map(|u| ([SRC_MUL, SRC_MUL1][u as usize], format!("m{u}acc"))).collect(),
         MulUnit::ShiftAdd { .. } => vec![(SRC_MUL, "macc".into())],
     };
-    srcs.extend([(SRC_DIVQ, "dq".into()), (SRC_DIVR, "dr".into())]);
+    let (dw, qm, _) = div_widths(cx.s);
+    srcs.extend([(SRC_DIVQ, crate::verilog::zext("dl", qm, w)), (SRC_DIVR, crate::verilog::zext("dr", dw, w))]);
     for (k, n) in ins.iter().enumerate() {
         let (wv, sg) = if k < 3 {
             (wd.cx, true)
@@ -625,12 +569,25 @@ fn write_bus(cx: &Cx, widths: &[u32], b: &mut Vec<Item>) {
         };
         srcs.push((SRC_IN + k as u64, if sg { crate::verilog::sext(n, wv, w) } else { crate::verilog::zext(n, wv, w) }));
     }
+    // Registered (`SeqPlan::bus_lat`): the source, width and sign from the microword a clock
+    // before the value, which is registered and written the clock after it.
+    let reg_bus = match cx.s.plan.bus_lat {
+        0 => false,
+        1 => true,
+        l => panic!("a write bus of {l} clocks (the RTL has 0 and 1)"),
+    };
+    let wb = bits_for(widths.len() as u32 - 1);
+    let (src, wc, wsg) = if reg_bus {
+        b.extend([reg("src_r", 4), reg("wc_r", wb), reg("wsg_r", 1), reg("bus_r", w)]);
+        ("src_r", "wc_r", "wsg_r")
+    } else {
+        ("u_src", "u_wc", "u_wsg")
+    };
     b.push(reg("raw", w));
     let arms = srcs.into_iter().map(|(k, x)| (format!("4'd{k}"), vec![Stmt::Blocking("raw".into(), x)])).collect();
-    b.push(Item::Comb(vec![Stmt::Case { sel: "u_src".into(), arms, default: vec![Stmt::Blocking("raw".into(), "ar".into())] }]));
+    b.push(Item::Comb(vec![Stmt::Case { sel: src.into(), arms, default: vec![Stmt::Blocking("raw".into(), "ar".into())] }]));
     b.push(reg("wmask", w));
     b.push(reg("wsign", 1));
-    let wb = bits_for(widths.len() as u32 - 1);
     let arms: Vec<(String, Vec<Stmt>)> = widths
         .iter()
         .enumerate()
@@ -640,11 +597,21 @@ fn write_bus(cx: &Cx, widths: &[u32], b: &mut Vec<Item>) {
         })
         .collect();
     b.push(Item::Comb(vec![Stmt::Case {
-        sel: "u_wc".into(),
+        sel: wc.into(),
         arms,
         default: vec![Stmt::Blocking("wmask".into(), format!("{{{w}{{1'b1}}}}")), Stmt::Blocking("wsign".into(), "1'b0".into())],
     }]));
-    b.push(Item::Assign("bus".into(), "(raw & wmask) | ((u_wsg && wsign) ? ~wmask : {".to_string() + &format!("{w}{{1'b0}}}})")));
+    let wrapped = format!("(raw & wmask) | (({wsg} && wsign) ? ~wmask : {{{w}{{1'b0}}}})");
+    if reg_bus {
+        b.push(Item::Always(vec![Stmt::If(
+            "en".into(),
+            vec![set("src_r", "u_src"), set("wc_r", "u_wc"), set("wsg_r", "u_wsg"), set("bus_r", wrapped)],
+            vec![],
+        )]));
+        b.push(Item::Assign("bus".into(), "bus_r".into()));
+    } else {
+        b.push(Item::Assign("bus".into(), wrapped));
+    }
     b.push(Item::Blank);
 }
 
