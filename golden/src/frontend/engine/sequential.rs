@@ -45,8 +45,9 @@ pub const READ: u32 = 1;
 /// A plan's own is [`SeqPlan::alu_lat`].
 pub const ALU_LAT: u32 = 1;
 /// The split ALU's latency: the operands registered, the adder in two halves with the carry
-/// registered between them, the high half and the result multiplexer a clock of their own.
-pub const ALU_LAT_SPLIT: u32 = 3;
+/// registered between them (and the shift and the leading-zero count in two steps), the
+/// result multiplexer a clock of its own.
+pub const ALU_LAT_SPLIT: u32 = 4;
 
 /// iCE40 SB_LUT4 a bit of the ALU, not calibrated (the estimate puts the HX8K plan's engine at
 /// 2,182 SB_LUT4; its RTL measures 3,281, docs/fpga.md): the adder-subtractor with its operand

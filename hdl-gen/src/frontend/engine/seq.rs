@@ -317,11 +317,10 @@ fn microprogram(cx: &Cx, fields: &[Field]) -> Micro {
         };
         let wt = sl.write;
         // A registered bus selects its source two clocks before the write ([`write_bus`]).
-        let st = wt - 2 * s.plan.bus_lat;
-        let x = &mut mw[st as usize];
-        x.set("src", src, st);
-        x.set("wc", widths.iter().position(|&k| k == op.w).unwrap() as u64, st);
-        x.set("wsg", op.signed as u64, st);
+        let (st, wrap) = (wt - 2 * s.plan.bus_lat, wt - s.plan.bus_lat);
+        mw[st as usize].set("src", src, st);
+        mw[wrap as usize].set("wc", widths.iter().position(|&k| k == op.w).unwrap() as u64, wrap);
+        mw[wrap as usize].set("wsg", op.signed as u64, wrap);
         let x = &mut mw[wt as usize];
         match sl.loc {
             Loc::Ram(a) => {
@@ -559,32 +558,50 @@ fn write_bus(cx: &Cx, widths: &[u32], b: &mut Vec<Item>) {
     };
     let (dw, qm, _) = div_widths(cx.s);
     srcs.extend([(SRC_DIVQ, crate::verilog::zext("dl", qm, w)), (SRC_DIVR, crate::verilog::zext("dr", dw, w))]);
-    for (k, n) in ins.iter().enumerate() {
-        let (wv, sg) = if k < 3 {
+    let mut srcs: Vec<(String, String)> = srcs.into_iter().map(|(k, x)| (format!("4'd{k}"), x)).collect();
+    let kind = |k: usize| {
+        if k < 3 {
             (wd.cx, true)
         } else if k < 6 {
             (wd.cy, true)
         } else {
             (iw, false)
-        };
-        srcs.push((SRC_IN + k as u64, if sg { crate::verilog::sext(n, wv, w) } else { crate::verilog::zext(n, wv, w) }));
-    }
-    // Registered (`SeqPlan::bus_lat`): the source, width and sign from the microword a clock
-    // before the value, which is registered and written the clock after it.
+        }
+    };
+    let ext = |n: &str, (wv, sg): (u32, bool), to: u32| if sg { crate::verilog::sext(n, wv, to) } else { crate::verilog::zext(n, wv, to) };
+    // Registered (`SeqPlan::bus_lat`): the source from the microword two clocks before the
+    // write (registered; the input it names picked then, as the inputs hold for the period),
+    // the source's value registered a clock before the write, and at the write wrapped to its
+    // width and sign (from the microword the clock before): no path through both multiplexers.
     let reg_bus = match cx.s.plan.bus_lat {
         0 => false,
         1 => true,
         l => panic!("a write bus of {l} clocks (the RTL has 0 and 1)"),
     };
     let wb = bits_for(widths.len() as u32 - 1);
-    let (src, wc, wsg) = if reg_bus {
-        b.extend([reg("src_r", 4), reg("wc_r", wb), reg("wsg_r", 1), reg("bus_r", w)]);
-        ("src_r", "wc_r", "wsg_r")
+    let (src, wc, wsg, val) = if reg_bus {
+        // The inputs in one register as wide as the widest, sign-extended (the unsigned ones
+        // with a zero bit on top).
+        let wi = (0..ins.len()).map(|k| kind(k).0 + !kind(k).1 as u32).max().expect("inputs");
+        b.extend([reg("src_r", 4), reg("in_r", wi), reg("inp", wi), reg("wc_r", wb), reg("wsg_r", 1), reg("bus_r", w)]);
+        let arms = ins
+            .iter()
+            .enumerate()
+            .map(|(k, n)| (format!("4'd{}", SRC_IN + k as u64), vec![Stmt::Blocking("inp".into(), ext(n, kind(k), wi))]));
+        b.push(Item::Comb(vec![Stmt::Case {
+            sel: "u_src".into(),
+            arms: arms.collect(),
+            default: vec![Stmt::Blocking("inp".into(), format!("{wi}'d0"))],
+        }]));
+        let labels: Vec<String> = (0..ins.len()).map(|k| format!("4'd{}", SRC_IN + k as u64)).collect();
+        srcs.push((labels.join(", "), crate::verilog::sext("in_r", wi, w)));
+        ("src_r", "wc_r", "wsg_r", "bus_r")
     } else {
-        ("u_src", "u_wc", "u_wsg")
+        srcs.extend(ins.iter().enumerate().map(|(k, n)| (format!("4'd{}", SRC_IN + k as u64), ext(n, kind(k), w))));
+        ("u_src", "u_wc", "u_wsg", "raw")
     };
     b.push(reg("raw", w));
-    let arms = srcs.into_iter().map(|(k, x)| (format!("4'd{k}"), vec![Stmt::Blocking("raw".into(), x)])).collect();
+    let arms = srcs.into_iter().map(|(k, x)| (k, vec![Stmt::Blocking("raw".into(), x)])).collect();
     b.push(Item::Comb(vec![Stmt::Case { sel: src.into(), arms, default: vec![Stmt::Blocking("raw".into(), "ar".into())] }]));
     b.push(reg("wmask", w));
     b.push(reg("wsign", 1));
@@ -593,7 +610,7 @@ fn write_bus(cx: &Cx, widths: &[u32], b: &mut Vec<Item>) {
         .enumerate()
         .map(|(k, &x)| {
             let m = if x >= w { format!("{{{w}{{1'b1}}}}") } else { format!("{{{{{}{{1'b0}}}}, {{{x}{{1'b1}}}}}}", w - x) };
-            (format!("{wb}'d{k}"), vec![Stmt::Blocking("wmask".into(), m), Stmt::Blocking("wsign".into(), format!("raw[{}]", x - 1))])
+            (format!("{wb}'d{k}"), vec![Stmt::Blocking("wmask".into(), m), Stmt::Blocking("wsign".into(), format!("{val}[{}]", x - 1))])
         })
         .collect();
     b.push(Item::Comb(vec![Stmt::Case {
@@ -601,17 +618,15 @@ fn write_bus(cx: &Cx, widths: &[u32], b: &mut Vec<Item>) {
         arms,
         default: vec![Stmt::Blocking("wmask".into(), format!("{{{w}{{1'b1}}}}")), Stmt::Blocking("wsign".into(), "1'b0".into())],
     }]));
-    let wrapped = format!("(raw & wmask) | (({wsg} && wsign) ? ~wmask : {{{w}{{1'b0}}}})");
+    let wrapped = format!("({val} & wmask) | (({wsg} && wsign) ? ~wmask : {{{w}{{1'b0}}}})");
     if reg_bus {
         b.push(Item::Always(vec![Stmt::If(
             "en".into(),
-            vec![set("src_r", "u_src"), set("wc_r", "u_wc"), set("wsg_r", "u_wsg"), set("bus_r", wrapped)],
+            vec![set("src_r", "u_src"), set("in_r", "inp"), set("bus_r", "raw"), set("wc_r", "u_wc"), set("wsg_r", "u_wsg")],
             vec![],
         )]));
-        b.push(Item::Assign("bus".into(), "bus_r".into()));
-    } else {
-        b.push(Item::Assign("bus".into(), wrapped));
     }
+    b.push(Item::Assign("bus".into(), wrapped));
     b.push(Item::Blank);
 }
 

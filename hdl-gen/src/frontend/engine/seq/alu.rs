@@ -6,11 +6,14 @@
 //! - **One clock** ([`ALU_LAT`], the HX8K): the operand select, the whole adder and the
 //!   result multiplexer in one path, as first written.
 //! - **Split** ([`ALU_LAT_SPLIT`], the UP5K): on the UP5K that one path was the engine's
-//!   clock, 15.1 MHz (its 67-bit carry chain alone about 26 ns, docs/fpga.md). Clock 1
-//!   registers the operands and the function; clock 2 adds the low half (its carry
-//!   registered) and both sums of the high half (carry in 0 and 1, a carry select), and the
-//!   other functions; clock 3 picks the high half by the low half's carry, forms the compare
-//!   from the signs and multiplexes the result into `ar`.
+//!   clock, 15.1 MHz (its 67-bit carry chain alone about 26 ns, docs/fpga.md), and on this
+//!   slow fabric (about 4 ns a LUT level with its routing) a 40 MHz clock leaves about five
+//!   levels a clock. Clock 1 registers the operands and the function; clock 2 adds the low
+//!   half (its carry registered) and both sums of the high half (carry in 0 and 1, a carry
+//!   select), tests the operands for zero, shifts by the amount's low bits and counts each
+//!   group's leading zeros; clock 3 picks the high half by the low half's carry, forms the
+//!   compare from the signs, shifts by the amount's high bits and finds the first group that
+//!   is not zero; clock 4 multiplexes the result into `ar`.
 
 use super::{Cx, FN_ADD, FN_AND, FN_EQ, FN_LT, FN_LZC, FN_NOT, FN_OR, FN_SEL, FN_SHL, FN_SHLV, FN_SHR, FN_SUB};
 use crate::verilog::{comment, reg, set, wire, Item, Stmt};
@@ -130,15 +133,17 @@ fn one_clock(cx: &Cx, b: &mut Vec<Item>) {
     b.push(Item::Always(vec![Stmt::If("en".into(), vec![set("ar", "alu")], vec![])]));
 }
 
-/// The ALU over three clocks (module doc).
+/// The ALU over four clocks (module doc): each clock's logic a few LUT levels on the UP5K.
 fn split(cx: &Cx, b: &mut Vec<Item>) {
     let (w, sw) = (cx.w, cx.sw);
     // The low half as wide as the high one or one bit wider: the two carry chains even.
     let h = w.div_ceil(2);
     let hw = w - h;
-    b.push(comment("The ALU over three clocks: the operands and the function registered (ax*, af, ai); the low half's"));
-    b.push(comment("sum with its carry and both sums of the high half (carry in 0 and 1), and the other functions,"));
-    b.push(comment("registered; then the high half chosen by the carry, the compare and the result into ar."));
+    let one = |e: &str| format!("{{{{{}{{1'b0}}}}, {e}}}", w - 1);
+    b.push(comment("The ALU over four clocks. 1: the operands and the function registered (ax*, af, ai). 2: the low half's sum"));
+    b.push(comment("with its carry and both sums of the high half (carry in 0 and 1); the zero tests; the shift by the amount's"));
+    b.push(comment("low bits; the leading zeros of each group of bits; select, right shift or pass (b*). 3: the high half chosen"));
+    b.push(comment("by the carry and the compare; the shift by the amount's high bits; the count (c*). 4: the result into ar."));
     b.extend([reg("ax0", w), reg("ax1", w), reg("ax2", w), reg("af", 4), reg("ai", sw)]);
     b.push(wire("sub", 1, format!("af == 4'd{FN_SUB} || af == 4'd{FN_LT}")));
     b.push(wire("ay1", w, format!("ax1 ^ {{{w}{{sub}}}}")));
@@ -148,32 +153,128 @@ fn split(cx: &Cx, b: &mut Vec<Item>) {
     b.push(wire("ahi1", hw + 1, format!("{{ax0[{0}:{h}], 1'b1}} + {{ay1[{0}:{h}], 1'b1}}", w - 1)));
     b.push(comment("verilator lint_on UNUSEDSIGNAL"));
     b.push(wire("ahi0", hw, format!("ax0[{0}:{h}] + ay1[{0}:{h}]", w - 1)));
-    functions(cx, "ax", "af", "ai", (Vec::new(), &[]), "oth", b);
-    // Clock 3's registers: the low sum and its carry, the high sums, the signs, the function's class.
+    // The one-bit results (equal, and, or, not) from the operands' zero tests.
+    b.push(wire("nz0", 1, "|ax0"));
+    b.push(wire("nz1", 1, "|ax1"));
+    let flag = format!("(af == 4'd{FN_EQ}) ? (ax0 == ax1) : (af == 4'd{FN_AND}) ? (nz0 && nz1) : (af == 4'd{FN_OR}) ? (nz0 || nz1) : !nz0");
+    // Right shifts are by constants, and few (one at the named screens): a multiplexer over them.
+    let ops = &cx.s.prog.ops;
+    let mut shrs: Vec<u32> = ops.iter().filter_map(|o| if let Kind::Shr(_, n) = o.kind { Some(n) } else { None }).collect();
+    shrs.sort();
+    shrs.dedup();
+    b.push(reg("shr", w));
+    let arms = shrs.iter().map(|n| (format!("{sw}'d{n}"), vec![Stmt::Blocking("shr".into(), format!("$signed(ax0) >>> {n}"))])).collect();
+    b.push(Item::Comb(vec![Stmt::Case { sel: "ai".into(), arms, default: vec![Stmt::Blocking("shr".into(), "ax0".into())] }]));
+    let mv = format!("(af == 4'd{FN_SEL}) ? (nz0 ? ax1 : ax2) : (af == 4'd{FN_SHR}) ? shr : ax0");
+    // The result's kind, for clock 4's multiplexer.
+    let kind = format!(
+        "(af == 4'd{FN_ADD} || sub) ? {{af == 4'd{FN_LT}, 2'd0}} : (af == 4'd{FN_EQ} || af == 4'd{FN_AND} || af == 4'd{FN_OR} || af == 4'd{FN_NOT}) ? 3'd1 : (af == 4'd{FN_LZC}) ? 3'd2 : (af == 4'd{FN_SHL} || af == 4'd{FN_SHLV}) ? 3'd3 : 3'd5"
+    );
     b.extend([reg("blo", h), reg("bc", 1), reg("bhi0", hw), reg("bhi1", hw), reg("bs0", 1), reg("bs1", 1)]);
-    b.extend([reg("badd", 1), reg("blt", 1), reg("both", w), reg("ar", w)]);
+    b.extend([reg("bfl", 1), reg("bmv", w), reg("bk", 3), reg("ck", 3), reg("cfl", 1), reg("cmv", w)]);
+    b.extend([reg("caddsub", w), reg("clt", 1), reg("ar", w)]);
     b.push(wire("addsub", w, "{bc ? bhi1 : bhi0, blo}"));
-    b.push(wire("lt", 1, format!("(bs0 != bs1) ? bs0 : addsub[{}]", w - 1)));
-    let one = |e: &str| format!("{{{{{}{{1'b0}}}}, {e}}}", w - 1);
-    b.push(Item::Always(vec![Stmt::If(
-        "en".into(),
-        vec![
-            set("ax0", "x0"),
-            set("ax1", "x1"),
-            set("ax2", "x2"),
-            set("af", "u_fn"),
-            set("ai", "u_imm"),
-            set("blo", format!("alo[{}:1]", h)),
-            set("bc", format!("alo[{}]", h + 1)),
-            set("bhi0", "ahi0"),
-            set("bhi1", format!("ahi1[{hw}:1]")),
-            set("bs0", format!("ax0[{}]", w - 1)),
-            set("bs1", format!("ax1[{}]", w - 1)),
-            set("badd", format!("af == 4'd{FN_ADD} || sub")),
-            set("blt", format!("af == 4'd{FN_LT}")),
-            set("both", "oth"),
-            set("ar", format!("blt ? {} : badd ? addsub : both", one("lt"))),
-        ],
-        vec![],
-    )]));
+    let mut regs = vec![
+        set("ax0", "x0"),
+        set("ax1", "x1"),
+        set("ax2", "x2"),
+        set("af", "u_fn"),
+        set("ai", "u_imm"),
+        set("blo", format!("alo[{}:1]", h)),
+        set("bc", format!("alo[{}]", h + 1)),
+        set("bhi0", "ahi0"),
+        set("bhi1", format!("ahi1[{hw}:1]")),
+        set("bs0", format!("ax0[{}]", w - 1)),
+        set("bs1", format!("ax1[{}]", w - 1)),
+        set("bfl", flag),
+        set("bmv", mv),
+        set("bk", kind),
+        set("caddsub", "addsub"),
+        set("clt", format!("(bs0 != bs1) ? bs0 : addsub[{}]", w - 1)),
+        set("cfl", "bfl"),
+        set("cmv", "bmv"),
+        set("ck", "bk"),
+    ];
+    let (sh, lz) = (split_shift(cx, &mut regs, b), split_lzc(cx, &mut regs, b));
+    let ar = format!(
+        "(ck == 3'd0) ? caddsub : (ck == 3'd4) ? {} : (ck == 3'd1) ? {} : (ck == 3'd2) ? {} : (ck == 3'd3) ? {sh} : cmv",
+        one("clt"),
+        one("cfl"),
+        crate::verilog::zext(&lz, sw, w)
+    );
+    regs.push(set("ar", ar));
+    b.push(Item::Always(vec![Stmt::If("en".into(), regs, vec![])]));
+}
+
+/// The left shift in two clocks: by the amount's low three bits on clock 2, by its high bits
+/// on clock 3 (all out at W or more: the amount's bits above its width ORed, not a compare of
+/// the whole word). Returns clock 3's register.
+fn split_shift(cx: &Cx, regs: &mut Vec<Stmt>, b: &mut Vec<Item>) -> String {
+    let (w, sw) = (cx.w, cx.sw);
+    let lo = sw.min(3);
+    b.push(wire("shl_by", 1, format!("af == 4'd{FN_SHLV}")));
+    b.push(wire("shl_amt", sw, format!("shl_by ? ax1[{}:0] : ai", sw - 1)));
+    b.push(wire("shl_out", 1, format!("shl_by && (|ax1[{}:{sw}] || ax1[{}:0] >= {sw}'d{w})", w - 1, sw - 1)));
+    b.extend([reg("bsh", w), reg("bout", 1), reg("csh", w)]);
+    regs.extend([set("bsh", format!("ax0 << shl_amt[{}:0]", lo - 1)), set("bout", "shl_out")]);
+    if sw > lo {
+        b.push(reg("bamt", sw - lo));
+        regs.extend([set("bamt", format!("shl_amt[{}:{lo}]", sw - 1)), set("csh", format!("bout ? {w}'d0 : bsh << {{bamt, {lo}'d0}}"))]);
+    } else {
+        regs.push(set("csh", format!("bout ? {w}'d0 : bsh")));
+    }
+    "csh".into()
+}
+
+/// The leading-zero count in two clocks: on clock 2 each group of 8 bits' zero test and
+/// count, on clock 3 the first group that is not zero and its count. Returns clock 3's
+/// register.
+fn split_lzc(cx: &Cx, regs: &mut Vec<Stmt>, b: &mut Vec<Item>) -> String {
+    let (sw, ops) = (cx.sw, &cx.s.prog.ops);
+    let mut lzn: Vec<u32> = ops.iter().filter_map(|o| if let Kind::Lzc(_, n) = o.kind { Some(n) } else { None }).collect();
+    lzn.sort();
+    lzn.dedup();
+    b.extend([reg("bi", sw), reg("clz", sw)]);
+    regs.push(set("bi", "ai"));
+    let mut e = format!("{sw}'d0");
+    for &n in lzn.iter().rev() {
+        // Leading zeros of x0's low n bits, padded below with ones so that zero counts n.
+        let p = (n + 1).next_power_of_two();
+        let g = p.min(8);
+        assert!(g >= 2, "a count of {n} bits");
+        let k = p / g;
+        let gb = g.trailing_zeros();
+        // Its lowest bit decides nothing: a group's count is its width less one there.
+        b.push(comment("verilator lint_off UNUSEDSIGNAL"));
+        b.push(wire(&format!("lz{n}_v"), p, format!("{{ax0[{}:0], {{{}{{1'b1}}}}}}", n - 1, p - n)));
+        b.push(comment("verilator lint_on UNUSEDSIGNAL"));
+        // The last group's zero test is never read: the padding's ones.
+        if k > 1 {
+            b.push(reg(&format!("lz{n}_z"), k - 1));
+        }
+        b.push(reg(&format!("lz{n}_c"), k * gb));
+        for j in 0..k {
+            // Group j from the top: its zero test and its own count (a priority chain of g bits).
+            let top = p - 1 - j * g;
+            let mut c = format!("{}'d{}", gb, g - 1);
+            for bit in 1..g {
+                c = format!("lz{n}_v[{}] ? {}'d{} : ({c})", top + 1 - g + bit, gb, g - 1 - bit);
+            }
+            if j + 1 < k {
+                regs.push(set(format!("lz{n}_z[{j}]"), format!("~|lz{n}_v[{top}:{}]", top + 1 - g)));
+            }
+            let hi = (j + 1) * gb - 1;
+            regs.push(set(format!("lz{n}_c[{hi}:{}]", j * gb), c));
+        }
+        // Clock 3: the first group not zero (the last one never is: the padding's ones).
+        let mut cnt = String::new();
+        for j in (0..k).rev() {
+            // 8 j + the group's count: the group's index above its count's bits.
+            let here = format!("{{{}'d{j}, lz{n}_c[{}:{}]}}", sw - gb, (j + 1) * gb - 1, j * gb);
+            cnt = if j + 1 == k { here } else { format!("!lz{n}_z[{j}] ? ({here}) : ({cnt})") };
+        }
+        e = format!("(bi == {sw}'d{n}) ? ({cnt}) : ({e})");
+    }
+    regs.push(set("clz", e));
+    "clz".into()
 }
