@@ -82,15 +82,35 @@ pub struct SeqPlan {
     /// the microword's EBR through the source and wrap multiplexers was the path after the
     /// ALU's and the tiles' sums, 43 ns).
     pub bus_lat: u32,
+    /// Clocks from a unit's operands on the read ports to its load: 0, or 1 where the units
+    /// load them from the split ALU's operand registers (on the UP5K the operand select, the
+    /// flag file's read among it, then a tile's chunk select was the path after the ALU's).
+    pub load_lag: u32,
 }
 
 impl SeqPlan {
     /// The HX8K: no multiplier, so one shift-add unit and one divider, a bit a clock.
-    pub const ICE40_HX8K: SeqPlan =
-        SeqPlan { units: Plan::ICE40_HX8K, read_ports: 2, bank_bits: 16, bank_depth: 256, alu_lat: ALU_LAT, acc_lag: 0, bus_lat: 0 };
+    pub const ICE40_HX8K: SeqPlan = SeqPlan {
+        units: Plan::ICE40_HX8K,
+        read_ports: 2,
+        bank_bits: 16,
+        bank_depth: 256,
+        alu_lat: ALU_LAT,
+        acc_lag: 0,
+        bus_lat: 0,
+        load_lag: 0,
+    };
     /// The UP5K: 2 of its SB_MAC16 and one divider.
-    pub const ICE40_UP5K: SeqPlan =
-        SeqPlan { units: Plan::ICE40_UP5K, read_ports: 2, bank_bits: 16, bank_depth: 256, alu_lat: ALU_LAT_SPLIT, acc_lag: 1, bus_lat: 1 };
+    pub const ICE40_UP5K: SeqPlan = SeqPlan {
+        units: Plan::ICE40_UP5K,
+        read_ports: 2,
+        bank_bits: 16,
+        bank_depth: 256,
+        alu_lat: ALU_LAT_SPLIT,
+        acc_lag: 1,
+        bus_lat: 1,
+        load_lag: 1,
+    };
 
     /// The forms whose engine is sequential: the iCE40s' (`--fe-setup ice40-hx8k`, whose
     /// multiplier is shift-add, and `ice40-up5k`, whose products are SB_MAC16 passes: the
@@ -299,7 +319,7 @@ impl SeqSchedule {
                     // A tile product's passes then its pipeline; a shift-add's steps then its
                     // register; a division's load and steps: the unit holds until the write.
                     let lag = if matches!((c, units.mul), (Class::Mul, MulUnit::Tile { .. })) { plan.acc_lag } else { 0 };
-                    (Exec::Unit(c, 0), timing(&prog, op, &units).2 + lag + plan.bus_lat)
+                    (Exec::Unit(c, 0), timing(&prog, op, &units).2 + lag + plan.bus_lat + plan.load_lag)
                 }
                 _ => (Exec::Alu, plan.alu_lat + plan.bus_lat),
             })

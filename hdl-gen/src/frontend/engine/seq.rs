@@ -195,7 +195,7 @@ pub fn module(hw: &Hw, s: &SeqSchedule, name: &str) -> SeqEngine {
     memories(&cx, &l, &micro, &consts, &mut b);
     alu::alu(&cx, &mut b);
     match tile::Tiles::new(s) {
-        Some(t) => t.units(w, &mut b),
+        Some(t) => t.units(w, operands(&cx), &mut b),
         None => shift_add(&cx, &mut b),
     }
     divider(&cx, &mut b);
@@ -259,8 +259,9 @@ fn microprogram(cx: &Cx, fields: &[Field]) -> Micro {
                     }
                 }
             }
-            let x = &mut mw[(t + READ) as usize];
-            let e = t + READ;
+            // A unit loads its operands load_lag clocks after they are on the read ports.
+            let e = t + READ + if matches!(exec, Exec::Unit(..)) { s.plan.load_lag } else { 0 };
+            let x = &mut mw[e as usize];
             match (exec, op.kind) {
                 (Exec::Unit(Class::Mul, u), _) if tiles.is_some() => {
                     for (t, k, v) in tiles.as_ref().expect("tiles").passes(o, u) {
@@ -480,6 +481,7 @@ fn shift_add(cx: &Cx, b: &mut Vec<Item>) {
 /// golden's "unspecified", which the program never reads.
 fn divider(cx: &Cx, b: &mut Vec<Item>) {
     let (sw, w) = (cx.sw, cx.w);
+    let (x0, x1) = operands(cx);
     let (wd, qm, qbs) = div_widths(cx.s);
     b.push(comment(format!(
         "The restoring divider ({wd}-bit divisors, {qm} quotient bits): the remainder shifted past the divisor, the dividend's"
@@ -499,13 +501,13 @@ fn divider(cx: &Cx, b: &mut Vec<Item>) {
     // The quotient widths are few: a multiplexer over them, not a barrel shifter.
     let high = |q: u32| {
         if q + wd <= w {
-            format!("x0[{}:{q}]", q + wd - 1)
+            format!("{x0}[{}:{q}]", q + wd - 1)
         } else {
-            crate::verilog::zext(&format!("x0[{}:{q}]", w - 1), w - q, wd)
+            crate::verilog::zext(&format!("{x0}[{}:{q}]", w - 1), w - q, wd)
         }
     };
-    let low = |q: u32| if q < qm { format!("{{x0[{}:0], {}'d0}}", q - 1, qm - q) } else { format!("x0[{}:0]", q - 1) };
-    let mut top = vec![Stmt::Blocking("dr0".into(), format!("x0[{}:0]", wd - 1)), Stmt::Blocking("dl0".into(), format!("{qm}'d0"))];
+    let low = |q: u32| if q < qm { format!("{{{x0}[{}:0], {}'d0}}", q - 1, qm - q) } else { format!("{x0}[{}:0]", q - 1) };
+    let mut top = vec![Stmt::Blocking("dr0".into(), format!("{x0}[{}:0]", wd - 1)), Stmt::Blocking("dl0".into(), format!("{qm}'d0"))];
     for &q in qbs.iter().rev() {
         top = vec![Stmt::If(
             format!("u_dqb == {sw}'d{q}"),
@@ -518,7 +520,7 @@ fn divider(cx: &Cx, b: &mut Vec<Item>) {
         "en".into(),
         vec![Stmt::If(
             "u_dld".into(),
-            vec![set("dr", "dr0"), set("dl", "dl0"), set("dd", format!("x1[{}:0]", wd - 1)), set("dcnt", "u_dqb")],
+            vec![set("dr", "dr0"), set("dl", "dl0"), set("dd", format!("{x1}[{}:0]", wd - 1)), set("dcnt", "u_dqb")],
             vec![Stmt::If(
                 format!("dcnt != {sw}'d0"),
                 vec![
@@ -532,6 +534,23 @@ fn divider(cx: &Cx, b: &mut Vec<Item>) {
         vec![],
     )]));
     b.push(Item::Blank);
+}
+
+/// Where the units load their operands: the read ports' operands, or the split ALU's
+/// registers of them a clock later (`SeqPlan::load_lag`).
+fn operands(cx: &Cx) -> (&'static str, &'static str) {
+    match cx.s.plan.load_lag {
+        0 => ("x0", "x1"),
+        1 => {
+            assert_eq!(
+                cx.s.plan.alu_lat,
+                golden::frontend::engine::sequential::ALU_LAT_SPLIT,
+                "the operands' registers are the split ALU's"
+            );
+            ("ax0", "ax1")
+        }
+        l => panic!("units loading {l} clocks after their operands (the RTL has 0 and 1)"),
+    }
 }
 
 /// The divider's widths: the widest divisor, the widest quotient and the quotient widths.

@@ -63,7 +63,7 @@ impl<'a> Tiles<'a> {
         let mut p: Vec<(u32, u32)> =
             (0..ca).flat_map(|i| (0..cb).map(move |j| (i, j))).filter(|&(i, j)| (i + j) * self.bits < ops[o].w).collect();
         p.sort_by_key(|&(i, j)| std::cmp::Reverse(i + j));
-        let l = sl.issue + READ;
+        let l = sl.issue + READ + self.s.plan.load_lag;
         assert_eq!(sl.exec, Exec::Unit(golden::frontend::engine::schedule::Class::Mul, u));
         let lag = self.s.plan.acc_lag;
         assert!(lag <= 1, "a sum split in {} parts (the RTL has one or two)", lag + 1);
@@ -89,8 +89,8 @@ impl<'a> Tiles<'a> {
     }
 
     /// The units: per unit the held operands, the chunk selection, the tile and the sum.
-    /// `w`: the register file's word.
-    pub(super) fn units(&self, w: u32, b: &mut Vec<Item>) {
+    /// `w`: the register file's word; `x0`, `x1`: where the operands load from.
+    pub(super) fn units(&self, w: u32, (x0, x1): (&str, &str), b: &mut Vec<Item>) {
         let (bits, n) = (self.bits, self.chunks);
         // The operands sign-extended past their top chunk's sign bit (a register-file word holds
         // its value sign- or zero-extended to W: unsigned values have a zero bit on top).
@@ -106,7 +106,7 @@ impl<'a> Tiles<'a> {
             let m = |x: &str| format!("m{u}{x}");
             let uf = |x: &str| format!("u_m{u}{x}");
             b.extend([reg(&m("a"), w), reg(&m("b"), w)]);
-            for (o, x) in [("a", "x0"), ("b", "x1")] {
+            for (o, x) in [("a", x0), ("b", x1)] {
                 let src = m(&format!("x{o}"));
                 b.push(wire(&src, w, format!("{} ? {x} : {}", uf("ld"), m(o))));
                 b.push(wire(&m(&format!("e{o}")), ew, crate::verilog::sext(&src, w, ew)));
@@ -137,7 +137,7 @@ impl<'a> Tiles<'a> {
                 b.push(sreg(&m("pr"), pw));
             }
             let mut regs = vec![
-                Stmt::If(uf("ld"), vec![set(m("a"), "x0"), set(m("b"), "x1")], vec![]),
+                Stmt::If(uf("ld"), vec![set(m("a"), x0), set(m("b"), x1)], vec![]),
                 set(m("ra"), m("ca")),
                 set(m("rb"), m("cb")),
                 set(m("f1"), uf("ld")),
