@@ -493,11 +493,28 @@ fn divider(cx: &Cx, b: &mut Vec<Item>) {
         b.push(reg(n, wn));
     }
     b.push(wire("dt", wd + 1, format!("{{dr, dl[{}]}}", qm - 1)));
-    // Its bit wd is zero wherever it is taken.
-    b.push(comment("verilator lint_off UNUSEDSIGNAL"));
-    b.push(wire("dsub", wd + 2, "{1'b0, dt} - {2'b0, dd}"));
-    b.push(comment("verilator lint_on UNUSEDSIGNAL"));
-    b.push(wire("dge", 1, format!("!dsub[{}]", wd + 1)));
+    if cx.s.plan.alu_lat == golden::frontend::engine::sequential::ALU_LAT_SPLIT {
+        // The split form's step (the UP5K: one borrow chain through the divisor was its path
+        // at 29.9 MHz): a carry select, the low half's difference and both of the high
+        // half's (borrow in 0 and 1), chosen by the low half's borrow. Their top bits are
+        // zero wherever they are taken.
+        let l = wd.div_ceil(2);
+        let hb = wd + 1 - l;
+        b.push(comment("verilator lint_off UNUSEDSIGNAL"));
+        b.push(wire("dslo", l + 1, format!("{{1'b0, dt[{}:0]}} - {{1'b0, dd[{}:0]}}", l - 1, l - 1)));
+        b.push(wire("dshi0", hb + 1, format!("{{1'b0, dt[{wd}:{l}]}} - {{2'b0, dd[{}:{l}]}}", wd - 1)));
+        // The borrow in rides as a low bit: 0 - 1 borrows one.
+        b.push(wire("dshi1", hb + 2, format!("{{1'b0, dt[{wd}:{l}], 1'b0}} - {{2'b0, dd[{}:{l}], 1'b1}}", wd - 1)));
+        b.push(wire("dsub", wd + 1, format!("{{dslo[{l}] ? dshi1[{hb}:1] : dshi0[{}:0], dslo[{}:0]}}", hb - 1, l - 1)));
+        b.push(comment("verilator lint_on UNUSEDSIGNAL"));
+        b.push(wire("dge", 1, format!("!(dslo[{l}] ? dshi1[{}] : dshi0[{hb}])", hb + 1)));
+    } else {
+        // Its bit wd is zero wherever it is taken.
+        b.push(comment("verilator lint_off UNUSEDSIGNAL"));
+        b.push(wire("dsub", wd + 2, "{1'b0, dt} - {2'b0, dd}"));
+        b.push(comment("verilator lint_on UNUSEDSIGNAL"));
+        b.push(wire("dge", 1, format!("!dsub[{}]", wd + 1)));
+    }
     // The quotient widths are few: a multiplexer over them, not a barrel shifter.
     let high = |q: u32| {
         if q + wd <= w {
