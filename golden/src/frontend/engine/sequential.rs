@@ -499,7 +499,7 @@ impl SeqSchedule {
         (w, f)
     }
 
-    /// The microprogram's own rules: one operation issued (the ALU's or a unit's load),
+    /// The microprogram's own rules: the ALU's results written at its latency; one operation issued (the ALU's or a unit's load),
     /// `read_ports` RAM reads and one RAM write a clock; no unit running two operations at once; every operand written before
     /// it is read; and every read finding its value at its address (the last write to that
     /// address before the read is the value's, or the address holds a constant never written).
@@ -523,6 +523,11 @@ impl SeqSchedule {
                 if let Some(p) = writes.insert(s.write, o) {
                     return Err(format!("{} and {} both write at clock {}", name(p), name(o), s.write));
                 }
+            }
+            // The RTL's ALU writes its result at a fixed distance from the issue.
+            let alu = READ + self.plan.alu_lat + self.plan.bus_lat;
+            if s.exec == Exec::Alu && s.write != s.issue + alu {
+                return Err(format!("{} issued at {} is written at {}, not {alu} clocks later", name(o), s.issue, s.write));
             }
             if matches!(s.exec, Exec::Alu | Exec::Unit(..)) {
                 if let Some(p) = issues.insert(s.issue, o) {

@@ -446,6 +446,7 @@ fn memories(cx: &Cx, l: &Layout, micro: &[String], consts: &[String], b: &mut Ve
 
 /// The shift-add multiplier.
 fn shift_add(cx: &Cx, b: &mut Vec<Item>) {
+    let (x0, x1) = operands(cx);
     let (w, sw) = (cx.w, cx.sw);
     b.push(comment(
         "The shift-add multiplier: the product modulo 2^W, a bit of the second operand a clock (its sign bit's weight negative).",
@@ -457,7 +458,7 @@ fn shift_add(cx: &Cx, b: &mut Vec<Item>) {
         "en".into(),
         vec![Stmt::If(
             "u_mld".into(),
-            vec![set("ma", "x0"), set("mb", "x1"), set("macc", format!("{w}'d0")), set("mcnt", "u_mn"), set("mbs_r", "u_mbs")],
+            vec![set("ma", x0), set("mb", x1), set("macc", format!("{w}'d0")), set("mcnt", "u_mn"), set("mbs_r", "u_mbs")],
             vec![Stmt::If(
                 format!("mcnt != {sw}'d0"),
                 vec![

@@ -17,7 +17,7 @@
 
 use super::{Cx, FN_ADD, FN_AND, FN_EQ, FN_LT, FN_LZC, FN_NOT, FN_OR, FN_SEL, FN_SHL, FN_SHLV, FN_SHR, FN_SUB};
 use crate::verilog::{comment, reg, set, wire, Item, Stmt};
-use golden::frontend::engine::sequential::{ALU_LAT, ALU_LAT_SPLIT};
+use golden::frontend::engine::sequential::{Exec, ALU_LAT, ALU_LAT_SPLIT};
 use golden::frontend::engine::Kind;
 
 /// The ALU of the plan's latency.
@@ -153,19 +153,27 @@ fn split(cx: &Cx, b: &mut Vec<Item>) {
     b.push(wire("ahi1", hw + 1, format!("{{ax0[{0}:{h}], 1'b1}} + {{ay1[{0}:{h}], 1'b1}}", w - 1)));
     b.push(comment("verilator lint_on UNUSEDSIGNAL"));
     b.push(wire("ahi0", hw, format!("ax0[{0}:{h}] + ay1[{0}:{h}]", w - 1)));
-    // The one-bit results (equal, and, or, not) from the operands' zero tests.
+    // The one-bit results (equal, and, or, not) from the operands' zero tests. The select's
+    // condition: where the program's are all one-bit values (its compares, as golden builds
+    // them), their low bit, not a whole word's OR ahead of every bit's choice (the path at
+    // 31.3 MHz).
+    let ops = &cx.s.prog.ops;
+    let bit = ops.iter().zip(&cx.s.slots).all(|(o, sl)| match o.kind {
+        Kind::Sel(c, ..) if sl.exec == Exec::Alu => ops[c.0 as usize].w == 1,
+        _ => true,
+    });
     b.push(wire("nz0", 1, "|ax0"));
     b.push(wire("nz1", 1, "|ax1"));
+    b.push(wire("selc", 1, if bit { "ax0[0]" } else { "nz0" }));
     let flag = format!("(af == 4'd{FN_EQ}) ? (ax0 == ax1) : (af == 4'd{FN_AND}) ? (nz0 && nz1) : (af == 4'd{FN_OR}) ? (nz0 || nz1) : !nz0");
     // Right shifts are by constants, and few (one at the named screens): a multiplexer over them.
-    let ops = &cx.s.prog.ops;
     let mut shrs: Vec<u32> = ops.iter().filter_map(|o| if let Kind::Shr(_, n) = o.kind { Some(n) } else { None }).collect();
     shrs.sort();
     shrs.dedup();
     b.push(reg("shr", w));
     let arms = shrs.iter().map(|n| (format!("{sw}'d{n}"), vec![Stmt::Blocking("shr".into(), format!("$signed(ax0) >>> {n}"))])).collect();
     b.push(Item::Comb(vec![Stmt::Case { sel: "ai".into(), arms, default: vec![Stmt::Blocking("shr".into(), "ax0".into())] }]));
-    let mv = format!("(af == 4'd{FN_SEL}) ? (nz0 ? ax1 : ax2) : (af == 4'd{FN_SHR}) ? shr : ax0");
+    let mv = format!("(af == 4'd{FN_SEL}) ? (selc ? ax1 : ax2) : (af == 4'd{FN_SHR}) ? shr : ax0");
     // The result's kind, for clock 4's multiplexer.
     let kind = format!(
         "(af == 4'd{FN_ADD} || sub) ? {{af == 4'd{FN_LT}, 2'd0}} : (af == 4'd{FN_EQ} || af == 4'd{FN_AND} || af == 4'd{FN_OR} || af == 4'd{FN_NOT}) ? 3'd1 : (af == 4'd{FN_LZC}) ? 3'd2 : (af == 4'd{FN_SHL} || af == 4'd{FN_SHLV}) ? 3'd3 : 3'd5"
