@@ -15,7 +15,7 @@
 //!   compare from the signs, shifts by the amount's high bits and finds the first group that
 //!   is not zero; clock 4 multiplexes the result into `ar`.
 
-use super::{Cx, FN_ADD, FN_AND, FN_EQ, FN_LT, FN_LZC, FN_NOT, FN_OR, FN_SEL, FN_SHL, FN_SHLV, FN_SHR, FN_SUB};
+use super::cx::{Cx, FN_ADD, FN_AND, FN_EQ, FN_LT, FN_LZC, FN_NOT, FN_OR, FN_SEL, FN_SHL, FN_SHLV, FN_SHR, FN_SUB};
 use crate::verilog::{comment, reg, set, wire, Item, Stmt};
 use golden::frontend::engine::sequential::{Exec, ALU_LAT, ALU_LAT_SPLIT};
 use golden::frontend::engine::Kind;
