@@ -152,10 +152,7 @@ pub(super) fn write_bus(cx: &Cx, widths: &[u32], b: &mut Vec<Item>) {
         // The inputs in one register as wide as the widest, sign-extended (the unsigned ones
         // with a zero bit on top).
         let wi = (0..ins.len()).map(|k| kind(k).0 + !kind(k).1 as u32).max().expect("inputs");
-        // The width one-hot (wh_r): the wrap's sign and mask an AND-OR of it, not a multiplexer
-        // by its code (the write clock's path at 32.7 MHz).
-        let nw = widths.len() as u32;
-        b.extend([reg("src_r", 4), reg("in_r", wi), reg("inp", wi), reg("wh_r", nw), reg("wsg_r", 1), reg("bus_r", w)]);
+        b.extend([reg("src_r", 4), reg("in_r", wi), reg("inp", wi), reg("wc_r", wb), reg("wsg_r", 1), reg("bus_r", w)]);
         let arms = ins
             .iter()
             .enumerate()
@@ -167,7 +164,7 @@ pub(super) fn write_bus(cx: &Cx, widths: &[u32], b: &mut Vec<Item>) {
         }]));
         let labels: Vec<String> = (0..ins.len()).map(|k| format!("4'd{}", SRC_IN + k as u64)).collect();
         srcs.push((labels.join(", "), crate::verilog::sext("in_r", wi, w)));
-        ("src_r", "wh_r", "wsg_r", "bus_r")
+        ("src_r", "wc_r", "wsg_r", "bus_r")
     } else {
         srcs.extend(ins.iter().enumerate().map(|(k, n)| (format!("4'd{}", SRC_IN + k as u64), ext(n, kind(k), w))));
         ("u_src", "u_wc", "u_wsg", "raw")
@@ -175,39 +172,14 @@ pub(super) fn write_bus(cx: &Cx, widths: &[u32], b: &mut Vec<Item>) {
     b.push(reg("raw", w));
     let arms = srcs.into_iter().map(|(k, x)| (k, vec![Stmt::Blocking("raw".into(), x)])).collect();
     b.push(Item::Comb(vec![Stmt::Case { sel: src.into(), arms, default: vec![Stmt::Blocking("raw".into(), "ar".into())] }]));
-    let mask = |x: u32| if x >= w { format!("{{{w}{{1'b1}}}}") } else { format!("{{{{{}{{1'b0}}}}, {{{x}{{1'b1}}}}}}", w - x) };
-    if reg_bus {
-        let nw = widths.len();
-        let sign = widths.iter().enumerate().map(|(k, &x)| format!("(wh_r[{k}] & {val}[{}])", x - 1)).collect::<Vec<_>>().join(" | ");
-        let m = widths.iter().enumerate().map(|(k, &x)| format!("({{{w}{{wh_r[{k}]}}}} & {})", mask(x))).collect::<Vec<_>>().join(" | ");
-        b.push(wire("wsign", 1, sign));
-        b.push(wire("wmask", w, m));
-        let wrapped = format!("({val} & wmask) | (({wsg} && wsign) ? ~wmask : {{{w}{{1'b0}}}})");
-        b.push(Item::Always(vec![Stmt::If(
-            "en".into(),
-            vec![
-                set("src_r", "u_src"),
-                set("in_r", "inp"),
-                set("bus_r", "raw"),
-                set("wh_r", format!("{nw}'d1 << u_wc")),
-                set("wsg_r", "u_wsg"),
-            ],
-            vec![],
-        )]));
-        b.push(Item::Assign("bus".into(), wrapped));
-        b.push(Item::Blank);
-        return;
-    }
     b.push(reg("wmask", w));
     b.push(reg("wsign", 1));
     let arms: Vec<(String, Vec<Stmt>)> = widths
         .iter()
         .enumerate()
         .map(|(k, &x)| {
-            (
-                format!("{wb}'d{k}"),
-                vec![Stmt::Blocking("wmask".into(), mask(x)), Stmt::Blocking("wsign".into(), format!("{val}[{}]", x - 1))],
-            )
+            let m = if x >= w { format!("{{{w}{{1'b1}}}}") } else { format!("{{{{{}{{1'b0}}}}, {{{x}{{1'b1}}}}}}", w - x) };
+            (format!("{wb}'d{k}"), vec![Stmt::Blocking("wmask".into(), m), Stmt::Blocking("wsign".into(), format!("{val}[{}]", x - 1))])
         })
         .collect();
     b.push(Item::Comb(vec![Stmt::Case {
@@ -216,6 +188,13 @@ pub(super) fn write_bus(cx: &Cx, widths: &[u32], b: &mut Vec<Item>) {
         default: vec![Stmt::Blocking("wmask".into(), format!("{{{w}{{1'b1}}}}")), Stmt::Blocking("wsign".into(), "1'b0".into())],
     }]));
     let wrapped = format!("({val} & wmask) | (({wsg} && wsign) ? ~wmask : {{{w}{{1'b0}}}})");
+    if reg_bus {
+        b.push(Item::Always(vec![Stmt::If(
+            "en".into(),
+            vec![set("src_r", "u_src"), set("in_r", "inp"), set("bus_r", "raw"), set("wc_r", "u_wc"), set("wsg_r", "u_wsg")],
+            vec![],
+        )]));
+    }
     b.push(Item::Assign("bus".into(), wrapped));
     b.push(Item::Blank);
 }
