@@ -495,8 +495,9 @@ fn engine_spans_equal_golden_at_640x480_and_on_the_ice40_plans() {
 /// 37x23 and 640x480, levels 0 and 1 (the target's), the UP5K's (`ice40-up5k`, its products as
 /// SB_MAC16 tile passes) at 37x23 level 0 and 640x480 level 1 (its target's); 1,000 triangles
 /// each (about 340 clocks a triangle); a fault planted in the HX8K's ALU (the subtract made an
-/// add) and one in the UP5K's tiles (the sum not shifted a chunk up where the pass's weight
-/// drops) are caught. Slow tier: `cargo nextest run -p verilator-harness --run-ignored only -E
+/// add) and four in the UP5K's engine (the tiles' sum not shifted a chunk up where the pass's
+/// weight drops, its high half or the split ALU's without the low half's carry, the divider's
+/// dividend bits not shifted in) are caught. Slow tier: `cargo nextest run -p verilator-harness --run-ignored only -E
 /// 'test(/sequential_engine/)'`.
 #[test]
 #[ignore]
@@ -517,14 +518,22 @@ fn sequential_engine_spans_equal_golden() {
         let fe = opts.frontend().unwrap().fe;
         let tris = random_triangles(&mut SeedRng::seed_from_u64(seed), &fe, 1000);
         let engine = &base.sources.iter().find(|(n, _)| n == "tri_fe_engine.v").expect("the engine's file").1;
-        let fault = if form == SetupForm::Ice40Up5k {
-            let held = engine.lines().find(|l| l.contains(" m0held = ")).expect("the first tile's sum");
-            (held.to_string(), held.replacen(" m0s1 ? ", " 1'b0 ? ", 1), "the tile's sum not shifted where the weight drops")
-        } else {
-            let sub = engine.lines().find(|l| l.contains(" sub = ")).expect("the ALU's subtract select");
-            (sub.to_string(), sub.replacen(" sub = u_fn == 4'd2 || ", " sub = ", 1), "the ALU's subtract made an add")
+        let line = |has: &str| engine.lines().find(|l| l.contains(has)).unwrap_or_else(|| panic!("no line with {has}")).to_string();
+        let fault = |has: &str, from: &str, to: &str, what| {
+            let l = line(has);
+            (l.clone(), l.replacen(from, to, 1), what)
         };
-        assert_faults_caught(&base, "tri_fe_engine.v", "seqfault", [fault], seed, &tris);
+        let faults = if form == SetupForm::Ice40Up5k {
+            vec![
+                fault(" m0lon = ", " m0s1 ? ", " 1'b0 ? ", "the tile's sum not shifted where the weight drops"),
+                fault(" m0his = ", ", m0c2}", ", 1'b0}", "the tile's high half without the low half's carry"),
+                fault(" addsub = ", "{bc ? ", "{1'b0 ? ", "the split ALU's high half without the low half's carry"),
+                fault(" dt = ", "{dr, dl[", "{dr, 1'b0 & dl[", "the divider's dividend bits not shifted in"),
+            ]
+        } else {
+            vec![fault(" sub = ", " == 4'd2 || ", " == 4'd15 || ", "the ALU's subtract made an add")]
+        };
+        assert_faults_caught(&base, "tri_fe_engine.v", "seqfault", faults, seed, &tris);
     }
 }
 

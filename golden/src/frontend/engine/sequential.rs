@@ -11,10 +11,10 @@
 //! - **The machine.** A register file of `read_ports` copies of one bank (EBRs of
 //!   [`SeqPlan::bank_bits`] side by side for the widest value, each copy a read port, all
 //!   written together through one write port), registered reads ([`READ`] clock); one ALU
-//!   (adds, compares, selects, leading zeros, shifts by a constant or by a value: [`ALU_LAT`]
-//!   clock); the plan's multipliers and dividers, each loading its operands from the read ports
-//!   and holding its result until it is written; every value wrapped to its width and sign as
-//!   it is written. One operation issues a clock (reads its operands), the ALU's or a unit's.
+//!   (adds, compares, selects, leading zeros, shifts by a constant or by a value:
+//!   [`SeqPlan::alu_lat`] clocks); the plan's multipliers and dividers, each loading its
+//!   operands from the read ports and holding its result until it is written; every value
+//!   wrapped to its width and sign as it is written. One operation issues a clock (reads its operands), the ALU's or a unit's.
 //!   One-bit unsigned values (compares, their `and`/`or`/`not`) live in a flag file of
 //!   flip-flops, read without a port. Constants are the RAM's initial contents, never
 //!   overwritten; the triangle's nine inputs are written first, from the vertex register.
@@ -32,16 +32,22 @@
 //!
 //! The RTL: `hdl-gen`'s `frontend/engine/seq.rs`; docs/design.md, *A sequential engine for the iCE40 HX8K*.
 
-use super::placement::{ceil, class, timing, Class};
-use super::schedule::{lut_per_bit_step, Result3};
+use super::placement::{class, timing, Class};
+use super::schedule::Result3;
 use super::{compute, Kind, MulUnit, Plan, Program, SetupForm, V};
 use crate::frontend::{FixedTriangle, FrontEnd};
 use std::collections::HashMap;
 
 /// Clocks from a read address to its data: an EBR with registered output.
 pub const READ: u32 = 1;
-/// Clocks from an ALU operation's operands to its registered result.
+/// Clocks from an ALU operation's operands to its registered result in the first form (one
+/// clock: the operand select, the full-width adder and the result multiplexer in one path).
+/// A plan's own is [`SeqPlan::alu_lat`].
 pub const ALU_LAT: u32 = 1;
+/// The split ALU's latency: the operands registered, the adder in two halves with the carry
+/// registered between them (and the shift and the leading-zero count in two steps), the
+/// result multiplexer a clock of its own.
+pub const ALU_LAT_SPLIT: u32 = 4;
 
 /// iCE40 SB_LUT4 a bit of the ALU, not calibrated (the estimate puts the HX8K plan's engine at
 /// 2,182 SB_LUT4; its RTL measures 3,281, docs/fpga.md): the adder-subtractor with its operand
@@ -60,13 +66,51 @@ pub struct SeqPlan {
     /// One EBR's word width and depth (iCE40 SB_RAM40_4K as 256 x 16).
     pub bank_bits: u32,
     pub bank_depth: u32,
+    /// Clocks from an ALU operation's operands (on the read ports) to its registered result:
+    /// [`ALU_LAT`] (one path through the whole adder) or [`ALU_LAT_SPLIT`]. On the UP5K the
+    /// one-clock ALU set the engine's clock at 15.1 MHz (its 67-bit carry chain alone about
+    /// 26 ns, docs/fpga.md); the schedule keeps the ALU issuing a clock, so the extra clocks
+    /// only lengthen dependent chains.
+    pub alu_lat: u32,
+    /// Clocks a tile product's sum takes after golden's `MUL_PIPE` (0, or 1 where the
+    /// accumulator adds in two halves, the high one a clock behind the low one's carry: on
+    /// the UP5K its 66-bit add in one clock was the next path after the ALU's).
+    pub acc_lag: u32,
+    /// Clocks from a source's value (the ALU's result, a unit's, an input) to its write: 0, or
+    /// 1 where the write bus is registered (its source and wrap selected from the microword a
+    /// clock before, the wrapped value written from a register: on the UP5K the write bus from
+    /// the microword's EBR through the source and wrap multiplexers was the path after the
+    /// ALU's and the tiles' sums, 43 ns).
+    pub bus_lat: u32,
+    /// Clocks from a unit's operands on the read ports to its load: 0, or 1 where the units
+    /// load them from the split ALU's operand registers (on the UP5K the operand select, the
+    /// flag file's read among it, then a tile's chunk select was the path after the ALU's).
+    pub load_lag: u32,
 }
 
 impl SeqPlan {
     /// The HX8K: no multiplier, so one shift-add unit and one divider, a bit a clock.
-    pub const ICE40_HX8K: SeqPlan = SeqPlan { units: Plan::ICE40_HX8K, read_ports: 2, bank_bits: 16, bank_depth: 256 };
+    pub const ICE40_HX8K: SeqPlan = SeqPlan {
+        units: Plan::ICE40_HX8K,
+        read_ports: 2,
+        bank_bits: 16,
+        bank_depth: 256,
+        alu_lat: ALU_LAT,
+        acc_lag: 0,
+        bus_lat: 0,
+        load_lag: 0,
+    };
     /// The UP5K: 2 of its SB_MAC16 and one divider.
-    pub const ICE40_UP5K: SeqPlan = SeqPlan { units: Plan::ICE40_UP5K, read_ports: 2, bank_bits: 16, bank_depth: 256 };
+    pub const ICE40_UP5K: SeqPlan = SeqPlan {
+        units: Plan::ICE40_UP5K,
+        read_ports: 2,
+        bank_bits: 16,
+        bank_depth: 256,
+        alu_lat: ALU_LAT_SPLIT,
+        acc_lag: 1,
+        bus_lat: 1,
+        load_lag: 1,
+    };
 
     /// The forms whose engine is sequential: the iCE40s' (`--fe-setup ice40-hx8k`, whose
     /// multiplier is shift-add, and `ice40-up5k`, whose products are SB_MAC16 passes: the
@@ -274,9 +318,10 @@ impl SeqSchedule {
                     }
                     // A tile product's passes then its pipeline; a shift-add's steps then its
                     // register; a division's load and steps: the unit holds until the write.
-                    (Exec::Unit(c, 0), timing(&prog, op, &units).2)
+                    let lag = if matches!((c, units.mul), (Class::Mul, MulUnit::Tile { .. })) { plan.acc_lag } else { 0 };
+                    (Exec::Unit(c, 0), timing(&prog, op, &units).2 + lag + plan.bus_lat + plan.load_lag)
                 }
-                _ => (Exec::Alu, ALU_LAT),
+                _ => (Exec::Alu, plan.alu_lat + plan.bus_lat),
             })
         };
         let mut ex = Vec::with_capacity(n);
@@ -341,7 +386,10 @@ impl SeqSchedule {
             let earliest = prog.ops[o].kind.args().iter().map(|a| avail(&slots, a.0 as usize)).max().unwrap_or(0);
             let reads = wide_reads(o);
             let rem = rem_of[o];
-            let mut t = earliest;
+            // A registered bus selects its source two clocks before the write (its select, then
+            // its register): an input's write no earlier than the period's clock 2, whose select
+            // is this period's microword.
+            let mut t = if e == Exec::Input { earliest.max(2 * plan.bus_lat) } else { earliest };
             let (issue, write, unit) = loop {
                 let write = match e {
                     Exec::Input => t,
@@ -451,69 +499,7 @@ impl SeqSchedule {
         (w, f)
     }
 
-    fn cost(&self) -> SeqCost {
-        let ops = &self.prog.ops;
-        let units = &self.plan.units;
-        let (words, flags) = self.words();
-        let ram_ops: Vec<usize> = (0..ops.len()).filter(|&o| matches!(self.slots[o].loc, Loc::Ram(_))).collect();
-        let ram_width = ram_ops.iter().map(|&o| ops[o].w + !ops[o].signed as u32).max().unwrap_or(1);
-        let ebr = |width: u32, depth: u32| ceil(width, self.plan.bank_bits) * ceil(depth.max(1), self.plan.bank_depth);
-        let abits = |k: u32| 32 - k.max(2).saturating_sub(1).leading_zeros();
-        let wbits = abits(ram_width + 1);
-        // The microword: two read addresses and a write address, the ALU's function and the
-        // width and sign to wrap to, the flag file's addresses (two read, one write), the
-        // shift amount, each unit's start, the write bus's source, the queue field to capture.
-        let outs = self.prog.out.all().len() as u32;
-        let micro_bits = 3 * abits(words) + 4 + wbits + 1 + 3 * abits(flags) + wbits + 3 + 3 + abits(outs + 1);
-        let per_bit = lut_per_bit_step();
-        let w = |v: V| ops[v.0 as usize].w;
-        let (mut mul_w, mut div_w, mut div_q) = (0u32, 0u32, 0u32);
-        for (op, _) in ops.iter().zip(&self.slots).filter(|(_, s)| s.exec != Exec::Dead) {
-            match op.kind {
-                Kind::Mul(a, b) => mul_w = mul_w.max(op.w.min(w(a) + w(b))),
-                Kind::Div { d, qb, .. } => {
-                    div_w = div_w.max(w(d) + 1);
-                    div_q = div_q.max(qb);
-                }
-                _ => {}
-            }
-        }
-        let lut_mul = match units.mul {
-            // The accumulator and the chunk multiplexers of each operand.
-            MulUnit::Tile { bits } => units.mults * (2 * mul_w + 2 * bits * ceil(ceil(ram_width, bits), 2)),
-            // An adder as wide as the product, its operand gated by the multiplier's bit.
-            MulUnit::ShiftAdd { bits } => units.mults * (per_bit * (mul_w * bits) as f64).round() as u32,
-        };
-        let lut_div = units.dividers * (per_bit * (div_w * units.div_bits) as f64).round() as u32;
-        // Left by a value or a constant, right by a constant: one barrel shifter and the
-        // operand's reversal on each side.
-        let lut_shift = units.shifters * (ram_width * abits(ram_width) + 2 * ram_width);
-        // The write bus: ALU, shifter, product, quotient, remainder, input.
-        let lut_ctl = ram_width * 3 + flags * 3 + outs + abits(self.clocks) * 4;
-        let result_bits: u32 = self.prog.out.all().iter().map(|&v| w(v)).sum();
-        let ff = ram_width * 2 // ALU and shifter results
-            + units.mults * (2 * mul_w) + units.dividers * (2 * div_w + div_q)
-            + flags + abits(self.clocks) + result_bits;
-        SeqCost {
-            clocks: self.clocks,
-            ram_width,
-            ram_words: words,
-            ebr_regfile: self.plan.read_ports * ebr(ram_width, words),
-            micro_bits,
-            ebr_micro: ebr(micro_bits, self.clocks),
-            flags,
-            value_bits_ram: ram_ops.iter().map(|&o| ops[o].w).sum(),
-            lut_alu: ram_width * ALU_LUT4_PER_BIT,
-            lut_shift,
-            lut_mul,
-            lut_div,
-            lut_ctl,
-            ff,
-            result_bits,
-        }
-    }
-
-    /// The microprogram's own rules: one operation issued (the ALU's or a unit's load),
+    /// The microprogram's own rules: the ALU's results written at its latency; one operation issued (the ALU's or a unit's load),
     /// `read_ports` RAM reads and one RAM write a clock; no unit running two operations at once; every operand written before
     /// it is read; and every read finding its value at its address (the last write to that
     /// address before the read is the value's, or the address holds a constant never written).
@@ -537,6 +523,11 @@ impl SeqSchedule {
                 if let Some(p) = writes.insert(s.write, o) {
                     return Err(format!("{} and {} both write at clock {}", name(p), name(o), s.write));
                 }
+            }
+            // The RTL's ALU writes its result at a fixed distance from the issue.
+            let alu = READ + self.plan.alu_lat + self.plan.bus_lat;
+            if s.exec == Exec::Alu && s.write != s.issue + alu {
+                return Err(format!("{} issued at {} is written at {}, not {alu} clocks later", name(o), s.issue, s.write));
             }
             if matches!(s.exec, Exec::Alu | Exec::Unit(..)) {
                 if let Some(p) = issues.insert(s.issue, o) {
@@ -676,5 +667,6 @@ impl FrontEnd {
     }
 }
 
+mod cost;
 #[cfg(test)]
 mod tests;

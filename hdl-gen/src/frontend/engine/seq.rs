@@ -11,39 +11,23 @@
 //! engine; co-simulated in `verilator-harness/tests/frontend.rs` (`sequential_engine_*`, slow
 //! tier). docs/design.md, *A sequential engine for the iCE40 HX8K*.
 
+mod alu;
+mod cx;
+mod datapath;
 mod tile;
 
 use super::result::{fields, ports, Field};
 use super::units::bits_for;
 use crate::frontend::hw::Hw;
 use crate::verilog::{comment, reg, set, sreg, wire, Item, Module, Param, Port, Stmt};
+use cx::{
+    operands, Cx, FN_ADD, FN_AND, FN_EQ, FN_LT, FN_LZC, FN_NOT, FN_OR, FN_PASS, FN_SEL, FN_SHL, FN_SHLV, FN_SHR, FN_SUB, SRC_ALU, SRC_DIVQ,
+    SRC_DIVR, SRC_IN, SRC_MUL, SRC_MUL1,
+};
+use datapath::{divider, shift_add, write_bus};
 use golden::frontend::engine::schedule::Class;
-use golden::frontend::engine::sequential::{Exec, Loc, SeqSchedule, ALU_LAT, READ};
+use golden::frontend::engine::sequential::{Exec, Loc, SeqSchedule, READ};
 use golden::frontend::engine::{Kind, MulUnit, V};
-
-/// The ALU's functions (the microword's `fn` field).
-const FN_PASS: u64 = 0;
-const FN_ADD: u64 = 1;
-const FN_SUB: u64 = 2;
-const FN_LT: u64 = 3;
-const FN_EQ: u64 = 4;
-const FN_AND: u64 = 5;
-const FN_OR: u64 = 6;
-const FN_NOT: u64 = 7;
-const FN_SEL: u64 = 8;
-const FN_LZC: u64 = 9;
-const FN_SHL: u64 = 10;
-const FN_SHR: u64 = 11;
-const FN_SHLV: u64 = 12;
-
-/// The write bus's sources (the microword's `src` field); an input `k` is `SRC_IN + k`.
-const SRC_ALU: u64 = 0;
-const SRC_MUL: u64 = 1;
-const SRC_DIVQ: u64 = 2;
-const SRC_DIVR: u64 = 3;
-const SRC_IN: u64 = 4;
-/// The second multiplier's product (the UP5K's two tiles; after the nine inputs).
-const SRC_MUL1: u64 = 13;
 
 /// The microword's fields, least significant first: name and width.
 struct Layout {
@@ -130,18 +114,6 @@ pub struct SeqEngine {
     pub module: Module,
 }
 
-/// What every part of the block reads: golden's microprogram and the block's widths (the
-/// register file's word, a shift amount, `pc`, an address) and clocks a triangle.
-struct Cx<'a> {
-    hw: &'a Hw,
-    s: &'a SeqSchedule,
-    w: u32,
-    sw: u32,
-    cw: u32,
-    aw: u32,
-    c: u32,
-}
-
 /// The microprogram as [`microprogram`] lays it out.
 struct Micro {
     l: Layout,
@@ -192,9 +164,9 @@ pub fn module(hw: &Hw, s: &SeqSchedule, name: &str) -> SeqEngine {
     let mut b: Vec<Item> = Vec::new();
     sequencer(&cx, &mut b);
     memories(&cx, &l, &micro, &consts, &mut b);
-    alu(&cx, &mut b);
+    alu::alu(&cx, &mut b);
     match tile::Tiles::new(s) {
-        Some(t) => t.units(w, &mut b),
+        Some(t) => t.units(w, operands(&cx), &mut b),
         None => shift_add(&cx, &mut b),
     }
     divider(&cx, &mut b);
@@ -258,8 +230,9 @@ fn microprogram(cx: &Cx, fields: &[Field]) -> Micro {
                     }
                 }
             }
-            let x = &mut mw[(t + READ) as usize];
-            let e = t + READ;
+            // A unit loads its operands load_lag clocks after they are on the read ports.
+            let e = t + READ + if matches!(exec, Exec::Unit(..)) { s.plan.load_lag } else { 0 };
+            let x = &mut mw[e as usize];
             match (exec, op.kind) {
                 (Exec::Unit(Class::Mul, u), _) if tiles.is_some() => {
                     for (t, k, v) in tiles.as_ref().expect("tiles").passes(o, u) {
@@ -296,7 +269,8 @@ fn microprogram(cx: &Cx, fields: &[Field]) -> Micro {
                     assert!(imm <= w, "shift or count {imm} beyond the word");
                     x.set("fn", f, e);
                     x.set("imm", imm as u64, e);
-                    assert_eq!(sl.write, t + READ + ALU_LAT, "the ALU's result is written the clock after");
+                    let lat = s.plan.alu_lat + s.plan.bus_lat;
+                    assert_eq!(sl.write, t + READ + lat, "the ALU's result is written alu_lat + bus_lat clocks after its operands");
                 }
                 other => panic!("{other:?} issued"),
             }
@@ -314,10 +288,12 @@ fn microprogram(cx: &Cx, fields: &[Field]) -> Micro {
             other => panic!("{other:?} writes"),
         };
         let wt = sl.write;
+        // A registered bus selects its source two clocks before the write ([`write_bus`]).
+        let (st, wrap) = (wt - 2 * s.plan.bus_lat, wt - s.plan.bus_lat);
+        mw[st as usize].set("src", src, st);
+        mw[wrap as usize].set("wc", widths.iter().position(|&k| k == op.w).unwrap() as u64, wrap);
+        mw[wrap as usize].set("wsg", op.signed as u64, wrap);
         let x = &mut mw[wt as usize];
-        x.set("src", src, wt);
-        x.set("wc", widths.iter().position(|&k| k == op.w).unwrap() as u64, wt);
-        x.set("wsg", op.signed as u64, wt);
         match sl.loc {
             Loc::Ram(a) => {
                 x.set("we", 1, wt);
@@ -436,215 +412,6 @@ fn memories(cx: &Cx, l: &Layout, micro: &[String], consts: &[String], b: &mut Ve
         ],
         vec![],
     )]));
-    b.push(Item::Blank);
-}
-
-/// The operands and the ALU.
-fn alu(cx: &Cx, b: &mut Vec<Item>) {
-    let (w, sw, ops) = (cx.w, cx.sw, &cx.s.prog.ops);
-    b.push(comment("Operands: a flag from the flag file, else the port the microword names."));
-    for j in 0..3 {
-        b.push(wire(&format!("x{j}"), w, format!("u_fl{j} ? {{{{{}{{1'b0}}}}, fl[u_fa{j}]}} : (u_pb{j} ? db : da)", w - 1)));
-    }
-    b.push(comment("The ALU, its result registered (written the clock after)."));
-    b.push(reg("ar", w));
-    // Leading zeros of x0's low n bits (the program's counts: one width at the named screens),
-    // halving: the top half zero or not, a bit of the count each, below it ones so that zero
-    // counts n. Log depth, where a bit-serial chain would set the clock.
-    let mut lzn: Vec<u32> = ops.iter().filter_map(|o| if let Kind::Lzc(_, n) = o.kind { Some(n) } else { None }).collect();
-    lzn.sort();
-    lzn.dedup();
-    b.push(reg("lz", sw));
-    // The last stage reads only the top bit of its pair.
-    b.push(comment("verilator lint_off UNUSEDSIGNAL"));
-    let mut sel = Vec::new();
-    for &n in &lzn {
-        let p = (n + 1).next_power_of_two();
-        let lb = p.trailing_zeros();
-        let mut st = vec![Stmt::Blocking(format!("lz{n}_v{lb}"), format!("{{x0[{}:0], {{{}{{1'b1}}}}}}", n - 1, p - n))];
-        b.push(reg(&format!("lz{n}_v{lb}"), p));
-        b.push(reg(&format!("lz{n}"), lb));
-        for k in (0..lb).rev() {
-            let h = 1u32 << k;
-            let (v, nv) = (format!("lz{n}_v{}", k + 1), format!("lz{n}_v{k}"));
-            if k > 0 {
-                b.push(reg(&nv, h));
-            }
-            st.push(Stmt::Blocking(format!("lz{n}[{k}]"), format!("{v}[{}:{h}] == {h}'d0", 2 * h - 1)));
-            if k > 0 {
-                st.push(Stmt::Blocking(nv, format!("lz{n}[{k}] ? {v}[{}:0] : {v}[{}:{h}]", h - 1, 2 * h - 1)));
-            }
-        }
-        b.push(Item::Comb(st));
-        b.push(comment("verilator lint_on UNUSEDSIGNAL"));
-        sel.push((n, format!("{{{{{}{{1'b0}}}}, lz{n}}}", sw - lb)));
-    }
-    let mut e = format!("{sw}'d0");
-    for (n, x) in sel.iter().rev() {
-        e = format!("(u_imm == {sw}'d{n}) ? {x} : {e}");
-    }
-    b.push(Item::Comb(vec![Stmt::Blocking("lz".into(), e)]));
-    let one = |e: &str| format!("{{{{{}{{1'b0}}}}, {e}}}", w - 1);
-    // One adder for add, subtract and the signed compare (the difference's sign, corrected
-    // where the operands' signs differ); one left shifter for shifts by a constant and by the
-    // value on x1 (all out at W or more).
-    b.push(wire("sub", 1, format!("u_fn == 4'd{FN_SUB} || u_fn == 4'd{FN_LT}")));
-    b.push(comment("verilator lint_off UNUSEDSIGNAL"));
-    b.push(wire("as1", w + 1, format!("{{x0, 1'b1}} + {{x1 ^ {{{w}{{sub}}}}, sub}}")));
-    b.push(comment("verilator lint_on UNUSEDSIGNAL"));
-    b.push(wire("addsub", w, format!("as1[{w}:1]")));
-    b.push(wire("lt", 1, format!("(x0[{0}] != x1[{0}]) ? x0[{0}] : addsub[{0}]", w - 1)));
-    b.push(wire("shl_by", 1, format!("u_fn == 4'd{FN_SHLV}")));
-    b.push(wire("shl_amt", sw, format!("shl_by ? x1[{}:0] : u_imm", sw - 1)));
-    b.push(wire("shl", w, format!("(shl_by && x1 >= {w}) ? {w}'d0 : x0 << shl_amt")));
-    // Right shifts are by constants, and few (one at the named screens): a multiplexer over them.
-    let mut shrs: Vec<u32> = ops.iter().filter_map(|o| if let Kind::Shr(_, n) = o.kind { Some(n) } else { None }).collect();
-    shrs.sort();
-    shrs.dedup();
-    b.push(reg("shr", w));
-    let arms = shrs.iter().map(|n| (format!("{sw}'d{n}"), vec![Stmt::Blocking("shr".into(), format!("$signed(x0) >>> {n}"))])).collect();
-    b.push(Item::Comb(vec![Stmt::Case { sel: "u_imm".into(), arms, default: vec![Stmt::Blocking("shr".into(), "x0".into())] }]));
-    let alu = [
-        (vec![FN_ADD, FN_SUB], "addsub".to_string()),
-        (vec![FN_LT], one("lt")),
-        (vec![FN_EQ], one("x0 == x1")),
-        (vec![FN_AND], one("|x0 && |x1")),
-        (vec![FN_OR], one("|x0 || |x1")),
-        (vec![FN_NOT], one("~|x0")),
-        (vec![FN_SEL], "|x0 ? x1 : x2".to_string()),
-        (vec![FN_LZC], format!("{{{{{}{{1'b0}}}}, lz}}", w - sw)),
-        (vec![FN_SHL, FN_SHLV], "shl".to_string()),
-        (vec![FN_SHR], "shr".to_string()),
-    ];
-    // A parallel case: Yosys builds one multiplexer per bit, not a chain of twelve.
-    b.push(reg("alu", w));
-    let arms = alu
-        .iter()
-        .map(|(fs, x)| (fs.iter().map(|f| format!("4'd{f}")).collect::<Vec<_>>().join(", "), vec![Stmt::Blocking("alu".into(), x.clone())]))
-        .collect();
-    b.push(Item::Comb(vec![Stmt::Case { sel: "u_fn".into(), arms, default: vec![Stmt::Blocking("alu".into(), "x0".into())] }]));
-    b.push(Item::Always(vec![Stmt::If("en".into(), vec![set("ar", "alu")], vec![])]));
-    b.push(Item::Blank);
-}
-
-/// The shift-add multiplier.
-fn shift_add(cx: &Cx, b: &mut Vec<Item>) {
-    let (w, sw) = (cx.w, cx.sw);
-    b.push(comment(
-        "The shift-add multiplier: the product modulo 2^W, a bit of the second operand a clock (its sign bit's weight negative).",
-    ));
-    for (n, wn) in [("ma", w), ("mb", w), ("macc", w), ("mcnt", sw), ("mbs_r", 1)] {
-        b.push(reg(n, wn));
-    }
-    b.push(Item::Always(vec![Stmt::If(
-        "en".into(),
-        vec![Stmt::If(
-            "u_mld".into(),
-            vec![set("ma", "x0"), set("mb", "x1"), set("macc", format!("{w}'d0")), set("mcnt", "u_mn"), set("mbs_r", "u_mbs")],
-            vec![Stmt::If(
-                format!("mcnt != {sw}'d0"),
-                vec![
-                    set("macc", format!("mb[0] ? ((mcnt == {sw}'d1 && mbs_r) ? macc - ma : macc + ma) : macc")),
-                    set("ma", "ma << 1"),
-                    set("mb", "mb >> 1"),
-                    set("mcnt", format!("mcnt - {sw}'d1")),
-                ],
-                vec![],
-            )],
-        )],
-        vec![],
-    )]));
-    b.push(Item::Blank);
-}
-
-/// The restoring divider.
-fn divider(cx: &Cx, b: &mut Vec<Item>) {
-    let (w, sw, ops) = (cx.w, cx.sw, &cx.s.prog.ops);
-    b.push(comment("The restoring divider: the remainder shifted past the divisor, the dividend's low qb bits shifted in, a bit a clock."));
-    let mut qbs: Vec<u32> = ops.iter().filter_map(|o| if let Kind::Div { qb, .. } = o.kind { Some(qb) } else { None }).collect();
-    qbs.sort();
-    qbs.dedup();
-    for (n, wn) in [("dr", w), ("dd", w), ("dn", w), ("dq", w), ("dcnt", sw), ("dr0", w), ("dn0", w)] {
-        b.push(reg(n, wn));
-    }
-    b.push(wire("dt", w + 1, format!("{{dr, dn[{}]}}", w - 1)));
-    // The partial remainder stays below the divisor: it fits W bits after each step.
-    b.push(wire("dge", 1, "dt >= {1'b0, dd}"));
-    // Its top bit is zero wherever it is taken.
-    b.push(comment("verilator lint_off UNUSEDSIGNAL"));
-    b.push(wire("dsub", w + 1, "dt - {1'b0, dd}"));
-    b.push(comment("verilator lint_on UNUSEDSIGNAL"));
-    // The quotient widths are few: a multiplexer over them, not a barrel shifter.
-    let mut top = vec![Stmt::Blocking("dr0".into(), "x0".into()), Stmt::Blocking("dn0".into(), "x0".into())];
-    for q in qbs.iter().rev() {
-        top = vec![Stmt::If(
-            format!("u_dqb == {sw}'d{q}"),
-            vec![Stmt::Blocking("dr0".into(), format!("x0 >> {q}")), Stmt::Blocking("dn0".into(), format!("x0 << {}", w - q))],
-            top,
-        )];
-    }
-    b.push(Item::Comb(top));
-    b.push(Item::Always(vec![Stmt::If(
-        "en".into(),
-        vec![Stmt::If(
-            "u_dld".into(),
-            vec![set("dr", "dr0"), set("dn", "dn0"), set("dd", "x1"), set("dq", format!("{w}'d0")), set("dcnt", "u_dqb")],
-            vec![Stmt::If(
-                format!("dcnt != {sw}'d0"),
-                vec![
-                    set("dr", format!("dge ? dsub[{0}:0] : dt[{0}:0]", w - 1)),
-                    set("dq", format!("{{dq[{}:0], dge}}", w - 2)),
-                    set("dn", "dn << 1"),
-                    set("dcnt", format!("dcnt - {sw}'d1")),
-                ],
-                vec![],
-            )],
-        )],
-        vec![],
-    )]));
-    b.push(Item::Blank);
-}
-
-/// The write bus: its source, wrapped to the value's width and sign.
-fn write_bus(cx: &Cx, widths: &[u32], b: &mut Vec<Item>) {
-    let (wd, iw, w) = (cx.hw.fe.widths(), cx.hw.fe.cfg.iw(), cx.w);
-    b.push(comment("The write bus: the source the microword names, wrapped to the value's width and sign."));
-    let ins = ["nx0", "nx1", "nx2", "ny0", "ny1", "ny2", "ni0", "ni1", "ni2"];
-    let mut srcs: Vec<(u64, String)> = match cx.s.plan.units.mul {
-        MulUnit::Tile { .. } => (0..cx.s.plan.units.mults).map(|u| ([SRC_MUL, SRC_MUL1][u as usize], format!("m{u}acc"))).collect(),
-        MulUnit::ShiftAdd { .. } => vec![(SRC_MUL, "macc".into())],
-    };
-    srcs.extend([(SRC_DIVQ, "dq".into()), (SRC_DIVR, "dr".into())]);
-    for (k, n) in ins.iter().enumerate() {
-        let (wv, sg) = if k < 3 {
-            (wd.cx, true)
-        } else if k < 6 {
-            (wd.cy, true)
-        } else {
-            (iw, false)
-        };
-        srcs.push((SRC_IN + k as u64, if sg { crate::verilog::sext(n, wv, w) } else { crate::verilog::zext(n, wv, w) }));
-    }
-    b.push(reg("raw", w));
-    let arms = srcs.into_iter().map(|(k, x)| (format!("4'd{k}"), vec![Stmt::Blocking("raw".into(), x)])).collect();
-    b.push(Item::Comb(vec![Stmt::Case { sel: "u_src".into(), arms, default: vec![Stmt::Blocking("raw".into(), "ar".into())] }]));
-    b.push(reg("wmask", w));
-    b.push(reg("wsign", 1));
-    let wb = bits_for(widths.len() as u32 - 1);
-    let arms: Vec<(String, Vec<Stmt>)> = widths
-        .iter()
-        .enumerate()
-        .map(|(k, &x)| {
-            let m = if x >= w { format!("{{{w}{{1'b1}}}}") } else { format!("{{{{{}{{1'b0}}}}, {{{x}{{1'b1}}}}}}", w - x) };
-            (format!("{wb}'d{k}"), vec![Stmt::Blocking("wmask".into(), m), Stmt::Blocking("wsign".into(), format!("raw[{}]", x - 1))])
-        })
-        .collect();
-    b.push(Item::Comb(vec![Stmt::Case {
-        sel: "u_wc".into(),
-        arms,
-        default: vec![Stmt::Blocking("wmask".into(), format!("{{{w}{{1'b1}}}}")), Stmt::Blocking("wsign".into(), "1'b0".into())],
-    }]));
-    b.push(Item::Assign("bus".into(), "(raw & wmask) | ((u_wsg && wsign) ? ~wmask : {".to_string() + &format!("{w}{{1'b0}}}})")));
     b.push(Item::Blank);
 }
 

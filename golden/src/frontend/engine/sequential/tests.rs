@@ -93,6 +93,22 @@ fn planted_sequencing_faults_are_caught() {
     assert!(v.is_err() && m.is_some(), "a constant overwritten: {v:?}");
 }
 
+/// The UP5K plan's latencies (the ALU over four clocks, a registered write bus) are its
+/// schedule's, and `verify` holds it to them: an ALU result planted a clock early (where the
+/// RTL's result is not there yet) fails it.
+#[test]
+fn the_plans_latencies_are_the_schedules() {
+    let fe = &screens()[1];
+    let s = SeqPlan::ICE40_UP5K.schedule(fe).unwrap();
+    let alu = READ + s.plan.alu_lat + s.plan.bus_lat;
+    assert!(s.slots.iter().filter(|x| x.exec == Exec::Alu).all(|x| x.write == x.issue + alu));
+    assert!(s.slots.iter().filter(|x| x.exec == Exec::Input).all(|x| x.write >= 2 * s.plan.bus_lat));
+    let mut bad = s.clone();
+    let o = (0..bad.slots.len()).find(|&o| bad.slots[o].exec == Exec::Alu).unwrap();
+    bad.slots[o].write -= 1;
+    assert!(bad.verify().is_err(), "an ALU result a clock early");
+}
+
 /// The figures docs/design.md quotes: `cargo test -p golden --lib sequential_figures --
 /// --ignored --nocapture`.
 #[test]

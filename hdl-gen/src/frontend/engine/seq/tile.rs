@@ -21,8 +21,10 @@ use golden::frontend::engine::{Kind, MulUnit};
 use super::super::units::bits_for;
 
 /// Per unit, its microword fields: load (the first pass), chunk of a, chunk of b, a's chunk
-/// signed (its top one, of a signed operand), b's, the sum shifted a chunk up.
-const FIELDS: [[&str; 6]; 2] = [["m0ld", "m0ca", "m0cb", "m0ta", "m0tb", "m0s"], ["m1ld", "m1ca", "m1cb", "m1ta", "m1tb", "m1s"]];
+/// signed (its top one, of a signed operand), b's, the sum shifted a chunk up; where the sum
+/// is split (`SeqPlan::acc_lag`), its low half's enable, a clock before it adds.
+const FIELDS: [[&str; 7]; 2] =
+    [["m0ld", "m0ca", "m0cb", "m0ta", "m0tb", "m0s", "m0e"], ["m1ld", "m1ca", "m1cb", "m1ta", "m1tb", "m1s", "m1e"]];
 
 /// The tile units of a sequential schedule whose plan has them.
 pub(super) struct Tiles<'a> {
@@ -44,7 +46,10 @@ impl<'a> Tiles<'a> {
     }
 
     pub(super) fn fields(&self) -> Vec<(&'static str, u32)> {
-        (0..self.mults as usize).flat_map(|u| FIELDS[u].iter().zip([1, self.cbw, self.cbw, 1, 1, 1]).map(|(n, w)| (*n, w))).collect()
+        let n = 6 + (self.s.plan.acc_lag > 0) as usize;
+        (0..self.mults as usize)
+            .flat_map(|u| FIELDS[u][..n].iter().zip([1, self.cbw, self.cbw, 1, 1, 1, 1]).map(|(n, w)| (*n, w)))
+            .collect()
     }
 
     /// Product `o` on unit `u`: its passes' fields, `(clock, field, value)`, from its load on.
@@ -58,9 +63,11 @@ impl<'a> Tiles<'a> {
         let mut p: Vec<(u32, u32)> =
             (0..ca).flat_map(|i| (0..cb).map(move |j| (i, j))).filter(|&(i, j)| (i + j) * self.bits < ops[o].w).collect();
         p.sort_by_key(|&(i, j)| std::cmp::Reverse(i + j));
-        let l = sl.issue + READ;
+        let l = sl.issue + READ + self.s.plan.load_lag;
         assert_eq!(sl.exec, Exec::Unit(golden::frontend::engine::schedule::Class::Mul, u));
-        assert_eq!(sl.write, l + p.len() as u32 + MUL_PIPE, "{}: golden's passes", ops[o].name);
+        let lag = self.s.plan.acc_lag;
+        assert!(lag <= 1, "a sum split in {} parts (the RTL has one or two)", lag + 1);
+        assert_eq!(sl.write, l + p.len() as u32 + MUL_PIPE + lag + self.s.plan.bus_lat, "{}: golden's passes", ops[o].name);
         let f = &FIELDS[u as usize];
         let mut set = Vec::new();
         for (k, &(i, j)) in p.iter().enumerate() {
@@ -74,12 +81,16 @@ impl<'a> Tiles<'a> {
                 (t, f[5], (k > 0 && i + j < p[k - 1].0 + p[k - 1].1) as u64),
             ]);
         }
+        if lag > 0 {
+            // The low half adds a clock after each pass's chunks, and once more for the last product.
+            set.extend((0..=p.len() as u32).map(|k| (l + k, f[6], 1)));
+        }
         set
     }
 
     /// The units: per unit the held operands, the chunk selection, the tile and the sum.
-    /// `w`: the register file's word.
-    pub(super) fn units(&self, w: u32, b: &mut Vec<Item>) {
+    /// `w`: the register file's word; `x0`, `x1`: where the operands load from.
+    pub(super) fn units(&self, w: u32, (x0, x1): (&str, &str), b: &mut Vec<Item>) {
         let (bits, n) = (self.bits, self.chunks);
         // The operands sign-extended past their top chunk's sign bit (a register-file word holds
         // its value sign- or zero-extended to W: unsigned values have a zero bit on top).
@@ -95,7 +106,7 @@ impl<'a> Tiles<'a> {
             let m = |x: &str| format!("m{u}{x}");
             let uf = |x: &str| format!("u_m{u}{x}");
             b.extend([reg(&m("a"), w), reg(&m("b"), w)]);
-            for (o, x) in [("a", "x0"), ("b", "x1")] {
+            for (o, x) in [("a", x0), ("b", x1)] {
                 let src = m(&format!("x{o}"));
                 b.push(wire(&src, w, format!("{} ? {x} : {}", uf("ld"), m(o))));
                 b.push(wire(&m(&format!("e{o}")), ew, crate::verilog::sext(&src, w, ew)));
@@ -125,25 +136,75 @@ impl<'a> Tiles<'a> {
             } else {
                 b.push(sreg(&m("pr"), pw));
             }
-            b.push(reg(&m("acc"), w));
-            let pe = if w > pw { crate::verilog::sext(&m("pr"), pw, w) } else { format!("{}[{}:0]", m("pr"), w - 1) };
-            b.push(wire(&m("accn"), w, format!("{} + {pe}", m("acc"))));
-            let up = if w > bits { format!("{{{}[{}:0], {bits}'d0}}", m("accn"), w - bits - 1) } else { format!("{w}'d0") };
-            b.push(wire(&m("held"), w, format!("{} ? {w}'d0 : {} ? {up} : {}", m("f1"), m("s1"), m("accn"))));
-            b.push(Item::Always(vec![Stmt::If(
-                "en".into(),
-                vec![
-                    Stmt::If(uf("ld"), vec![set(m("a"), "x0"), set(m("b"), "x1")], vec![]),
-                    set(m("ra"), m("ca")),
-                    set(m("rb"), m("cb")),
-                    set(m("f1"), uf("ld")),
-                    set(m("s1"), uf("s")),
-                    set(m("pr"), format!("{} * {}", m("ra"), m("rb"))),
-                    set(m("acc"), m("held")),
-                ],
-                vec![],
-            )]));
+            let mut regs = vec![
+                Stmt::If(uf("ld"), vec![set(m("a"), x0), set(m("b"), x1)], vec![]),
+                set(m("ra"), m("ca")),
+                set(m("rb"), m("cb")),
+                set(m("f1"), uf("ld")),
+                set(m("s1"), uf("s")),
+                set(m("pr"), format!("{} * {}", m("ra"), m("rb"))),
+            ];
+            if self.s.plan.acc_lag == 0 {
+                b.push(reg(&m("acc"), w));
+                let pe = if w > pw { crate::verilog::sext(&m("pr"), pw, w) } else { format!("{}[{}:0]", m("pr"), w - 1) };
+                b.push(wire(&m("accn"), w, format!("{} + {pe}", m("acc"))));
+                let up = if w > bits { format!("{{{}[{}:0], {bits}'d0}}", m("accn"), w - bits - 1) } else { format!("{w}'d0") };
+                b.push(wire(&m("held"), w, format!("{} ? {w}'d0 : {} ? {up} : {}", m("f1"), m("s1"), m("accn"))));
+                regs.push(set(m("acc"), m("held")));
+            } else {
+                self.split_sum(u, &mut regs, b);
+            }
+            b.push(Item::Always(vec![Stmt::If("en".into(), regs, vec![])]));
         }
         b.push(Item::Blank);
+    }
+
+    /// Unit `u`'s sum in two halves (`SeqPlan::acc_lag` = 1): the low half (`h` bits, at
+    /// least the product's) adds the product and registers its carry, the product's sign (or
+    /// its bits above `h`) and the bits a shift moves up; the high half adds them a clock later,
+    /// so neither carry chain is the word's. Each half runs only while its enable is on (the
+    /// low half's from the microword, the high half's a clock after), so the sum holds until
+    /// golden's write. The sum is `m<u>acc`, as in the one-clock form.
+    fn split_sum(&self, u: u32, regs: &mut Vec<Stmt>, b: &mut Vec<Item>) {
+        let (w, bits) = (self.s.cost.ram_width, self.bits);
+        let pw = 2 * bits + 2;
+        let h = w.div_ceil(2).max(pw.min(w - bits - 1));
+        let hw = w - h;
+        assert!(h > bits && hw > bits, "a {w}-bit sum split in halves wider than a chunk of {bits}");
+        let m = |x: &str| format!("m{u}{x}");
+        // The product's bits above the low half: its sign where it fits in it.
+        let (pt, ptw) = if pw <= h { (format!("{}[{}]", m("pr"), pw - 1), 1) } else { (format!("{}[{}:{h}]", m("pr"), pw - 1), pw - h) };
+        let plo = if pw <= h { crate::verilog::sext(&m("pr"), pw, h) } else { format!("{}[{}:0]", m("pr"), h - 1) };
+        b.push(comment(format!("Unit {u}'s sum in halves: the low {h} bits, then the high {hw} a clock later from its carry.")));
+        b.extend([reg(&m("e1"), 1), reg(&m("e2"), 1), reg(&m("lo"), h), reg(&m("hi"), hw)]);
+        b.extend([reg(&m("c2"), 1), reg(&m("p2"), ptw), reg(&m("t2"), bits), reg(&m("s2"), 1), reg(&m("f2"), 1)]);
+        b.push(wire(&m("los"), h + 1, format!("{{1'b0, {}}} + {{1'b0, {plo}}}", m("lo"))));
+        let lup = format!("{{{}[{}:0], {bits}'d0}}", m("los"), h - bits - 1);
+        b.push(wire(&m("lon"), h, format!("{} ? {h}'d0 : {} ? {lup} : {}[{}:0]", m("f1"), m("s1"), m("los"), h - 1)));
+        // The carry rides as a low bit: {hi, 1} + {p, c} carries c into bit 0.
+        b.push(comment("verilator lint_off UNUSEDSIGNAL"));
+        let pe = crate::verilog::sext(&m("p2"), ptw, hw);
+        b.push(wire(&m("his"), hw + 1, format!("{{{}, 1'b1}} + {{{pe}, {}}}", m("hi"), m("c2"))));
+        b.push(comment("verilator lint_on UNUSEDSIGNAL"));
+        let hup = format!("{{{}[{}:1], {}}}", m("his"), hw - bits, m("t2"));
+        b.push(wire(&m("hin"), hw, format!("{} ? {hw}'d0 : {} ? {hup} : {}[{hw}:1]", m("f2"), m("s2"), m("his"))));
+        b.push(wire(&m("acc"), w, format!("{{{}, {}}}", m("hi"), m("lo"))));
+        regs.extend([
+            set(m("e1"), format!("u_m{u}e")),
+            set(m("e2"), m("e1")),
+            Stmt::If(
+                m("e1"),
+                vec![
+                    set(m("lo"), m("lon")),
+                    set(m("c2"), format!("{}[{h}]", m("los"))),
+                    set(m("p2"), pt),
+                    set(m("t2"), format!("{}[{}:{}]", m("los"), h - 1, h - bits)),
+                    set(m("s2"), m("s1")),
+                    set(m("f2"), m("f1")),
+                ],
+                vec![],
+            ),
+            Stmt::If(m("e2"), vec![set(m("hi"), m("hin"))], vec![]),
+        ]);
     }
 }
