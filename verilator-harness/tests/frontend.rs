@@ -412,7 +412,7 @@ pub(crate) fn engine(screen: golden::setup::Screen, form: golden::frontend::engi
 /// Spans of every kind of triangle under random gaps and backpressure, then under resets, bit
 /// for bit golden's; every triangle costs the engine's II clocks at full rate; a wrong
 /// expectation is caught.
-fn engine_spans_of(opts: hdl_gen::Options, n: usize) {
+pub(crate) fn engine_spans_of(opts: hdl_gen::Options, n: usize) {
     let m = verilator_harness::registry::frontend(&opts).unwrap_or_else(|e| panic!("{e}"));
     let seed = verilator_harness::seed("frontend engine");
     // Golden's spans are the same in both I0 forms; the incremental form's are its own model's.
@@ -488,130 +488,6 @@ fn engine_spans_equal_golden_at_640x480_and_on_the_ice40_plans() {
         let Some(opts) = engine(screen, form) else { return };
         engine_spans_of(opts, 3000);
     }
-}
-
-/// The sequential engines (issue 27: golden's microprogram on one ALU, the values in a
-/// block-RAM register file): the HX8K's (`--fe-setup ice40-hx8k`, a shift-add multiplier) at
-/// 37x23 and 640x480, levels 0 and 1 (the target's), the UP5K's (`ice40-up5k`, its products as
-/// SB_MAC16 tile passes) at 37x23 level 0 and 640x480 level 1 (its target's); 1,000 triangles
-/// each (about 340 clocks a triangle); a fault planted in the HX8K's ALU (the subtract made an
-/// add) and four in the UP5K's engine (the tiles' sum not shifted a chunk up where the pass's
-/// weight drops, its high half or the split ALU's without the low half's carry, the divider's
-/// dividend bits not shifted in) are caught. Slow tier: `cargo nextest run -p verilator-harness --run-ignored only -E
-/// 'test(/sequential_engine/)'`.
-#[test]
-#[ignore]
-fn sequential_engine_spans_equal_golden() {
-    use golden::frontend::engine::SetupForm;
-    let small = golden::setup::Screen { width: 37, height: 23 };
-    let big = golden::setup::Screen::default();
-    let runs = [(SetupForm::Ice40Hx8k, small, 0), (SetupForm::Ice40Hx8k, big, 0), (SetupForm::Ice40Hx8k, small, 1)];
-    for (form, screen, level) in runs.into_iter().chain([(SetupForm::Ice40Up5k, small, 0), (SetupForm::Ice40Up5k, big, 1)]) {
-        let Some(opts) = engine(screen, form) else { return };
-        engine_spans_of(hdl_gen::Options { pipeline: golden::pipeline::Pipeline::at(level), ..opts }, 1000);
-    }
-    for form in [SetupForm::Ice40Hx8k, SetupForm::Ice40Up5k] {
-        let Some(opts) = engine(small, form) else { return };
-        let base =
-            verilator_harness::ondemand::describe(&opts, verilator_harness::models::Kind::Frontend).unwrap_or_else(|e| panic!("{e}"));
-        let seed = verilator_harness::seed("frontend sequential engine fault");
-        let fe = opts.frontend().unwrap().fe;
-        let tris = random_triangles(&mut SeedRng::seed_from_u64(seed), &fe, 1000);
-        let engine = &base.sources.iter().find(|(n, _)| n == "tri_fe_engine.v").expect("the engine's file").1;
-        let line = |has: &str| engine.lines().find(|l| l.contains(has)).unwrap_or_else(|| panic!("no line with {has}")).to_string();
-        let fault = |has: &str, from: &str, to: &str, what| {
-            let l = line(has);
-            (l.clone(), l.replacen(from, to, 1), what)
-        };
-        let faults = if form == SetupForm::Ice40Up5k {
-            vec![
-                fault(" m0lon = ", " m0s1 ? ", " 1'b0 ? ", "the tile's sum not shifted where the weight drops"),
-                fault(" m0his = ", ", m0c2}", ", 1'b0}", "the tile's high half without the low half's carry"),
-                fault(" addsub = ", "{bc ? ", "{1'b0 ? ", "the split ALU's high half without the low half's carry"),
-                fault(" dt = ", "{dr, dl[", "{dr, 1'b0 & dl[", "the divider's dividend bits not shifted in"),
-            ]
-        } else {
-            vec![fault(" sub = ", " == 4'd2 || ", " == 4'd15 || ", "the ALU's subtract made an add")]
-        };
-        assert_faults_caught(&base, "tri_fe_engine.v", "seqfault", faults, seed, &tris);
-    }
-}
-
-/// A fault planted in one line of a front-end's file: in `file`'s first line holding `line`,
-/// `from` made `to`.
-struct LineFault {
-    file: &'static str,
-    line: &'static str,
-    from: &'static str,
-    to: &'static str,
-}
-
-impl LineFault {
-    /// The model of `opts` with this fault (tagged `<base><suffix>0`) is caught on 1,000
-    /// random triangles (the seed named `seed_name`).
-    fn caught(&self, opts: &hdl_gen::Options, seed_name: &str, suffix: &str, what: &'static str) {
-        let base = verilator_harness::ondemand::describe(opts, verilator_harness::models::Kind::Frontend).unwrap_or_else(|e| panic!("{e}"));
-        let seed = verilator_harness::seed(seed_name);
-        let fe = opts.frontend().unwrap().fe;
-        let tris = random_triangles(&mut SeedRng::seed_from_u64(seed), &fe, 1000);
-        let text = &base.sources.iter().find(|(n, _)| n == self.file).unwrap_or_else(|| panic!("no {}", self.file)).1;
-        let line = text.lines().find(|l| l.contains(self.line)).unwrap_or_else(|| panic!("{what}: no line with {}", self.line));
-        let faults = [(line.to_string(), line.replacen(self.from, self.to, 1), what)];
-        assert_faults_caught(&base, self.file, suffix, faults, seed, &tris);
-    }
-}
-
-/// The HX8K's span path without a product (`--target ice40-hx8k --fe-i0 incremental`, issue
-/// 27): the sequential engine's set-up, the incremental I0 with its starts on a shift-add
-/// multiplier (RW clocks a product), at 37x23 and 640x480, levels 0 and 1, 1,000 triangles
-/// each, bit for bit golden's spans; a fault planted in the shift-add (a partial product from
-/// the wrong bit) is caught. Slow tier: `cargo nextest run -p verilator-harness --run-ignored
-/// only -E 'test(/sequential_incremental/)'`.
-#[test]
-#[ignore]
-fn sequential_incremental_i0_spans_equal_golden() {
-    use golden::frontend::engine::SetupForm;
-    use golden::frontend::I0Form;
-    let small = golden::setup::Screen { width: 37, height: 23 };
-    let form = |screen, level| {
-        engine(screen, SetupForm::Ice40Hx8k).map(|o| hdl_gen::Options {
-            fe_i0: I0Form::Incremental,
-            pipeline: golden::pipeline::Pipeline::at(level),
-            ..o
-        })
-    };
-    for (screen, level) in [(small, 0), (golden::setup::Screen::default(), 1), (small, 1)] {
-        let Some(opts) = form(screen, level) else { return };
-        engine_spans_of(opts, 1000);
-    }
-    let Some(opts) = form(small, 0) else { return };
-    let fault = LineFault { file: "tri_frontend.v", line: "ie_p <= ie_p + (ie_sb[0]", from: "ie_sb[0]", to: "ie_sb[1]" };
-    fault.caught(&opts, "frontend sequential incremental fault", "seqincfault", "the shift-add's partial product from the wrong bit");
-}
-
-/// The sequential span path (`--fe-span sequential`, the iCE40 targets' choice) behind both
-/// iCE40 engines, 1,000 triangles each (37x23 and 640x480, levels 0 and 1), as
-/// [`engine_spans_of`]; a fault (the correction's `q~ + 1` made `q~`) is caught. Slow tier:
-/// `cargo nextest run -p verilator-harness --run-ignored only -E 'test(/sequential_span/)'`.
-#[test]
-#[ignore]
-fn sequential_span_path_spans_equal_golden() {
-    use golden::frontend::{engine::SetupForm::*, SpanForm};
-    let (small, big) = (golden::setup::Screen { width: 37, height: 23 }, golden::setup::Screen::default());
-    let form = |screen, setup, level| {
-        engine(screen, setup).map(|o| hdl_gen::Options {
-            fe_span: SpanForm::Sequential,
-            pipeline: golden::pipeline::Pipeline::at(level),
-            ..o
-        })
-    };
-    for (screen, setup, level) in [(small, Ice40Hx8k, 0), (big, Ice40Hx8k, 1), (small, Ice40Up5k, 1), (big, Ice40Up5k, 1)] {
-        let Some(opts) = form(screen, setup, level) else { return };
-        engine_spans_of(opts, 1000);
-    }
-    let Some(opts) = form(small, Ice40Hx8k, 1) else { return };
-    let fault = LineFault { file: "tri_frontend.v", line: "sq_qt_now} + ", from: "} + ", to: "} - " };
-    fault.caught(&opts, "frontend sequential span fault", "seqspanfault", "the correction's q~ + 1 made q~ - 1");
 }
 
 /// The shared-edge mesh through `tri_fb_p8` with the engine's front-end: every pixel of the

@@ -48,6 +48,7 @@ mod bfpi;
 mod cli_harness;
 mod frontend;
 mod frontend_faults;
+mod frontend_seq;
 mod ondemand;
 mod readme;
 mod reliability;
