@@ -209,10 +209,11 @@ pub(super) fn setup(hw: &Hw, names: &Names, body: &mut Vec<Item>) {
     let (depth, credit) = (hw.queue_depth(), hw.queue_credit());
     let capture = hw.sequential().is_some();
     body.push(comment(format!(
-        "Set-up: the {} engine ({}, II = {ii} clocks a triangle, latency {latency}), then its result queue ({}, {depth} entries).",
+        "Set-up: the {} engine ({}, II = {ii} clocks a triangle, latency {latency}), then its result queue ({}, {depth} {}).",
         if hw.sequential().is_some() { "sequential" } else { "shared" },
         names.fe_engine,
         names.fe_queue,
+        if depth == 1 { "entry" } else { "entries" },
     )));
     body.push(comment(if credit {
         "A triangle is taken only with a queue entry for its result (cr counts those neither held nor reserved): the engine never freezes; a guard-band drop pulses err; a culled triangle is dropped."

@@ -201,7 +201,11 @@ fn control(hw: &Hw, body: &mut Vec<Item>) {
         body.push(wire("w_end", 1, "w_row == w_last"));
         // The sequential span path (its own `adv`) reads the walker's registers without row
         // stages: the next triangle is taken once the last row has left.
-        if hw.fe.span_seq().is_some() && hw.engine_form() { "!w_valid" } else { "(!w_valid || w_end)" }
+        if hw.fe.span_seq().is_some() && hw.engine_form() {
+            "!w_valid"
+        } else {
+            "(!w_valid || w_end)"
+        }
     };
     let inc = super::incremental::on(hw);
     let engine = hw.engine_form();
