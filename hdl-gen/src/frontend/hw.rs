@@ -153,7 +153,7 @@ impl Hw {
     /// The incremental I0's shift-add start (`FrontEnd::start_product_clocks` above 1): the
     /// width of its clock count within a product, `ie_k` (0 .. clocks - 1).
     pub fn start_count_bits(&self) -> u32 {
-        (32 - (self.fe.start_product_clocks() - 1).leading_zeros()).max(1)
+        crate::widths::bits_for(self.fe.start_product_clocks() - 1)
     }
 
     /// The exact plane's widths, CALC's oriented `Nx` and `Ny` (signed), as the incremental I0's

@@ -8,6 +8,7 @@ use super::properties::{SpanStage, SpanUnit};
 use super::stager::Stager;
 use super::walker;
 use crate::verilog::{comment, lit, reg, set, wire, zext, Item, Stmt};
+use crate::widths::bits_for;
 use golden::frontend::span_seq::{AccLoad, Multiplicand, Multiplier, SpanSeq};
 use golden::frontend::Widths;
 
@@ -28,8 +29,7 @@ pub(super) fn stage(hw: &Hw) -> SpanStage {
 pub(super) fn shape(hw: &Hw) -> Option<SpanUnit> {
     let q = unit(hw)?;
     let (n, cnt_w) = (SpanSeq::PHASES.len(), count_bits(&q));
-    let phase_w = 32 - (n as u32 - 1).leading_zeros();
-    let sw = 32 - q.row_clocks().leading_zeros();
+    let (phase_w, sw) = (phase_bits(), bits_for(q.row_clocks()));
     let after = |k: usize| -> u32 { SpanSeq::PHASES[k + 1..].iter().map(|p| 1 + q.steps(p)).sum() };
     let left = (0..n - 1)
         .rev()
@@ -47,15 +47,19 @@ pub(super) fn shape(hw: &Hw) -> Option<SpanUnit> {
 
 /// Width of the unit's step count: the most steps a phase takes.
 fn count_bits(q: &SpanSeq) -> u32 {
-    let most = SpanSeq::PHASES.iter().map(|p| q.steps(p)).max().expect("phases");
-    32 - most.leading_zeros()
+    bits_for(SpanSeq::PHASES.iter().map(|p| q.steps(p)).max().expect("phases"))
+}
+
+/// Width of the unit's phase register: it holds each phase's index.
+fn phase_bits() -> u32 {
+    bits_for(SpanSeq::PHASES.len() as u32 - 1)
 }
 
 /// The unit's control registers and `adv` (declared before the walker reads it): the walker
 /// moves when the unit is idle, or in the clock it writes its result to a free output.
 pub(super) fn handshake(hw: &Hw, body: &mut Vec<Item>) {
     let q = unit(hw).expect("the sequential span path");
-    let phase_w = 32 - (SpanSeq::PHASES.len() as u32 - 1).leading_zeros();
+    let phase_w = phase_bits();
     body.push(comment("The sequential span path's control: busy from a covered row's accept to its result's write."));
     body.extend([reg("sq_busy", 1), reg("sq_ph", phase_w), reg("sq_cnt", count_bits(&q))]);
     let last = lit(phase_w, SpanSeq::PHASES.len() as u64 - 1);
@@ -138,7 +142,7 @@ pub(super) fn emit(hw: &Hw, body: &mut Vec<Item>) -> Stager {
     };
     let load = |k: usize, accept: bool| -> Vec<Stmt> {
         let p = SpanSeq::PHASES[k];
-        let mut v = vec![set("sq_ph", lit(32 - (SpanSeq::PHASES.len() as u32 - 1).leading_zeros(), k as u64))];
+        let mut v = vec![set("sq_ph", lit(phase_bits(), k as u64))];
         v.push(set("sq_cnt", lit(cnt_w, q.steps(&p) as u64)));
         v.extend(acc_load(p.acc).map(|a| set("sq_acc", a)));
         v.push(set("sq_mc", mc_load(p.mc, accept)));
@@ -172,7 +176,7 @@ pub(super) fn emit(hw: &Hw, body: &mut Vec<Item>) -> Stager {
         set("sq_mp", format!("sq_mp >> {b}")),
         set("sq_cnt", format!("sq_cnt - {}", lit(cnt_w, 1))),
     ];
-    let phase_w = 32 - (SpanSeq::PHASES.len() as u32 - 1).leading_zeros();
+    let phase_w = phase_bits();
     // The next phase's load, by the current phase (none after the last: its result waits).
     let mut next: Vec<Stmt> = Vec::new();
     for k in (1..SpanSeq::PHASES.len()).rev() {
