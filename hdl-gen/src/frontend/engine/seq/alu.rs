@@ -8,12 +8,13 @@
 //! - **Split** ([`ALU_LAT_SPLIT`], the UP5K): on the UP5K that one path was the engine's
 //!   clock, 15.1 MHz (its 67-bit carry chain alone about 26 ns, docs/fpga.md), and on this
 //!   slow fabric (about 4 ns a LUT level with its routing) a 40 MHz clock leaves about five
-//!   levels a clock. Clock 1 registers the operands (a select's choice among them) and the function; clock 2 adds the low
-//!   half (its carry registered) and both sums of the high half (carry in 0 and 1, a carry
-//!   select), tests the operands for zero, shifts by the amount's low bits and counts each
-//!   group's leading zeros; clock 3 picks the high half by the low half's carry, forms the
-//!   compare from the signs, shifts by the amount's high bits and finds the first group that
-//!   is not zero; clock 4 multiplexes the result into `ar`.
+//!   levels a clock. Clock 1 registers the operands (a select's choice among them) and the
+//!   function; clock 2 adds the low half (its carry registered) and both sums of the high
+//!   half (carry in 0 and 1, a carry select), tests the operands for zero, shifts by the
+//!   amount's low bits and counts each group's leading zeros; clock 3 picks the high half by
+//!   the low half's carry, forms the compare from the signs, shifts by the amount's high bits,
+//!   finds the first group that is not zero and registers the wide result; clock 4
+//!   multiplexes the result into `ar`.
 
 use super::cx::{Cx, FN_ADD, FN_AND, FN_EQ, FN_LT, FN_LZC, FN_NOT, FN_OR, FN_SEL, FN_SHL, FN_SHLV, FN_SHR, FN_SUB};
 use crate::verilog::{comment, reg, set, wire, Item, Stmt};

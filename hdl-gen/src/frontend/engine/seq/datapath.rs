@@ -139,9 +139,10 @@ pub(super) fn write_bus(cx: &Cx, widths: &[u32], b: &mut Vec<Item>) {
     };
     let ext = |n: &str, (wv, sg): (u32, bool), to: u32| if sg { crate::verilog::sext(n, wv, to) } else { crate::verilog::zext(n, wv, to) };
     // Registered (`SeqPlan::bus_lat`): the source from the microword two clocks before the
-    // write (registered; the input it names picked then, as the vertex register holds them until then),
-    // the source's value registered a clock before the write, and at the write wrapped to its
-    // width and sign (from the microword the clock before): no path through both multiplexers.
+    // write (registered; the input it names picked then, as the vertex register holds them
+    // until then), the source's value registered a clock before the write, and at the write
+    // wrapped to its width and sign (from the microword the clock before): no path through
+    // both multiplexers.
     let reg_bus = match cx.s.plan.bus_lat {
         0 => false,
         1 => true,
