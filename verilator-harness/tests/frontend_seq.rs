@@ -12,9 +12,12 @@ use verilator_harness::frontend::random_triangles;
 /// 37x23 and 640x480, levels 0 and 1 (the target's), the UP5K's (`ice40-up5k`, its products as
 /// SB_MAC16 tile passes) at 37x23 level 0 and 640x480 level 1 (its target's); 1,000 triangles
 /// each (about 340 clocks a triangle); a fault planted in the HX8K's ALU (the subtract made an
-/// add) and four in the UP5K's engine (the tiles' sum not shifted a chunk up where the pass's
-/// weight drops, its high half or the split ALU's without the low half's carry, the divider's
-/// dividend bits not shifted in) are caught. Slow tier: `cargo nextest run -p verilator-harness --run-ignored only -E
+/// add; the vertex register freed at the period's first clocks, before the entered triangle's
+/// inputs are read) and seven in the UP5K's engine (the tiles' sum not shifted a chunk up where
+/// the pass's weight drops, its high half or the split ALU's without the low half's carry, the
+/// divider's dividend bits not shifted in, the select's second choice never taken into `ax1`, a
+/// tile's held operand, only as wide as its unit's widest, without its top bit, the vertex
+/// register freed early) are caught. Slow tier: `cargo nextest run -p verilator-harness --run-ignored only -E
 /// 'test(/sequential_engine/)'`.
 #[test]
 #[ignore]
@@ -46,9 +49,20 @@ fn sequential_engine_spans_equal_golden() {
                 fault(" m0his = ", ", m0c2}", ", 1'b0}", "the tile's high half without the low half's carry"),
                 fault(" addsub = ", "{bc ? ", "{1'b0 ? ", "the split ALU's high half without the low half's carry"),
                 fault(" dt = ", "{dr, dl[", "{dr, 1'b0 & dl[", "the divider's dividend bits not shifted in"),
+                fault(" ax1 <= ", "sel2 ? x2", "1'b0 ? x2", "the select's second choice not taken into the operand register"),
+                fault(
+                    " m1b <= ",
+                    "m1b <= m1xb",
+                    "m1b <= m1xb << 1 >> 1",
+                    "a tile's held operand without its top bit, the sign above its chunks",
+                ),
+                fault("&& vld[0]) begin", "en && pc == ", "en && pc != ", "the vertex register freed before its inputs are read"),
             ]
         } else {
-            vec![fault(" sub = ", " == 4'd2 || ", " == 4'd15 || ", "the ALU's subtract made an add")]
+            vec![
+                fault(" sub = ", " == 4'd2 || ", " == 4'd15 || ", "the ALU's subtract made an add"),
+                fault("&& vld[0]) begin", "en && pc == ", "en && pc != ", "the vertex register freed before its inputs are read"),
+            ]
         };
         assert_faults_caught(&base, "tri_fe_engine.v", "seqfault", faults, seed, &tris);
     }

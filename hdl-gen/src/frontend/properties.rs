@@ -65,6 +65,7 @@ pub(super) fn emit_engine(hw: &Hw, sp: &Stager) -> Item {
         entry_w: super::engine::entry_bits(hw, &s),
         binary_phase: hw.sequential().is_some(),
         capture: hw.sequential().is_some(),
+        held: hw.sequential().map(|s| s.inputs_read_by()),
     };
     let mut shape = shape(hw, sp, SetupShape::Engine(engine));
     shape.starts = super::incremental::on(hw).then_some(hw.fe.start_product_clocks());
@@ -324,7 +325,13 @@ impl Reference<'_> {
                     b.push(wire("f_room", 1, "1'b1"));
                 }
                 b.push(wire("f_enter", 1, format!("f_en && f_ph == {}", lit(phw, (e.ii - 1) as u64))));
-                b.push(wire("f_rdy", 1, "(!f_vf || f_enter) && f_room"));
+                if let Some(h) = e.held {
+                    b.push(comment("The vertex register holds the entered triangle's inputs until their last read."));
+                    b.push(wire("f_hold", 1, format!("{} && f_ph <= {}", bit("f_vld", e.periods(), 0), lit(phw, h as u64))));
+                    b.push(wire("f_rdy", 1, "!f_vf && !f_hold && f_room"));
+                } else {
+                    b.push(wire("f_rdy", 1, "(!f_vf || f_enter) && f_room"));
+                }
             }
         }
         b.push(wire("f_acc", 1, "in_valid && f_rdy"));

@@ -485,6 +485,17 @@ impl SeqSchedule {
         }
     }
 
+    /// The last clock of a period on which an input of the period's triangle is read, where
+    /// its write is selected (`2 * bus_lat` clocks before the write): the vertex register must
+    /// hold the triangle until then, and may take the next one after it, so the engine needs
+    /// no second copy of the inputs.
+    pub fn inputs_read_by(&self) -> u32 {
+        let last = self.slots.iter().filter(|s| s.exec == Exec::Input).map(|s| s.write - 2 * self.plan.bus_lat).max();
+        let last = last.expect("a program with inputs");
+        assert!(last + 1 < self.clocks, "the inputs read before the period's last clock, the entry's");
+        last
+    }
+
     /// Register-file words and flags in use.
     pub fn words(&self) -> (u32, u32) {
         let mut w = 0;

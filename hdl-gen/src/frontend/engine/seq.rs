@@ -316,43 +316,45 @@ fn microprogram(cx: &Cx, fields: &[Field]) -> Micro {
     Micro { l, micro, groups, widths }
 }
 
-/// The sequencer: `pc`, the vertex register, the entered triangle's inputs, the valid bits, boot.
+/// The sequencer: `pc`, the vertex register, the valid bits, boot. The entered triangle's
+/// inputs are read from the vertex register itself, which takes the next triangle only after
+/// the last of them is read ([`SeqSchedule::inputs_read_by`], early in the period): a second
+/// copy of the inputs was 183 flip-flops at 640x480, on devices short of cells.
 fn sequencer(cx: &Cx, b: &mut Vec<Item>) {
     let (wd, iw, cw, c) = (cx.hw.fe.widths(), cx.hw.fe.cfg.iw(), cx.cw, cx.c);
-    b.push(comment("Sequencer: the clock of the triangle (pc), the vertex register (v*) and the entered triangle's inputs"));
-    b.push(comment("(n*), a valid bit per period in flight, boot (the first period after reset)."));
+    let held = cx.s.inputs_read_by();
+    b.push(comment("Sequencer: the clock of the triangle (pc), the vertex register (v*: a triangle waiting, then the entered"));
+    b.push(comment(format!("one's inputs until clock {held}, their last read), a valid bit per period in flight, boot (the first")));
+    b.push(comment("period after reset)."));
     b.push(reg("pc", cw));
     b.push(reg("vld", 2));
     b.push(reg("v_full", 1));
     b.push(reg("boot", 1));
     for k in 0..3 {
         for (v, wv, sg) in [("x", wd.cx, true), ("y", wd.cy, true), ("i", iw, false)] {
-            for p in ["v", "n"] {
-                b.push(if sg { sreg(&format!("{p}{v}{k}"), wv) } else { reg(&format!("{p}{v}{k}"), wv) });
-            }
+            let n = format!("v{v}{k}");
+            b.push(if sg { sreg(&n, wv) } else { reg(&n, wv) });
         }
     }
     let last = format!("pc == {cw}'d{}", c - 1);
-    b.push(wire("enter", 1, format!("en && {last}")));
     b.push(wire("pc_n", cw, format!("({last}) ? {cw}'d0 : pc + {cw}'d1")));
-    b.push(Item::Assign("in_ready".into(), "!v_full || enter".into()));
+    b.push(Item::Assign("in_ready".into(), "!v_full".into()));
     b.push(Item::Assign("res_v".into(), format!("pc == {cw}'d0 && vld[1]")));
     let mut take = vec![set("v_full", "1'b1")];
-    let mut entry = vec![set("vld", "{vld[0], v_full}")];
     for k in 0..3 {
         for (v, p) in [("x", "in_x"), ("y", "in_y"), ("i", "in_i")] {
             take.push(set(format!("v{v}{k}"), format!("{p}{k}")));
-            entry.push(set(format!("n{v}{k}"), format!("v{v}{k}")));
         }
     }
+    let free = format!("en && pc == {cw}'d{held} && vld[0]");
     b.push(Item::Always(vec![Stmt::If(
         "rst".into(),
         vec![set("v_full", "1'b0"), set("vld", "2'd0"), set("pc", format!("{cw}'d0")), set("boot", "1'b1")],
         vec![
-            Stmt::If("in_valid && in_ready".into(), take, vec![Stmt::If("enter".into(), vec![set("v_full", "1'b0")], vec![])]),
+            Stmt::If("in_valid && in_ready".into(), take, vec![Stmt::If(free, vec![set("v_full", "1'b0")], vec![])]),
             Stmt::If(
                 "en".into(),
-                vec![set("pc", "pc_n"), Stmt::If(last.clone(), [entry, vec![set("boot", "1'b0")]].concat(), vec![])],
+                vec![set("pc", "pc_n"), Stmt::If(last, vec![set("vld", "{vld[0], v_full}"), set("boot", "1'b0")], vec![])],
                 vec![],
             ),
         ],

@@ -165,8 +165,12 @@ impl Reference<'_> {
     /// registers only.
     pub(super) fn engine_links(&self, e: &EngineShape) -> Vec<Stmt> {
         let (phw, qw, pw) = (e.phw(), e.qw(), bits_for(e.depth - 1));
-        let mut link =
-            vec![assert("f_e_vfull == f_vf"), assert("f_e_vld == f_vld"), assert(format!("f_ph <= {}", lit(phw, (e.ii - 1) as u64)))];
+        let vfull = if e.held.is_some() { "f_e_vfull == (f_vf || f_hold)" } else { "f_e_vfull == f_vf" };
+        let mut link = vec![assert(vfull), assert("f_e_vld == f_vld"), assert(format!("f_ph <= {}", lit(phw, (e.ii - 1) as u64)))];
+        if e.held.is_some() {
+            // No triangle waits while the entered one holds the vertex register.
+            link.push(assert("!(f_vf && f_hold)"));
+        }
         if e.binary_phase {
             link.push(assert("f_e_ph == f_ph"));
         } else if e.ii > 1 {

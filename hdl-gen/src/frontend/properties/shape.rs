@@ -95,6 +95,10 @@ pub struct EngineShape {
     /// The engine writes the result's fields into the queue's tail as it produces them (the
     /// sequential engine's `res_we`, taken as given), and the push makes the tail an entry.
     pub capture: bool,
+    /// The sequential engine's vertex register holds the entered triangle's inputs until this
+    /// phase (their last read) and takes the next triangle only after it; else it passes them
+    /// on at the entry and takes the next one then.
+    pub held: Option<u32>,
 }
 
 /// A register stage of the front-end's span path: where it holds a span's valid, row, columns

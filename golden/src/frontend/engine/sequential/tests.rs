@@ -150,3 +150,22 @@ fn sequential_figures() {
         }
     }
 }
+
+/// The vertex register holds a triangle only until its inputs are read (the engine keeps no
+/// second copy of them): that clock is early in the period, and an input read at the period's
+/// last clock (the entry's) is refused.
+#[test]
+fn the_inputs_are_read_before_the_next_entry() {
+    let fe = &screens()[1];
+    for plan in [SeqPlan::ICE40_HX8K, SeqPlan::ICE40_UP5K] {
+        let s = plan.schedule(fe).unwrap();
+        let last = s.inputs_read_by();
+        let reads: Vec<u32> = s.slots.iter().filter(|x| x.exec == Exec::Input).map(|x| x.write - 2 * s.plan.bus_lat).collect();
+        assert!(reads.iter().all(|&r| r <= last) && reads.contains(&last));
+        assert!(last < s.clocks / 4, "inputs read by clock {last} of {}", s.clocks);
+        let mut bad = s.clone();
+        let o = (0..bad.slots.len()).find(|&o| bad.slots[o].exec == Exec::Input).unwrap();
+        bad.slots[o].write = bad.clocks - 1 + 2 * bad.plan.bus_lat;
+        assert!(std::panic::catch_unwind(|| bad.inputs_read_by()).is_err(), "an input read at the entry's clock");
+    }
+}

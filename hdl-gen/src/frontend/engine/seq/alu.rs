@@ -8,12 +8,13 @@
 //! - **Split** ([`ALU_LAT_SPLIT`], the UP5K): on the UP5K that one path was the engine's
 //!   clock, 15.1 MHz (its 67-bit carry chain alone about 26 ns, docs/fpga.md), and on this
 //!   slow fabric (about 4 ns a LUT level with its routing) a 40 MHz clock leaves about five
-//!   levels a clock. Clock 1 registers the operands and the function; clock 2 adds the low
-//!   half (its carry registered) and both sums of the high half (carry in 0 and 1, a carry
-//!   select), tests the operands for zero, shifts by the amount's low bits and counts each
-//!   group's leading zeros; clock 3 picks the high half by the low half's carry, forms the
-//!   compare from the signs, shifts by the amount's high bits and finds the first group that
-//!   is not zero; clock 4 multiplexes the result into `ar`.
+//!   levels a clock. Clock 1 registers the operands (a select's choice among them) and the
+//!   function; clock 2 adds the low half (its carry registered) and both sums of the high
+//!   half (carry in 0 and 1, a carry select), tests the operands for zero, shifts by the
+//!   amount's low bits and counts each group's leading zeros; clock 3 picks the high half by
+//!   the low half's carry, forms the compare from the signs, shifts by the amount's high bits,
+//!   finds the first group that is not zero and registers the wide result; clock 4
+//!   multiplexes the result into `ar`.
 
 use super::cx::{Cx, FN_ADD, FN_AND, FN_EQ, FN_LT, FN_LZC, FN_NOT, FN_OR, FN_SEL, FN_SHL, FN_SHLV, FN_SHR, FN_SUB};
 use crate::verilog::{comment, reg, set, wire, Item, Stmt};
@@ -140,11 +141,12 @@ fn split(cx: &Cx, b: &mut Vec<Item>) {
     let h = w.div_ceil(2);
     let hw = w - h;
     let one = |e: &str| format!("{{{{{}{{1'b0}}}}, {e}}}", w - 1);
-    b.push(comment("The ALU over four clocks. 1: the operands and the function registered (ax*, af, ai). 2: the low half's sum"));
-    b.push(comment("with its carry and both sums of the high half (carry in 0 and 1); the zero tests; the shift by the amount's"));
-    b.push(comment("low bits; the leading zeros of each group of bits; select, right shift or pass (b*). 3: the high half chosen"));
-    b.push(comment("by the carry and the compare; the shift by the amount's high bits; the count (c*). 4: the result into ar."));
-    b.extend([reg("ax0", w), reg("ax1", w), reg("ax2", w), reg("af", 4), reg("ai", sw)]);
+    b.push(comment("The ALU over four clocks. 1: the operands and the function registered (ax*, af, ai; the select's choice"));
+    b.push(comment("into ax1). 2: the low half's sum with its carry and both sums of the high half (carry in 0 and 1); the zero"));
+    b.push(comment("tests; the shift by the amount's low bits; the leading zeros of each group of bits; select, right shift or"));
+    b.push(comment("pass (b*). 3: the high half chosen by the carry and the compare; the shift by the amount's high bits; the"));
+    b.push(comment("count; the wide result in one register (c*). 4: the result into ar."));
+    b.extend([reg("ax0", w), reg("ax1", w), reg("af", 4), reg("ai", sw)]);
     b.push(wire("sub", 1, format!("af == 4'd{FN_SUB} || af == 4'd{FN_LT}")));
     b.push(wire("ay1", w, format!("ax1 ^ {{{w}{{sub}}}}")));
     // The carry in rides as a low bit: 1 + sub carries sub into bit 0.
@@ -164,7 +166,10 @@ fn split(cx: &Cx, b: &mut Vec<Item>) {
     });
     b.push(wire("nz0", 1, "|ax0"));
     b.push(wire("nz1", 1, "|ax1"));
-    b.push(wire("selc", 1, if bit { "ax0[0]" } else { "nz0" }));
+    // The select chooses on clock 1, into the second operand's register: no third operand
+    // register (a word of flip-flops on the UP5K, which is short of cells). The units load
+    // from `ax1` only on their own read clocks, whose function is never the select.
+    b.push(wire("sel2", 1, format!("u_fn == 4'd{FN_SEL} && !{}", if bit { "x0[0]" } else { "(|x0)" })));
     let flag = format!("(af == 4'd{FN_EQ}) ? (ax0 == ax1) : (af == 4'd{FN_AND}) ? (nz0 && nz1) : (af == 4'd{FN_OR}) ? (nz0 || nz1) : !nz0");
     // Right shifts are by constants, and few (one at the named screens): a multiplexer over them.
     let mut shrs: Vec<u32> = ops.iter().filter_map(|o| if let Kind::Shr(_, n) = o.kind { Some(n) } else { None }).collect();
@@ -173,19 +178,18 @@ fn split(cx: &Cx, b: &mut Vec<Item>) {
     b.push(reg("shr", w));
     let arms = shrs.iter().map(|n| (format!("{sw}'d{n}"), vec![Stmt::Blocking("shr".into(), format!("$signed(ax0) >>> {n}"))])).collect();
     b.push(Item::Comb(vec![Stmt::Case { sel: "ai".into(), arms, default: vec![Stmt::Blocking("shr".into(), "ax0".into())] }]));
-    let mv = format!("(af == 4'd{FN_SEL}) ? (selc ? ax1 : ax2) : (af == 4'd{FN_SHR}) ? shr : ax0");
+    let mv = format!("(af == 4'd{FN_SEL}) ? ax1 : (af == 4'd{FN_SHR}) ? shr : ax0");
     // The result's kind, for clock 4's multiplexer.
     let kind = format!(
         "(af == 4'd{FN_ADD} || sub) ? {{af == 4'd{FN_LT}, 2'd0}} : (af == 4'd{FN_EQ} || af == 4'd{FN_AND} || af == 4'd{FN_OR} || af == 4'd{FN_NOT}) ? 3'd1 : (af == 4'd{FN_LZC}) ? 3'd2 : (af == 4'd{FN_SHL} || af == 4'd{FN_SHLV}) ? 3'd3 : 3'd5"
     );
     b.extend([reg("blo", h), reg("bc", 1), reg("bhi0", hw), reg("bhi1", hw), reg("bs0", 1), reg("bs1", 1)]);
-    b.extend([reg("bfl", 1), reg("bmv", w), reg("bk", 3), reg("ck", 3), reg("cfl", 1), reg("cmv", w)]);
-    b.extend([reg("caddsub", w), reg("clt", 1), reg("ar", w)]);
+    b.extend([reg("bfl", 1), reg("bmv", w), reg("bk", 3), reg("ck", 3), reg("cfl", 1)]);
+    b.extend([reg("cv", w), reg("clt", 1), reg("ar", w)]);
     b.push(wire("addsub", w, "{bc ? bhi1 : bhi0, blo}"));
     let mut regs = vec![
         set("ax0", "x0"),
-        set("ax1", "x1"),
-        set("ax2", "x2"),
+        set("ax1", "sel2 ? x2 : x1"),
         set("af", "u_fn"),
         set("ai", "u_imm"),
         set("blo", format!("alo[{}:1]", h)),
@@ -197,39 +201,38 @@ fn split(cx: &Cx, b: &mut Vec<Item>) {
         set("bfl", flag),
         set("bmv", mv),
         set("bk", kind),
-        set("caddsub", "addsub"),
         set("clt", format!("(bs0 != bs1) ? bs0 : addsub[{}]", w - 1)),
         set("cfl", "bfl"),
-        set("cmv", "bmv"),
         set("ck", "bk"),
     ];
+    // The wide results (the sum, the shift, the moves) share clock 3's register: a word of
+    // flip-flops each was a word of logic cells on the UP5K; clock 4 picks among it and the
+    // one-bit and count results.
     let (sh, lz) = (split_shift(cx, &mut regs, b), split_lzc(cx, &mut regs, b));
-    let ar = format!(
-        "(ck == 3'd0) ? caddsub : (ck == 3'd4) ? {} : (ck == 3'd1) ? {} : (ck == 3'd2) ? {} : (ck == 3'd3) ? {sh} : cmv",
-        one("clt"),
-        one("cfl"),
-        crate::verilog::zext(&lz, sw, w)
-    );
+    regs.push(set("cv", format!("(bk == 3'd0) ? addsub : (bk == 3'd3) ? {sh} : bmv")));
+    let ar =
+        format!("(ck == 3'd4) ? {} : (ck == 3'd1) ? {} : (ck == 3'd2) ? {} : cv", one("clt"), one("cfl"), crate::verilog::zext(&lz, sw, w));
     regs.push(set("ar", ar));
     b.push(Item::Always(vec![Stmt::If("en".into(), regs, vec![])]));
 }
 
 /// The left shift in two clocks: by the amount's low three bits on clock 2, by its high bits
 /// on clock 3 (all out at W or more: the amount's bits above its width ORed, not a compare of
-/// the whole word). Returns clock 3's register.
+/// the whole word). Returns clock 3's shifted value, which [`split`] registers.
 fn split_shift(cx: &Cx, regs: &mut Vec<Stmt>, b: &mut Vec<Item>) -> String {
     let (w, sw) = (cx.w, cx.sw);
     let lo = sw.min(3);
     b.push(wire("shl_by", 1, format!("af == 4'd{FN_SHLV}")));
     b.push(wire("shl_amt", sw, format!("shl_by ? ax1[{}:0] : ai", sw - 1)));
     b.push(wire("shl_out", 1, format!("shl_by && (|ax1[{}:{sw}] || ax1[{}:0] >= {sw}'d{w})", w - 1, sw - 1)));
-    b.extend([reg("bsh", w), reg("bout", 1), reg("csh", w)]);
+    b.extend([reg("bsh", w), reg("bout", 1)]);
     regs.extend([set("bsh", format!("ax0 << shl_amt[{}:0]", lo - 1)), set("bout", "shl_out")]);
     if sw > lo {
         b.push(reg("bamt", sw - lo));
-        regs.extend([set("bamt", format!("shl_amt[{}:{lo}]", sw - 1)), set("csh", format!("bout ? {w}'d0 : bsh << {{bamt, {lo}'d0}}"))]);
+        regs.push(set("bamt", format!("shl_amt[{}:{lo}]", sw - 1)));
+        b.push(wire("csh", w, format!("bout ? {w}'d0 : bsh << {{bamt, {lo}'d0}}")));
     } else {
-        regs.push(set("csh", format!("bout ? {w}'d0 : bsh")));
+        b.push(wire("csh", w, format!("bout ? {w}'d0 : bsh")));
     }
     "csh".into()
 }

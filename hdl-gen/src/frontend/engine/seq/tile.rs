@@ -31,8 +31,7 @@ pub(super) struct Tiles<'a> {
     s: &'a SeqSchedule,
     bits: u32,
     mults: u32,
-    /// Chunks of the widest operand, and the chunk index's bits.
-    chunks: u32,
+    /// The chunk index's bits (chunks of the widest operand).
     cbw: u32,
 }
 
@@ -42,7 +41,7 @@ impl<'a> Tiles<'a> {
         let mults = s.plan.units.mults;
         assert!((1..=FIELDS.len() as u32).contains(&mults), "{mults} tile multipliers (the RTL has fields for 1 or 2)");
         let chunks = s.cost.ram_width.div_ceil(bits);
-        Some(Tiles { s, bits, mults, chunks, cbw: bits_for(chunks - 1) })
+        Some(Tiles { s, bits, mults, cbw: bits_for(chunks - 1) })
     }
 
     pub(super) fn fields(&self) -> Vec<(&'static str, u32)> {
@@ -50,6 +49,21 @@ impl<'a> Tiles<'a> {
         (0..self.mults as usize)
             .flat_map(|u| FIELDS[u][..n].iter().zip([1, self.cbw, self.cbw, 1, 1, 1, 1]).map(|(n, w)| (*n, w)))
             .collect()
+    }
+
+    /// Unit `u`'s chunks of its widest first and second operands: the chunks it holds.
+    fn held(&self, u: u32) -> [u32; 2] {
+        let ops = &self.s.prog.ops;
+        let mut n = [1, 1];
+        for (o, op) in ops.iter().enumerate() {
+            if let (Kind::Mul(a, b), Exec::Unit(_, k)) = (op.kind, self.s.slots[o].exec) {
+                if k == u {
+                    n[0] = n[0].max(ops[a.0 as usize].w.div_ceil(self.bits));
+                    n[1] = n[1].max(ops[b.0 as usize].w.div_ceil(self.bits));
+                }
+            }
+        }
+        n
     }
 
     /// Product `o` on unit `u`: its passes' fields, `(clock, field, value)`, from its load on.
@@ -91,10 +105,7 @@ impl<'a> Tiles<'a> {
     /// The units: per unit the held operands, the chunk selection, the tile and the sum.
     /// `w`: the register file's word; `x0`, `x1`: where the operands load from.
     pub(super) fn units(&self, w: u32, (x0, x1): (&str, &str), b: &mut Vec<Item>) {
-        let (bits, n) = (self.bits, self.chunks);
-        // The operands sign-extended past their top chunk's sign bit (a register-file word holds
-        // its value sign- or zero-extended to W: unsigned values have a zero bit on top).
-        let ew = n * bits + 1;
+        let bits = self.bits;
         let (pw, cbw) = (2 * bits + 2, self.cbw);
         b.push(comment(format!(
             "The tile multipliers: a product as golden's passes of {bits}-bit chunks on a {0} x {0} signed multiplier (SB_MAC16),",
@@ -105,11 +116,19 @@ impl<'a> Tiles<'a> {
         for u in 0..self.mults {
             let m = |x: &str| format!("m{u}{x}");
             let uf = |x: &str| format!("u_m{u}{x}");
-            b.extend([reg(&m("a"), w), reg(&m("b"), w)]);
-            for (o, x) in [("a", x0), ("b", x1)] {
+            let held = self.held(u);
+            for (side, (o, x)) in [("a", x0), ("b", x1)].into_iter().enumerate() {
+                // The operand held only as wide as this unit's widest on this side needs: its
+                // chunks and the sign bit above them (a register-file word holds its value sign-
+                // or zero-extended to W: unsigned values have a zero bit on top), sign-extended
+                // past the top chunk's sign bit where that is beyond the word.
+                let n = held[side];
+                let (hw, ew) = ((n * bits + 1).min(w), n * bits + 1);
+                b.push(reg(&m(o), hw));
                 let src = m(&format!("x{o}"));
-                b.push(wire(&src, w, format!("{} ? {x} : {}", uf("ld"), m(o))));
-                b.push(wire(&m(&format!("e{o}")), ew, crate::verilog::sext(&src, w, ew)));
+                let at = if hw < w { format!("{x}[{}:0]", hw - 1) } else { x.to_string() };
+                b.push(wire(&src, hw, format!("{} ? {at} : {}", uf("ld"), m(o))));
+                b.push(wire(&m(&format!("e{o}")), ew, crate::verilog::sext(&src, hw, ew)));
                 // The chunk the microword names, its sign bit the operand's where it is the
                 // signed top chunk.
                 let c = m(&format!("c{o}"));
@@ -137,7 +156,7 @@ impl<'a> Tiles<'a> {
                 b.push(sreg(&m("pr"), pw));
             }
             let mut regs = vec![
-                Stmt::If(uf("ld"), vec![set(m("a"), x0), set(m("b"), x1)], vec![]),
+                Stmt::If(uf("ld"), vec![set(m("a"), m("xa")), set(m("b"), m("xb"))], vec![]),
                 set(m("ra"), m("ca")),
                 set(m("rb"), m("cb")),
                 set(m("f1"), uf("ld")),
