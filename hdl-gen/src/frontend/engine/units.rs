@@ -173,6 +173,9 @@ pub(super) fn multipliers(v: &Values, seq: &Seq, body: &mut Vec<Item>) -> Vec<Ca
             for (k, &(i, j, x, top_a, top_b)) in p.iter().enumerate() {
                 let t = st + k as u32;
                 let c = seq.when_any(t, &es);
+                // The operand ports' selects and the operand registers' loads are registered: set
+                // the clock before (t - 1, a whole binding period on where t is 0).
+                let cb = seq.when_any(t + s.ii * seq.epochs - 1, &es);
                 let (va, vb) = match plan.mul {
                     MulUnit::Tile { bits } => (chunk(&v.at(a, t), i, bits, top_a, sg(a)), chunk(&v.at(b, t), j, bits, top_b, sg(b))),
                     MulUnit::ShiftAdd { bits } => (v.at(a, t).ext(acc_w), chunk(&v.at(b, t), j, bits, top_b, sg(b))),
@@ -183,8 +186,8 @@ pub(super) fn multipliers(v: &Values, seq: &Seq, body: &mut Vec<Item>) -> Vec<Ca
                 for (port, x) in [(0, va), (1, vb)] {
                     let again = tile && k > 0 && src[u][port].last().is_some_and(|(_, y)| *y == x) && held[port];
                     if !again {
-                        src[u][port].push((c.clone(), x));
-                        src[u][4 + port].push((c.clone(), "1'b1".into()));
+                        src[u][port].push((cb.clone(), x));
+                        src[u][4 + port].push((cb.clone(), "1'b1".into()));
                     }
                     held[port] = true;
                 }
@@ -222,7 +225,11 @@ pub(super) fn multipliers(v: &Values, seq: &Seq, body: &mut Vec<Item>) -> Vec<Ca
             &[("a", lane_a), ("b", lane_b), ("f", 1), ("sh", sh_w)]
         };
         for &(x, lw) in ports {
-            body.push(crate::verilog::bus(&bus(x), n * lw));
+            if x == "la" || x == "lb" {
+                body.push(reg(&bus(x), n * lw));
+            } else {
+                body.push(crate::verilog::bus(&bus(x), n * lw));
+            }
         }
         // Each product keeps the accumulator's low bits it needs.
         body.push(comment("verilator lint_off UNUSEDSIGNAL"));
@@ -230,8 +237,10 @@ pub(super) fn multipliers(v: &Values, seq: &Seq, body: &mut Vec<Item>) -> Vec<Ca
         body.push(comment("verilator lint_on UNUSEDSIGNAL"));
         for (li, &u) in members.iter().enumerate() {
             let (li, sr) = (li as u32, &src[u as usize]);
-            body.push(Item::Assign(lane_bits(&bus("a"), li, lane_a, lane_a), and_or(&sr[0], lane_a)));
-            body.push(Item::Assign(lane_bits(&bus("b"), li, lane_b, lane_b), and_or(&sr[1], lane_b)));
+            for (port, x, lw) in [(0, "a", lane_a), (1, "b", lane_b)] {
+                let terms = selected(&merged(&sr[port]), &format!("m{gi}_s{x}{li}"), body);
+                body.push(Item::Assign(lane_bits(&bus(x), li, lw, lw), and_or(&terms, lw)));
+            }
             let firsts: Vec<String> = sr[2].iter().map(|(c, _)| c.clone()).collect();
             body.push(Item::Assign(lane_bits(&bus("f"), li, 1, 1), or(&firsts)));
             let sh: Vec<(String, String)> =
@@ -242,10 +251,13 @@ pub(super) fn multipliers(v: &Values, seq: &Seq, body: &mut Vec<Item>) -> Vec<Ca
             };
             body.push(Item::Assign(lane_bits(&bus("sh"), li, sh_w, sh_w), sh));
             if tile {
-                for (x, port) in [("la", 4), ("lb", 5)] {
-                    let loads: Vec<String> = sr[port].iter().map(|(c, _)| c.clone()).collect();
-                    body.push(Item::Assign(lane_bits(&bus(x), li, 1, 1), or(&loads)));
-                }
+                // Registered, so an operand register's clock enable is a flip-flop, not the OR of
+                // its phases (the chain's critical path on one 25F, seed 2 of stop 32).
+                let loads: Vec<Stmt> = [("la", 4), ("lb", 5)]
+                    .iter()
+                    .map(|&(x, port)| set(lane_bits(&bus(x), li, 1, 1), or(&sr[port].iter().map(|(c, _)| c.clone()).collect::<Vec<_>>())))
+                    .collect();
+                body.push(Item::Always(loads));
             }
         }
         let k = format!("m{gi}k");
@@ -479,6 +491,19 @@ pub(super) fn shifters(v: &Values, seq: &Seq, body: &mut Vec<Item>) -> Vec<Captu
     }
     body.push(Item::Blank);
     caps
+}
+
+/// A port's sources each with a select register (one-hot, set the clock before from the merged
+/// conditions), so the port is an AND-OR of flip-flops and values, one term a source; a lone
+/// source needs none.
+fn selected(terms: &[(String, String)], sel: &str, body: &mut Vec<Item>) -> Vec<(String, String)> {
+    if terms.len() < 2 {
+        return terms.to_vec();
+    }
+    let k = terms.len() as u32;
+    body.push(reg(sel, k));
+    body.push(Item::Always(terms.iter().enumerate().map(|(j, (c, _))| set(format!("{sel}[{j}]"), c.clone())).collect()));
+    terms.iter().enumerate().map(|(j, (_, x))| (format!("{sel}[{j}]"), x.clone())).collect()
 }
 
 /// AND-OR sources with the same value merged into one term (the amount is one value's copy
