@@ -61,9 +61,8 @@ fn engine_planted_faults_are_caught() {
     let epoch_line =
         engine.lines().find(|l| l.contains("<= (") && l.contains("_q[") && l.contains("ep[0]")).expect("a quotient captured by epoch");
     let lzc_line = engine.lines().find(|l| l.contains("_h & ")).expect("the leading-zero count's bits");
-    let load_line = line(engine, "a tile operand register's registered load", &|l| {
-        l.trim_start().starts_with("m") && l.contains("_la[") && l.contains(" <= ")
-    });
+    let load_line =
+        line(engine, "a tile operand register's registered load", &|l| l.trim_start().starts_with("m") && l.contains("_la0 <= "));
     let sel_line = line(engine, "a tile port's registered select", &|l| l.trim_start().starts_with("m") && l.contains("_sa0[0] <= "));
     let lzc_odd = format!("{}, 1'b1}};", lzc_line.rsplit_once(", |(").expect("the count's lowest bit").0);
     let faults = [

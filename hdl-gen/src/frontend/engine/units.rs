@@ -225,11 +225,7 @@ pub(super) fn multipliers(v: &Values, seq: &Seq, body: &mut Vec<Item>) -> Vec<Ca
             &[("a", lane_a), ("b", lane_b), ("f", 1), ("sh", sh_w)]
         };
         for &(x, lw) in ports {
-            if x == "la" || x == "lb" {
-                body.push(reg(&bus(x), n * lw));
-            } else {
-                body.push(crate::verilog::bus(&bus(x), n * lw));
-            }
+            body.push(crate::verilog::bus(&bus(x), n * lw));
         }
         // Each product keeps the accumulator's low bits it needs.
         body.push(comment("verilator lint_off UNUSEDSIGNAL"));
@@ -253,10 +249,13 @@ pub(super) fn multipliers(v: &Values, seq: &Seq, body: &mut Vec<Item>) -> Vec<Ca
             if tile {
                 // Registered, so an operand register's clock enable is a flip-flop, not the OR of
                 // its phases (the chain's critical path on one 25F, seed 2 of stop 32).
-                let loads: Vec<Stmt> = [("la", 4), ("lb", 5)]
-                    .iter()
-                    .map(|&(x, port)| set(lane_bits(&bus(x), li, 1, 1), or(&sr[port].iter().map(|(c, _)| c.clone()).collect::<Vec<_>>())))
-                    .collect();
+                let mut loads = Vec::new();
+                for (x, port) in [("la", 4), ("lb", 5)] {
+                    let r = format!("m{gi}_{x}{li}");
+                    body.push(reg(&r, 1));
+                    body.push(Item::Assign(lane_bits(&bus(x), li, 1, 1), r.clone()));
+                    loads.push(set(r, or(&sr[port].iter().map(|(c, _)| c.clone()).collect::<Vec<_>>())));
+                }
                 body.push(Item::Always(loads));
             }
         }
