@@ -34,7 +34,9 @@ fn row_stage_base(label: &str) -> Option<(verilator_harness::models::Model, u64,
 /// period), a tile's passes added at the wrong weights (its accumulator never shifted), a division's quotient taken from the
 /// divider of another epoch (a binding rotated), the shared shifter's amount read from the next
 /// triangle's copy, the leading-zero count's lowest bit stuck at one (an even count one too
-/// large: the normalised `|A|` loses its top bit; stuck at zero, 0 mismatches at 37x23);
+/// large: the normalised `|A|` loses its top bit; stuck at zero, 0 mismatches at 37x23), a
+/// tile's operand register loaded on every clock (its registered load ignored: a held chunk
+/// overwritten), a tile port's registered select bit stuck at zero (a source never selected);
 /// and in `tri_frontend.v`, a triangle taken with no queue entry reserved for its
 /// result (the credits ignored), under backpressure heavy enough to fill the queue, which the
 /// clean model passes. Slow tier.

@@ -1,6 +1,7 @@
 //! The shared units: per unit an operand multiplexer per port, selected by phase and epoch
-//! (AND-OR: the binding puts one operation on a unit at a time, golden's `verify_binding`),
-//! then the units themselves as `generate` loops over identical lanes.
+//! (AND-OR: the binding puts one operation on a unit at a time, golden's `verify_binding`; a
+//! multiplier's selects and operand loads registered a clock ahead), then the units themselves
+//! as `generate` loops over identical lanes.
 //!
 //! - **Tile** (`MulUnit::Tile`): one pass multiplies a chunk of each operand (the top chunk of
 //!   a signed operand signed, the others unsigned: `bits + 1`-bit signed lanes), registered;
