@@ -234,10 +234,7 @@ pub(super) fn multipliers(v: &Values, seq: &Seq, body: &mut Vec<Item>) -> Vec<Ca
         body.push(comment("verilator lint_on UNUSEDSIGNAL"));
         for (li, &u) in members.iter().enumerate() {
             let (li, sr) = (li as u32, &src[u as usize]);
-            for (port, x, lw) in [(0, "a", lane_a), (1, "b", lane_b)] {
-                let terms = selected(&merged(&sr[port]), &format!("m{gi}_s{x}{li}"), body);
-                body.push(Item::Assign(lane_bits(&bus(x), li, lw, lw), and_or(&terms, lw)));
-            }
+            operands(gi, li, sr, (lane_a, lane_b), body);
             let firsts: Vec<String> = sr[2].iter().map(|(c, _)| c.clone()).collect();
             body.push(Item::Assign(lane_bits(&bus("f"), li, 1, 1), or(&firsts)));
             let sh: Vec<(String, String)> =
@@ -248,16 +245,7 @@ pub(super) fn multipliers(v: &Values, seq: &Seq, body: &mut Vec<Item>) -> Vec<Ca
             };
             body.push(Item::Assign(lane_bits(&bus("sh"), li, sh_w, sh_w), sh));
             if tile {
-                // Registered, so an operand register's clock enable is a flip-flop, not the OR of
-                // its phases (the chain's critical path on one 25F, seed 2 of stop 32).
-                let mut loads = Vec::new();
-                for (x, port) in [("la", 4), ("lb", 5)] {
-                    let r = format!("m{gi}_{x}{li}");
-                    body.push(reg(&r, 1));
-                    body.push(Item::Assign(lane_bits(&bus(x), li, 1, 1), r.clone()));
-                    loads.push(set(r, or(&sr[port].iter().map(|(c, _)| c.clone()).collect::<Vec<_>>())));
-                }
-                body.push(Item::Always(loads));
+                loads(gi, li, sr, body);
             }
         }
         let k = format!("m{gi}k");
@@ -268,6 +256,29 @@ pub(super) fn multipliers(v: &Values, seq: &Seq, body: &mut Vec<Item>) -> Vec<Ca
     }
     body.push(Item::Blank);
     caps
+}
+
+/// Lane `li` of multiplier group `gi`: its operand ports from their sources `sr[0]`, `sr[1]`
+/// (conditions of the clock before).
+fn operands(gi: usize, li: u32, sr: &[Vec<(String, String)>; 6], (lane_a, lane_b): (u32, u32), body: &mut Vec<Item>) {
+    for (port, x, lw) in [(0, "a", lane_a), (1, "b", lane_b)] {
+        let terms = selected(&merged(&sr[port]), &format!("m{gi}_s{x}{li}"), body);
+        body.push(Item::Assign(lane_bits(&format!("m{gi}_{x}"), li, lw, lw), and_or(&terms, lw)));
+    }
+}
+
+/// Lane `li` of tile group `gi`: its operand registers' loads `sr[4]`, `sr[5]`, registered, so
+/// an operand register's clock enable is a flip-flop, not the OR of its phases (the chain's
+/// critical path on one 25F, seed 2 of stop 32).
+fn loads(gi: usize, li: u32, sr: &[Vec<(String, String)>; 6], body: &mut Vec<Item>) {
+    let mut loads = Vec::new();
+    for (x, port) in [("la", 4), ("lb", 5)] {
+        let r = format!("m{gi}_{x}{li}");
+        body.push(reg(&r, 1));
+        body.push(Item::Assign(lane_bits(&format!("m{gi}_{x}"), li, 1, 1), r.clone()));
+        loads.push(set(r, or(&sr[port].iter().map(|(c, _)| c.clone()).collect::<Vec<_>>())));
+    }
+    body.push(Item::Always(loads));
 }
 
 /// One multiplier unit's datapath (the body of its group's generate loop): `lane` names its
