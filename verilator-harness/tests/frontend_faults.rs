@@ -34,7 +34,9 @@ fn row_stage_base(label: &str) -> Option<(verilator_harness::models::Model, u64,
 /// period), a tile's passes added at the wrong weights (its accumulator never shifted), a division's quotient taken from the
 /// divider of another epoch (a binding rotated), the shared shifter's amount read from the next
 /// triangle's copy, the leading-zero count's lowest bit stuck at one (an even count one too
-/// large: the normalised `|A|` loses its top bit; stuck at zero, 0 mismatches at 37x23);
+/// large: the normalised `|A|` loses its top bit; stuck at zero, 0 mismatches at 37x23), a
+/// tile's operand register loaded on every clock (its registered load ignored: a held chunk
+/// overwritten), a tile port's registered select bit stuck at zero (a source never selected);
 /// and in `tri_frontend.v`, a triangle taken with no queue entry reserved for its
 /// result (the credits ignored), under backpressure heavy enough to fill the queue, which the
 /// clean model passes. Slow tier.
@@ -61,6 +63,9 @@ fn engine_planted_faults_are_caught() {
     let epoch_line =
         engine.lines().find(|l| l.contains("<= (") && l.contains("_q[") && l.contains("ep[0]")).expect("a quotient captured by epoch");
     let lzc_line = engine.lines().find(|l| l.contains("_h & ")).expect("the leading-zero count's bits");
+    let load_line =
+        line(engine, "a tile operand register's registered load", &|l| l.trim_start().starts_with("m") && l.contains("_la0 <= "));
+    let sel_line = line(engine, "a tile port's registered select", &|l| l.trim_start().starts_with("m") && l.contains("_sa0[0] <= "));
     let lzc_odd = format!("{}, 1'b1}};", lzc_line.rsplit_once(", |(").expect("the count's lowest bit").0);
     let faults = [
         (copy_line.to_string(), copy_line.replacen("_1 ", "_0 ", 1), "an operand's copy off by one period"),
@@ -72,6 +77,8 @@ fn engine_planted_faults_are_caught() {
         (epoch_line.to_string(), epoch_line.replacen("ep[0]", "ep[1]", 1), "a quotient from another epoch's divider"),
         (shift_line.to_string(), shift_line.replacen("_1)", "_0)", 1), "a shared shift's amount from the next triangle's copy"),
         (lzc_line.to_string(), lzc_odd, "the leading-zero count's lowest bit stuck at one"),
+        (load_line.clone(), format!("{}<= 1'b1;", load_line.split_once("<=").unwrap().0), "a tile's operand register loaded every clock"),
+        (sel_line.clone(), format!("{}<= 1'b0;", sel_line.split_once("<=").unwrap().0), "a tile port's select bit stuck at zero"),
     ];
     assert_faults_caught(&base, "tri_fe_engine.v", "fault", faults, seed, &tris);
     // The credits: with out_ready high a clock in ten, triangles arrive faster than they are

@@ -1,6 +1,7 @@
 //! The shared units: per unit an operand multiplexer per port, selected by phase and epoch
-//! (AND-OR: the binding puts one operation on a unit at a time, golden's `verify_binding`),
-//! then the units themselves as `generate` loops over identical lanes.
+//! (AND-OR: the binding puts one operation on a unit at a time, golden's `verify_binding`; a
+//! multiplier's selects and operand loads registered a clock ahead), then the units themselves
+//! as `generate` loops over identical lanes.
 //!
 //! - **Tile** (`MulUnit::Tile`): one pass multiplies a chunk of each operand (the top chunk of
 //!   a signed operand signed, the others unsigned: `bits + 1`-bit signed lanes), registered;
@@ -173,6 +174,9 @@ pub(super) fn multipliers(v: &Values, seq: &Seq, body: &mut Vec<Item>) -> Vec<Ca
             for (k, &(i, j, x, top_a, top_b)) in p.iter().enumerate() {
                 let t = st + k as u32;
                 let c = seq.when_any(t, &es);
+                // The operand ports' selects and the operand registers' loads are registered: set
+                // the clock before (t - 1, a whole binding period on where t is 0).
+                let cb = seq.when_any(t + s.ii * seq.epochs - 1, &es);
                 let (va, vb) = match plan.mul {
                     MulUnit::Tile { bits } => (chunk(&v.at(a, t), i, bits, top_a, sg(a)), chunk(&v.at(b, t), j, bits, top_b, sg(b))),
                     MulUnit::ShiftAdd { bits } => (v.at(a, t).ext(acc_w), chunk(&v.at(b, t), j, bits, top_b, sg(b))),
@@ -183,8 +187,8 @@ pub(super) fn multipliers(v: &Values, seq: &Seq, body: &mut Vec<Item>) -> Vec<Ca
                 for (port, x) in [(0, va), (1, vb)] {
                     let again = tile && k > 0 && src[u][port].last().is_some_and(|(_, y)| *y == x) && held[port];
                     if !again {
-                        src[u][port].push((c.clone(), x));
-                        src[u][4 + port].push((c.clone(), "1'b1".into()));
+                        src[u][port].push((cb.clone(), x));
+                        src[u][4 + port].push((cb.clone(), "1'b1".into()));
                     }
                     held[port] = true;
                 }
@@ -230,8 +234,7 @@ pub(super) fn multipliers(v: &Values, seq: &Seq, body: &mut Vec<Item>) -> Vec<Ca
         body.push(comment("verilator lint_on UNUSEDSIGNAL"));
         for (li, &u) in members.iter().enumerate() {
             let (li, sr) = (li as u32, &src[u as usize]);
-            body.push(Item::Assign(lane_bits(&bus("a"), li, lane_a, lane_a), and_or(&sr[0], lane_a)));
-            body.push(Item::Assign(lane_bits(&bus("b"), li, lane_b, lane_b), and_or(&sr[1], lane_b)));
+            operands(gi, li, sr, (lane_a, lane_b), body);
             let firsts: Vec<String> = sr[2].iter().map(|(c, _)| c.clone()).collect();
             body.push(Item::Assign(lane_bits(&bus("f"), li, 1, 1), or(&firsts)));
             let sh: Vec<(String, String)> =
@@ -242,10 +245,7 @@ pub(super) fn multipliers(v: &Values, seq: &Seq, body: &mut Vec<Item>) -> Vec<Ca
             };
             body.push(Item::Assign(lane_bits(&bus("sh"), li, sh_w, sh_w), sh));
             if tile {
-                for (x, port) in [("la", 4), ("lb", 5)] {
-                    let loads: Vec<String> = sr[port].iter().map(|(c, _)| c.clone()).collect();
-                    body.push(Item::Assign(lane_bits(&bus(x), li, 1, 1), or(&loads)));
-                }
+                loads(gi, li, sr, body);
             }
         }
         let k = format!("m{gi}k");
@@ -256,6 +256,29 @@ pub(super) fn multipliers(v: &Values, seq: &Seq, body: &mut Vec<Item>) -> Vec<Ca
     }
     body.push(Item::Blank);
     caps
+}
+
+/// Lane `li` of multiplier group `gi`: its operand ports from their sources `sr[0]`, `sr[1]`
+/// (conditions of the clock before).
+fn operands(gi: usize, li: u32, sr: &[Vec<(String, String)>; 6], (lane_a, lane_b): (u32, u32), body: &mut Vec<Item>) {
+    for (port, x, lw) in [(0, "a", lane_a), (1, "b", lane_b)] {
+        let terms = selected(&merged(&sr[port]), &format!("m{gi}_s{x}{li}"), body);
+        body.push(Item::Assign(lane_bits(&format!("m{gi}_{x}"), li, lw, lw), and_or(&terms, lw)));
+    }
+}
+
+/// Lane `li` of tile group `gi`: its operand registers' loads `sr[4]`, `sr[5]`, registered, so
+/// an operand register's clock enable is a flip-flop, not the OR of its phases (the chain's
+/// critical path on one 25F, seed 2 of stop 32).
+fn loads(gi: usize, li: u32, sr: &[Vec<(String, String)>; 6], body: &mut Vec<Item>) {
+    let mut loads = Vec::new();
+    for (x, port) in [("la", 4), ("lb", 5)] {
+        let r = format!("m{gi}_{x}{li}");
+        body.push(reg(&r, 1));
+        body.push(Item::Assign(lane_bits(&format!("m{gi}_{x}"), li, 1, 1), r.clone()));
+        loads.push(set(r, or(&sr[port].iter().map(|(c, _)| c.clone()).collect::<Vec<_>>())));
+    }
+    body.push(Item::Always(loads));
 }
 
 /// One multiplier unit's datapath (the body of its group's generate loop): `lane` names its
@@ -479,6 +502,19 @@ pub(super) fn shifters(v: &Values, seq: &Seq, body: &mut Vec<Item>) -> Vec<Captu
     }
     body.push(Item::Blank);
     caps
+}
+
+/// A port's sources each with a select register (one-hot, set the clock before from the merged
+/// conditions), so the port is an AND-OR of flip-flops and values, one term a source; a lone
+/// source needs none.
+fn selected(terms: &[(String, String)], sel: &str, body: &mut Vec<Item>) -> Vec<(String, String)> {
+    if terms.len() < 2 {
+        return terms.to_vec();
+    }
+    let k = terms.len() as u32;
+    body.push(reg(sel, k));
+    body.push(Item::Always(terms.iter().enumerate().map(|(j, (c, _))| set(format!("{sel}[{j}]"), c.clone())).collect()));
+    terms.iter().enumerate().map(|(j, (_, x))| (format!("{sel}[{j}]"), x.clone())).collect()
 }
 
 /// AND-OR sources with the same value merged into one term (the amount is one value's copy
