@@ -36,6 +36,25 @@ fn tile_bits(hw: &Hw) -> u32 {
     }
 }
 
+/// Whether the tiles read their operands from registers of their own ([`Stager::tap`]): where
+/// each product's partial products are registered (level 1 and above), so the tile has a
+/// register on both sides by its MULT18X18D. A stage register that fed tiles and logic alike sat
+/// far from its tile (the 25F's seed-3 critical path, docs/fpga.md).
+fn tile_taps(hw: &Hw) -> bool {
+    golden::pipeline::i0_registers(hw.pipeline).iter().all(|&r| r)
+}
+
+/// `f`'s definitions, with Verilator's unused-signal warning off around them when `on`.
+fn unread_bits(sp: &mut Stager, on: bool, f: impl FnOnce(&mut Stager)) {
+    if on {
+        sp.note(comment("verilator lint_off UNUSEDSIGNAL"));
+    }
+    f(sp);
+    if on {
+        sp.note(comment("verilator lint_on UNUSEDSIGNAL"));
+    }
+}
+
 /// A chunk of at most this many bits is multiplied in logic, one adder a bit after the first,
 /// instead of taking tiles: a wider one costs more LUT4 than a tile is worth (Yosys 0.23 maps
 /// an 8 x 8 product modulo 2^8 to 111 LUT4, docs/fpga.md).
@@ -155,10 +174,7 @@ pub(super) fn path(hw: &Hw, body: &mut Vec<Item>) -> Stager {
     // takes its top IW + 1 bits, and the correction is modulo 2^(AW+3): golden's
     // `Widths::reciprocal_quotient`, whose documentation proves the estimate two below at most.
     let s2_w = hw.s2n_bits();
-    // Where each product's partial products are registered (level 1 and above), its tiles'
-    // operands are too, each from a register of its own by its MULT18X18D: a stage register
-    // that fed tiles and logic alike sat far from its tile (the 25F's seed-3 critical path).
-    let tile = (tile_bits(hw), golden::pipeline::i0_registers(hw.pipeline).iter().all(|&r| r));
+    let tile = (tile_bits(hw), tile_taps(hw));
     let t = fe.widths().i0_shift();
     let h_w = s2_w - t;
     // The estimate's bits and the ones below: the product modulo 2^(K - t + IW).
@@ -248,13 +264,8 @@ pub(super) fn path(hw: &Hw, body: &mut Vec<Item>) -> Stager {
         for k in [2, 4] {
             sp.def(&format!("{}_a{k}", e.corr), corr_w, false, format!("{} - an{k}", e.lo));
         }
-        if tile.1 {
-            sp.note(comment("verilator lint_off UNUSEDSIGNAL"));
-        }
-        sp.def_slice(e.h, e.s2, t, h_w);
-        if tile.1 {
-            sp.note(comment("verilator lint_on UNUSEDSIGNAL"));
-        }
+        // With taps, H's bits that only tiles read are unread here.
+        unread_bits(&mut sp, tile.1, |sp| sp.def_slice(e.h, e.s2, t, h_w));
         partials.push(partial_products(&mut sp, tile, e.prod, (e.h, h_w), ("rn", recip_w), prod_w));
     }
     sp.cut();
