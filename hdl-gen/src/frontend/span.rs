@@ -5,7 +5,7 @@
 
 use super::divider::DivConns;
 use super::hw::Hw;
-use super::stager::{bits_of, Stager};
+use super::stager::Stager;
 use super::walker::{self, scanline_divider};
 use crate::verilog::{comment, lit, reg, set, wire, zext, Item, Stmt};
 use crate::Names;
@@ -36,25 +36,6 @@ fn tile_bits(hw: &Hw) -> u32 {
     }
 }
 
-/// Whether the tiles read their operands from registers of their own ([`Stager::tap`]): where
-/// each product's partial products are registered (level 1 and above), so the tile has a
-/// register on both sides by its MULT18X18D. A stage register that fed tiles and logic alike sat
-/// far from its tile (the 25F's seed-3 critical path, docs/fpga.md).
-fn tile_taps(hw: &Hw) -> bool {
-    golden::pipeline::i0_registers(hw.pipeline).iter().all(|&r| r)
-}
-
-/// `f`'s definitions, with Verilator's unused-signal warning off around them when `on`.
-fn unread_bits(sp: &mut Stager, on: bool, f: impl FnOnce(&mut Stager)) {
-    if on {
-        sp.note(comment("verilator lint_off UNUSEDSIGNAL"));
-    }
-    f(sp);
-    if on {
-        sp.note(comment("verilator lint_on UNUSEDSIGNAL"));
-    }
-}
-
 /// A chunk of at most this many bits is multiplied in logic, one adder a bit after the first,
 /// instead of taking tiles: a wider one costs more LUT4 than a tile is worth (Yosys 0.23 maps
 /// an 8 x 8 product modulo 2^8 to 111 LUT4, docs/fpga.md).
@@ -72,64 +53,64 @@ fn adder_bits(n: u32, need: u32) -> u32 {
     (1..n).map(|k| need.saturating_sub(k)).sum()
 }
 
-/// The partial products of `out = (a * b) mod 2^m` (`a` and `b` staged values, unsigned), which
-/// [`sum_partials`] joins (a stage later from `--pipeline 1`): the products of `tile`-bit chunks
-/// ([`tile_bits`]), only those with a bit below 2^m, each cut to the bits it adds there, each
-/// its own wire `<out>_<n>`, returned as `(name, width, offset)`. A plain `*` would take every
-/// tile of the full product: synthesis keeps a tile as long as one of its bits is read. A chunk
-/// of at most [`LOGIC_BITS`] bits (the narrower operand's top, say) is multiplied in logic
-/// instead, as shifted adds against the whole other operand, and so is a piece of at most
-/// [`LOGIC_ADDER_BITS`] adder bits. With `taps` a tile reads each operand from a register of its
-/// own ([`Stager::tap`]).
-fn partial_products(
-    sp: &mut Stager,
-    (tile, taps): (u32, bool),
-    out: &str,
-    a: (&str, u32),
-    b: (&str, u32),
-    m: u32,
-) -> Vec<(String, u32, u32)> {
-    let ((an, aw), (bn, bw)) = if a.1 >= b.1 { (a, b) } else { (b, a) };
-    let (a, b) = (sp.at(an), sp.at(bn));
-    let (a, b) = (a.as_str(), b.as_str());
+/// `x[hi:lo]` of a value as it reads in a stage: its whole self, a slice of a name, or of a
+/// slice (the walker's `hi3[..]`).
+fn bits_of(x: &str, w: u32, hi: u32, lo: u32) -> String {
+    if lo == 0 && hi + 1 == w {
+        return x.to_string();
+    }
+    if let Some((name, range)) = x.strip_suffix(']').and_then(|r| r.split_once('[')) {
+        if let Some(base) = range.split_once(':').and_then(|(_, l)| l.parse::<u32>().ok()) {
+            return format!("{name}[{}:{}]", base + hi, base + lo);
+        }
+    }
+    format!("{x}[{hi}:{lo}]")
+}
+
+/// The partial products of `out = (a * b) mod 2^m` (`a` and `b` read as they are in the stage,
+/// unsigned), which [`sum_partials`] joins (a stage later from `--pipeline 1`): the products of
+/// `tile`-bit chunks ([`tile_bits`]), only those with a bit below 2^m, each cut to the bits it
+/// adds there, each its own wire `<out>_<n>`, returned as `(name, width, offset)`. A plain `*`
+/// would take every tile of the full product: synthesis keeps a tile as long as one of its bits
+/// is read. A chunk of at most [`LOGIC_BITS`] bits (the narrower operand's top, say) is
+/// multiplied in logic instead, as shifted adds against the whole other operand, and so is a
+/// piece of at most [`LOGIC_ADDER_BITS`] adder bits.
+fn partial_products(sp: &mut Stager, tile: u32, out: &str, (a, aw): (&str, u32), (b, bw): (&str, u32), m: u32) -> Vec<(String, u32, u32)> {
+    let ((a, aw), (b, bw)) = if aw >= bw { ((a, aw), (b, bw)) } else { ((b, bw), (a, aw)) };
     let chunks = |w: u32| (0..w.div_ceil(tile)).map(move |i| (i * tile, (w - i * tile).min(tile)));
     let mut terms: Vec<(String, u32, u32)> = Vec::new();
-    let mut piece =
-        |sp: &mut Stager, (x, xn, xo, xw): (&str, &str, u32, u32), (y, yn, yo, yw): (&str, &str, u32, u32), wx: u32, wy: u32| {
-            let off = xo + yo;
-            if off >= m {
-                return;
-            }
-            let need = m - off;
-            let (nx, ny) = (xw.min(need), yw.min(need));
-            let (sx, sy) = (bits_of(x, wx, xo + nx - 1, xo), bits_of(y, wy, yo + ny - 1, yo));
-            let name = format!("{out}_{}", terms.len());
-            let value = if nx.min(ny) <= LOGIC_BITS || adder_bits(nx.min(ny), need) <= LOGIC_ADDER_BITS {
-                let ((n, nw), (v, vw)) = if nx <= ny { ((sx, nx), (sy, ny)) } else { ((sy, ny), (sx, nx)) };
-                let v = zext(&v, vw, need);
-                (0..nw)
-                    .map(|k| {
-                        let shifted = if k == 0 { v.clone() } else { format!("({v} << {k})") };
-                        format!("({{{need}{{{}}}}} & {shifted})", bits_of(&n, nw, k, k))
-                    })
-                    .collect::<Vec<_>>()
-                    .join(" + ")
-            } else if taps {
-                let (tx, ty) = (sp.tap(xn, xo + nx - 1, xo), sp.tap(yn, yo + ny - 1, yo));
-                format!("{} * {}", zext(&tx, nx, need), zext(&ty, ny, need))
-            } else {
-                format!("{} * {}", zext(&sx, nx, need), zext(&sy, ny, need))
-            };
-            sp.def(&name, need, false, value);
-            terms.push((name, need, off));
+    let mut piece = |sp: &mut Stager, (x, xo, xw): (&str, u32, u32), (y, yo, yw): (&str, u32, u32), wx: u32, wy: u32| {
+        let off = xo + yo;
+        if off >= m {
+            return;
+        }
+        let need = m - off;
+        let (nx, ny) = (xw.min(need), yw.min(need));
+        let (sx, sy) = (bits_of(x, wx, xo + nx - 1, xo), bits_of(y, wy, yo + ny - 1, yo));
+        let name = format!("{out}_{}", terms.len());
+        let value = if nx.min(ny) <= LOGIC_BITS || adder_bits(nx.min(ny), need) <= LOGIC_ADDER_BITS {
+            let ((n, nw), (v, vw)) = if nx <= ny { ((sx, nx), (sy, ny)) } else { ((sy, ny), (sx, nx)) };
+            let v = zext(&v, vw, need);
+            (0..nw)
+                .map(|k| {
+                    let shifted = if k == 0 { v.clone() } else { format!("({v} << {k})") };
+                    format!("({{{need}{{{}}}}} & {shifted})", bits_of(&n, nw, k, k))
+                })
+                .collect::<Vec<_>>()
+                .join(" + ")
+        } else {
+            format!("{} * {}", zext(&sx, nx, need), zext(&sy, ny, need))
         };
+        sp.def(&name, need, false, value);
+        terms.push((name, need, off));
+    };
     for (bo, bc) in chunks(bw) {
         if bc <= LOGIC_BITS {
-            piece(sp, (b, bn, bo, bc), (a, an, 0, aw), bw, aw);
+            piece(sp, (b, bo, bc), (a, 0, aw), bw, aw);
             continue;
         }
         for (ao, ac) in chunks(aw) {
-            piece(sp, (a, an, ao, ac), (b, bn, bo, bc), aw, bw);
+            piece(sp, (a, ao, ac), (b, bo, bc), aw, bw);
         }
     }
     terms
@@ -174,7 +155,7 @@ pub(super) fn path(hw: &Hw, body: &mut Vec<Item>) -> Stager {
     // takes its top IW + 1 bits, and the correction is modulo 2^(AW+3): golden's
     // `Widths::reciprocal_quotient`, whose documentation proves the estimate two below at most.
     let s2_w = hw.s2n_bits();
-    let tile = (tile_bits(hw), tile_taps(hw));
+    let tile = tile_bits(hw);
     let t = fe.widths().i0_shift();
     let h_w = s2_w - t;
     // The estimate's bits and the ones below: the product modulo 2^(K - t + IW).
@@ -232,7 +213,8 @@ pub(super) fn path(hw: &Hw, body: &mut Vec<Item>) -> Stager {
     // their sum in the next.
     let mut gx_partials = Vec::new();
     for e in ends.iter().filter(|e| by_product(e)) {
-        gx_partials.push(partial_products(&mut sp, tile, e.gx, ("gxn", gx_w), (e.x, xw), gx_w));
+        let (gxn, x) = (sp.at("gxn"), sp.at(e.x));
+        gx_partials.push(partial_products(&mut sp, tile, e.gx, (&gxn, gx_w), (&x, xw), gx_w));
     }
     sp.cut();
     i0_section(&mut sp);
@@ -264,9 +246,9 @@ pub(super) fn path(hw: &Hw, body: &mut Vec<Item>) -> Stager {
         for k in [2, 4] {
             sp.def(&format!("{}_a{k}", e.corr), corr_w, false, format!("{} - an{k}", e.lo));
         }
-        // With taps, H's bits that only tiles read are unread here.
-        unread_bits(&mut sp, tile.1, |sp| sp.def_slice(e.h, e.s2, t, h_w));
-        partials.push(partial_products(&mut sp, tile, e.prod, (e.h, h_w), ("rn", recip_w), prod_w));
+        sp.def(e.h, h_w, false, format!("{s2}[{}:{t}]", s2_w - 1));
+        let rn = sp.at("rn");
+        partials.push(partial_products(&mut sp, tile, e.prod, (e.h, h_w), (&rn, recip_w), prod_w));
     }
     sp.cut();
     i0_section(&mut sp);
@@ -284,9 +266,8 @@ pub(super) fn path(hw: &Hw, body: &mut Vec<Item>) -> Stager {
     // stage, their sum in the next.
     let mut m_partials = Vec::new();
     for e in &ends {
-        // `an` read after `q~`: the stage registers are declared in the order of their first read.
-        let (qt, _) = (sp.at(e.qt), sp.at("an"));
-        m_partials.push(partial_products(&mut sp, tile, &format!("{}_an", e.m), ("an", area_w), (e.qt, iw), corr_w - 1));
+        let (qt, an) = (sp.at(e.qt), sp.at("an"));
+        m_partials.push(partial_products(&mut sp, tile, &format!("{}_an", e.m), (&an, area_w), (&qt, iw), corr_w - 1));
         // The corrected quotient's other two values, beside the product.
         for k in [1, 2] {
             sp.def(&format!("{}{k}", e.qt), iw, false, format!("{qt} + {}", lit(iw, k)));
@@ -391,9 +372,5 @@ pub(super) fn output(hw: &Hw, names: &Names, mut sp: Stager, body: &mut Vec<Item
     let mut resets: Vec<Stmt> = (1..=nsp).map(|j| set(pv(j), "1'b0")).collect();
     resets.push(set("out_valid", "1'b0"));
     body.push(Item::Always(vec![Stmt::If("rst".into(), resets, vec![Stmt::If("adv".into(), moves, ostall)])]));
-    let taps: Vec<Stmt> = (0..nsp).flat_map(|j| sp.tap_loads(j)).collect();
-    if !taps.is_empty() {
-        body.push(Item::Always(vec![Stmt::If("adv".into(), taps, vec![])]));
-    }
     sp
 }
