@@ -268,24 +268,34 @@ pub(super) fn module(hw: &Hw, names: &Names) -> Module {
 /// clock is the iCE40's): D itself is held, not thr, and the carry is the borrow of s minus D
 /// (s = rem + rs256), whose difference is also the next remainder; the bound's step adds the
 /// carry as its adder's carry in. Two chained carry chains where the side-by-side form has four
-/// beside a compare, a held qs + 1 and two selects: about 70 logic cells an edge (docs/fpga.md).
+/// beside a compare, a held qs + 1 and two selects; and D and rs256 have eight zero bits (both
+/// are 256 times an integer), so rem's low byte never moves nor carries and the DDA holds the
+/// high bits alone (the queue's low bytes then have no reader either): about 140 logic cells an
+/// edge (docs/fpga.md).
 fn dda(e: &EdgeWidths) -> Vec<Item> {
     let EdgeWidths { row_w, bound_w, ediv_w, end_w, tracked, .. } = *e;
     let mut body = vec![Item::Blank, comment("Walker: the edge's DDA state, loaded from the set-up result.")];
     if e.lean {
+        // D = 256 |dy| and rs256 = 256 Rs have eight zero bits, so rem's low byte never changes
+        // the carry nor moves: the DDA runs on the high bits alone (HW = ediv_w - 8).
+        let hw_ = ediv_w - 8;
+        body.push(comment("The DDA on the high bits (D and rs256 have eight zero bits: rem's low byte never carries nor moves):"));
         body.push(comment("s = rem + rs256, its carry s >= D (the borrow of s - D): the next remainder s - D or s, g + qs + carry."));
-        body.extend([reg("w_act", 1), reg("w_right", 1), reg("w_rs", row_w), reg("w_re", row_w), reg("w_d", ediv_w)]);
-        body.extend([reg("w_rem", ediv_w), reg("w_rs256", ediv_w), sreg("w_g", bound_w), sreg("w_qs", bound_w)]);
+        body.extend([reg("w_act", 1), reg("w_right", 1), reg("w_rs", row_w), reg("w_re", row_w), reg("w_d", hw_)]);
+        body.extend([reg("w_rem", hw_), reg("w_rs256", hw_), sreg("w_g", bound_w), sreg("w_qs", bound_w)]);
+        body.push(comment("verilator lint_off UNUSEDSIGNAL"));
+        body.push(wire("unused_low", 24, "{d[7:0], rem[7:0], rs256[7:0]}"));
+        body.push(comment("verilator lint_on UNUSEDSIGNAL"));
         body.push(wire("in_rows", 1, "w_act && row >= w_rs && row <= w_re"));
         body.push(swire("gg", end_w, sext("w_g", bound_w, end_w)));
         body.push(Item::Assign("lg".into(), "(in_rows && !w_right && gg < lo) ? gg : lo".into()));
         body.push(Item::Assign("ha".into(), "(in_rows && w_right && gg < hi) ? gg : hi".into()));
-        // rem < D and rs256 < D: s < 2D fits ediv_w + 1 bits, s - D lies in (-D, D).
-        let sw = ediv_w + 1;
-        body.push(wire("s", sw, format!("{} + {}", zext("w_rem", ediv_w, sw), zext("w_rs256", ediv_w, sw))));
-        body.push(wire("dif", sw + 1, format!("{} - {}", zext("s", sw, sw + 1), zext("w_d", ediv_w, sw + 1))));
+        // rem < D and rs256 < D: s < 2D fits HW + 1 bits, s - D lies in (-D, D).
+        let sw = hw_ + 1;
+        body.push(wire("s", sw, format!("{} + {}", zext("w_rem", hw_, sw), zext("w_rs256", hw_, sw))));
+        body.push(wire("dif", sw + 1, format!("{} - {}", zext("s", sw, sw + 1), zext("w_d", hw_, sw + 1))));
         body.push(wire("cy", 1, format!("!dif[{sw}]")));
-        body.push(wire("rnext", ediv_w, format!("cy ? dif[{}:0] : s[{}:0]", ediv_w - 1, ediv_w - 1)));
+        body.push(wire("rnext", hw_, format!("cy ? dif[{}:0] : s[{}:0]", hw_ - 1, hw_ - 1)));
         body.push(swire("gnext", bound_w, format!("w_g + w_qs + {}", zext("cy", 1, bound_w))));
         return body;
     }
@@ -372,9 +382,11 @@ fn module_engine(hw: &Hw, names: &Names) -> Module {
     ports.extend(walker_ports(&e));
     ports.extend(state_ports(hw));
     let mut body = dda(&e);
-    let mut load = ["act", "right", "rs", "re", "g", "rem", "qs", "rs256"].map(|p| set(format!("w_{p}"), p)).to_vec();
+    // The lean DDA holds the high bits of rem, rs256 and D (see dda).
+    let held = |p: &str| if e.lean && ["rem", "rs256", "d"].contains(&p) { format!("{p}[{}:8]", ediv_w - 1) } else { p.to_string() };
+    let mut load = ["act", "right", "rs", "re", "g", "rem", "qs", "rs256"].map(|p| set(format!("w_{p}"), held(p))).to_vec();
     if e.lean {
-        load.push(set("w_d", "d"));
+        load.push(set("w_d", held("d")));
     } else {
         load.extend([set("w_thr", "d - rs256"), set("w_qs1", format!("qs + {}", zext("1'b1", 1, bound_w)))]);
     }
