@@ -290,11 +290,12 @@ fn dda(e: &EdgeWidths) -> Vec<Item> {
         body.push(swire("gg", end_w, sext("w_g", bound_w, end_w)));
         body.push(Item::Assign("lg".into(), "(in_rows && !w_right && gg < lo) ? gg : lo".into()));
         body.push(Item::Assign("ha".into(), "(in_rows && w_right && gg < hi) ? gg : hi".into()));
-        // rem < D and rs256 < D: s < 2D fits HW + 1 bits, s - D lies in (-D, D).
+        // rem < D and rs256 < D: s < 2D fits HW + 1 bits, and s - D lies in (-D, D), so in
+        // HW + 1 bits too, its sign the top bit.
         let sw = hw_ + 1;
         body.push(wire("s", sw, format!("{} + {}", zext("w_rem", hw_, sw), zext("w_rs256", hw_, sw))));
-        body.push(wire("dif", sw + 1, format!("{} - {}", zext("s", sw, sw + 1), zext("w_d", hw_, sw + 1))));
-        body.push(wire("cy", 1, format!("!dif[{sw}]")));
+        body.push(wire("dif", sw, format!("s - {}", zext("w_d", hw_, sw))));
+        body.push(wire("cy", 1, format!("!dif[{hw_}]")));
         body.push(wire("rnext", hw_, format!("cy ? dif[{}:0] : s[{}:0]", hw_ - 1, hw_ - 1)));
         body.push(swire("gnext", bound_w, format!("w_g + w_qs + {}", zext("cy", 1, bound_w))));
         return body;
