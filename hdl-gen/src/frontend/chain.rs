@@ -6,10 +6,11 @@ use crate::widths::bits_for;
 use crate::Names;
 
 /// Entries of the span FIFO and of the `y` FIFO beside it: four, or two behind the sequential
-/// span path, which offers a span at most every `row_clocks` (36 at 640x480) clocks, while the
-/// shader cuts a span of up to 144 pixels in fewer at P = 4: two more entries of 75 and 9
-/// flip-flops, each a logic cell of its own, and their wider read multiplexers were about 250
-/// of the HX8K's logic cells (docs/fpga.md).
+/// span path, which offers a span at most every 36 clocks (at 640x480), so that the FIFOs
+/// rarely hold more than one (the sweep's iCE40 rows are the same with two): their two entries
+/// more (84 flip-flops each, every one a logic cell of its own on an iCE40) and wider read
+/// selects were 105 SB_LUT4 and 176 flip-flops of the HX8K's `tri_shader_p4` (docs/fpga.md,
+/// *The HX8K fit*).
 fn fifo_depth(hw: &Hw) -> u32 {
     if hw.fe.span_seq().is_some() {
         2

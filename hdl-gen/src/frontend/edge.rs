@@ -270,15 +270,15 @@ pub(super) fn module(hw: &Hw, names: &Names) -> Module {
 /// carry as its adder's carry in. Two chained carry chains where the side-by-side form has four
 /// beside a compare, a held qs + 1 and two selects; and D and rs256 have eight zero bits (both
 /// are 256 times an integer), so rem's low byte never moves nor carries and the DDA holds the
-/// high bits alone (the queue's low bytes then have no reader either): about 140 logic cells an
-/// edge (docs/fpga.md).
+/// high bits alone (the queue's low bytes then have no reader either): an edge 201 SB_LUT4 and
+/// 107 flip-flops where the side-by-side form has 452 and 146 (docs/fpga.md, *The HX8K fit*).
 fn dda(e: &EdgeWidths) -> Vec<Item> {
     let EdgeWidths { row_w, bound_w, ediv_w, end_w, tracked, .. } = *e;
     let mut body = vec![Item::Blank, comment("Walker: the edge's DDA state, loaded from the set-up result.")];
+    // D = 256 |dy| and rs256 = 256 Rs have eight zero bits, so the lean DDA runs on the high
+    // bits (HW = ediv_w - 8) alone.
+    let hw_ = ediv_w - 8;
     if e.lean {
-        // D = 256 |dy| and rs256 = 256 Rs have eight zero bits, so rem's low byte never changes
-        // the carry nor moves: the DDA runs on the high bits alone (HW = ediv_w - 8).
-        let hw_ = ediv_w - 8;
         body.push(comment("The DDA on the high bits (D and rs256 have eight zero bits: rem's low byte never carries nor moves):"));
         body.push(comment("s = rem + rs256, its carry s >= D (the borrow of s - D): the next remainder s - D or s, g + qs + carry."));
         body.extend([reg("w_act", 1), reg("w_right", 1), reg("w_rs", row_w), reg("w_re", row_w), reg("w_d", hw_)]);
@@ -286,27 +286,15 @@ fn dda(e: &EdgeWidths) -> Vec<Item> {
         body.push(comment("verilator lint_off UNUSEDSIGNAL"));
         body.push(wire("unused_low", 24, "{d[7:0], rem[7:0], rs256[7:0]}"));
         body.push(comment("verilator lint_on UNUSEDSIGNAL"));
-        body.push(wire("in_rows", 1, "w_act && row >= w_rs && row <= w_re"));
-        body.push(swire("gg", end_w, sext("w_g", bound_w, end_w)));
-        body.push(Item::Assign("lg".into(), "(in_rows && !w_right && gg < lo) ? gg : lo".into()));
-        body.push(Item::Assign("ha".into(), "(in_rows && w_right && gg < hi) ? gg : hi".into()));
-        // rem < D and rs256 < D: s < 2D fits HW + 1 bits, and s - D lies in (-D, D), so in
-        // HW + 1 bits too, its sign the top bit.
-        let sw = hw_ + 1;
-        body.push(wire("s", sw, format!("{} + {}", zext("w_rem", hw_, sw), zext("w_rs256", hw_, sw))));
-        body.push(wire("dif", sw, format!("s - {}", zext("w_d", hw_, sw))));
-        body.push(wire("cy", 1, format!("!dif[{hw_}]")));
-        body.push(wire("rnext", hw_, format!("cy ? dif[{}:0] : s[{}:0]", hw_ - 1, hw_ - 1)));
-        body.push(swire("gnext", bound_w, format!("w_g + w_qs + {}", zext("cy", 1, bound_w))));
-        return body;
+    } else {
+        // The step's carry, rem + rs256 >= D, is decided as rem >= thr (thr = D - rs256, from the
+        // load), and both next remainders and both next bounds (qs, qs + 1) are formed beside it:
+        // the add, compare, add it chained was the staged front-end's clock once the row stage
+        // took the span's decision off the walker (docs/fpga.md).
+        body.push(comment("thr = D - rs256 (> 0: rs256 < D), qs1 = qs + 1: the carry and both steps side by side."));
+        body.extend([reg("w_act", 1), reg("w_right", 1), reg("w_rs", row_w), reg("w_re", row_w), reg("w_thr", ediv_w)]);
+        body.extend([reg("w_rem", ediv_w), reg("w_rs256", ediv_w), sreg("w_g", bound_w), sreg("w_qs", bound_w), sreg("w_qs1", bound_w)]);
     }
-    // The step's carry, rem + rs256 >= D, is decided as rem >= thr (thr = D - rs256, from the
-    // load), and both next remainders and both next bounds (qs, qs + 1) are formed beside it:
-    // the add, compare, add it chained was the staged front-end's clock once the row stage
-    // took the span's decision off the walker (docs/fpga.md).
-    body.push(comment("thr = D - rs256 (> 0: rs256 < D), qs1 = qs + 1: the carry and both steps side by side."));
-    body.extend([reg("w_act", 1), reg("w_right", 1), reg("w_rs", row_w), reg("w_re", row_w), reg("w_thr", ediv_w)]);
-    body.extend([reg("w_rem", ediv_w), reg("w_rs256", ediv_w), sreg("w_g", bound_w), sreg("w_qs", bound_w), sreg("w_qs1", bound_w)]);
     if tracked {
         body.push(comment("The walked row among the edge's rows, moved with it: w_ge = row >= rs, w_le = row <= re."));
         body.extend([reg("w_ge", 1), reg("w_le", 1)]);
@@ -319,6 +307,17 @@ fn dda(e: &EdgeWidths) -> Vec<Item> {
     // a left edge's bound is -g, kept as g (its smallest is the span's left end).
     body.push(Item::Assign("lg".into(), "(in_rows && !w_right && gg < lo) ? gg : lo".into()));
     body.push(Item::Assign("ha".into(), "(in_rows && w_right && gg < hi) ? gg : hi".into()));
+    if e.lean {
+        // rem < D and rs256 < D: s < 2D fits HW + 1 bits, and s - D lies in (-D, D), so in
+        // HW + 1 bits too, its sign the top bit.
+        let sw = hw_ + 1;
+        body.push(wire("s", sw, format!("{} + {}", zext("w_rem", hw_, sw), zext("w_rs256", hw_, sw))));
+        body.push(wire("dif", sw, format!("s - {}", zext("w_d", hw_, sw))));
+        body.push(wire("cy", 1, format!("!dif[{hw_}]")));
+        body.push(wire("rnext", hw_, format!("cy ? dif[{}:0] : s[{}:0]", hw_ - 1, hw_ - 1)));
+        body.push(swire("gnext", bound_w, format!("w_g + w_qs + {}", zext("cy", 1, bound_w))));
+        return body;
+    }
     if tracked {
         // The carry as the borrow of the subtraction it selects: one carry chain, where the
         // compare on its own was mapped to a tree of LUTs in front of the bound's select.
