@@ -26,6 +26,8 @@ struct EdgeWidths {
     /// (behind the row stages, [`Hw::row_stage`]), and the walker's load and step taken apart
     /// from its stall: see [`dda`].
     tracked: bool,
+    /// The lean DDA behind the sequential span path (the iCE40 forms): see [`dda`].
+    lean: bool,
 }
 
 impl EdgeWidths {
@@ -43,6 +45,7 @@ impl EdgeWidths {
             pw_step: bound_w + vy_w,
             cnt_w: counter_width(&wd),
             tracked: hw.row_stage(),
+            lean: hw.engine_form() && hw.fe.span_seq().is_some() && !hw.row_stage(),
         }
     }
 }
@@ -260,16 +263,38 @@ pub(super) fn module(hw: &Hw, names: &Names) -> Module {
 /// constant compare and a select from registers: the rows' compares, then the bound's compare
 /// and select into the row stage, were the walker's longest path once the row stages took the
 /// span's decision (docs/fpga.md).
+///
+/// Lean (behind the sequential span path, where the walker waits 36 clocks a covered row and the
+/// clock is the iCE40's): D itself is held, not thr, and the carry is the borrow of s minus D
+/// (s = rem + rs256), whose difference is also the next remainder; the bound's step adds the
+/// carry as its adder's carry in. Two chained carry chains where the side-by-side form has four
+/// beside a compare, a held qs + 1 and two selects; and D and rs256 have eight zero bits (both
+/// are 256 times an integer), so rem's low byte never moves nor carries and the DDA holds the
+/// high bits alone (the queue's low bytes then have no reader either): an edge 201 SB_LUT4 and
+/// 107 flip-flops where the side-by-side form has 452 and 146 (docs/fpga.md, *The HX8K fit*).
 fn dda(e: &EdgeWidths) -> Vec<Item> {
     let EdgeWidths { row_w, bound_w, ediv_w, end_w, tracked, .. } = *e;
     let mut body = vec![Item::Blank, comment("Walker: the edge's DDA state, loaded from the set-up result.")];
-    // The step's carry, rem + rs256 >= D, is decided as rem >= thr (thr = D - rs256, from the
-    // load), and both next remainders and both next bounds (qs, qs + 1) are formed beside it:
-    // the add, compare, add it chained was the staged front-end's clock once the row stage
-    // took the span's decision off the walker (docs/fpga.md).
-    body.push(comment("thr = D - rs256 (> 0: rs256 < D), qs1 = qs + 1: the carry and both steps side by side."));
-    body.extend([reg("w_act", 1), reg("w_right", 1), reg("w_rs", row_w), reg("w_re", row_w), reg("w_thr", ediv_w)]);
-    body.extend([reg("w_rem", ediv_w), reg("w_rs256", ediv_w), sreg("w_g", bound_w), sreg("w_qs", bound_w), sreg("w_qs1", bound_w)]);
+    // D = 256 |dy| and rs256 = 256 Rs have eight zero bits, so the lean DDA runs on the high
+    // bits (HW = ediv_w - 8) alone.
+    let hw_ = ediv_w - 8;
+    if e.lean {
+        body.push(comment("The DDA on the high bits (D and rs256 have eight zero bits: rem's low byte never carries nor moves):"));
+        body.push(comment("s = rem + rs256, its carry s >= D (the borrow of s - D): the next remainder s - D or s, g + qs + carry."));
+        body.extend([reg("w_act", 1), reg("w_right", 1), reg("w_rs", row_w), reg("w_re", row_w), reg("w_d", hw_)]);
+        body.extend([reg("w_rem", hw_), reg("w_rs256", hw_), sreg("w_g", bound_w), sreg("w_qs", bound_w)]);
+        body.push(comment("verilator lint_off UNUSEDSIGNAL"));
+        body.push(wire("unused_low", 24, "{d[7:0], rem[7:0], rs256[7:0]}"));
+        body.push(comment("verilator lint_on UNUSEDSIGNAL"));
+    } else {
+        // The step's carry, rem + rs256 >= D, is decided as rem >= thr (thr = D - rs256, from the
+        // load), and both next remainders and both next bounds (qs, qs + 1) are formed beside it:
+        // the add, compare, add it chained was the staged front-end's clock once the row stage
+        // took the span's decision off the walker (docs/fpga.md).
+        body.push(comment("thr = D - rs256 (> 0: rs256 < D), qs1 = qs + 1: the carry and both steps side by side."));
+        body.extend([reg("w_act", 1), reg("w_right", 1), reg("w_rs", row_w), reg("w_re", row_w), reg("w_thr", ediv_w)]);
+        body.extend([reg("w_rem", ediv_w), reg("w_rs256", ediv_w), sreg("w_g", bound_w), sreg("w_qs", bound_w), sreg("w_qs1", bound_w)]);
+    }
     if tracked {
         body.push(comment("The walked row among the edge's rows, moved with it: w_ge = row >= rs, w_le = row <= re."));
         body.extend([reg("w_ge", 1), reg("w_le", 1)]);
@@ -282,6 +307,17 @@ fn dda(e: &EdgeWidths) -> Vec<Item> {
     // a left edge's bound is -g, kept as g (its smallest is the span's left end).
     body.push(Item::Assign("lg".into(), "(in_rows && !w_right && gg < lo) ? gg : lo".into()));
     body.push(Item::Assign("ha".into(), "(in_rows && w_right && gg < hi) ? gg : hi".into()));
+    if e.lean {
+        // rem < D and rs256 < D: s < 2D fits HW + 1 bits, and s - D lies in (-D, D), so in
+        // HW + 1 bits too, its sign the top bit.
+        let sw = hw_ + 1;
+        body.push(wire("s", sw, format!("{} + {}", zext("w_rem", hw_, sw), zext("w_rs256", hw_, sw))));
+        body.push(wire("dif", sw, format!("s - {}", zext("w_d", hw_, sw))));
+        body.push(wire("cy", 1, format!("!dif[{hw_}]")));
+        body.push(wire("rnext", hw_, format!("cy ? dif[{}:0] : s[{}:0]", hw_ - 1, hw_ - 1)));
+        body.push(swire("gnext", bound_w, format!("w_g + w_qs + {}", zext("cy", 1, bound_w))));
+        return body;
+    }
     if tracked {
         // The carry as the borrow of the subtraction it selects: one carry chain, where the
         // compare on its own was mapped to a tree of LUTs in front of the bound's select.
@@ -330,7 +366,12 @@ fn module_engine(hw: &Hw, names: &Names) -> Module {
         format!("Its set-up result comes from the shared set-up engine ({}) through the queue: rows rs..re, side,", names.fe_engine),
         "divisor D = 256 |dy|, first bound g with its remainder, step qs with rs256 = 256 (its remainder).".into(),
         format!("Walker ({}): on an active row g += qs + carry, the remainder", walker_moves(&e)),
-        "rem += rs256 modulo D (its carry rem >= D - rs256 and both steps side by side); lg/ha is g on the edge's side of the row, else lo/hi.".into(),
+        if e.lean {
+            "rem += rs256 modulo D (its carry s = rem + rs256 >= D, the borrow of s - D); lg/ha is g on the edge's side of the row, else lo/hi."
+        } else {
+            "rem += rs256 modulo D (its carry rem >= D - rs256 and both steps side by side); lg/ha is g on the edge's side of the row, else lo/hi."
+        }
+        .into(),
         format!("Widths: bound GW = {bound_w} signed, divisor {ediv_w}, rows {row_w}, bounds out {end_w} signed."),
     ];
     let mut ports = vec![Port::input("clk", 1, "", "rising edge")];
@@ -341,8 +382,14 @@ fn module_engine(hw: &Hw, names: &Names) -> Module {
     ports.extend(walker_ports(&e));
     ports.extend(state_ports(hw));
     let mut body = dda(&e);
-    let mut load = ["act", "right", "rs", "re", "g", "rem", "qs", "rs256"].map(|p| set(format!("w_{p}"), p)).to_vec();
-    load.extend([set("w_thr", "d - rs256"), set("w_qs1", format!("qs + {}", zext("1'b1", 1, bound_w)))]);
+    // The lean DDA holds the high bits of rem, rs256 and D (see dda).
+    let held = |p: &str| if e.lean && ["rem", "rs256", "d"].contains(&p) { format!("{p}[{}:8]", ediv_w - 1) } else { p.to_string() };
+    let mut load = ["act", "right", "rs", "re", "g", "rem", "qs", "rs256"].map(|p| set(format!("w_{p}"), held(p))).to_vec();
+    if e.lean {
+        load.push(set("w_d", held("d")));
+    } else {
+        load.extend([set("w_thr", "d - rs256"), set("w_qs1", format!("qs + {}", zext("1'b1", 1, bound_w)))]);
+    }
     body.push(walk(&e, load, ("rs", "re")));
     body.extend(state_outputs(hw).into_iter().map(|(port, _, _, signal, _)| Item::Assign(port.into(), signal)));
     Module { name: names.fe_edge.clone(), header, params: vec![], ports, body }
