@@ -246,7 +246,7 @@ pub(super) fn module(hw: &Hw, names: &Names) -> Module {
         set("w_re", "s_re"),
         set("w_thr", format!("s_d - {rs256}")),
         set("w_g", flip("ei_q")),
-        set("w_rem", format!("ei_p[{}:0]", ediv_w - 1)),
+        rem_load(&e, &mut body, (&format!("ei_p[{}:0]", ediv_w - 1), &rs256, "s_d")),
         set("w_qs", flip("es_q")),
         set("w_qs1", format!("{} + {}", flip("es_q"), zext("1'b1", 1, bound_w))),
         set("w_rs256", rs256),
@@ -293,7 +293,11 @@ fn dda(e: &EdgeWidths) -> Vec<Item> {
         // took the span's decision off the walker (docs/fpga.md).
         body.push(comment("thr = D - rs256 (> 0: rs256 < D), qs1 = qs + 1: the carry and both steps side by side."));
         body.extend([reg("w_act", 1), reg("w_right", 1), reg("w_rs", row_w), reg("w_re", row_w), reg("w_thr", ediv_w)]);
-        body.extend([reg("w_rem", ediv_w), reg("w_rs256", ediv_w), sreg("w_g", bound_w), sreg("w_qs", bound_w), sreg("w_qs1", bound_w)]);
+        // Behind the row stages the remainder is held offset by the threshold, so the carry is
+        // that register's sign: the compare on the carry chain, then the walker's running sums'
+        // enables, was the ECP5 target's critical path (docs/fpga.md).
+        body.push(if tracked { sreg("w_t", ediv_w + 1) } else { reg("w_rem", ediv_w) });
+        body.extend([reg("w_rs256", ediv_w), sreg("w_g", bound_w), sreg("w_qs", bound_w), sreg("w_qs1", bound_w)]);
     }
     if tracked {
         body.push(comment("The walked row among the edge's rows, moved with it: w_ge = row >= rs, w_le = row <= re."));
@@ -319,17 +323,33 @@ fn dda(e: &EdgeWidths) -> Vec<Item> {
         return body;
     }
     if tracked {
-        // The carry as the borrow of the subtraction it selects: one carry chain, where the
-        // compare on its own was mapped to a tree of LUTs in front of the bound's select.
-        body.push(wire("dif", ediv_w + 1, format!("{} - {}", zext("w_rem", ediv_w, ediv_w + 1), zext("w_thr", ediv_w, ediv_w + 1))));
-        body.push(wire("cy", 1, format!("!dif[{ediv_w}]")));
-        body.push(wire("rnext", ediv_w, format!("cy ? dif[{}:0] : w_rem + w_rs256", ediv_w - 1)));
+        // The carry rem >= thr is t >= 0 for t = rem - thr: a register's sign. Both next t side by
+        // side, rem - thr - thr and rem + rs256 - thr; t's range is -thr..rs256 - 1 (0 <= rem < D).
+        let t = |e: &str| zext(e, ediv_w, ediv_w + 1);
+        body.push(comment("w_t = rem - thr: the carry is its sign."));
+        body.push(wire("cy", 1, format!("!w_t[{ediv_w}]")));
+        body.push(swire("tnext", ediv_w + 1, format!("cy ? w_t - {} : w_t + {}", t("w_thr"), t("w_rs256"))));
     } else {
         body.push(wire("cy", 1, "w_rem >= w_thr"));
         body.push(wire("rnext", ediv_w, "cy ? w_rem - w_thr : w_rem + w_rs256"));
     }
     body.push(swire("gnext", bound_w, "cy ? w_g + w_qs1 : w_g + w_qs"));
     body
+}
+
+/// The load of the DDA's remainder `rem`: as itself, or behind the row stages as `t = rem - thr`
+/// = `rem + rs256 - D` ([`dda`]), its wires into `body`. The three operands are added carry-save,
+/// `rem + rs256 + ~D + 1` as the bits' sum plus their majority a place up with the 1 below it:
+/// one LUT then one carry chain from the queue head, as the load's `D - rs256`, not two chains.
+fn rem_load(e: &EdgeWidths, body: &mut Vec<Item>, (rem, rs256, d): (&str, &str, &str)) -> Stmt {
+    let w = e.ediv_w;
+    if !e.tracked {
+        return set("w_rem", rem);
+    }
+    body.push(comment("The load's t = rem + rs256 - D carry-save: the bits' sum, their majority a place up, + 1."));
+    body.push(wire("t_x", w + 1, format!("{{1'b1, {rem} ^ {rs256} ^ ~{d}}}")));
+    body.push(wire("t_m", w, format!("({rem} & {rs256}) | ({rem} & ~{d}) | ({rs256} & ~{d})")));
+    set("w_t", "t_x + {t_m, 1'b1}")
 }
 
 /// The DDA's always block: `load` on take, else a step on an active row. Tracked (`dda`): the
@@ -339,10 +359,11 @@ fn dda(e: &EdgeWidths) -> Vec<Item> {
 /// walker's other long path); the row's place moved on each row, `rs`/`re` the loaded rows'
 /// sources.
 fn walk(e: &EdgeWidths, load: Vec<Stmt>, (rs, re): (&str, &str)) -> Item {
-    let step = vec![set("w_rem", "rnext"), set("w_g", "gnext")];
     if !e.tracked {
+        let step = vec![set("w_rem", "rnext"), set("w_g", "gnext")];
         return Item::Always(vec![Stmt::If("take".into(), load, vec![Stmt::If("step && w_act && row >= w_rs".into(), step, vec![])])]);
     }
+    let step = vec![set("w_t", "tnext"), set("w_g", "gnext")];
     let mut load = load;
     load.extend([set("w_ge", format!("first >= {rs}")), set("w_le", format!("first <= {re}"))]);
     let one = format!("{}'d1", e.row_w);
@@ -383,11 +404,14 @@ fn module_engine(hw: &Hw, names: &Names) -> Module {
     ports.extend(state_ports(hw));
     let mut body = dda(&e);
     // The lean DDA holds the high bits of rem, rs256 and D (see dda).
-    let held = |p: &str| if e.lean && ["rem", "rs256", "d"].contains(&p) { format!("{p}[{}:8]", ediv_w - 1) } else { p.to_string() };
-    let mut load = ["act", "right", "rs", "re", "g", "rem", "qs", "rs256"].map(|p| set(format!("w_{p}"), held(p))).to_vec();
-    if e.lean {
-        load.push(set("w_d", held("d")));
+    let held = |p: &str| if ["rem", "rs256", "d"].contains(&p) { format!("{p}[{}:8]", ediv_w - 1) } else { p.to_string() };
+    let mut load = if e.lean {
+        ["act", "right", "rs", "re", "g", "rem", "qs", "rs256", "d"].map(|p| set(format!("w_{p}"), held(p))).to_vec()
     } else {
+        ["act", "right", "rs", "re", "g", "qs", "rs256"].map(|p| set(format!("w_{p}"), p)).to_vec()
+    };
+    if !e.lean {
+        load.push(rem_load(&e, &mut body, ("rem", "rs256", "d")));
         load.extend([set("w_thr", "d - rs256"), set("w_qs1", format!("qs + {}", zext("1'b1", 1, bound_w)))]);
     }
     body.push(walk(&e, load, ("rs", "re")));

@@ -236,6 +236,24 @@ fn control(hw: &Hw, body: &mut Vec<Item>) {
     }
 }
 
+/// The walker's moves behind the row stages. As the edges: the stall gates the enables, the
+/// registers choose the load or the step. Only the walk's valid and end are reset; the triangle's
+/// registers matter only under the valid and the next load sets them all, so their enables are
+/// `adv && w_next` and `adv && !w_end`, one LUT4 of registers each (`!w_end` holds only while a
+/// row is walked), where the reset and the valid made them two LUTs in front of hundreds of
+/// enables (docs/fpga.md).
+fn tracked_moves(body: &mut Vec<Item>, load: Vec<Stmt>, step: Vec<Stmt>) {
+    let control = |st: &Stmt| matches!(st, Stmt::Set(l, _) if l == "w_valid" || l == "w_end");
+    let (load_c, load_d): (Vec<_>, Vec<_>) = load.into_iter().partition(control);
+    let (step_c, step_d): (Vec<_>, Vec<_>) = step.into_iter().partition(control);
+    let walked = vec![Stmt::If("w_end".into(), vec![set("w_valid", "1'b0")], step_c)];
+    let moves = vec![Stmt::If("adv".into(), vec![Stmt::If("w_next".into(), load_c, walked)], vec![])];
+    let reset = vec![set("w_valid", "1'b0"), set("w_end", "1'b1")];
+    body.push(Item::Always(vec![Stmt::If("rst".into(), reset, moves)]));
+    let data = Stmt::If("w_next".into(), load_d, vec![Stmt::If("!w_end".into(), step_d, vec![])]);
+    body.push(Item::Always(vec![Stmt::If("adv".into(), vec![data], vec![])]));
+}
+
 pub(super) fn emit(hw: &Hw, names: &Names, body: &mut Vec<Item>) {
     let fe = &hw.fe;
     let Widths { yw: row_w, aw: area_w, k: sum_w, rw: recip_w, .. } = fe.widths();
@@ -337,22 +355,17 @@ pub(super) fn emit(hw: &Hw, names: &Names, body: &mut Vec<Item>) {
         step.push(set("w_end", format!("w_row + {} == w_last", lit(row_w, 1))));
     }
     step.extend(sum_step);
-    let walked = vec![Stmt::If("w_end".into(), vec![set("w_valid", "1'b0")], step)];
-    let moves = if tracked {
-        // As the edges: the stall gates the enables, the registers choose the load or the step.
-        vec![Stmt::If("adv".into(), vec![Stmt::If("w_next".into(), load, vec![Stmt::If("w_valid".into(), walked, vec![])])], vec![])]
+    if tracked {
+        tracked_moves(body, load, step);
     } else {
-        vec![Stmt::If(
+        let walked = vec![Stmt::If("w_end".into(), vec![set("w_valid", "1'b0")], step)];
+        let moves = vec![Stmt::If(
             "take".into(),
             load,
             vec![Stmt::If(if inc { "adv && w_valid && !ie_wait" } else { "adv && w_valid" }.into(), walked, vec![])],
-        )]
-    };
-    let mut reset = vec![set("w_valid", "1'b0")];
-    if tracked {
-        reset.push(set("w_end", "1'b1"));
+        )];
+        body.push(Item::Always(vec![Stmt::If("rst".into(), vec![set("w_valid", "1'b0")], moves)]));
     }
-    body.push(Item::Always(vec![Stmt::If("rst".into(), reset, moves)]));
     body.push(Item::Blank);
     if inc {
         super::incremental::engine(hw, body);
