@@ -11,6 +11,10 @@ use crate::Names;
 use golden::frontend::Widths;
 
 /// The widths one edge works in.
+/// D = 256 |dy| and rs256 = 256 Rs: both end in this many zero bits, so the remainder's low bits
+/// never move nor carry (the lean DDA holds the rest, [`EdgeWidths::high_w`]).
+const SCALE_BITS: u32 = 8;
+
 struct EdgeWidths {
     row_w: u32,
     vy_w: u32,
@@ -47,6 +51,11 @@ impl EdgeWidths {
             tracked: hw.row_stage(),
             lean: hw.engine_form() && hw.fe.span_seq().is_some() && !hw.row_stage(),
         }
+    }
+
+    /// The lean DDA's width: the divisor's bits above [`SCALE_BITS`].
+    fn high_w(&self) -> u32 {
+        self.ediv_w - SCALE_BITS
     }
 }
 
@@ -225,7 +234,13 @@ pub(super) fn module(hw: &Hw, names: &Names) -> Module {
     body.extend([reg("s_act", 1), reg("s_right", 1), reg("s_rs", row_w), reg("s_re", row_w), reg("s_d", ediv_w)]);
     body.push(Item::Always(vec![Stmt::If(
         "calc_go".into(),
-        vec![set("s_act", "act"), set("s_right", "right"), set("s_rs", "rs"), set("s_re", "re"), set("s_d", "{ady, 8'd0}")],
+        vec![
+            set("s_act", "act"),
+            set("s_right", "right"),
+            set("s_rs", "rs"),
+            set("s_re", "re"),
+            set("s_d", format!("{{ady, {SCALE_BITS}'d0}}")),
+        ],
         vec![],
     )]));
     body.push(comment("Its divisions: the first bound (ei) and the step (es), q - B = g."));
@@ -237,7 +252,7 @@ pub(super) fn module(hw: &Hw, names: &Names) -> Module {
         body.extend(d.instance(&names.fe_div, hw.div_bits, cnt_w, &conns, &["q"]));
     }
     let flip = |q: &str| offset_to_signed(q, bound_w);
-    let rs256 = format!("{{es_p[{}:0], 8'd0}}", vy_w - 1);
+    let rs256 = format!("{{es_p[{}:0], {SCALE_BITS}'d0}}", vy_w - 1);
     body.extend(dda(&e));
     let load = vec![
         set("w_act", "s_act"),
@@ -275,16 +290,15 @@ pub(super) fn module(hw: &Hw, names: &Names) -> Module {
 fn dda(e: &EdgeWidths) -> Vec<Item> {
     let EdgeWidths { row_w, bound_w, ediv_w, end_w, tracked, .. } = *e;
     let mut body = vec![Item::Blank, comment("Walker: the edge's DDA state, loaded from the set-up result.")];
-    // D = 256 |dy| and rs256 = 256 Rs have eight zero bits, so the lean DDA runs on the high
-    // bits (HW = ediv_w - 8) alone.
-    let hw_ = ediv_w - 8;
+    let hw_ = e.high_w();
     if e.lean {
         body.push(comment("The DDA on the high bits (D and rs256 have eight zero bits: rem's low byte never carries nor moves):"));
         body.push(comment("s = rem + rs256, its carry s >= D (the borrow of s - D): the next remainder s - D or s, g + qs + carry."));
         body.extend([reg("w_act", 1), reg("w_right", 1), reg("w_rs", row_w), reg("w_re", row_w), reg("w_d", hw_)]);
         body.extend([reg("w_rem", hw_), reg("w_rs256", hw_), sreg("w_g", bound_w), sreg("w_qs", bound_w)]);
         body.push(comment("verilator lint_off UNUSEDSIGNAL"));
-        body.push(wire("unused_low", 24, "{d[7:0], rem[7:0], rs256[7:0]}"));
+        let low = SCALE_BITS - 1;
+        body.push(wire("unused_low", 3 * SCALE_BITS, format!("{{d[{low}:0], rem[{low}:0], rs256[{low}:0]}}")));
         body.push(comment("verilator lint_on UNUSEDSIGNAL"));
     } else {
         // The step's carry, rem + rs256 >= D, is decided as rem >= thr (thr = D - rs256, from the
@@ -404,7 +418,7 @@ fn module_engine(hw: &Hw, names: &Names) -> Module {
     ports.extend(state_ports(hw));
     let mut body = dda(&e);
     // The lean DDA holds the high bits of rem, rs256 and D (see dda).
-    let held = |p: &str| if ["rem", "rs256", "d"].contains(&p) { format!("{p}[{}:8]", ediv_w - 1) } else { p.to_string() };
+    let held = |p: &str| if ["rem", "rs256", "d"].contains(&p) { format!("{p}[{}:{SCALE_BITS}]", ediv_w - 1) } else { p.to_string() };
     let mut load = if e.lean {
         ["act", "right", "rs", "re", "g", "rem", "qs", "rs256", "d"].map(|p| set(format!("w_{p}"), held(p))).to_vec()
     } else {
