@@ -89,16 +89,19 @@ pub struct SeqPlan {
 }
 
 impl SeqPlan {
-    /// The HX8K: no multiplier, so one shift-add unit and one divider, a bit a clock.
+    /// The HX8K: no multiplier, so one shift-add unit and one divider, a bit a clock. The
+    /// UP5K's latencies (issue 27, stop 34): with the one-clock ALU its 66-bit subtract behind
+    /// the register file's read was every seed's critical path (37-40 MHz, 25-27 ns); split, the
+    /// engine leaves it for about 40 clocks a triangle more (docs/fpga.md).
     pub const ICE40_HX8K: SeqPlan = SeqPlan {
         units: Plan::ICE40_HX8K,
         read_ports: 2,
         bank_bits: 16,
         bank_depth: 256,
-        alu_lat: ALU_LAT,
-        acc_lag: 0,
-        bus_lat: 0,
-        load_lag: 0,
+        alu_lat: ALU_LAT_SPLIT,
+        acc_lag: 1,
+        bus_lat: 1,
+        load_lag: 1,
     };
     /// The UP5K: 2 of its SB_MAC16 and one divider.
     pub const ICE40_UP5K: SeqPlan = SeqPlan {

@@ -3,9 +3,9 @@
 //! their constants, its result registered in `ar`, which the write bus reads at golden's
 //! write clock (`issue + READ + SeqPlan::alu_lat`).
 //!
-//! - **One clock** ([`ALU_LAT`], the HX8K): the operand select, the whole adder and the
-//!   result multiplexer in one path, as first written.
-//! - **Split** ([`ALU_LAT_SPLIT`], the UP5K): on the UP5K that one path was the engine's
+//! - **One clock** ([`ALU_LAT`], the HX8K's until issue 27's stop 34, no plan's since): the
+//!   operand select, the whole adder and the result multiplexer in one path, as first written.
+//! - **Split** ([`ALU_LAT_SPLIT`], both iCE40 plans): on the UP5K that one path was the engine's
 //!   clock, 15.1 MHz (its 67-bit carry chain alone about 26 ns, docs/fpga.md), and on this
 //!   slow fabric (about 4 ns a LUT level with its routing) a 40 MHz clock leaves about five
 //!   levels a clock. Clock 1 registers the operands (a select's choice among them) and the
