@@ -121,10 +121,11 @@ fn sequential_incremental_i0_spans_equal_golden() {
 }
 
 /// The sequential span path (`--fe-span sequential`, the iCE40 targets' choice) behind both
-/// iCE40 engines, 1,000 triangles each (37x23 and 640x480, levels 0 and 1; the HX8K's target,
-/// 640x480 at level 0, with the edges' lean DDA), as [`engine_spans_of`]; a fault (the
-/// correction's `q~ + 1` made `q~`) and one in the lean DDA (the bound's step with its carry
-/// subtracted) are caught. Slow tier: `cargo nextest run -p verilator-harness --run-ignored only
+/// iCE40 engines, 1,000 triangles each (37x23 and 640x480, levels 0 and 1; at level 0 the
+/// edges' lean DDA and the span's ends from their bounds side by side, the HX8K's target at
+/// 640x480 and the UP5K's engine at 37x23), as [`engine_spans_of`]; a fault (the correction's
+/// `q~ + 1` made `q~`), one in the lean DDA (the bound's step with its carry subtracted) and one
+/// in the side-by-side ends (an edge's bound the right end without its side test) are caught. Slow tier: `cargo nextest run -p verilator-harness --run-ignored only
 /// -E 'test(/sequential_span/)'`.
 #[test]
 #[ignore]
@@ -138,7 +139,14 @@ fn sequential_span_path_spans_equal_golden() {
             ..o
         })
     };
-    let runs = [(small, Ice40Hx8k, 0), (big, Ice40Hx8k, 0), (big, Ice40Hx8k, 1), (small, Ice40Up5k, 1), (big, Ice40Up5k, 1)];
+    let runs = [
+        (small, Ice40Hx8k, 0),
+        (big, Ice40Hx8k, 0),
+        (big, Ice40Hx8k, 1),
+        (small, Ice40Up5k, 0),
+        (small, Ice40Up5k, 1),
+        (big, Ice40Up5k, 1),
+    ];
     for (screen, setup, level) in runs {
         let Some(opts) = form(screen, setup, level) else { return };
         engine_spans_of(opts, 1000);
@@ -149,4 +157,6 @@ fn sequential_span_path_spans_equal_golden() {
     let Some(opts) = form(small, Ice40Hx8k, 0) else { return };
     let fault = LineFault { file: "tri_fe_edge.v", line: " gnext = w_g + w_qs + ", from: "w_qs + {", to: "w_qs - {" };
     fault.caught(&opts, "frontend lean edge fault", "leanedgefault", "the lean DDA's bound step with its carry subtracted");
+    let fault = LineFault { file: "tri_frontend.v", line: " bhw0 = ", from: "bh0 &&", to: "1'b1 &&" };
+    fault.caught(&opts, "frontend side by side ends fault", "sideendsfault", "an edge's bound made the right end without its side test");
 }

@@ -163,7 +163,7 @@ fn state_ports(hw: &Hw) -> Vec<Port> {
 }
 
 /// The `generate` loop of the three edges in `tri_frontend`: each lane of the input buses into
-/// its edge, each edge's bounds into `e_lg`, `e_ha`.
+/// its edge, each edge's outputs for the span's ends into `e_<port>` ([`end_ports`]).
 pub(super) fn instances(hw: &Hw, names: &Names, buses: &EdgeBuses) -> Item {
     let e = EdgeWidths::new(hw);
     let lane = |bus: &str, w: u32| if w == 1 { format!("{bus}[k]") } else { format!("{bus}[k*{w} +: {w}]") };
@@ -181,7 +181,7 @@ pub(super) fn instances(hw: &Hw, names: &Names, buses: &EdgeBuses) -> Item {
         .map(|(p, s)| (p.to_string(), s.to_string()))
         .collect();
     conns.extend(buses.inputs.iter().map(|(port, bus, w)| (port.to_string(), lane(bus, *w))));
-    conns.extend([("lg", "e_lg"), ("ha", "e_ha")].map(|(p, bus)| (p.to_string(), lane(bus, e.end_w))));
+    conns.extend(end_ports(hw).iter().map(|(p, w)| (p.to_string(), lane(&format!("e_{p}"), *w))));
     conns.extend(state_outputs(hw).iter().map(|(port, w, ..)| (port.to_string(), lane(&format!("e_{port}"), *w))));
     Item::ForGenerate {
         var: "k".into(),
@@ -321,10 +321,19 @@ fn dda(e: &EdgeWidths) -> Vec<Item> {
         body.push(wire("in_rows", 1, "w_act && row >= w_rs && row <= w_re"));
     }
     body.push(swire("gg", end_w, sext("w_g", bound_w, end_w)));
-    // This edge's bound on its side of the row, or the screen's where it bounds none here;
-    // a left edge's bound is -g, kept as g (its smallest is the span's left end).
-    body.push(Item::Assign("lg".into(), "(in_rows && !w_right && gg < lo) ? gg : lo".into()));
-    body.push(Item::Assign("ha".into(), "(in_rows && w_right && gg < hi) ? gg : hi".into()));
+    if e.lean {
+        // The bound and whether it bounds the row, not the bound or the screen's: the walker
+        // compares the three bounds side by side with these tests (`walker::side_by_side_ends`),
+        // where the bound chosen first, then compared, chained two carry chains (docs/fpga.md).
+        body.push(Item::Assign("gb".into(), "gg".into()));
+        body.push(Item::Assign("bl".into(), "in_rows && !w_right && gg < lo".into()));
+        body.push(Item::Assign("bh".into(), "in_rows && w_right && gg < hi".into()));
+    } else {
+        // This edge's bound on its side of the row, or the screen's where it bounds none here;
+        // a left edge's bound is -g, kept as g (its smallest is the span's left end).
+        body.push(Item::Assign("lg".into(), "(in_rows && !w_right && gg < lo) ? gg : lo".into()));
+        body.push(Item::Assign("ha".into(), "(in_rows && w_right && gg < hi) ? gg : hi".into()));
+    }
     if e.lean {
         // rem < D and rs256 < D: s < 2D fits HW + 1 bits, and s - D lies in (-D, D), so in
         // HW + 1 bits too, its sign the top bit.
@@ -464,8 +473,36 @@ fn walker_ports(e: &EdgeWidths) -> Vec<Port> {
             Port::input("row", row_w, "unsigned integer", "the walked row"),
             Port::input("lo", end_w, "signed integer", "the screen's left bound (as -x)").signed(),
             Port::input("hi", end_w, "signed integer", "the screen's right bound").signed(),
-            Port::output("lg", end_w, "signed integer", "a left edge's bound on the row (as -x), else lo").signed(),
-            Port::output("ha", end_w, "signed integer", "a right edge's bound on the row, else hi").signed(),
         ])
+        .chain(if e.lean {
+            vec![
+                Port::output("gb", end_w, "signed integer", "the edge's bound on the row (a left edge's as -x)").signed(),
+                Port::output("bl", 1, "", "gb bounds the row's left end: a left edge on its rows, gb < lo"),
+                Port::output("bh", 1, "", "gb bounds the row's right end: a right edge on its rows, gb < hi"),
+            ]
+        } else {
+            vec![
+                Port::output("lg", end_w, "signed integer", "a left edge's bound on the row (as -x), else lo").signed(),
+                Port::output("ha", end_w, "signed integer", "a right edge's bound on the row, else hi").signed(),
+            ]
+        })
         .collect()
+}
+
+/// The edge's outputs for the row's span, `(port, width)`: its bound on each side or the
+/// screen's (`lg`, `ha`), or behind the lean DDA its bound and whether it bounds each side (`gb`,
+/// `bl`, `bh`).
+pub(super) fn end_ports(hw: &Hw) -> Vec<(&'static str, u32)> {
+    let e = EdgeWidths::new(hw);
+    if e.lean {
+        vec![("gb", e.end_w), ("bl", 1), ("bh", 1)]
+    } else {
+        vec![("lg", e.end_w), ("ha", e.end_w)]
+    }
+}
+
+/// Whether the edges give the walker their bounds with side tests ([`end_ports`]): the lean DDA's
+/// form.
+pub(super) fn ends_side_by_side(hw: &Hw) -> bool {
+    EdgeWidths::new(hw).lean
 }

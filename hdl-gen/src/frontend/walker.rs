@@ -39,6 +39,39 @@ fn least_of_three(side: &str) -> String {
     format!("({} && {}) ? {side}0 : ({}) ? {side}1 : {side}2", c(0, 1), c(0, 2), c(1, 2))
 }
 
+/// The span's ends from the edges' bounds `gb0..2` and their side tests (`bl`, `bh`: the lean
+/// edges, [`edge::end_ports`]): the three bounds compared pairwise from the edges' registers,
+/// beside the side tests, each end then the bound that bounds its side and is the least there,
+/// or the screen's. The same ends as [`least_of_three`] of the bounds chosen first, whose
+/// compares followed the choice: the edge's test, its choice, the compare, the pick and the
+/// length's add in one clock were the HX8K's critical path once its engine's ALU was split
+/// (docs/fpga.md, issue 27).
+fn side_by_side_ends(end_w: u32, body: &mut Vec<Item>) {
+    body.push(comment("The span's ends: the three bounds compared pairwise beside their side tests (bl: bounds the"));
+    body.push(comment("left end, as -x; bh: the right), each end the least bound of its side, else the screen's."));
+    let pairs = [(0, 1), (0, 2), (1, 2)];
+    for (i, j) in pairs {
+        body.push(wire(&format!("le{i}{j}"), 1, format!("gb{i} <= gb{j}")));
+    }
+    // k wins its side when it bounds it and no other bound there is less (ties to the lower k).
+    let wins = |side: &str, k: u32| -> String {
+        let mut terms = vec![format!("{side}{k}")];
+        for o in (0..3).filter(|&o| o != k) {
+            let le = if k < o { format!("le{k}{o}") } else { format!("!le{o}{k}") };
+            terms.push(format!("(!{side}{o} || {le})"));
+        }
+        terms.join(" && ")
+    };
+    for (end, side, screen) in [("mg", "bl", "lo0"), ("hi3", "bh", "hi0")] {
+        for k in 0..3 {
+            body.push(wire(&format!("{side}w{k}"), 1, wins(side, k)));
+        }
+        let picks: Vec<String> = (0..3).map(|k| format!("({{{end_w}{{{side}w{k}}}}} & gb{k})")).collect();
+        let none = format!("({{{end_w}{{!({side}w0 || {side}w1 || {side}w2)}}}} & {screen})");
+        body.push(swire(end, end_w, format!("{} | {none}", picks.join(" | "))));
+    }
+}
+
 /// Row stage `j`'s valid (1, 2): a row, with a pixel or not.
 pub(super) fn row_valid(j: u32) -> &'static str {
     ["wr_v", "we_v"][j as usize - 1]
@@ -269,8 +302,10 @@ pub(super) fn emit(hw: &Hw, names: &Names, body: &mut Vec<Item>) {
     control(hw, body);
     let (inc, engine, tracked) = (super::incremental::on(hw), hw.engine_form(), hw.row_stage());
     let end_w = edge::end_width(hw);
-    body.push(net("e_lg", 3 * end_w));
-    body.push(net("e_ha", 3 * end_w));
+    let ends = edge::end_ports(hw);
+    for (port, w) in &ends {
+        body.push(net(&format!("e_{port}"), 3 * w));
+    }
     let state = edge::state_outputs(hw);
     for (port, w, ..) in &state {
         body.push(net(&format!("e_{port}"), 3 * w));
@@ -285,8 +320,14 @@ pub(super) fn emit(hw: &Hw, names: &Names, body: &mut Vec<Item>) {
         }
     }
     for k in 0..3 {
-        body.push(swire(&format!("lg{k}"), end_w, format!("e_lg[{}:{}]", (k + 1) * end_w - 1, k * end_w)));
-        body.push(swire(&format!("ha{k}"), end_w, format!("e_ha[{}:{}]", (k + 1) * end_w - 1, k * end_w)));
+        for (port, w) in &ends {
+            let name = format!("{port}{k}");
+            body.push(if *w == 1 {
+                wire(&name, 1, format!("e_{port}[{k}]"))
+            } else {
+                swire(&name, *w, format!("e_{port}[{}:{}]", (k + 1) * w - 1, k * w))
+            });
+        }
     }
     // The row's span is decided from the edges' bounds in the walker's clock, or two clocks
     // later from the row stages' registers (`--pipeline 1`): the bounds then the minima, the
@@ -303,6 +344,8 @@ pub(super) fn emit(hw: &Hw, names: &Names, body: &mut Vec<Item>) {
         body.push(comment("The span from the row's ends: x = lo3 = -mg; the row has a pixel when hi3 + mg >= 0."));
         body.push(swire("mg", end_w, "we_mg"));
         body.push(swire("hi3", end_w, "we_hi3"));
+    } else if edge::ends_side_by_side(hw) {
+        side_by_side_ends(end_w, body);
     } else {
         // Side by side rather than in a chain, and no negation before the pixel test or the
         // length: this was the walker's row clock, the staged front-end's limit at 2 and 1
