@@ -125,7 +125,8 @@ fn sequential_incremental_i0_spans_equal_golden() {
 /// edges' lean DDA and the span's ends from their bounds side by side, the HX8K's target at
 /// 640x480 and the UP5K's engine at 37x23), as [`engine_spans_of`]; a fault (the correction's
 /// `q~ + 1` made `q~`), one in the lean DDA (the bound's step with its carry subtracted) and one
-/// in the side-by-side ends (an edge's bound the right end without its side test) are caught. Slow tier: `cargo nextest run -p verilator-harness --run-ignored only
+/// in the side-by-side ends (an edge's bound the right end without its side test; the pixel
+/// test without one pair's sum) are caught. Slow tier: `cargo nextest run -p verilator-harness --run-ignored only
 /// -E 'test(/sequential_span/)'`.
 #[test]
 #[ignore]
@@ -159,4 +160,6 @@ fn sequential_span_path_spans_equal_golden() {
     fault.caught(&opts, "frontend lean edge fault", "leanedgefault", "the lean DDA's bound step with its carry subtracted");
     let fault = LineFault { file: "tri_frontend.v", line: " bhw0 = ", from: "bh0 &&", to: "1'b1 &&" };
     fault.caught(&opts, "frontend side by side ends fault", "sideendsfault", "an edge's bound made the right end without its side test");
+    let fault = LineFault { file: "tri_frontend.v", line: " covered = ", from: "!sg01[", to: "1'b1 || !sg01[" };
+    fault.caught(&opts, "frontend pixel test fault", "pixeltestfault", "the pixel test without edges 0 and 1's sum");
 }

@@ -103,12 +103,26 @@ pub(super) fn emit(hw: &Hw, body: &mut Vec<Item>) -> Stager {
             (false, _) => format!("w_{n}"),
         }
     };
-    let mut held = vec![("sq_y", row_w), ("sq_x", xw), ("sq_len", xw + 1)];
+    // Behind the lean edges the row's ends are held as the walker picks them and x and the length
+    // formed from the registers: their adds after the picks were the HX8K's clock (docs/fpga.md).
+    let ends = super::edge::ends_side_by_side(hw);
+    let end_w = super::edge::end_width(hw);
+    let mut held = vec![("sq_y", row_w)];
+    held.extend(if ends { [("sq_mg", end_w), ("sq_hi3", end_w)] } else { [("sq_x", xw), ("sq_len", xw + 1)] });
     if copies {
         held.extend([("sq_di", dw), ("sq_gxn", gx_w), ("sq_an", area_w), ("sq_rn", recip_w)]);
     }
     held.extend([("sq_l", area_w + 2), ("sq_qt", iw), ("sq_ge2", 1), ("sq_acc", w), ("sq_mc", w), ("sq_mp", mp_w)]);
     body.extend(held.iter().map(|(n, ww)| reg(n, *ww)));
+    if ends {
+        body.push(comment("The span's x = -mg and length hi3 + mg + 1, from the held ends."));
+        body.push(comment("verilator lint_off UNUSEDSIGNAL"));
+        body.push(wire("sq_lo", end_w, "-sq_mg"));
+        body.push(wire("sq_lw", end_w, "sq_hi3 + sq_mg + 1"));
+        body.push(comment("verilator lint_on UNUSEDSIGNAL"));
+        body.push(wire("sq_x", xw, format!("sq_lo[{}:0]", xw - 1)));
+        body.push(wire("sq_len", xw + 1, format!("sq_lw[{xw}:0]")));
+    }
     // One step: the accumulator plus the multiplicand times the multiplier's low B bits, as B
     // shifted adds (an iCE40 LUT4 and carry a bit each).
     let terms: Vec<String> = (0..b)
@@ -161,7 +175,12 @@ pub(super) fn emit(hw: &Hw, body: &mut Vec<Item>) -> Stager {
     // test's fan-out was the HX8K's critical path at level 0 (docs/fpga.md).
     let mut on_accept = vec![set("sq_busy", "emit")];
     on_accept.extend(load(0, true));
-    on_accept.extend([set("sq_y", row("w_row")), set("sq_x", "lo_u"), set("sq_len", format!("len_w[{xw}:0]"))]);
+    on_accept.push(set("sq_y", row("w_row")));
+    if ends {
+        on_accept.extend([set("sq_mg", "mg"), set("sq_hi3", "hi3")]);
+    } else {
+        on_accept.extend([set("sq_x", "lo_u"), set("sq_len", format!("len_w[{xw}:0]"))]);
+    }
     if copies {
         on_accept.extend([
             set("sq_di", row("w_di")),

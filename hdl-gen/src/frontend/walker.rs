@@ -70,6 +70,29 @@ fn side_by_side_ends(end_w: u32, body: &mut Vec<Item>) {
         let none = format!("({{{end_w}{{!({side}w0 || {side}w1 || {side}w2)}}}} & {screen})");
         body.push(swire(end, end_w, format!("{} | {none}", picks.join(" | "))));
     }
+    // hi3 + mg >= 0 for the least bound on each side is every right bound plus every left bound
+    // >= 0: the sums are formed from the registers beside the compares, not after the picks.
+    body.push(comment("The row has a pixel (hi3 + mg >= 0) when every right bound plus every left bound is >= 0, the"));
+    body.push(comment("screen's among them: each pair's sum formed beside the compares, then only the side tests."));
+    let sw = end_w + 1;
+    let sum = |a: &str, b: &str| format!("{} + {}", sext(a, end_w, sw), sext(b, end_w, sw));
+    let mut ok = Vec::new();
+    // Only the sums' signs are read.
+    body.push(comment("verilator lint_off UNUSEDSIGNAL"));
+    for (i, j) in pairs {
+        body.push(wire(&format!("sg{i}{j}"), sw, sum(&format!("gb{i}"), &format!("gb{j}"))));
+        ok.push(format!("(!((bl{i} && bh{j}) || (bh{i} && bl{j})) || !sg{i}{j}[{end_w}])"));
+    }
+    for k in 0..3 {
+        body.push(wire(&format!("sl{k}"), sw, sum(&format!("gb{k}"), "hi0")));
+        body.push(wire(&format!("sh{k}"), sw, sum(&format!("gb{k}"), "lo0")));
+        ok.push(format!("(!bl{k} || !sl{k}[{end_w}])"));
+        ok.push(format!("(!bh{k} || !sh{k}[{end_w}])"));
+    }
+    body.push(wire("ss", sw, sum("hi0", "lo0")));
+    ok.push(format!("!ss[{end_w}]"));
+    body.push(comment("verilator lint_on UNUSEDSIGNAL"));
+    body.push(wire("covered", 1, ok.join(" && ")));
 }
 
 /// Row stage `j`'s valid (1, 2): a row, with a pixel or not.
@@ -378,9 +401,13 @@ pub(super) fn emit(hw: &Hw, names: &Names, body: &mut Vec<Item>) {
         body.push(wire("emit", 1, "px && !ie_wait"));
         body.push(assign("w_step", format!("{STEP_WHEN} && !ie_wait")));
     } else {
-        body.push(wire("emit", 1, format!("{row_valid} && !room[{end_w}]")));
+        let covered = if edge::ends_side_by_side(hw) { "covered".to_string() } else { format!("!room[{end_w}]") };
+        body.push(wire("emit", 1, format!("{row_valid} && {covered}")));
     }
-    body.push(wire("lo_u", xw, format!("lo3[{}:0]", xw - 1)));
+    // Behind the lean edges the span path holds the ends, not x (span_seq).
+    if !edge::ends_side_by_side(hw) {
+        body.push(wire("lo_u", xw, format!("lo3[{}:0]", xw - 1)));
+    }
     let mut load = vec![set("w_valid", "1'b1"), set("w_row", "s_first"), set("w_last", "s_last")];
     load.extend([
         set("w_di", "r_di"),
