@@ -126,8 +126,8 @@ fn sequential_incremental_i0_spans_equal_golden() {
 /// 640x480 and the UP5K's engine at 37x23), as [`engine_spans_of`]; a fault (the correction's
 /// `q~ + 1` made `q~`), one in the lean DDA (the bound's step with its carry subtracted) and one
 /// in the side-by-side ends (an edge's bound the right end without its side test; the pixel
-/// test without one pair's sum) are caught. Slow tier: `cargo nextest run -p verilator-harness --run-ignored only
-/// -E 'test(/sequential_span/)'`.
+/// test without one pair's sum) are caught. Slow tier: `cargo nextest run -p verilator-harness
+/// --run-ignored only -E 'test(/sequential_span/)'`.
 #[test]
 #[ignore]
 fn sequential_span_path_spans_equal_golden() {

@@ -68,6 +68,19 @@ pub(super) fn handshake(hw: &Hw, body: &mut Vec<Item>) {
     body.push(wire("adv", 1, "!sq_busy || sq_fin"));
 }
 
+/// The span's `sq_x` and `sq_len` from the held ends `sq_mg`, `sq_hi3` (`end_w` bits).
+fn span_of_ends(end_w: u32, xw: u32) -> Vec<Item> {
+    vec![
+        comment("The span's x = -mg and length hi3 + mg + 1, from the held ends."),
+        comment("verilator lint_off UNUSEDSIGNAL"),
+        wire("sq_lo", end_w, "-sq_mg"),
+        wire("sq_lw", end_w, "sq_hi3 + sq_mg + 1"),
+        comment("verilator lint_on UNUSEDSIGNAL"),
+        wire("sq_x", xw, format!("sq_lo[{}:0]", xw - 1)),
+        wire("sq_len", xw + 1, format!("sq_lw[{xw}:0]")),
+    ]
+}
+
 /// The unit and the output register, after the walker: returns the span path's (empty) stages.
 pub(super) fn emit(hw: &Hw, body: &mut Vec<Item>) -> Stager {
     let q = unit(hw).expect("the sequential span path");
@@ -115,13 +128,7 @@ pub(super) fn emit(hw: &Hw, body: &mut Vec<Item>) -> Stager {
     held.extend([("sq_l", area_w + 2), ("sq_qt", iw), ("sq_ge2", 1), ("sq_acc", w), ("sq_mc", w), ("sq_mp", mp_w)]);
     body.extend(held.iter().map(|(n, ww)| reg(n, *ww)));
     if ends {
-        body.push(comment("The span's x = -mg and length hi3 + mg + 1, from the held ends."));
-        body.push(comment("verilator lint_off UNUSEDSIGNAL"));
-        body.push(wire("sq_lo", end_w, "-sq_mg"));
-        body.push(wire("sq_lw", end_w, "sq_hi3 + sq_mg + 1"));
-        body.push(comment("verilator lint_on UNUSEDSIGNAL"));
-        body.push(wire("sq_x", xw, format!("sq_lo[{}:0]", xw - 1)));
-        body.push(wire("sq_len", xw + 1, format!("sq_lw[{xw}:0]")));
+        body.extend(span_of_ends(end_w, xw));
     }
     // One step: the accumulator plus the multiplicand times the multiplier's low B bits, as B
     // shifted adds (an iCE40 LUT4 and carry a bit each).
