@@ -11,7 +11,7 @@ use crate::frontend::{drain_clocks, run_chain};
 use crate::models::ModelError;
 use crate::registry;
 use crate::traffic::Traffic;
-use golden::frontend::{FixedTriangle, I0Form, SetupForm};
+use golden::frontend::{FixedTriangle, I0Form, SetupForm, SpanForm};
 use golden::schemes::{workload_count, Scheme};
 use golden::setup::{Screen, Triangle};
 use golden::Align;
@@ -35,6 +35,10 @@ pub fn measured_mhz(opts: &hdl_gen::Options) -> Option<(f64, &'static str)> {
         (SetupForm::Parallel, 1, 1, I0Form::Reciprocal) => Some((48.3, "one seed")),
         // The engine has no parallel dividers: their rate does not matter.
         (SetupForm::Ecp5_25f, 1, _, I0Form::Reciprocal) => Some((94.9, "LFE5U-25F, median of 3 seeds")),
+        // The HX8K's target, its sequential span path: the whole `tri_fb_p4` placed (issue 27, stop 34).
+        (SetupForm::Ice40Hx8k, 0, _, I0Form::Reciprocal) if opts.fe_span == SpanForm::Sequential => {
+            Some((62.3, "iCE40 HX8K, tri_fb_p4, median of 3 seeds"))
+        }
         _ => None,
     }
 }
@@ -132,16 +136,19 @@ mod tests {
         variant: VariantArgs,
     }
 
-    /// The defaults and the ECP5 target, whose front-ends were placed and routed, have a
-    /// measured clock; an unmeasured form has none (the negative control).
+    /// The defaults, the ECP5 target and the HX8K's, whose front-ends were placed and routed,
+    /// have a measured clock; an unmeasured form has none (the negative controls: the
+    /// incremental I0, the HX8K's engine without its sequential span path).
     #[test]
     fn every_target_chooses_a_measured_front_end() {
         let base = Cli::parse_from(["t"]).variant;
-        // The iCE40 targets' front-ends have not been placed: none fits its device yet.
-        for target in [None, Some(Target::Ecp5_25f)] {
+        // The UP5K's front-end has not been placed: it does not fit its device yet.
+        for target in [None, Some(Target::Ecp5_25f), Some(Target::Ice40Hx8k)] {
             let opts = VariantArgs { target, ..base.clone() }.options(8, Align::Span, None).expect("valid");
             assert!(measured_mhz(&opts).is_some(), "{target:?}");
         }
+        let hx = VariantArgs { target: Some(Target::Ice40Hx8k), fe_span: Some(SpanForm::Parallel), ..base.clone() };
+        assert_eq!(measured_mhz(&hx.options(8, Align::Span, None).expect("valid")), None);
         let inc = VariantArgs { fe_i0: Some(I0Form::Incremental), ..base }.options(8, Align::Span, None).expect("valid");
         assert_eq!(measured_mhz(&inc), None);
     }
