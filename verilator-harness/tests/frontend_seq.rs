@@ -121,11 +121,13 @@ fn sequential_incremental_i0_spans_equal_golden() {
 }
 
 /// The sequential span path (`--fe-span sequential`, the iCE40 targets' choice) behind both
-/// iCE40 engines, 1,000 triangles each (37x23 and 640x480, levels 0 and 1; the HX8K's target,
-/// 640x480 at level 0, with the edges' lean DDA), as [`engine_spans_of`]; a fault (the
-/// correction's `q~ + 1` made `q~`) and one in the lean DDA (the bound's step with its carry
-/// subtracted) are caught. Slow tier: `cargo nextest run -p verilator-harness --run-ignored only
-/// -E 'test(/sequential_span/)'`.
+/// iCE40 engines, 1,000 triangles each (37x23 and 640x480, levels 0 and 1; both targets, 640x480
+/// at level 0, with the edges' lean DDA and the walk's constants in block RAM), as
+/// [`engine_spans_of`]; a fault (the correction's `q~ + 1` made `q~`), one in the lean DDA (the
+/// bound's step with its carry subtracted) and two in the walk's memories (`Gxn`'s read
+/// addressed as `An`'s; the read slot not moved on at the take, so a triangle's first row reads
+/// the one before's) are caught. Slow tier: `cargo nextest run -p verilator-harness
+/// --run-ignored only -E 'test(/sequential_span/)'`.
 #[test]
 #[ignore]
 fn sequential_span_path_spans_equal_golden() {
@@ -138,7 +140,15 @@ fn sequential_span_path_spans_equal_golden() {
             ..o
         })
     };
-    let runs = [(small, Ice40Hx8k, 0), (big, Ice40Hx8k, 0), (big, Ice40Hx8k, 1), (small, Ice40Up5k, 1), (big, Ice40Up5k, 1)];
+    let runs = [
+        (small, Ice40Hx8k, 0),
+        (big, Ice40Hx8k, 0),
+        (big, Ice40Hx8k, 1),
+        (small, Ice40Up5k, 0),
+        (big, Ice40Up5k, 0),
+        (small, Ice40Up5k, 1),
+        (big, Ice40Up5k, 1),
+    ];
     for (screen, setup, level) in runs {
         let Some(opts) = form(screen, setup, level) else { return };
         engine_spans_of(opts, 1000);
@@ -149,4 +159,9 @@ fn sequential_span_path_spans_equal_golden() {
     let Some(opts) = form(small, Ice40Hx8k, 0) else { return };
     let fault = LineFault { file: "tri_fe_edge.v", line: " gnext = w_g + w_qs + ", from: "w_qs + {", to: "w_qs - {" };
     fault.caught(&opts, "frontend lean edge fault", "leanedgefault", "the lean DDA's bound step with its carry subtracted");
+    let Some(opts) = form(small, Ice40Up5k, 0) else { return };
+    let fault = LineFault { file: "tri_frontend.v", line: " wk_ra = (sq_busy && sq_ph == 3'd0) ? 2'd1", from: "? 2'd1", to: "? 2'd0" };
+    fault.caught(&opts, "frontend walk ram fault", "walkramfault", "Gxn's read addressed as An's");
+    let fault = LineFault { file: "tri_frontend.v", line: " wk_slot = wk_rs ^ take", from: "^ take", to: "^ 1'b0" };
+    fault.caught(&opts, "frontend walk ram slot fault", "walkslotfault", "the read slot not moved on at the take");
 }
