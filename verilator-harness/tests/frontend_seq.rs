@@ -124,9 +124,9 @@ fn sequential_incremental_i0_spans_equal_golden() {
 /// iCE40 engines, 1,000 triangles each (37x23 and 640x480, levels 0 and 1; both targets, 640x480
 /// at level 0, with the edges' lean DDA and the walk's constants in block RAM), as
 /// [`engine_spans_of`]; a fault (the correction's `q~ + 1` made `q~`), one in the lean DDA (the
-/// bound's step with its carry subtracted) and two in the walk's memories (`Gxn`'s read
+/// bound's step with its carry subtracted) and three in the walk's memories (`Gxn`'s read
 /// addressed as `An`'s; the read slot not moved on at the take, so a triangle's first row reads
-/// the one before's) are caught. Slow tier: `cargo nextest run -p verilator-harness
+/// the one before's; `Tn` read at the take from the walked triangle's slot) are caught. Slow tier: `cargo nextest run -p verilator-harness
 /// --run-ignored only -E 'test(/sequential_span/)'`.
 #[test]
 #[ignore]
@@ -164,4 +164,6 @@ fn sequential_span_path_spans_equal_golden() {
     fault.caught(&opts, "frontend walk ram fault", "walkramfault", "Gxn's read addressed as An's");
     let fault = LineFault { file: "tri_frontend.v", line: " wk_slot = wk_rs ^ take", from: "^ take", to: "^ 1'b0" };
     fault.caught(&opts, "frontend walk ram slot fault", "walkslotfault", "the read slot not moved on at the take");
+    let fault = LineFault { file: "tri_frontend.v", line: " wk_da = wk_tnr ? {!wk_rs", from: "{!wk_rs", to: "{wk_rs" };
+    fault.caught(&opts, "frontend walk ram tn fault", "walktnfault", "Tn read from the walked triangle's slot, not the queued one's");
 }

@@ -206,5 +206,8 @@ pub(super) fn emit(hw: &Hw, body: &mut Vec<Item>) -> Stager {
             vec![],
         )],
     )]));
+    if walk_ram::on(hw) {
+        walk_ram::emit_ports(hw, body);
+    }
     Stager::new("p", Vec::new())
 }

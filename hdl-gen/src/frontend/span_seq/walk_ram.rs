@@ -2,10 +2,11 @@
 //! and span path, no row stages). `An`, `Gxn` and `Rn`, which the span path reads one at a
 //! time at its phases' loads, and `dYn`, which the walker adds once a row, are constant
 //! through a triangle's walk. Held in flip-flops they were stored twice, in the queue's entry
-//! and in the walker's copy (about 250 logic cells on the UP5K, each a flip-flop no LUT
+//! and in the walker's copy (about 360 logic cells on the UP5K, each a flip-flop no LUT
 //! feeds): here the engine writes each of them into a two-slot memory as it produces it (the
 //! slot the queue's next push takes) and the span path and the walker read them from the slot
-//! of the triangle being walked, which changes at the take. A slot is never read where it is
+//! of the triangle being walked, which changes at the take. `Tn`, which the walker loads at the
+//! take and steps, is beside `dYn`: read in the clock before a take can come. A slot is never read where it is
 //! written: the engine writes only while the queue is empty, and its slot is then the one the
 //! walker does not hold (`no_rw_check`, so Yosys adds no collision logic).
 //!
@@ -25,6 +26,9 @@ const SPAN_FIELDS: [&str; 3] = ["an", "gxn", "rn"];
 /// The field the walker's row step reads, alone in the second memory (a read port of its own:
 /// the walker steps while the span path reads).
 const STEP_FIELD: &str = "dyn";
+/// The field the walker loads at the take and then steps, beside `dYn` in the second memory:
+/// read there, from the queued triangle's slot, in the clock before a take can come.
+const TAKE_FIELD: &str = "tn";
 
 /// Whether this front-end holds the walk's constants in block RAM: the sequential engine (its
 /// fields written one at a time, `res_we`) behind the sequential span path without row stages
@@ -43,7 +47,17 @@ pub(crate) fn we(name: &str) -> String {
 /// Whether set-up result field `name` is in the memories, not in the queue's entry nor the
 /// walker's registers.
 pub(crate) fn holds(hw: &Hw, name: &str) -> bool {
-    on(hw) && (SPAN_FIELDS.contains(&name) || name == STEP_FIELD)
+    on(hw) && (SPAN_FIELDS.contains(&name) || name == STEP_FIELD || name == TAKE_FIELD)
+}
+
+/// Whether the walker's register for field `name` is gone: the memories' read is it.
+pub(crate) fn replaces(hw: &Hw, name: &str) -> bool {
+    holds(hw, name) && name != TAKE_FIELD
+}
+
+/// What the walker loads field `name` from at the take, where the memories hold it.
+pub(crate) fn take_value(hw: &Hw, name: &str) -> Option<&'static str> {
+    (holds(hw, name) && name == TAKE_FIELD).then_some("wk_tn")
 }
 
 /// The first memory's word: its widest field.
@@ -95,16 +109,17 @@ fn index(name: &str) -> u64 {
 
 /// The memories, their writes from the engine (`res_bus`, a field's `we` bit of `res_we`) and
 /// their reads, the walker's `w_an`, `w_gxn`, `w_rn` (the span path's, valid at its loads) and
-/// `w_dyn` (the walked triangle's, from the clock after the take). After the span path's control
-/// (`sq_busy`, `sq_ph`), the queue's `q_in` and the fields' write enables ([`we`]).
+/// `w_dyn` (the walked triangle's, from the clock after the take), `wk_tn` (the queued one's, at
+/// the take). After the span path's control (`sq_busy`, `sq_ph`), the queue's `q_in` and the
+/// fields' write enables ([`we`]); [`emit_ports`] after the walker.
 pub(crate) fn emit(hw: &Hw, body: &mut Vec<Item>) {
     let q = hw.fe.span_seq().expect("the sequential span path");
     let Widths { aw, k, rw, .. } = hw.fe.widths();
     let (sw, aw_ram) = (span_width(hw), 1 + bits_for(SPAN_FIELDS.len() as u32 - 1));
     let fw = aw_ram - 1;
-    body.push(comment("The walk's constants in block RAM: An, Gxn, Rn (the span path's, one a load) and dYn (the walker's"));
-    body.push(comment("step's), written by the engine into the slot of the queue's next push (wk_ws), read from the walked"));
-    body.push(comment("triangle's (wk_rs, the taken one's from the take), a clock ahead of the load that uses them."));
+    body.push(comment("The walk's constants in block RAM: An, Gxn, Rn (the span path's, one a load), dYn (the walker's step's)"));
+    body.push(comment("and Tn (its load at the take), written by the engine into the slot of the queue's next push (wk_ws), read"));
+    body.push(comment("from the walked triangle's (wk_rs, the taken one's from the take; Tn the queued one's), a clock ahead."));
     body.push(Item::Memory { name: "wk_m".into(), width: sw, depth: 1 << aw_ram, no_rw_check: true });
     // As deep as the first: Yosys keeps a two-word memory in flip-flops.
     body.push(Item::Memory { name: "wk_d".into(), width: k, depth: 1 << aw_ram, no_rw_check: true });
@@ -116,18 +131,32 @@ pub(crate) fn emit(hw: &Hw, body: &mut Vec<Item>) {
         format!("(sq_busy && sq_ph == {}) ? {} : {acc}", lit(phase_w, p as u64), lit(fw, index(f)))
     });
     body.push(wire("wk_ra", fw, ra));
-    let span_we: Vec<String> = SPAN_FIELDS.iter().map(|f| we(f)).collect();
     let wa =
         SPAN_FIELDS.iter().enumerate().skip(1).rev().fold(lit(fw, 0), |acc, (j, f)| format!("{} ? {} : {acc}", we(f), lit(fw, j as u64)));
     body.push(wire("wk_wa", fw, wa));
-    for (n, w, from) in [("w_an", aw, "wk_q"), ("w_gxn", k, "wk_q"), ("w_rn", rw, "wk_q"), ("w_dyn", k, "wk_dq")] {
+    for (n, w, from) in [("w_an", aw, "wk_q"), ("w_gxn", k, "wk_q"), ("w_rn", rw, "wk_q"), ("w_dyn", k, "wk_dq"), ("wk_tn", k, "wk_dq")] {
         body.push(wire(n, w, format!("{from}[{}:0]", w - 1)));
     }
+    body.push(Item::Blank);
+}
+
+/// The memories' writes and reads, after the walker (whose `w_valid`, `w_end` choose the second
+/// memory's word): `Tn` of the queued triangle (the slot the walker does not hold) while a take
+/// can come next clock and the walker does not step, else `dYn` of the walked (or taken) one.
+/// Neither is written then: the engine writes no field while the queue is full nor at its push.
+pub(crate) fn emit_ports(hw: &Hw, body: &mut Vec<Item>) {
+    let k = hw.fe.widths().k;
+    let (sw, fw) = (span_width(hw), bits_for(SPAN_FIELDS.len() as u32 - 1));
+    let span_we: Vec<String> = SPAN_FIELDS.iter().map(|f| we(f)).collect();
+    body.push(wire("wk_tnr", 1, "(q_full || q_in) && !take && !(w_valid && !w_end)"));
+    body.push(wire("wk_da", fw + 1, format!("wk_tnr ? {{!wk_rs, {}}} : {{wk_slot, {}}}", lit(fw, 1), lit(fw, 0))));
+    let dwe = format!("{} || {}", we(STEP_FIELD), we(TAKE_FIELD));
+    let dwa = format!("{{wk_ws, {} ? {} : {}}}", we(TAKE_FIELD), lit(fw, 1), lit(fw, 0));
     body.push(Item::Always(vec![
         Stmt::If(span_we.join(" || "), vec![set("wk_m[{wk_ws, wk_wa}]", format!("res_bus[{}:0]", sw - 1))], vec![]),
-        Stmt::If(we(STEP_FIELD), vec![set(format!("wk_d[{{wk_ws, {}}}]", lit(fw, 0)), format!("res_bus[{}:0]", k - 1))], vec![]),
+        Stmt::If(dwe, vec![set(format!("wk_d[{dwa}]"), format!("res_bus[{}:0]", k - 1))], vec![]),
         set("wk_q", "wk_m[{wk_slot, wk_ra}]"),
-        set("wk_dq", format!("wk_d[{{wk_slot, {}}}]", lit(fw, 0))),
+        set("wk_dq", "wk_d[wk_da]"),
         Stmt::If(
             "rst".into(),
             vec![set("wk_ws", "1'b0"), set("wk_rs", "1'b1")],
