@@ -124,7 +124,7 @@ pub fn draw_module(fe: &FrontEnd, w: &Writer, names: &Names, triangles: usize) -
     let mut body = vec![
         Item::Localparam { name: "NTRI".into(), width: kw, value: lit(kw, triangles as u64) },
         Item::Localparam { name: "LAST_BLOCK".into(), width: aw, value: lit(aw, w.blocks() as u64 - 1) },
-        Item::Memory { name: "rom".into(), width: bits, depth: depth as u32 },
+        Item::Memory { name: "rom".into(), width: bits, depth: depth as u32, no_rw_check: false },
         Item::ReadMemH { file: "INIT_FILE".into(), mem: "rom".into() },
         Item::Blank,
     ];

@@ -24,7 +24,7 @@ pub fn module(name: &str, rom: &Rom, file: &str, doc: &str) -> Module {
             Port::output("data", rom.width, "", "the word at addr, one clock later").reg(),
         ],
         body: vec![
-            Item::Memory { name: "mem".into(), width: rom.width, depth: rom.depth() as u32 },
+            Item::Memory { name: "mem".into(), width: rom.width, depth: rom.depth() as u32, no_rw_check: false },
             Item::ReadMemH { file: "INIT_FILE".into(), mem: "mem".into() },
             Item::Blank,
             Item::Always(vec![Stmt::If("en".into(), vec![crate::verilog::set("data", "mem[addr]")], vec![])]),

@@ -63,8 +63,7 @@ impl Port {
         self.vector = true;
         self
     }
-    /// Declares the port `[width-1:0]`, `width` a parameter expression; `self.width` stays its
-    /// width at the parameters' defaults.
+    /// Declares the port `[width-1:0]`, `width` a parameter expression; `self.width` stays its width at the parameters' defaults.
     pub fn param_width(mut self, width: &str) -> Port {
         self.param_width = Some(width.into());
         self
@@ -184,18 +183,18 @@ pub enum Item {
         file: String,
         mem: String,
     },
-    /// `reg [w-1:0] name [0:depth-1];`
+    /// `reg [w-1:0] name [0:depth-1];`, after `(* no_rw_check *)` if never read where written that clock.
     Memory {
         name: String,
         width: u32,
         depth: u32,
+        no_rw_check: bool,
     },
     /// Testbench only (SPEC §3 allows no `initial` in the modules): `initial begin ... end`.
     Initial(Vec<Stmt>),
     /// `always @(*) begin ... end`: combinational checks of the formal properties.
     Comb(Vec<Stmt>),
-    /// `always @(*) name = {...};`: a bus of lanes (`lanes[0]` least significant) assembled by
-    /// one process. See [`gather`].
+    /// `always @(*) name = {...};`: a bus of lanes (`lanes[0]` least significant) assembled by one process. See [`gather`].
     Gather {
         name: String,
         lanes: Vec<String>,
@@ -211,8 +210,7 @@ pub enum Item {
     /// defines FORMAL), invisible to every other tool, so the product stays Verilog-2005.
     Formal(Vec<Item>),
     /// Formal only: `` `ifdef name `` `then` `` `else `` `els` `` `endif ``, a choice a proof
-    /// script makes with `read_verilog -Dname` (e.g. a lemma asserted in its own proof and
-    /// assumed in the proof that uses it).
+    /// script makes with `read_verilog -Dname` (e.g. a lemma asserted in its own proof and assumed in the proof that uses it).
     IfDef {
         name: String,
         then: Vec<Item>,
@@ -268,8 +266,7 @@ pub fn comment(text: impl Into<String>) -> Item {
 /// copies, O(P^3) when P readers each take a lane). One process runs once per clock however
 /// many of its inputs change, so the bus changes once. Icarus builds a concatenation left to
 /// right, copying what it has built at each step; rows of eight lanes, nested, divide that
-/// copying by about eight (a few per cent of a P = 256 clock). Synthesis and Verilator see the
-/// same wires either way.
+/// copying by about eight (a few per cent of a P = 256 clock). Synthesis and Verilator see the same wires either way.
 pub fn gather(name: &str, lanes: Vec<String>) -> Item {
     assert!(!lanes.is_empty(), "gather {name} from no lanes");
     Item::Gather { name: name.into(), lanes }
@@ -499,7 +496,10 @@ fn render_items(o: &mut String, items: &[Item], level: usize) {
                 o.push_str("end\n");
             }
             Item::ReadMemH { file, mem } => writeln!(o, "initial $readmemh({file}, {mem});").unwrap(),
-            Item::Memory { name, width, depth } => writeln!(o, "reg {}{name} [0:{}];", range(*width), depth - 1).unwrap(),
+            Item::Memory { name, width, depth, no_rw_check } => {
+                let attr = if *no_rw_check { "(* no_rw_check *) " } else { "" };
+                writeln!(o, "{attr}reg {}{name} [0:{}];", range(*width), depth - 1).unwrap()
+            }
             Item::Initial(stmts) => {
                 o.push_str("initial begin\n");
                 render_stmts(o, stmts, level + 1);

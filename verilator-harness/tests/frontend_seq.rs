@@ -121,13 +121,15 @@ fn sequential_incremental_i0_spans_equal_golden() {
 }
 
 /// The sequential span path (`--fe-span sequential`, the iCE40 targets' choice) behind both
-/// iCE40 engines, 1,000 triangles each (37x23 and 640x480, levels 0 and 1; at level 0 the
-/// edges' lean DDA and the span's ends from their bounds side by side, the HX8K's target at
-/// 640x480 and the UP5K's engine at 37x23), as [`engine_spans_of`]; a fault (the correction's
-/// `q~ + 1` made `q~`), one in the lean DDA (the bound's step with its carry subtracted) and one
-/// in the side-by-side ends (an edge's bound the right end without its side test; the pixel
-/// test without one pair's sum) are caught. Slow tier: `cargo nextest run -p verilator-harness
-/// --run-ignored only -E 'test(/sequential_span/)'`.
+/// iCE40 engines, 1,000 triangles each (37x23 and 640x480, levels 0 and 1; both targets, 640x480
+/// at level 0, with the edges' lean DDA, the span's ends from their bounds side by side and the
+/// walk's constants in block RAM), as [`engine_spans_of`]; a fault (the correction's `q~ + 1`
+/// made `q~`), one in the lean DDA (the bound's step with its carry subtracted), two in the
+/// side-by-side ends (an edge's bound the right end without its side test; the pixel test
+/// without one pair's sum) and three in the walk's memories (`Gxn`'s read addressed as `An`'s;
+/// the read slot not moved on at the take, so a triangle's first row reads the one before's;
+/// `Tn` read at the take from the walked triangle's slot) are caught. Slow tier: `cargo nextest
+/// run -p verilator-harness --run-ignored only -E 'test(/sequential_span/)'`.
 #[test]
 #[ignore]
 fn sequential_span_path_spans_equal_golden() {
@@ -145,6 +147,7 @@ fn sequential_span_path_spans_equal_golden() {
         (big, Ice40Hx8k, 0),
         (big, Ice40Hx8k, 1),
         (small, Ice40Up5k, 0),
+        (big, Ice40Up5k, 0),
         (small, Ice40Up5k, 1),
         (big, Ice40Up5k, 1),
     ];
@@ -162,4 +165,11 @@ fn sequential_span_path_spans_equal_golden() {
     fault.caught(&opts, "frontend side by side ends fault", "sideendsfault", "an edge's bound made the right end without its side test");
     let fault = LineFault { file: "tri_frontend.v", line: " covered = ", from: "!sg01[", to: "1'b1 || !sg01[" };
     fault.caught(&opts, "frontend pixel test fault", "pixeltestfault", "the pixel test without edges 0 and 1's sum");
+    let Some(opts) = form(small, Ice40Up5k, 0) else { return };
+    let fault = LineFault { file: "tri_frontend.v", line: " wk_ra = (sq_busy && sq_ph == 3'd0) ? 2'd1", from: "? 2'd1", to: "? 2'd0" };
+    fault.caught(&opts, "frontend walk ram fault", "walkramfault", "Gxn's read addressed as An's");
+    let fault = LineFault { file: "tri_frontend.v", line: " wk_slot = wk_rs ^ take", from: "^ take", to: "^ 1'b0" };
+    fault.caught(&opts, "frontend walk ram slot fault", "walkslotfault", "the read slot not moved on at the take");
+    let fault = LineFault { file: "tri_frontend.v", line: " wk_da = wk_tnr ? {!wk_rs", from: "{!wk_rs", to: "{wk_rs" };
+    fault.caught(&opts, "frontend walk ram tn fault", "walktnfault", "Tn read from the walked triangle's slot, not the queued one's");
 }

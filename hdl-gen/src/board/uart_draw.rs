@@ -77,7 +77,7 @@ pub fn draw_module(fe: &FrontEnd, w: &Writer, names: &Names, div: u32) -> Module
     body.extend([
         Item::Blank,
         comment("The queue: triangles and clears, in order (the top bit: a clear)."),
-        Item::Memory { name: "queue".into(), width: bits + 1, depth: 1 << qb },
+        Item::Memory { name: "queue".into(), width: bits + 1, depth: 1 << qb, no_rw_check: false },
         reg("wp", qb + 1),
         reg("rp", qb + 1),
         reg("q", bits + 1),

@@ -67,7 +67,7 @@ pub fn top_module(hw: &Hw, names: &Names) -> Module {
         body.push(Item::Wire { name: n.into(), width: w, signed: false, value: None });
     }
     body.extend([
-        Item::Memory { name: "sfifo".into(), width: shift_w, depth },
+        Item::Memory { name: "sfifo".into(), width: shift_w, depth, no_rw_check: false },
         reg("sf_n", nw),
         reg("sf_rd", pw),
         reg("sf_wr", pw),
@@ -85,7 +85,7 @@ pub fn top_module(hw: &Hw, names: &Names) -> Module {
         reg("fifo_n", nw),
         reg("fifo_rd", pw),
         reg("fifo_wr", pw),
-        Item::Memory { name: "fifo".into(), width: row_w, depth },
+        Item::Memory { name: "fifo".into(), width: row_w, depth, no_rw_check: false },
         wire("room", 1, format!("fifo_n != {full}")),
         wire("s_pop", 1, "s_valid && sh_ready && room"),
         wire("pop", 1, "out_valid && out_ready && out_last"),

@@ -41,15 +41,21 @@ pub(super) fn on(hw: &Hw) -> bool {
     hw.engine_form()
 }
 
-/// The queue entry's width.
+/// The queue entry's width: the fields the walk's memories do not hold.
 pub(super) fn entry_bits(hw: &Hw, s: &Schedule) -> u32 {
-    fields(hw, s).iter().map(|f| f.w).sum()
+    queued(hw, s).iter().map(|f| f.w).sum()
+}
+
+/// The set-up result's fields the queue's entry holds, in its order: all but the walk's
+/// constants in block RAM ([`super::span_seq::walk_ram`]), which the engine writes there.
+fn queued(hw: &Hw, s: &Schedule) -> Vec<result::Field> {
+    fields(hw, s).into_iter().filter(|f| !super::span_seq::walk_ram::holds(hw, &f.name)).collect()
 }
 
 /// The set-up result queue module of this configuration.
 pub(super) fn result_queue(hw: &Hw, names: &Names) -> Module {
     let s = hw.engine().expect("the engine form");
-    let widths: Vec<u32> = fields(hw, &s).iter().map(|f| f.w).collect();
+    let widths: Vec<u32> = queued(hw, &s).iter().map(|f| f.w).collect();
     queue_module(names, entry_bits(hw, &s), hw.queue_depth(), hw.sequential().is_some().then_some(&widths[..]))
 }
 
@@ -220,7 +226,8 @@ pub(super) fn setup(hw: &Hw, names: &Names, body: &mut Vec<Item>) {
     } else {
         "A result due while the queue is full freezes the engine (en); a guard-band drop pulses err; a culled triangle is dropped."
     }));
-    let mut nets = vec![("res_v", 1), ("res_guard", 1), ("res_cull", 1), ("res", res_w), ("q_head", res_w), ("q_ne", 1)];
+    let entry_w = entry_bits(hw, &s);
+    let mut nets = vec![("res_v", 1), ("res_guard", 1), ("res_cull", 1), ("res", res_w), ("q_head", entry_w), ("q_ne", 1)];
     nets.insert(0, if credit { ("e_ready", 1) } else { ("en", 1) });
     for (n, w) in nets {
         body.push(crate::verilog::net(n, w));
@@ -261,6 +268,9 @@ pub(super) fn setup(hw: &Hw, names: &Names, body: &mut Vec<Item>) {
             // the queue is full and it has a field to write.
             body.push(crate::verilog::net("res_we", fields.len() as u32));
             body.push(crate::verilog::net("res_wr", 1));
+            if super::span_seq::walk_ram::on(hw) {
+                walk_ram_entry(hw, &fields, body);
+            }
             body.push(Item::Assign("en".into(), "!(q_full && (q_push || res_wr))".into()));
         } else {
             body.push(Item::Assign("en".into(), "!(q_push && q_full)".into()));
@@ -282,6 +292,9 @@ pub(super) fn setup(hw: &Hw, names: &Names, body: &mut Vec<Item>) {
     if capture {
         conns.extend(["res_we", "res_wr"].map(|p| (p.to_string(), p.to_string())));
     }
+    if super::span_seq::walk_ram::on(hw) {
+        conns.push(("res_bus".into(), "res_bus".into()));
+    }
     body.push(Item::Instance { module: names.fe_engine.clone(), name: "u_engine".into(), params: vec![], conns });
     let mut qc = vec![
         ("clk", "clk"),
@@ -296,17 +309,21 @@ pub(super) fn setup(hw: &Hw, names: &Names, body: &mut Vec<Item>) {
     if capture {
         qc.insert(4, ("we", "res_we"));
     }
+    if super::span_seq::walk_ram::on(hw) {
+        qc[3].1 = "q_din";
+        qc[4].1 = "q_we";
+    }
     body.push(Item::Instance {
         module: names.fe_queue.clone(),
         name: "u_queue".into(),
-        params: vec![("W".into(), res_w.to_string()), ("DEPTH".into(), depth.to_string())],
+        params: vec![("W".into(), entry_w.to_string()), ("DEPTH".into(), depth.to_string())],
         conns: qc.into_iter().map(|(a, b)| (a.to_string(), b.to_string())).collect(),
     });
     body.push(Item::Always(vec![Stmt::If("rst".into(), vec![set("err", "1'b0")], vec![set("err", "res_v && !res_guard")])]));
     body.push(comment("The queue head's fields: the set-up result the walker loads."));
     let mut lo = 0;
     let mut lanes: std::collections::BTreeMap<String, Vec<String>> = Default::default();
-    for f in &fields {
+    for f in &queued(hw, &s) {
         let slice = if f.w == 1 { format!("q_head[{lo}]") } else { format!("q_head[{}:{lo}]", lo + f.w - 1) };
         lo += f.w;
         match f.name.split_once('_') {
@@ -326,4 +343,32 @@ pub(super) fn setup(hw: &Hw, names: &Names, body: &mut Vec<Item>) {
         body.push(crate::verilog::wire(bus, 3 * w, format!("{{{}, {}, {}}}", l[2], l[1], l[0])));
     }
     body.push(Item::Blank);
+}
+
+/// The queue's entry without the walk's constants in block RAM: its data and field enables from
+/// the engine's (`q_din`, `q_we`), and the bus the memories are written from (`res_bus`).
+fn walk_ram_entry(hw: &Hw, fields: &[result::Field], body: &mut Vec<Item>) {
+    use crate::verilog::{comment, net, wire};
+    body.push(net("res_bus", super::span_seq::walk_ram::bus_width(hw)));
+    let (mut din, mut we, mut held, mut lo) = (Vec::new(), Vec::new(), Vec::new(), 0);
+    for (k, f) in fields.iter().enumerate() {
+        let slice = if f.w == 1 { format!("res[{lo}]") } else { format!("res[{}:{lo}]", lo + f.w - 1) };
+        if super::span_seq::walk_ram::holds(hw, &f.name) {
+            body.push(wire(&super::span_seq::walk_ram::we(&f.name), 1, format!("res_we[{k}]")));
+            held.push((slice, f.w));
+        } else {
+            din.push(slice);
+            we.push(format!("res_we[{k}]"));
+        }
+        lo += f.w;
+    }
+    let w = entry_bits(hw, &hw.engine().expect("the engine form"));
+    let cat = |v: &[String]| format!("{{{}}}", v.iter().rev().cloned().collect::<Vec<_>>().join(", "));
+    body.push(comment("The queue's entry: the fields the walk's memories do not hold (the engine writes those from res_bus)."));
+    body.push(wire("q_din", w, cat(&din)));
+    body.push(wire("q_we", we.len() as u32, cat(&we)));
+    body.push(comment("verilator lint_off UNUSEDSIGNAL"));
+    let names: Vec<String> = held.iter().map(|h| h.0.clone()).collect();
+    body.push(wire("unused_walk_fields", held.iter().map(|h| h.1).sum(), cat(&names)));
+    body.push(comment("verilator lint_on UNUSEDSIGNAL"));
 }

@@ -66,6 +66,7 @@ pub(super) fn emit_engine(hw: &Hw, sp: &Stager) -> Item {
         binary_phase: hw.sequential().is_some(),
         capture: hw.sequential().is_some(),
         held: hw.sequential().map(|s| s.inputs_read_by()),
+        walk_ram: super::span_seq::walk_ram::on(hw),
     };
     let mut shape = shape(hw, sp, SetupShape::Engine(engine));
     shape.starts = super::incremental::on(hw).then_some(hw.fe.start_product_clocks());

@@ -12,6 +12,8 @@ use crate::widths::bits_for;
 use golden::frontend::span_seq::{AccLoad, Multiplicand, Multiplier, SpanSeq};
 use golden::frontend::Widths;
 
+pub(super) mod walk_ram;
+
 /// The unit of a front-end whose span form is sequential.
 pub(super) fn unit(hw: &Hw) -> Option<SpanSeq> {
     hw.fe.span_seq()
@@ -56,7 +58,8 @@ fn phase_bits() -> u32 {
 }
 
 /// The unit's control registers and `adv` (declared before the walker reads it): the walker
-/// moves when the unit is idle, or in the clock it writes its result to a free output.
+/// moves when the unit is idle, or in the clock it writes its result to a free output. Then the
+/// walk's constants in block RAM, where the form has them ([`walk_ram`]).
 pub(super) fn handshake(hw: &Hw, body: &mut Vec<Item>) {
     let q = unit(hw).expect("the sequential span path");
     let phase_w = phase_bits();
@@ -66,6 +69,9 @@ pub(super) fn handshake(hw: &Hw, body: &mut Vec<Item>) {
     body.push(wire("sq_done", 1, format!("sq_busy && sq_ph == {last} && sq_cnt == {}", lit(count_bits(&q), 0))));
     body.push(wire("sq_fin", 1, "sq_done && (!out_valid || out_ready)"));
     body.push(wire("adv", 1, "!sq_busy || sq_fin"));
+    if walk_ram::on(hw) {
+        walk_ram::emit(hw, body);
+    }
 }
 
 /// The span's `sq_x` and `sq_len` from the held ends `sq_mg`, `sq_hi3` (`end_w` bits).
@@ -226,5 +232,8 @@ pub(super) fn emit(hw: &Hw, body: &mut Vec<Item>) -> Stager {
             vec![],
         )],
     )]));
+    if walk_ram::on(hw) {
+        walk_ram::emit_ports(hw, body);
+    }
     Stager::new("p", Vec::new())
 }

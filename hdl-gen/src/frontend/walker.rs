@@ -319,7 +319,9 @@ pub(super) fn emit(hw: &Hw, names: &Names, body: &mut Vec<Item>) {
     body.push(reg("w_row", row_w));
     body.push(reg("w_last", row_w));
     let regs = [("w_di", dw), ("w_an", area_w), ("w_rn", recip_w), ("w_tn", sum_w), ("w_gxn", sum_w), ("w_dyn", sum_w)];
-    body.extend(regs.iter().filter(|(n, _)| *n != "w_gxn" || reads_gxn(hw)).map(|(n, ww)| reg(n, *ww)));
+    // The walk's constants in block RAM are wires from its reads instead (`span_seq::walk_ram`).
+    let held = |n: &str| super::span_seq::walk_ram::replaces(hw, &n[2..]);
+    body.extend(regs.iter().filter(|(n, _)| (*n != "w_gxn" || reads_gxn(hw)) && !held(n)).map(|(n, ww)| reg(n, *ww)));
     let (sum_decls, sum_load, sum_step) = if hw.run_sums() { super::sums::walker(hw) } else { Default::default() };
     body.extend(sum_decls);
     control(hw, body);
@@ -413,11 +415,11 @@ pub(super) fn emit(hw: &Hw, names: &Names, body: &mut Vec<Item>) {
         set("w_di", "r_di"),
         set("w_an", "s_an"),
         set("w_rn", if engine { "r_rn" } else { "drn_q" }),
-        set("w_tn", "s_tn"),
+        set("w_tn", super::span_seq::walk_ram::take_value(hw, "tn").unwrap_or("s_tn")),
         set("w_gxn", "s_gxn"),
         set("w_dyn", "s_dyn"),
     ]);
-    load.retain(|st| reads_gxn(hw) || !matches!(st, Stmt::Set(l, _) if l == "w_gxn"));
+    load.retain(|st| !matches!(st, Stmt::Set(l, _) if (l == "w_gxn" && !reads_gxn(hw)) || (l.starts_with("w_") && held(l))));
     load.extend(sum_load);
     let mut step = vec![set("w_row", format!("w_row + {}", lit(row_w, 1))), set("w_tn", "w_tn + w_dyn")];
     if tracked {

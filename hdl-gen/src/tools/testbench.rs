@@ -303,8 +303,8 @@ fn declarations(b: &BenchSpec) -> Vec<Item> {
     });
     body.push(Item::Blank);
     body.push(comment("Vectors exported from the golden model."));
-    body.push(Item::Memory { name: "span_mem".into(), width: b.in_width, depth: b.n_in.max(1) as u32 });
-    body.push(Item::Memory { name: "out_mem".into(), width: b.exp_width, depth: b.n_exp.max(1) as u32 });
+    body.push(Item::Memory { name: "span_mem".into(), width: b.in_width, depth: b.n_in.max(1) as u32, no_rw_check: false });
+    body.push(Item::Memory { name: "out_mem".into(), width: b.exp_width, depth: b.n_exp.max(1) as u32, no_rw_check: false });
     body.push(Item::ReadMemH { file: "IN_FILE".into(), mem: "span_mem".into() });
     body.push(Item::ReadMemH { file: "EXP_FILE".into(), mem: "out_mem".into() });
     body.push(Item::Blank);

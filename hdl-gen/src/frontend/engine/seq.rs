@@ -148,6 +148,11 @@ pub fn module(hw: &Hw, s: &SeqSchedule, name: &str) -> SeqEngine {
     let mut ports = ports(hw, res_w);
     ports.push(Port::output("res_we", fields.len() as u32, "", "per field of res: write it into the queue's tail this clock"));
     ports.push(Port::output("res_wr", 1, "", "a field of res is due this clock (whether or not en)"));
+    let walk_ram = crate::frontend::span_seq::walk_ram::on(hw).then(|| crate::frontend::span_seq::walk_ram::bus_width(hw));
+    if let Some(bw) = walk_ram {
+        assert!(bw <= w, "the walk's constants are narrower than the word");
+        ports.push(Port::output("res_bus", bw, "", "the write bus: the walk's constants in block RAM are written from it at res_we"));
+    }
     let params: Vec<Param> = Vec::new();
     let header = vec![
         format!("{name} — the sequential set-up engine (issue 27; docs/design.md): golden's microprogram on one ALU."),
@@ -172,6 +177,9 @@ pub fn module(hw: &Hw, s: &SeqSchedule, name: &str) -> SeqEngine {
     divider(&cx, &mut b);
     write_bus(&cx, &widths, &mut b);
     results(&cx, &fields, &groups, &mut b);
+    if let Some(bw) = walk_ram {
+        b.push(Item::Assign("res_bus".into(), format!("bus[{}:0]", bw - 1)));
+    }
     SeqEngine { module: Module { name: name.into(), header, params, ports, body: b } }
 }
 
@@ -310,6 +318,13 @@ fn microprogram(cx: &Cx, fields: &[Field]) -> Micro {
         }
     }
     assert!(mw[c as usize..].iter().all(|x| x.0.is_empty()), "the microprogram ends within its clocks");
+    // No operand is read at the address written in the same clock: the register file's block
+    // RAM then needs no collision logic (`no_rw_check`, [`memories`]; about 130 logic cells).
+    for (t, x) in mw.iter().enumerate() {
+        if let Some(wa) = x.0.get("wa") {
+            assert!(["ra", "rb"].iter().all(|p| x.0.get(p) != Some(wa)), "clock {t} reads the register it writes");
+        }
+    }
     let mwn = l.width();
     assert!(mwn <= 128, "a microword of {mwn} bits");
     let micro: Vec<String> = mw[..c as usize].iter().map(|x| format!("{mwn}'h{}", x.hex(&l))).collect();
@@ -362,7 +377,8 @@ fn sequencer(cx: &Cx, b: &mut Vec<Item>) {
     b.push(Item::Blank);
 }
 
-/// The microprogram's and the constants' tables, the microword's fields, the register file and the flag file.
+/// The microprogram's and the constants' tables, the microword's fields, the register file (never
+/// read where it is written that clock: [`microprogram`]) and the flag file.
 fn memories(cx: &Cx, l: &Layout, micro: &[String], consts: &[String], b: &mut Vec<Item>) {
     let (w, cw, aw) = (cx.w, cx.cw, cx.aw);
     let (words, flags) = cx.s.words();
@@ -390,8 +406,8 @@ fn memories(cx: &Cx, l: &Layout, micro: &[String], consts: &[String], b: &mut Ve
     }
     b.push(Item::Blank);
     b.push(comment("The register file: two copies written together, a registered read port each; the flag file."));
-    b.push(Item::Memory { name: "rfa".into(), width: w, depth: words });
-    b.push(Item::Memory { name: "rfb".into(), width: w, depth: words });
+    b.push(Item::Memory { name: "rfa".into(), width: w, depth: words, no_rw_check: true });
+    b.push(Item::Memory { name: "rfb".into(), width: w, depth: words, no_rw_check: true });
     b.push(reg("da", w));
     b.push(reg("db", w));
     b.push(reg("fl", flags.max(1)));

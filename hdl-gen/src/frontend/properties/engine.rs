@@ -157,6 +157,11 @@ impl Reference<'_> {
             b.push(comment("The capture: no field is written into the tail while the queue is full (the tail is its oldest entry)."));
             b.push(Item::Comb(vec![when("f_past && q_full", vec![assert("res_we == 0")])]));
         }
+        if e.walk_ram {
+            // The memories have no collision logic (`no_rw_check`): their write slot is never read.
+            b.push(comment("The walk's memories: the engine's slot is the walked one's exactly while the queue is full, so it never writes the slot read."));
+            b.push(Item::Comb(vec![when("f_past", vec![assert("(wk_ws == wk_rs) == q_full"), assert("wk_ws != wk_slot || q_full")])]));
+        }
         b
     }
 

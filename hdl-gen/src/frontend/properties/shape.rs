@@ -99,6 +99,9 @@ pub struct EngineShape {
     /// phase (their last read) and takes the next triangle only after it; else it passes them
     /// on at the entry and takes the next one then.
     pub held: Option<u32>,
+    /// The walk's constants in block RAM (`span_seq::walk_ram`): its two slots, the engine's
+    /// and the walked triangle's, are one exactly while the queue is full.
+    pub walk_ram: bool,
 }
 
 /// A register stage of the front-end's span path: where it holds a span's valid, row, columns
