@@ -189,6 +189,21 @@ fn sum_partials(sp: &mut Stager, out: &str, terms: &[Term], m: u32) {
     sp.def(out, m, false, sum);
 }
 
+/// The walker's sums are modulo 2^K; the span path reads their residues modulo 2^(K-2), and
+/// Gxn's low bits are zero (golden's `Widths::GXN_ZEROS`): the bits it leaves, for the linter.
+fn unused_sums(hw: &Hw, sum_w: u32, body: &mut Vec<Item>) {
+    let zeros = Widths::GXN_ZEROS;
+    body.push(comment("verilator lint_off UNUSEDSIGNAL"));
+    if walker::reads_gxn(hw) {
+        body.push(wire("unused_sums_top", 4, format!("{{w_tn[{0}:{1}], w_gxn[{0}:{1}]}}", sum_w - 1, sum_w - 2)));
+        let gxn_low = format!("{}[{}:0]", walker::row(hw, "w_gxn"), zeros - 1);
+        body.push(wire("unused_gxn_low", zeros, gxn_low));
+    } else {
+        body.push(wire("unused_sums_top", 2, format!("w_tn[{}:{}]", sum_w - 1, sum_w - 2)));
+    }
+    body.push(comment("verilator lint_on UNUSEDSIGNAL"));
+}
+
 /// Span stage j's valid bit.
 pub(super) fn valid(j: usize) -> String {
     format!("p{j}_v")
@@ -247,17 +262,7 @@ pub(super) fn path(hw: &Hw, names: &Names, body: &mut Vec<Item>) -> Stager {
             sp.input_as(n, ww, false, &src);
         }
     }
-    // The walker's sums are modulo 2^K; the span path reads their residues modulo 2^(K-2), and
-    // Gxn's low bits are zero (golden's `Widths::GXN_ZEROS`).
-    body.push(comment("verilator lint_off UNUSEDSIGNAL"));
-    if gxn {
-        body.push(wire("unused_sums_top", 4, format!("{{w_tn[{0}:{1}], w_gxn[{0}:{1}]}}", sum_w - 1, sum_w - 2)));
-        let gxn_low = format!("{}[{}:0]", row("w_gxn"), zeros - 1);
-        body.push(wire("unused_gxn_low", zeros, gxn_low));
-    } else {
-        body.push(wire("unused_sums_top", 2, format!("w_tn[{}:{}]", sum_w - 1, sum_w - 2)));
-    }
-    body.push(comment("verilator lint_on UNUSEDSIGNAL"));
+    unused_sums(hw, sum_w, body);
     let by_product = |e: &End| !sums || e.x != head.x; // `Gxn lo` by a product by the column
     if scan {
         sp.input_as("xh", xw, false, &format!("hi3[{}:0]", xw - 1));
