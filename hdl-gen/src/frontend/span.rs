@@ -229,7 +229,8 @@ pub(super) fn path(hw: &Hw, names: &Names, body: &mut Vec<Item>) -> Stager {
     // takes its top IW + 1 bits, and the correction is modulo 2^(AW+3): golden's
     // `Widths::reciprocal_quotient`, whose documentation proves the estimate two below at most.
     let s2_w = hw.s2n_bits();
-    let dsp = hw.dsp_regs();
+    // A tile with its own registers stands for the stage registers on both sides of its stage.
+    let dsp = hw.dsp_regs() && golden::pipeline::i0_registers(hw.pipeline).iter().all(|&c| c);
     let tiles = Tiles { bits: tile_bits(hw), dsp: dsp.then_some(names.fe_mul.as_str()) };
     let t = fe.widths().i0_shift();
     let h_w = s2_w - t;
