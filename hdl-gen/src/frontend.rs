@@ -35,6 +35,7 @@ mod edge;
 mod engine;
 mod hw;
 mod incremental;
+mod mul18;
 mod properties;
 mod setup;
 mod span;
@@ -98,7 +99,9 @@ pub fn module(hw: &Hw, names: &Names) -> Module {
 pub fn submodules(hw: &Hw, names: &Names) -> Vec<Module> {
     if engine::on(hw) {
         // The engine made the divisions: no divider module, the engine and its queue instead.
-        return vec![edge::module(hw, names), engine::module(hw, names), engine::result_queue(hw, names)];
+        let mut parts = vec![edge::module(hw, names), engine::module(hw, names), engine::result_queue(hw, names)];
+        parts.extend(hw.dsp_regs().then(|| mul18::module(names)));
+        return parts;
     }
     let [ei, _] = edge::dividers(hw);
     vec![edge::module(hw, names), divider::module(names, &ei, hw.div_bits, divider::counter_width(&hw.fe.widths()))]
@@ -125,7 +128,7 @@ fn build(hw: &Hw, names: &Names) -> (Module, Vec<golden::pipeline::PipeStage>) {
             body.push(properties::emit_engine(hw, &sp));
             return (top(hw, names, body), stages);
         }
-        let sp = span::path(hw, &mut body);
+        let sp = span::path(hw, names, &mut body);
         let sp = span::output(hw, names, sp, &mut body);
         let stages = if hw.calc_clocks() > 1 { span_stage_list(hw, &sp) } else { Vec::new() };
         body.push(properties::emit_engine(hw, &sp));
@@ -133,7 +136,7 @@ fn build(hw: &Hw, names: &Names) -> (Module, Vec<golden::pipeline::PipeStage>) {
     }
     let set_up = setup::emit(hw, names, &mut body);
     walker::emit(hw, names, &mut body);
-    let sp = span::path(hw, &mut body);
+    let sp = span::path(hw, names, &mut body);
     let sp = span::output(hw, names, sp, &mut body);
     // Every boundary is registered above level 0, so stage j's logic is logical step j - 1's.
     let stages = if hw.calc_clocks() > 1 {

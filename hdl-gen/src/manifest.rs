@@ -316,6 +316,8 @@ pub fn render(opts: &Options, names: &Names, modules: &[Module], unit: &Specular
             (Role::FrontendPart, s.latency + 1, "one triangle every frontend.engine.ii clocks")
         } else if name == &names.fe_queue {
             (Role::FrontendPart, 1, "one entry in and one out per clock")
+        } else if name == &names.fe_mul {
+            (Role::FrontendPart, 2, "one product per clock")
         } else if name == &names.top {
             (Role::TriangleShader, fe_latency + seg_latency, "one segment per clock")
         } else if name == &names.writer {

@@ -14,6 +14,8 @@ pub struct Names {
     /// division and the per-scanline dI's) and one edge (its set-up result and its walker step).
     pub fe_div: String,
     pub fe_edge: String,
+    /// The ECP5 forms' 18 x 18 product with its tile's own registers (`frontend::mul18`).
+    pub fe_mul: String,
     /// The shared set-up engine (`--fe-setup` not `parallel`) and its result queue.
     pub fe_engine: String,
     pub fe_queue: String,
@@ -32,6 +34,7 @@ impl Names {
             frontend: format!("{prefix}tri_frontend"),
             fe_div: format!("{prefix}tri_fe_div"),
             fe_edge: format!("{prefix}tri_fe_edge"),
+            fe_mul: format!("{prefix}tri_fe_mul18"),
             fe_engine: format!("{prefix}tri_fe_engine"),
             fe_queue: format!("{prefix}tri_fe_queue"),
             top: format!("{prefix}tri_shader_p{}", cfg.p),

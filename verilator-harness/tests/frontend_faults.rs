@@ -196,3 +196,30 @@ fn running_sums_planted_faults_are_caught() {
     ];
     assert_faults_caught(&base, "tri_frontend.v", "sumfault", faults, seed, &tris);
 }
+
+/// Negative controls of `tri_fe_mul18`, the tiles with their own registers (`--target
+/// ecp5-25f`'s engine and span path; the ECP5 plan at level 1, 37x23, each a model built on
+/// first use), planted in the model the simulators read (the file's last branch, after the
+/// primitive's): the product register loaded on every clock (the span path's stall ignored), an
+/// operand register loaded on every clock (the engine's held chunk overwritten), and the
+/// operands' signedness ignored (the engine's signed top chunks read unsigned). Caught on the
+/// triangles the clean model passes (`engine_spans_equal_golden_at_the_targets_pipeline_level`).
+/// Slow tier: three models.
+#[test]
+#[ignore]
+fn mul18_planted_faults_are_caught() {
+    let Some((base, seed, tris)) = row_stage_base("frontend mul18 faults") else { return };
+    let text = &base.sources.iter().find(|(n, _)| n == "tri_fe_mul18.v").expect("the tile's file").1;
+    // The model after the primitive's branch: unique with the file's end in it.
+    let model = text.rsplit_once("`else\n").expect("the simulators' branch").1.to_string();
+    let fault = |from: &str, to: &str| {
+        assert!(model.contains(from), "no {from:?} in the model");
+        model.replacen(from, to, 1)
+    };
+    let faults = [
+        (model.clone(), fault("if (cep) begin", "if (1'b1) begin"), "the product register loaded every clock"),
+        (model.clone(), fault("if (cea) begin", "if (1'b1) begin"), "an operand register loaded every clock"),
+        (model.clone(), fault("A_SIGNED != 0 && ", "1'b0 && "), "operand a's signedness ignored"),
+    ];
+    assert_faults_caught(&base, "tri_fe_mul18.v", "mulfault", faults, seed, &tris);
+}

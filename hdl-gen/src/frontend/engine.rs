@@ -165,7 +165,7 @@ pub(super) fn module(hw: &Hw, names: &Names) -> Module {
     }
     body.push(comment("verilator lint_on UNUSEDSIGNAL"));
     body.push(Item::Blank);
-    let mut caps = units::multipliers(&v, &seq, &mut body);
+    let mut caps = units::multipliers(&v, &seq, hw.dsp_regs().then_some(names.fe_mul.as_str()), &mut body);
     caps.extend(units::dividers(&v, &seq, &mut body));
     caps.extend(units::shifters(&v, &seq, &mut body));
     for c in caps {

@@ -105,6 +105,14 @@ impl Hw {
         self.fe.setup.plan().is_some_and(|p| p.run_sums) && self.fe.i0 == I0Form::Reciprocal
     }
 
+    /// Whether the 18 x 18 tiles (the engine's and the span path's) are `tri_fe_mul18`
+    /// instances, the ECP5's MULT18X18D with its own input and product registers in place of the
+    /// fabric's: the engine form on the ECP5-25F plan from level 1, where every tile already sits
+    /// between an operand register and a product register, so golden's latencies hold.
+    pub fn dsp_regs(&self) -> bool {
+        self.fe.setup == golden::frontend::SetupForm::Ecp5_25f && self.pipeline.level() >= 1
+    }
+
     /// Whether the walker's row is registered before its span is decided
     /// ([`golden::pipeline::Pipeline::row_stage`]).
     pub fn row_stage(&self) -> bool {

@@ -5,9 +5,10 @@
 
 use super::divider::DivConns;
 use super::hw::Hw;
+use super::mul18::{self, MulConns};
 use super::stager::Stager;
 use super::walker::{self, scanline_divider};
-use crate::verilog::{comment, lit, reg, set, wire, zext, Item, Stmt};
+use crate::verilog::{comment, lit, net, reg, set, wire, zext, Item, Stmt};
 use crate::Names;
 use golden::frontend::{DiMode, SetupForm, Widths};
 
@@ -67,67 +68,140 @@ fn bits_of(x: &str, w: u32, hi: u32, lo: u32) -> String {
     format!("{x}[{hi}:{lo}]")
 }
 
+/// A product's operand: how it reads in the product's stage, its width, and, where the tiles
+/// are `tri_fe_mul18` ([`Hw::dsp_regs`]), how it reads in the stage before: the tile's own input
+/// register loads that.
+struct Opnd {
+    now: String,
+    w: u32,
+    before: Option<String>,
+}
+
+impl Opnd {
+    /// `name` as it reads in the stage being written, and the stage before when `dsp`.
+    fn of(sp: &Stager, name: &str, w: u32, dsp: bool) -> Opnd {
+        Opnd { now: sp.at(name), w, before: dsp.then(|| sp.before(name)) }
+    }
+}
+
+/// How a product's tiles are made: `bits` a tile's operand ([`tile_bits`]), and the
+/// `tri_fe_mul18` module when they are instances with their own registers.
+#[derive(Clone, Copy)]
+struct Tiles<'a> {
+    bits: u32,
+    dsp: Option<&'a str>,
+}
+
+/// A partial product: its name, width and weight; and for a `tri_fe_mul18` tile, its value
+/// from the instance's product register, which the next stage reads in place of a register of
+/// its own.
+struct Term {
+    name: String,
+    w: u32,
+    off: u32,
+    held: Option<String>,
+}
+
 /// The partial products of `out = (a * b) mod 2^m` (`a` and `b` read as they are in the stage,
 /// unsigned), which [`sum_partials`] joins (a stage later from `--pipeline 1`): the products of
 /// `tile`-bit chunks ([`tile_bits`]), only those with a bit below 2^m, each cut to the bits it
-/// adds there, each its own wire `<out>_<n>`, returned as `(name, width, offset)`. A plain `*`
-/// would take every tile of the full product: synthesis keeps a tile as long as one of its bits
-/// is read. A chunk of at most [`LOGIC_BITS`] bits (the narrower operand's top, say) is
-/// multiplied in logic instead, as shifted adds against the whole other operand, and so is a
-/// piece of at most [`LOGIC_ADDER_BITS`] adder bits.
-fn partial_products(sp: &mut Stager, tile: u32, out: &str, (a, aw): (&str, u32), (b, bw): (&str, u32), m: u32) -> Vec<(String, u32, u32)> {
-    let ((a, aw), (b, bw)) = if aw >= bw { ((a, aw), (b, bw)) } else { ((b, bw), (a, aw)) };
+/// adds there, each its own wire `<out>_<n>`. A plain `*` would take every tile of the full
+/// product: synthesis keeps a tile as long as one of its bits is read. A chunk of at most
+/// [`LOGIC_BITS`] bits (the narrower operand's top, say) is multiplied in logic instead, as
+/// shifted adds against the whole other operand, and so is a piece of at most
+/// [`LOGIC_ADDER_BITS`] adder bits. With `tri_fe_mul18` ([`Tiles::dsp`]) a tile is an instance
+/// whose input registers load the operands' chunks from the stage before and whose product
+/// register is the product's register into the next stage, all on `adv` as the stage registers.
+fn partial_products(sp: &mut Stager, tiles: Tiles, out: &str, a: &Opnd, b: &Opnd, m: u32) -> Vec<Term> {
+    let (a, b) = if a.w >= b.w { (a, b) } else { (b, a) };
+    let tile = tiles.bits;
     let chunks = |w: u32| (0..w.div_ceil(tile)).map(move |i| (i * tile, (w - i * tile).min(tile)));
-    let mut terms: Vec<(String, u32, u32)> = Vec::new();
-    let mut piece = |sp: &mut Stager, (x, xo, xw): (&str, u32, u32), (y, yo, yw): (&str, u32, u32), wx: u32, wy: u32| {
+    let mut terms: Vec<Term> = Vec::new();
+    let mut piece = |sp: &mut Stager, (x, xo, xw): (&Opnd, u32, u32), (y, yo, yw): (&Opnd, u32, u32)| {
         let off = xo + yo;
         if off >= m {
             return;
         }
         let need = m - off;
         let (nx, ny) = (xw.min(need), yw.min(need));
-        let (sx, sy) = (bits_of(x, wx, xo + nx - 1, xo), bits_of(y, wy, yo + ny - 1, yo));
+        let (sx, sy) = (bits_of(&x.now, x.w, xo + nx - 1, xo), bits_of(&y.now, y.w, yo + ny - 1, yo));
         let name = format!("{out}_{}", terms.len());
-        let value = if nx.min(ny) <= LOGIC_BITS || adder_bits(nx.min(ny), need) <= LOGIC_ADDER_BITS {
+        if nx.min(ny) <= LOGIC_BITS || adder_bits(nx.min(ny), need) <= LOGIC_ADDER_BITS {
             let ((n, nw), (v, vw)) = if nx <= ny { ((sx, nx), (sy, ny)) } else { ((sy, ny), (sx, nx)) };
             let v = zext(&v, vw, need);
-            (0..nw)
+            let value = (0..nw)
                 .map(|k| {
                     let shifted = if k == 0 { v.clone() } else { format!("({v} << {k})") };
                     format!("({{{need}{{{}}}}} & {shifted})", bits_of(&n, nw, k, k))
                 })
                 .collect::<Vec<_>>()
-                .join(" + ")
+                .join(" + ");
+            sp.def(&name, need, false, value);
+        } else if let (Some(module), Some(bx), Some(by)) = (tiles.dsp, &x.before, &y.before) {
+            let (ax, ay) = (bits_of(bx, x.w, xo + nx - 1, xo), bits_of(by, y.w, yo + ny - 1, yo));
+            let p = format!("{name}_p");
+            // The product's bits above 2^need are not read; nor, perhaps, the operands' bits as
+            // this stage holds them (the tile took them a clock earlier): `<name>_in` names them.
+            sp.note(comment("verilator lint_off UNUSEDSIGNAL"));
+            sp.note(net(&p, mul18::P_BITS));
+            sp.note(wire(&format!("{name}_in"), nx + ny, format!("{{{sx}, {sy}}}")));
+            sp.note(comment("verilator lint_on UNUSEDSIGNAL"));
+            let (ea, eb) = (zext(&ax, nx, mul18::BITS), zext(&ay, ny, mul18::BITS));
+            let conns = MulConns { a: &ea, b: &eb, cea: "adv", ceb: "adv", cep: "adv", p: &p, signed: (false, false) };
+            sp.note(mul18::instance(module, &format!("u_{name}"), &conns));
+            let held = if need >= mul18::P_BITS { zext(&p, mul18::P_BITS, need) } else { format!("{p}[{}:0]", need - 1) };
+            terms.push(Term { name, w: need, off, held: Some(held) });
+            return;
         } else {
-            format!("{} * {}", zext(&sx, nx, need), zext(&sy, ny, need))
-        };
-        sp.def(&name, need, false, value);
-        terms.push((name, need, off));
+            sp.def(&name, need, false, format!("{} * {}", zext(&sx, nx, need), zext(&sy, ny, need)));
+        }
+        terms.push(Term { name, w: need, off, held: None });
     };
-    for (bo, bc) in chunks(bw) {
+    for (bo, bc) in chunks(b.w) {
         if bc <= LOGIC_BITS {
-            piece(sp, (b, bo, bc), (a, 0, aw), bw, aw);
+            piece(sp, (b, bo, bc), (a, 0, a.w));
             continue;
         }
-        for (ao, ac) in chunks(aw) {
-            piece(sp, (a, ao, ac), (b, bo, bc), aw, bw);
+        for (ao, ac) in chunks(a.w) {
+            piece(sp, (a, ao, ac), (b, bo, bc));
         }
     }
     terms
 }
 
-/// `out`, the sum of [`partial_products`]' terms modulo 2^m, read where the stage is.
-fn sum_partials(sp: &mut Stager, out: &str, terms: &[(String, u32, u32)], m: u32) {
-    let sum = terms.iter().map(|(n, w, off)| {
-        let x = zext(&sp.at(n), *w, m);
-        if *off == 0 {
+/// `out`, the sum of [`partial_products`]' terms modulo 2^m, read where the stage is; a
+/// `tri_fe_mul18` tile's term is its product register, named here.
+fn sum_partials(sp: &mut Stager, out: &str, terms: &[Term], m: u32) {
+    for t in terms {
+        if let Some(held) = &t.held {
+            sp.def(&t.name, t.w, false, held.clone());
+        }
+    }
+    let sum = terms.iter().map(|t| {
+        let x = zext(&sp.at(&t.name), t.w, m);
+        if t.off == 0 {
             x
         } else {
-            format!("({x} << {off})")
+            format!("({x} << {})", t.off)
         }
     });
     let sum = sum.collect::<Vec<_>>().join(" + ");
     sp.def(out, m, false, sum);
+}
+
+/// The walker's sums are modulo 2^K; the span path reads their residues modulo 2^(K-2), and
+/// Gxn's low bits are zero (golden's `Widths::GXN_ZEROS`): the bits it leaves, for the linter.
+fn unused_sums(hw: &Hw, sum_w: u32, body: &mut Vec<Item>) {
+    let zeros = Widths::GXN_ZEROS;
+    body.push(comment("verilator lint_off UNUSEDSIGNAL"));
+    if walker::reads_gxn(hw) {
+        body.push(wire("unused_sums_top", 4, format!("{{w_tn[{0}:{1}], w_gxn[{0}:{1}]}}", sum_w - 1, sum_w - 2)));
+        let gxn_low = format!("{}[{}:0]", walker::row(hw, "w_gxn"), zeros - 1);
+        body.push(wire("unused_gxn_low", zeros, gxn_low));
+    } else {
+        body.push(wire("unused_sums_top", 2, format!("w_tn[{}:{}]", sum_w - 1, sum_w - 2)));
+    }
+    body.push(comment("verilator lint_on UNUSEDSIGNAL"));
 }
 
 /// Span stage j's valid bit.
@@ -137,7 +211,7 @@ pub(super) fn valid(j: usize) -> String {
 
 /// The span path's stages, from the walker's row to I0; returns them for the output and the
 /// properties.
-pub(super) fn path(hw: &Hw, body: &mut Vec<Item>) -> Stager {
+pub(super) fn path(hw: &Hw, names: &Names, body: &mut Vec<Item>) -> Stager {
     if super::incremental::on(hw) {
         return super::incremental::span_path(hw);
     }
@@ -155,7 +229,9 @@ pub(super) fn path(hw: &Hw, body: &mut Vec<Item>) -> Stager {
     // takes its top IW + 1 bits, and the correction is modulo 2^(AW+3): golden's
     // `Widths::reciprocal_quotient`, whose documentation proves the estimate two below at most.
     let s2_w = hw.s2n_bits();
-    let tile = tile_bits(hw);
+    // A tile with its own registers stands for the stage registers on both sides of its stage.
+    let dsp = hw.dsp_regs() && golden::pipeline::i0_registers(hw.pipeline).iter().all(|&c| c);
+    let tiles = Tiles { bits: tile_bits(hw), dsp: dsp.then_some(names.fe_mul.as_str()) };
     let t = fe.widths().i0_shift();
     let h_w = s2_w - t;
     // The estimate's bits and the ones below: the product modulo 2^(K - t + IW).
@@ -187,17 +263,7 @@ pub(super) fn path(hw: &Hw, body: &mut Vec<Item>) -> Stager {
             sp.input_as(n, ww, false, &src);
         }
     }
-    // The walker's sums are modulo 2^K; the span path reads their residues modulo 2^(K-2), and
-    // Gxn's low bits are zero (golden's `Widths::GXN_ZEROS`).
-    body.push(comment("verilator lint_off UNUSEDSIGNAL"));
-    if gxn {
-        body.push(wire("unused_sums_top", 4, format!("{{w_tn[{0}:{1}], w_gxn[{0}:{1}]}}", sum_w - 1, sum_w - 2)));
-        let gxn_low = format!("{}[{}:0]", row("w_gxn"), zeros - 1);
-        body.push(wire("unused_gxn_low", zeros, gxn_low));
-    } else {
-        body.push(wire("unused_sums_top", 2, format!("w_tn[{}:{}]", sum_w - 1, sum_w - 2)));
-    }
-    body.push(comment("verilator lint_on UNUSEDSIGNAL"));
+    unused_sums(hw, sum_w, body);
     let by_product = |e: &End| !sums || e.x != head.x; // `Gxn lo` by a product by the column
     if scan {
         sp.input_as("xh", xw, false, &format!("hi3[{}:0]", xw - 1));
@@ -213,8 +279,8 @@ pub(super) fn path(hw: &Hw, body: &mut Vec<Item>) -> Stager {
     // their sum in the next.
     let mut gx_partials = Vec::new();
     for e in ends.iter().filter(|e| by_product(e)) {
-        let (gxn, x) = (sp.at("gxn"), sp.at(e.x));
-        gx_partials.push(partial_products(&mut sp, tile, e.gx, (&gxn, gx_w), (&x, xw), gx_w));
+        let (gxn, x) = (Opnd::of(&sp, "gxn", gx_w, dsp), Opnd::of(&sp, e.x, xw, dsp));
+        gx_partials.push(partial_products(&mut sp, tiles, e.gx, &gxn, &x, gx_w));
     }
     sp.cut();
     i0_section(&mut sp);
@@ -247,8 +313,10 @@ pub(super) fn path(hw: &Hw, body: &mut Vec<Item>) -> Stager {
             sp.def(&format!("{}_a{k}", e.corr), corr_w, false, format!("{} - an{k}", e.lo));
         }
         sp.def(e.h, h_w, false, format!("{s2}[{}:{t}]", s2_w - 1));
-        let rn = sp.at("rn");
-        partials.push(partial_products(&mut sp, tile, e.prod, (e.h, h_w), (&rn, recip_w), prod_w));
+        // H is S2n's top bits: a clock earlier, those of S2n there.
+        let h = Opnd { now: e.h.into(), w: h_w, before: dsp.then(|| format!("{}[{}:{t}]", sp.before(e.s2), s2_w - 1)) };
+        let rn = Opnd::of(&sp, "rn", recip_w, dsp);
+        partials.push(partial_products(&mut sp, tiles, e.prod, &h, &rn, prod_w));
     }
     sp.cut();
     i0_section(&mut sp);
@@ -266,8 +334,9 @@ pub(super) fn path(hw: &Hw, body: &mut Vec<Item>) -> Stager {
     // stage, their sum in the next.
     let mut m_partials = Vec::new();
     for e in &ends {
-        let (qt, an) = (sp.at(e.qt), sp.at("an"));
-        m_partials.push(partial_products(&mut sp, tile, &format!("{}_an", e.m), (&an, area_w), (&qt, iw), corr_w - 1));
+        let (qt, an) = (sp.at(e.qt), Opnd::of(&sp, "an", area_w, dsp));
+        let qto = Opnd::of(&sp, e.qt, iw, dsp);
+        m_partials.push(partial_products(&mut sp, tiles, &format!("{}_an", e.m), &an, &qto, corr_w - 1));
         // The corrected quotient's other two values, beside the product.
         for k in [1, 2] {
             sp.def(&format!("{}{k}", e.qt), iw, false, format!("{qt} + {}", lit(iw, k)));

@@ -92,19 +92,31 @@ impl Stager {
     /// The name under which `name` reads in the stage being written, adding the registers that
     /// carry it there.
     pub fn at(&self, name: &str) -> String {
+        self.read_in(name, self.cur)
+    }
+
+    /// The name under which `name` reads in the physical stage before the one being written (a
+    /// tile's operand as its own input register loads it: `tri_fe_mul18`).
+    pub fn before(&self, name: &str) -> String {
+        assert!(self.cur >= 1, "staged value {name} read before stage 0");
+        self.read_in(name, self.cur - 1)
+    }
+
+    fn read_in(&self, name: &str, cur: usize) -> String {
         let d = self.defs.get(name).unwrap_or_else(|| panic!("staged value {name} read before it is defined"));
+        assert!(d.stage <= cur, "staged value {name} read in stage {cur}, before its own ({})", d.stage);
         let reg = |j: usize| format!("{}{j}_{name}", self.prefix);
-        for j in d.stage + 1..=self.cur {
+        for j in d.stage + 1..=cur {
             if self.carried.borrow_mut().insert(reg(j)) {
                 assert!(!self.declared.get(), "staged value {name} carried to stage {j} after the registers were declared");
                 let from = if j - 1 == d.stage { d.here.clone() } else { reg(j - 1) };
                 self.carries.borrow_mut()[j - 1].push((reg(j), d.width, d.signed, from));
             }
         }
-        if d.stage == self.cur {
+        if d.stage == cur {
             d.here.clone()
         } else {
-            reg(self.cur)
+            reg(cur)
         }
     }
 

@@ -19,6 +19,7 @@
 
 use super::sequencer::Seq;
 use super::values::{Src, Values};
+use crate::frontend::mul18;
 use crate::verilog::{comment, reg, set, sreg, wire, Item, Stmt};
 pub(super) use crate::widths::bits_for;
 use golden::frontend::engine::schedule::Class;
@@ -110,7 +111,8 @@ type Passes = (golden::frontend::engine::V, golden::frontend::engine::V, Vec<(u3
 
 /// The multipliers: their lanes' multiplexers, a generate loop per width, and what each
 /// product's value register captures.
-pub(super) fn multipliers(v: &Values, seq: &Seq, body: &mut Vec<Item>) -> Vec<Capture> {
+/// `dsp`: the `tri_fe_mul18` module, when the tiles are its instances ([`crate::frontend::Hw::dsp_regs`]).
+pub(super) fn multipliers(v: &Values, seq: &Seq, dsp: Option<&str>, body: &mut Vec<Item>) -> Vec<Capture> {
     let s = v.s;
     let plan = s.plan;
     let m = plan.mults as usize;
@@ -250,7 +252,7 @@ pub(super) fn multipliers(v: &Values, seq: &Seq, body: &mut Vec<Item>) -> Vec<Ca
         }
         let k = format!("m{gi}k");
         let lane = |x: &str, lw: u32| if lw == 1 { format!("{}[{k}]", bus(x)) } else { format!("{}[{k}*{lw} +: {lw}]", bus(x)) };
-        let mut g = multiplier(plan.mul, acc_w, (lane_a, lane_b, sh_w), &lane);
+        let mut g = multiplier(plan.mul, dsp, acc_w, (lane_a, lane_b, sh_w), &lane);
         g.push(Item::Assign(lane("acc", acc_w), "accn".into()));
         body.push(Item::ForGenerate { var: k.clone(), count: n, label: format!("g_mul{gi}"), body: g });
     }
@@ -283,19 +285,36 @@ fn loads(gi: usize, li: u32, sr: &[Vec<(String, String)>; 6], body: &mut Vec<Ite
 
 /// One multiplier unit's datapath (the body of its group's generate loop): `lane` names its
 /// slice of the group's buses.
-fn multiplier(mul: MulUnit, acc_w: u32, (lane_a, lane_b, sh_w): (u32, u32, u32), lane: &dyn Fn(&str, u32) -> String) -> Vec<Item> {
+fn multiplier(
+    mul: MulUnit,
+    dsp: Option<&str>,
+    acc_w: u32,
+    (lane_a, lane_b, sh_w): (u32, u32, u32),
+    lane: &dyn Fn(&str, u32) -> String,
+) -> Vec<Item> {
     let mut g = Vec::new();
     match mul {
         MulUnit::Tile { bits } => {
             let pw = 2 * bits + 2;
-            g.extend([sreg("ra", bits + 1), sreg("rb", bits + 1), reg("f1", 1), reg("s1", 1)]);
+            if dsp.is_none() {
+                g.extend([sreg("ra", bits + 1), sreg("rb", bits + 1)]);
+            }
+            g.extend([reg("f1", 1), reg("s1", 1)]);
+            // The operand and product registers are the tile's own with `tri_fe_mul18`.
+            let pr = if dsp.is_some() { Item::Wire { name: "pr".into(), width: pw, signed: true, value: None } } else { sreg("pr", pw) };
             if acc_w < pw {
                 // The accumulator keeps the product's low bits only.
                 g.push(comment("verilator lint_off UNUSEDSIGNAL"));
-                g.push(sreg("pr", pw));
+                g.push(pr);
                 g.push(comment("verilator lint_on UNUSEDSIGNAL"));
             } else {
-                g.push(sreg("pr", pw));
+                g.push(pr);
+            }
+            if let Some(module) = dsp {
+                assert_eq!((lane_a, lane_b, pw), (mul18::BITS, mul18::BITS, mul18::P_BITS), "tri_fe_mul18 takes 18-bit lanes");
+                let (la, lb, a, b) = (lane("la", 1), lane("lb", 1), lane("a", lane_a), lane("b", lane_b));
+                let conns = mul18::MulConns { a: &a, b: &b, cea: &la, ceb: &lb, cep: "1'b1", p: "pr", signed: (true, true) };
+                g.push(mul18::instance(module, "u_tile", &conns));
             }
             g.extend([reg("acc", acc_w)]);
             let pe = if acc_w > pw { crate::verilog::sext("pr", pw, acc_w) } else { format!("pr[{}:0]", acc_w - 1) };
@@ -307,14 +326,17 @@ fn multiplier(mul: MulUnit, acc_w: u32, (lane_a, lane_b, sh_w): (u32, u32, u32),
             let up = if acc_w > bits { format!("{{accn[{}:0], {bits}'d0}}", acc_w - bits - 1) } else { format!("{acc_w}'d0") };
             g.push(wire("accn", acc_w, "acc + pe"));
             g.push(wire("held", acc_w, format!("f1 ? {acc_w}'d0 : s1 ? {up} : accn")));
-            g.push(Item::Always(vec![
-                Stmt::If(lane("la", 1), vec![set("ra", lane("a", lane_a))], vec![]),
-                Stmt::If(lane("lb", 1), vec![set("rb", lane("b", lane_b))], vec![]),
-                set("f1", lane("f", 1)),
-                set("s1", lane("sh", sh_w)),
-                set("pr", "ra * rb"),
-                set("acc", "held"),
-            ]));
+            let mut moves = Vec::new();
+            if dsp.is_none() {
+                moves.push(Stmt::If(lane("la", 1), vec![set("ra", lane("a", lane_a))], vec![]));
+                moves.push(Stmt::If(lane("lb", 1), vec![set("rb", lane("b", lane_b))], vec![]));
+            }
+            moves.extend([set("f1", lane("f", 1)), set("s1", lane("sh", sh_w))]);
+            if dsp.is_none() {
+                moves.push(set("pr", "ra * rb"));
+            }
+            moves.push(set("acc", "held"));
+            g.push(Item::Always(moves));
         }
         MulUnit::ShiftAdd { bits } => {
             g.extend([reg("pp", acc_w), reg("f2", 1), reg("acc", acc_w)]);

@@ -1,0 +1,133 @@
+//! `tri_fe_mul18`: an 18 x 18 product with registered operands and a registered product, the
+//! ECP5's MULT18X18D with its own input and output registers (issue 27). Yosys 0.23 never moves
+//! a `$mul`'s registers into the tile, and a fabric register next to a tile was the chain's
+//! critical path on the 25F (docs/fpga.md, *The span path's tiles with operand registers of
+//! their own, not kept*): instantiated, the tile's registers take the multiplier's 3.9 ns off
+//! the fabric's paths.
+//!
+//! Under synthesis (`SYNTHESIS`, which Yosys's `read_verilog` defines unless `-nosynthesis`) and
+//! not in a proof (`FORMAL`, which `read_verilog -formal` defines), the module is the primitive;
+//! everywhere else (Verilator, Icarus, the proofs) it is a model with the primitive's register
+//! semantics: each input register loads on its clock enable, the product register on its own,
+//! no reset (`RST0` tied low). A user's `synth_ecp5` on the generated folder gets the primitive
+//! with no define of its own (docs/design.md, *The front-end's MULT18X18D*).
+
+use crate::verilog::{assign, comment, reg, set, wire, Item, Module, Param, Port, Stmt};
+use crate::Names;
+
+/// Operand bits of the tile, and its product's.
+pub(super) const BITS: u32 = 18;
+pub(super) const P_BITS: u32 = 2 * BITS;
+
+/// What an instance connects: its operands (`BITS` bits each), the clock enables of the A and B
+/// input registers and of the product register, its product's net (`P_BITS` bits), and
+/// whether each operand is signed.
+pub(super) struct MulConns<'a> {
+    pub a: &'a str,
+    pub b: &'a str,
+    pub cea: &'a str,
+    pub ceb: &'a str,
+    pub cep: &'a str,
+    pub p: &'a str,
+    pub signed: (bool, bool),
+}
+
+/// An instance of the module named `module`, as `name`.
+pub(super) fn instance(module: &str, name: &str, c: &MulConns) -> Item {
+    let flag = |s: bool| if s { "1" } else { "0" }.to_string();
+    Item::Instance {
+        module: module.into(),
+        name: name.into(),
+        params: vec![("A_SIGNED".into(), flag(c.signed.0)), ("B_SIGNED".into(), flag(c.signed.1))],
+        conns: [("clk", "clk"), ("cea", c.cea), ("ceb", c.ceb), ("cep", c.cep), ("a", c.a), ("b", c.b), ("p", c.p)]
+            .map(|(k, v)| (k.to_string(), v.to_string()))
+            .into(),
+    }
+}
+
+/// The model: the primitive's registers, in the fabric.
+fn model() -> Vec<Item> {
+    let ext = |x: &str, s: &str| format!("{{{{{BITS}{{{s} != 0 && {x}[{}]}}}}, {x}}}", BITS - 1);
+    vec![
+        comment("Model: the primitive's input and product registers, each loaded on its clock enable."),
+        reg("ra", BITS),
+        reg("rb", BITS),
+        reg("rp", P_BITS),
+        // Each operand extended to the product's width by its signedness: the product modulo
+        // 2^36 is then the primitive's, signed or not.
+        wire("xa", P_BITS, ext("ra", "A_SIGNED")),
+        wire("xb", P_BITS, ext("rb", "B_SIGNED")),
+        wire("prod", P_BITS, "xa * xb"),
+        Item::Always(vec![
+            Stmt::If("cea".into(), vec![set("ra", "a")], vec![]),
+            Stmt::If("ceb".into(), vec![set("rb", "b")], vec![]),
+            Stmt::If("cep".into(), vec![set("rp", "prod")], vec![]),
+        ]),
+        assign("p", "rp"),
+    ]
+}
+
+/// The primitive: A and B registered on CLK0 with CE0 and CE1, the product on CLK0 with CE2, no
+/// pipeline register, reset tied low.
+fn primitive() -> Vec<Item> {
+    let mut params: Vec<(String, String)> = Vec::new();
+    for (reg, ce) in [("INPUTA", "CE0"), ("INPUTB", "CE1"), ("OUTPUT", "CE2")] {
+        params.push((format!("REG_{reg}_CLK"), "\"CLK0\"".into()));
+        params.push((format!("REG_{reg}_CE"), format!("\"{ce}\"")));
+        params.push((format!("REG_{reg}_RST"), "\"RST0\"".into()));
+    }
+    let mut conns: Vec<(String, String)> = Vec::new();
+    for (port, from) in [("A", "a"), ("B", "b")] {
+        conns.extend((0..BITS).map(|k| (format!("{port}{k}"), format!("{from}[{k}]"))));
+    }
+    conns.extend((0..BITS).map(|k| (format!("C{k}"), "1'b0".into())));
+    for (port, v) in [
+        ("SIGNEDA", "A_SIGNED != 0"),
+        ("SIGNEDB", "B_SIGNED != 0"),
+        ("SOURCEA", "1'b0"),
+        ("SOURCEB", "1'b0"),
+        ("CLK0", "clk"),
+        ("CE0", "cea"),
+        ("CE1", "ceb"),
+        ("CE2", "cep"),
+        ("RST0", "1'b0"),
+    ] {
+        conns.push((port.into(), v.into()));
+    }
+    conns.extend((0..P_BITS).map(|k| (format!("P{k}"), format!("p[{k}]"))));
+    vec![
+        comment("The ECP5's MULT18X18D with its input and output registers (nextpnr-ecp5 times them as registers)."),
+        Item::Instance { module: "MULT18X18D".into(), name: "u_dsp".into(), params, conns },
+    ]
+}
+
+/// The module: the primitive under synthesis, the model elsewhere.
+pub(super) fn module(names: &Names) -> Module {
+    let name = &names.fe_mul;
+    let header = vec![
+        format!("{name} — an 18 x 18 product of {}, its operands and product registered.", names.frontend),
+        "Generated by segshade hdl-gen; do not edit.".into(),
+        String::new(),
+        "p is the product of the operands cea and ceb loaded two clocks ago, loaded itself when cep was high the clock".into(),
+        "before: ra <= a on cea, rb <= b on ceb, p <= ra * rb on cep (modulo 2^36; an operand signed when its".into(),
+        "parameter says so). No reset.".into(),
+        "Under synthesis (SYNTHESIS defined, as Yosys's read_verilog does, and not FORMAL) it is the ECP5's MULT18X18D with".into(),
+        "its own input and output registers; elsewhere (Verilator, Icarus, the proofs) a model of the same registers.".into(),
+    ];
+    let params = vec![
+        Param { name: "A_SIGNED".into(), value: "0".into(), doc: "1: a is two's complement".into() },
+        Param { name: "B_SIGNED".into(), value: "0".into(), doc: "1: b is two's complement".into() },
+    ];
+    let ports = vec![
+        Port::input("clk", 1, "", "rising edge"),
+        Port::input("cea", 1, "", "load a into its register"),
+        Port::input("ceb", 1, "", "load b into its register"),
+        Port::input("cep", 1, "", "load the registers' product into p"),
+        Port::input("a", BITS, "integer", "signed when A_SIGNED"),
+        Port::input("b", BITS, "integer", "signed when B_SIGNED"),
+        Port::output("p", P_BITS, "integer", "the product, registered"),
+    ];
+    let under_synthesis = Item::IfDef { name: "FORMAL".into(), then: model(), els: primitive() };
+    let body = vec![Item::IfDef { name: "SYNTHESIS".into(), then: vec![under_synthesis], els: model() }];
+    Module { name: name.clone(), header, params, ports, body }
+}
