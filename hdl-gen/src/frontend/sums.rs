@@ -49,6 +49,15 @@ pub(super) fn walker(hw: &Hw) -> (Vec<Item>, Vec<Stmt>, Vec<Stmt>) {
         let carry = Stmt::If(format!("|(e_x_cy & {s})"), vec![set(&c, format!("{c} + w_g8"))], vec![]);
         step.push(Stmt::If(format!("|(e_x_on & {s})"), vec![set(&p, format!("{p} + {q}")), carry], vec![]));
     }
+    if super::walker::slotted(hw) {
+        // The right end's slots, on the same pairs of edges: slot a holds its own edge if that
+        // is an active right edge, else the other (the row stages' bounds, `walker::bound_registers`).
+        decls.push(comment("The right end's slots: w_ra (w_rb) when edge 0 (2) is an active right edge, else edge 1."));
+        for (r, (own, _)) in ["w_ra", "w_rb"].iter().zip(LEFT_SLOTS) {
+            decls.push(reg(r, 1));
+            load.push(set(*r, format!("e_act[{own}] && e_right[{own}]")));
+        }
+    }
     // The queue head's Gxn is read for its steps only, modulo 2^(K-2) and above its zero bits.
     decls.push(comment("verilator lint_off UNUSEDSIGNAL"));
     decls.push(wire("unused_s_gxn", 2 + z, format!("{{s_gxn[{}:{}], s_gxn[{}:0]}}", wd.k - 1, wd.k - 2, z - 1)));

@@ -99,6 +99,9 @@ pub struct EngineShape {
     /// phase (their last read) and takes the next triangle only after it; else it passes them
     /// on at the entry and takes the next one then.
     pub held: Option<u32>,
+    /// The queue's head is a register of its own (`u_queue.hd`, valid `hv`), refilled from its
+    /// memory while empty: an entry is the head a clock after it is in the memory.
+    pub head: bool,
 }
 
 /// A register stage of the front-end's span path: where it holds a span's valid, row, columns
