@@ -237,6 +237,7 @@ impl Reference<'_> {
             let qh = zext("f_qh", 1, pw + 1);
             link.extend([
                 assert("f_q_hv == f_qh"),
+                assert(format!("!f_qh || f_qn != {}", lit(qw, 0))),
                 assert(format!("f_q_mc == {} - {qh}", zext("f_qn", qw, pw + 1))),
                 assert(format!("f_q_mne == (f_q_mc != {})", lit(pw + 1, 0))),
                 when(format!("f_tin && f_qh && f_tp == {}", lit(pw, 0)), vec![assert("f_q_hd == f_tv")]),
