@@ -40,20 +40,10 @@ fn least_of_three(side: &str) -> String {
     format!("({} && {}) ? {side}0 : ({}) ? {side}1 : {side}2", c(0, 1), c(0, 2), c(1, 2))
 }
 
-/// Whether the row stages hold the edges' bounds by slot (the running sums' form): a triangle
-/// has at most two left edges and two right ones (its edges' dy sum to 0), so each end is the
-/// least of two slots' bounds, each slot a select of two edges ([`LEFT_SLOTS`]: the running
-/// sums' slots for the left end, the same pairs for the right), made as the walked row's bounds
-/// are registered. One compare and a select of two a clock where the least of three, three
-/// compares then a select of three, was the 25F's critical path (docs/fpga.md).
-pub(super) fn slotted(hw: &Hw) -> bool {
-    hw.run_sums() && hw.row_stage()
-}
-
 /// The first row stage's bound registers: `(register, the walker's value it loads, the screen's
-/// bound it lies within)`, each edge's two bounds, or each slot's ([`slotted`]).
+/// bound it lies within)`, each edge's two bounds, or each slot's ([`super::sums::slotted`]).
 pub(super) fn bound_registers(hw: &Hw) -> Vec<(String, String, &'static str)> {
-    if slotted(hw) {
+    if super::sums::slotted(hw) {
         let [(a, a_other), (b, b_other)] = LEFT_SLOTS;
         let pick = |sel: String, own: usize, other: usize, side: &str| format!("{sel} ? {side}{own} : {side}{other}");
         return vec![
@@ -113,9 +103,9 @@ fn sum_stage_registers(hw: &Hw) -> [Vec<(String, u32)>; 2] {
         return [Vec::new(), Vec::new()];
     }
     let sb = hw.fe.widths().sum_bits();
-    // The row stages hold the bounds by slot ([`slotted`]): slot a wins where its bound is the
+    // The row stages hold the bounds by slot ([`super::sums::slotted`]): slot a wins where its bound is the
     // lesser, so the slots' edges are not registered.
-    assert!(slotted(hw), "the running sums' row stages hold the bounds by slot");
+    assert!(super::sums::slotted(hw), "the running sums' row stages hold the bounds by slot");
     [vec![("wr_pa".into(), sb), ("wr_pb".into(), sb)], vec![("we_pa".into(), sb), ("we_pb".into(), sb), ("we_ga".into(), 1)]]
 }
 
@@ -152,7 +142,7 @@ fn row_stages(hw: &Hw, body: &mut Vec<Item>) {
     // The edges compared side by side, each end a three-way select: these compares and selects
     // then the add of the pixel test were one clock, the staged front-end's longest in the
     // walker (docs/fpga.md).
-    if slotted(hw) {
+    if super::sums::slotted(hw) {
         body.push(comment("The span's ends from the row's slots, each end's two compared: mg the smallest left-edge g"));
         body.push(comment("(x = -mg), hi3 the smallest right bound."));
         body.push(swire("mg_w", end_w, least_of_two("wr_la", "wr_lb")));
