@@ -38,8 +38,9 @@ fn row_stage_base(label: &str) -> Option<(verilator_harness::models::Model, u64,
 /// tile's operand register loaded on every clock (its registered load ignored: a held chunk
 /// overwritten), a tile port's registered select bit stuck at zero (a source never selected);
 /// and in `tri_frontend.v`, a triangle taken with no queue entry reserved for its
-/// result (the credits ignored), under backpressure heavy enough to fill the queue, which the
-/// clean model passes. Slow tier.
+/// result (the credits ignored), and in `tri_fe_queue.v` the registered head refilled from the
+/// memory while it holds an entry (that entry lost), under backpressure heavy enough to fill
+/// the queue, which the clean model passes. Slow tier.
 #[test]
 #[ignore]
 fn engine_planted_faults_are_caught() {
@@ -89,26 +90,45 @@ fn engine_planted_faults_are_caught() {
         run_frontend(info, seed, heavy, Stress::NONE, &tris)
     };
     assert!(run(&base).ok(), "the clean model under heavy backpressure");
-    let mut m = base.clone();
-    let top = &mut m.sources.iter_mut().find(|(n, _)| n == "tri_frontend.v").expect("the front-end's file").1;
-    let room = top.lines().find(|l| l.contains("wire q_room = cr != 0;")).expect("the credits' room").to_string();
-    *top = top.replacen(&room, &room.replacen("cr != 0", "1'b1", 1), 1);
-    m.tag = format!("{}_cfault", base.tag);
-    let report = run(&m);
-    eprintln!("a triangle taken with no queue entry for its result: {} mismatches", report.mismatch_count);
-    assert!(!report.ok(), "planted fault not caught: a triangle taken with no queue entry for its result");
+    let faults = [
+        (
+            "tri_frontend.v",
+            "wire q_room = cr != 0;",
+            "wire q_room = 1'b1;",
+            "cfault",
+            "a triangle taken with no queue entry for its result",
+        ),
+        (
+            "tri_fe_queue.v",
+            "wire ld = !hv && ne;",
+            "wire ld = ne;",
+            "qfault",
+            "the queue's registered head refilled while it holds an entry",
+        ),
+    ];
+    for (file, from, to, tag, what) in faults {
+        let mut m = base.clone();
+        let text = &mut m.sources.iter_mut().find(|(n, _)| n == file).unwrap_or_else(|| panic!("no {file}")).1;
+        assert!(text.contains(from), "{what}: the fault does not apply");
+        *text = text.replacen(from, to, 1);
+        m.tag = format!("{}_{tag}", base.tag);
+        let report = run(&m);
+        eprintln!("{what}: {} mismatches", report.mismatch_count);
+        assert!(!report.ok(), "planted fault not caught: {what}");
+    }
 }
 
 /// Negative controls of the walker behind the row stages (`--pipeline 1`, the ECP5 plan at
 /// 37x23, each a model built on first use): an edge's place among its rows moved onto its first
 /// row a row late, an edge starting at the walk's first row never entered, the DDA's carry read
 /// from the bit under the sign of its offset remainder `t = rem - thr`, `t` loaded without the
-/// `+ 1` of `-D` (carry-save), the span's left end taken from one edge alone in the row stages,
-/// and the walk's registered end made a row early (12,387, 17,918, 8,746, 12,054, 15,168 and
-/// 13,517 mismatches). Caught on the triangles the clean model passes
+/// `+ 1` of `-D` (carry-save), the span's left end taken from one slot alone in the row stages,
+/// the walk's registered end made a row early (12,387, 17,918, 8,746, 12,054, 15,168 and
+/// 13,517 mismatches before the slots), and the right end's slot a always edge 0 (edge 1 lost
+/// where it and edge 2 are the right edges). Caught on the triangles the clean model passes
 /// (`engine_spans_equal_golden_at_the_targets_pipeline_level`). (The place not moved past an
 /// edge's last row is no fault: beyond its end vertex an edge's line lies outside the triangle,
-/// so its bound never wins.) Slow tier: six models, about 15 s of CPU each to build.
+/// so its bound never wins.) Slow tier: seven models, about 15 s of CPU each to build.
 #[test]
 #[ignore]
 fn walker_planted_faults_are_caught() {
@@ -131,9 +151,11 @@ fn walker_planted_faults_are_caught() {
     let fe_text = text("tri_frontend.v");
     let mg = line(&fe_text, "the span's left end", &|l| l.contains("we_mg <= mg_w;"));
     let end = line(&fe_text, "the walk's end stepped", &|l| l.contains("w_end <= w_row + ") && l.contains(" == w_last;"));
+    let ra = line(&fe_text, "the right end's slot a", &|l| l.contains("w_ra <= e_act[0] && e_right[0];"));
     let faults = [
-        (mg.clone(), mg.replacen("mg_w", "wr_lg0", 1), "the span's left end from one edge alone"),
+        (mg.clone(), mg.replacen("mg_w", "wr_la", 1), "the span's left end from one slot alone"),
         (end.clone(), end.replacen("'d1 == w_last", "'d2 == w_last", 1), "the walk's registered end a row early"),
+        (ra.clone(), ra.replacen("e_act[0] && e_right[0]", "1'b1", 1), "the right end's slot a always edge 0"),
     ];
     assert_faults_caught(&base, "tri_frontend.v", "wsfault", faults, seed, &tris);
 }

@@ -31,6 +31,20 @@ pub fn left_slots(edges: &[EdgeWalk; 3]) -> [usize; 2] {
     LEFT_SLOTS.map(|(own, other)| if edges[own].active && !edges[own].right { own } else { other })
 }
 
+/// The right end's slots, on [`LEFT_SLOTS`]' pairs of edges: a triangle has at most two right
+/// edges as well (`dy > 0`, and its edges' dy sum to 0), so the span's right end is the lesser
+/// of two slots' bounds, each slot a select of two edges (the RTL's row stages hold both ends
+/// so: one compare an end, not three).
+pub fn right_slots(edges: &[EdgeWalk; 3]) -> [usize; 2] {
+    slots(edges, true, LEFT_SLOTS)
+}
+
+/// The slots of the edges on one side (`right`) on the pairs `pairs`: each its own edge if that
+/// is an active edge of the side, else the other.
+pub(crate) fn slots(edges: &[EdgeWalk; 3], right: bool, pairs: [(usize, usize); 2]) -> [usize; 2] {
+    pairs.map(|(own, other)| if edges[own].active && edges[own].right == right { own } else { other })
+}
+
 /// A fault planted in the running sums: the tests' negative controls.
 #[cfg_attr(not(test), allow(dead_code))]
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

@@ -646,8 +646,19 @@ fn running_sums_against_the_product(fraction: u64) {
         let z = Widths::GXN_ZEROS;
         let exact = |st: &TriSetup, c: u32, r: u32| ((2 * st.plane.s(c as i64, r as i64) + st.plane.a) / (2 * st.plane.a)) as u32;
         let (mut ties, mut caught, mut caught_i0) = (0u64, [0u64; 3], [0u64; 3]);
+        // Every active edge is in its side's slots (hdl-gen's row stages); slot b on 1, 2 misses some.
+        let mut missed_by_bad_pairs = 0u64;
         let per_kind = spans_of_every_kind(&mut rng, &fe, want, |t, st| {
             assert!(st.sums.is_some(), "the ECP5-25F form's set-up has the sums");
+            for right in [false, true] {
+                let side = |pairs| {
+                    let s = super::sums::slots(&st.edges, right, pairs);
+                    st.edges.iter().enumerate().all(|(k, e)| !(e.active && e.right == right) || s.contains(&k))
+                };
+                let ours = if right { super::sums::right_slots(&st.edges) } else { super::sums::left_slots(&st.edges) };
+                assert!(side(super::sums::LEFT_SLOTS) && ours == super::sums::slots(&st.edges, right, super::sums::LEFT_SLOTS), "{t:?}");
+                missed_by_bad_pairs += !side([(0, 1), (1, 2)]) as u64;
+            }
             let mut edges = st.edges;
             let mut row = st.first;
             let mut spans = 0;
@@ -681,6 +692,7 @@ fn running_sums_against_the_product(fraction: u64) {
         );
         assert!(per_kind.iter().all(|&n| n >= want / 6), "every kind of triangle: {per_kind:?}");
         assert!(caught.iter().all(|&c| c > 0), "a planted fault went uncaught on {screen:?}: {caught:?}");
+        assert!(missed_by_bad_pairs > 0, "slots on the wrong pairs went uncaught on {screen:?}");
         if screen == Screen::default() {
             assert!(ties > 0 && caught_i0.iter().all(|&c| c > 0), "ties {ties}, I0 caught {caught_i0:?}");
         }

@@ -56,7 +56,7 @@ fn queued(hw: &Hw, s: &Schedule) -> Vec<result::Field> {
 pub(super) fn result_queue(hw: &Hw, names: &Names) -> Module {
     let s = hw.engine().expect("the engine form");
     let widths: Vec<u32> = queued(hw, &s).iter().map(|f| f.w).collect();
-    queue_module(names, entry_bits(hw, &s), hw.queue_depth(), hw.sequential().is_some().then_some(&widths[..]))
+    queue_module(names, entry_bits(hw, &s), hw.queue_depth(), hw.sequential().is_some().then_some(&widths[..]), hw.queue_head())
 }
 
 fn plan_text(s: &Schedule) -> String {

@@ -58,6 +58,19 @@ impl Hw {
         self.engine_form() && self.sequential().is_none()
     }
 
+    /// Whether the set-up result queue's head is a register of its own (the pipelined engine's
+    /// queue, behind credits): the walker's loads then read a register, not the queue's memory
+    /// (its distributed RAM's read into an edge's load was a 25F critical path, docs/fpga.md).
+    pub fn queue_head(&self) -> bool {
+        self.queue_credit()
+    }
+
+    /// Clocks from a result's push into an empty queue until the walker can take it: 1, or 2
+    /// with a registered head, refilled from the memory the clock after the push.
+    pub fn queue_head_clocks(&self) -> u32 {
+        1 + self.queue_head() as u32
+    }
+
     /// The set-up result queue's entries: [`QUEUE_DEPTH`] behind the sequential engine; behind
     /// the pipelined one, with credits, as many as the freeze held (the two entries, a triangle
     /// per period in flight and the vertex register's), so the rate is kept.
@@ -140,11 +153,11 @@ impl Hw {
     /// per scanline, the span's division when it has two pixels or more).
     ///
     /// With the shared engine: up to II - 1 clocks waiting for the engine's entry slot, the
-    /// entry clock, the schedule's latency, the queue, the walker's load and the span path: the
+    /// entry clock, the schedule's latency, the queue ([`Hw::queue_head_clocks`]), the walker's load and the span path: the
     /// figure is the worst case of the slot's wait.
     pub fn latency(&self) -> u32 {
         if let Some((ii, latency, _)) = self.engine_timing() {
-            return ii + latency + 3 + self.i0_stages() + self.start_clocks();
+            return ii + latency + 2 + self.queue_head_clocks() + self.i0_stages() + self.start_clocks();
         }
         self.calc_clocks() + self.div_clocks() + 2 + self.i0_stages() + self.span_div_clocks() + self.start_clocks()
     }

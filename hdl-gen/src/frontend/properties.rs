@@ -67,6 +67,7 @@ pub(super) fn emit_engine(hw: &Hw, sp: &Stager) -> Item {
         capture: hw.sequential().is_some(),
         held: hw.sequential().map(|s| s.inputs_read_by()),
         walk_ram: super::span_seq::walk_ram::on(hw),
+        head: hw.queue_head(),
     };
     let mut shape = shape(hw, sp, SetupShape::Engine(engine));
     shape.starts = super::incremental::on(hw).then_some(hw.fe.start_product_clocks());
@@ -83,7 +84,9 @@ fn row_stage(hw: &Hw, j: u32) -> RowStage {
     // Per group (an edge's pair of bounds, or the span's two ends): each within the screen's,
     // then each at least `least`.
     let groups: Vec<[(String, &str); 2]> = if j == 1 {
-        (0..3).map(|k| [(format!("wr_lg{k}"), "lo0"), (format!("wr_ha{k}"), "hi0")]).collect()
+        let b = super::walker::bound_registers(hw);
+        let (lo, hi) = b.split_at(b.len() / 2);
+        lo.iter().zip(hi).map(|((l, _, sl), (h, _, sh))| [(l.clone(), *sl), (h.clone(), *sh)]).collect()
     } else {
         vec![[("we_mg".into(), "lo0"), ("we_hi3".into(), "hi0")]]
     };
@@ -281,9 +284,9 @@ impl Reference<'_> {
         b.push(wire("f_wend", 1, "f_wrow == f_wlast"));
         let empty = self.s.span_unit.as_ref().is_some_and(|u| u.take_when_empty);
         let take = match (&self.s.setup, self.s.starts) {
-            (SetupShape::Engine(e), None) if empty => format!("f_qn != {} && f_adv && !f_wv", lit(e.qw(), 0)),
-            (SetupShape::Engine(e), None) => format!("f_qn != {} && f_adv && (!f_wv || f_wend)", lit(e.qw(), 0)),
-            (SetupShape::Engine(e), Some(_)) => format!("f_qn != {} && ie_pv && f_adv && !ie_wait && (!f_wv || f_wend)", lit(e.qw(), 0)),
+            (SetupShape::Engine(e), None) if empty => format!("{} && f_adv && !f_wv", engine::head_ready(e)),
+            (SetupShape::Engine(e), None) => format!("{} && f_adv && (!f_wv || f_wend)", engine::head_ready(e)),
+            (SetupShape::Engine(e), Some(_)) => format!("{} && ie_pv && f_adv && !ie_wait && (!f_wv || f_wend)", engine::head_ready(e)),
             (_, Some(_)) => "f_sb && f_sh && ie_pv && f_adv && !ie_wait && (!f_wv || f_wend)".into(),
             (_, None) => "f_sb && f_sh && f_adv && (!f_wv || f_wend)".into(),
         };

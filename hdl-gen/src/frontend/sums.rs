@@ -20,6 +20,16 @@ fn onehot(k: usize) -> String {
     lit(3, 1 << k)
 }
 
+/// Whether the row stages hold the edges' bounds by slot (the running sums' form): a triangle
+/// has at most two left edges and two right ones (its edges' dy sum to 0), so each end is the
+/// least of two slots' bounds, each slot a select of two edges ([`LEFT_SLOTS`]: the running
+/// sums' slots for the left end, the same pairs for the right), made as the walked row's bounds
+/// are registered. One compare and a select of two a clock where the least of three, three
+/// compares then a select of three, was the 25F's critical path (docs/fpga.md).
+pub(super) fn slotted(hw: &Hw) -> bool {
+    hw.run_sums() && hw.row_stage()
+}
+
 /// The walker's declarations, its load (from the queue head) and its step (on the walker's
 /// next row, each slot as its edge steps).
 pub(super) fn walker(hw: &Hw) -> (Vec<Item>, Vec<Stmt>, Vec<Stmt>) {
@@ -48,6 +58,15 @@ pub(super) fn walker(hw: &Hw) -> (Vec<Item>, Vec<Stmt>, Vec<Stmt>) {
         // where the select was a LUT4 a bit).
         let carry = Stmt::If(format!("|(e_x_cy & {s})"), vec![set(&c, format!("{c} + w_g8"))], vec![]);
         step.push(Stmt::If(format!("|(e_x_on & {s})"), vec![set(&p, format!("{p} + {q}")), carry], vec![]));
+    }
+    if slotted(hw) {
+        // The right end's slots, on the same pairs of edges: slot a holds its own edge if that
+        // is an active right edge, else the other (the row stages' bounds, `walker::bound_registers`).
+        decls.push(comment("The right end's slots: w_ra (w_rb) when edge 0 (2) is an active right edge, else edge 1."));
+        for (r, (own, _)) in ["w_ra", "w_rb"].iter().zip(LEFT_SLOTS) {
+            decls.push(reg(r, 1));
+            load.push(set(*r, format!("e_act[{own}] && e_right[{own}]")));
+        }
     }
     // The queue head's Gxn is read for its steps only, modulo 2^(K-2) and above its zero bits.
     decls.push(comment("verilator lint_off UNUSEDSIGNAL"));

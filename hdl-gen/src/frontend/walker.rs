@@ -7,6 +7,7 @@ use super::edge;
 use super::hw::{slit, Hw};
 use crate::verilog::{assign, comment, lit, net, reg, set, sext, sreg, swire, wire, Item, Stmt};
 use crate::Names;
+use golden::frontend::sums::LEFT_SLOTS;
 use golden::frontend::{DiMode, Widths};
 
 /// The per-scanline dI's divider (the comparison option `--fe-di scanline`), and its counter's
@@ -95,6 +96,31 @@ fn side_by_side_ends(end_w: u32, body: &mut Vec<Item>) {
     body.push(wire("covered", 1, ok.join(" && ")));
 }
 
+/// The first row stage's bound registers: `(register, the walker's value it loads, the screen's
+/// bound it lies within)`, each edge's two bounds, or each slot's ([`super::sums::slotted`]).
+pub(super) fn bound_registers(hw: &Hw) -> Vec<(String, String, &'static str)> {
+    if super::sums::slotted(hw) {
+        let [(a, a_other), (b, b_other)] = LEFT_SLOTS;
+        let pick = |sel: String, own: usize, other: usize, side: &str| format!("{sel} ? {side}{own} : {side}{other}");
+        return vec![
+            ("wr_la".into(), pick(format!("w_sa[{a}]"), a, a_other, "lg"), "lo0"),
+            ("wr_lb".into(), pick(format!("w_sb[{b}]"), b, b_other, "lg"), "lo0"),
+            ("wr_ra".into(), pick("w_ra".into(), a, a_other, "ha"), "hi0"),
+            ("wr_rb".into(), pick("w_rb".into(), b, b_other, "ha"), "hi0"),
+        ];
+    }
+    let mut v = Vec::new();
+    for (side, screen) in [("lg", "lo0"), ("ha", "hi0")] {
+        v.extend((0..3).map(|k| (format!("wr_{side}{k}"), format!("{side}{k}"), screen)));
+    }
+    v
+}
+
+/// The least of two registers, `a` when they tie.
+fn least_of_two(a: &str, b: &str) -> String {
+    format!("({a} <= {b}) ? {a} : {b}")
+}
+
 /// Row stage `j`'s valid (1, 2): a row, with a pixel or not.
 pub(super) fn row_valid(j: u32) -> &'static str {
     ["wr_v", "we_v"][j as usize - 1]
@@ -123,9 +149,9 @@ pub(super) fn reads_gxn(hw: &Hw) -> bool {
     !hw.run_sums() || hw.fe.di == DiMode::Scanline
 }
 
-/// The running sums' row-stage registers (`Hw::run_sums`): the slots' sums and slot a's edge
-/// with the row's bounds, then the two sums again with the left end's choice (`we_ga`: slot a's
-/// edge wins) beside the span's ends. The source is selected from these registers
+/// The running sums' row-stage registers (`Hw::run_sums`): the slots' sums with the row's
+/// bounds, then the two sums again with the left end's choice (`we_ga`: slot a's bound is the
+/// lesser) beside the span's ends. The source is selected from these registers
 /// ([`sum_source`]): the compares, the choice and a 54-bit select in one clock into `we_gxs`
 /// were the merged front-end's critical path (docs/fpga.md).
 fn sum_stage_registers(hw: &Hw) -> [Vec<(String, u32)>; 2] {
@@ -133,10 +159,10 @@ fn sum_stage_registers(hw: &Hw) -> [Vec<(String, u32)>; 2] {
         return [Vec::new(), Vec::new()];
     }
     let sb = hw.fe.widths().sum_bits();
-    [
-        vec![("wr_pa".into(), sb), ("wr_pb".into(), sb), ("wr_sa".into(), 3)],
-        vec![("we_pa".into(), sb), ("we_pb".into(), sb), ("we_ga".into(), 1)],
-    ]
+    // The row stages hold the bounds by slot ([`super::sums::slotted`]): slot a wins where its bound is the
+    // lesser, so the slots' edges are not registered.
+    assert!(super::sums::slotted(hw), "the running sums' row stages hold the bounds by slot");
+    [vec![("wr_pa".into(), sb), ("wr_pb".into(), sb)], vec![("we_pa".into(), sb), ("we_pb".into(), sb), ("we_ga".into(), 1)]]
 }
 
 /// The span's `Gxn lo` source in the second row stage, `we_gxs`: selected from its registers, so
@@ -160,12 +186,9 @@ fn row_stages(hw: &Hw, body: &mut Vec<Item>) {
     let (v1, v2) = (row_valid(1), row_valid(2));
     body.push(reg(v1, 1));
     let mut moves = vec![set(v1, "w_valid")];
-    for side in ["lg", "ha"] {
-        for k in 0..3 {
-            let r = format!("wr_{side}{k}");
-            body.push(sreg(&r, end_w));
-            moves.push(set(r, format!("{side}{k}")));
-        }
+    for (r, v, _) in bound_registers(hw) {
+        body.push(sreg(&r, end_w));
+        moves.push(set(r, v));
     }
     for (n, w) in row_values(hw) {
         body.push(reg(&row_at(hw, n, 1), w));
@@ -175,26 +198,29 @@ fn row_stages(hw: &Hw, body: &mut Vec<Item>) {
     // The edges compared side by side, each end a three-way select: these compares and selects
     // then the add of the pixel test were one clock, the staged front-end's longest in the
     // walker (docs/fpga.md).
-    body.push(comment("The span's ends from the row's bounds, the edges compared side by side: mg the smallest"));
-    body.push(comment("left-edge g (x = -mg), hi3 the smallest right bound."));
-    for (end, side) in [("mg", "wr_lg"), ("hi3", "wr_ha")] {
-        body.push(swire(&format!("{end}_w"), end_w, least_of_three(side)));
+    if super::sums::slotted(hw) {
+        body.push(comment("The span's ends from the row's slots, each end's two compared: mg the smallest left-edge g"));
+        body.push(comment("(x = -mg), hi3 the smallest right bound."));
+        body.push(swire("mg_w", end_w, least_of_two("wr_la", "wr_lb")));
+        body.push(swire("hi3_w", end_w, least_of_two("wr_ra", "wr_rb")));
+    } else {
+        body.push(comment("The span's ends from the row's bounds, the edges compared side by side: mg the smallest"));
+        body.push(comment("left-edge g (x = -mg), hi3 the smallest right bound."));
+        for (end, side) in [("mg", "wr_lg"), ("hi3", "wr_ha")] {
+            body.push(swire(&format!("{end}_w"), end_w, least_of_three(side)));
+        }
     }
     let [first, second] = sum_stage_registers(hw);
     for (n, w) in first.iter().chain(&second) {
         body.push(reg(n, *w));
     }
     for (n, _) in &first {
-        let v = match n.as_str() {
-            "wr_pa" => super::sums::slot_sum("a"),
-            "wr_pb" => super::sums::slot_sum("b"),
-            _ => n.replace("wr_", "w_"),
-        };
+        let v = super::sums::slot_sum(n.strip_prefix("wr_p").expect("a slot's sum"));
         moves.push(set(n, v));
     }
     for (n, _) in &second {
         let v = match n.as_str() {
-            "we_ga" => super::sums::slot_a_wins("wr_lg", "wr_sa"),
+            "we_ga" => "wr_la <= wr_lb".to_string(),
             _ => n.replace("we_", "wr_"),
         };
         moves.push(set(n, v));
@@ -219,7 +245,7 @@ pub(super) fn row_registers(hw: &Hw) -> Vec<Vec<(String, u32, bool)>> {
     }
     let end_w = edge::end_width(hw);
     let mut first = vec![(row_valid(1).to_string(), 1, false)];
-    first.extend(["lg", "ha"].iter().flat_map(|side| (0..3).map(move |k| (format!("wr_{side}{k}"), end_w, true))));
+    first.extend(bound_registers(hw).into_iter().map(|(r, ..)| (r, end_w, true)));
     first.extend(row_values(hw).into_iter().map(|(n, w)| (row_at(hw, n, 1), w, false)));
     let [sums1, sums2] = sum_stage_registers(hw);
     first.extend(sums1.into_iter().map(|(n, w)| (n, w, false)));

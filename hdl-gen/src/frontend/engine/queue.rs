@@ -6,13 +6,24 @@
 //! the result into the tail entry as its program produces it (a write enable a field), and
 //! `push` then makes the tail an entry; the engine freezes while the queue is full and it has a
 //! field to write. The engine then holds no copy of the result (689 flip-flops at 640x480).
+//!
+//! The registered head (`head`, the pipelined engine's form behind credits): `dout` is a
+//! register the oldest entry is read into a clock after it leaves the memory, as a FIFO with a
+//! registered output, so the walker's loads read a register, not the memory's read multiplexer
+//! (the 25F's distributed RAM, whose read from `rd` into an edge's load was a critical path,
+//! docs/fpga.md). The head is refilled only while it is empty (its enable one LUT of two
+//! registers, not the walker's take): a result pushed into an empty queue is the head two
+//! clocks later, not one ([`crate::frontend::Hw::queue_head_clocks`]), and a take leaves the
+//! head empty for a clock, which a walked triangle's rows cover from its second row on.
 
 use crate::verilog::{comment, reg, set, sized, wire, Item, Kind, Module, Param, Port, Stmt};
 use crate::Names;
 
 /// The queue module, its parameters' defaults `w` bits and `depth` entries; with `capture`
-/// (the entry's fields' widths, least significant first) the tail is written a field at a time.
-pub(crate) fn module(names: &Names, w: u32, depth: u32, capture: Option<&[u32]>) -> Module {
+/// (the entry's fields' widths, least significant first) the tail is written a field at a time;
+/// with `head` the head is a register of its own (the module's doc).
+pub(crate) fn module(names: &Names, w: u32, depth: u32, capture: Option<&[u32]>, head: bool) -> Module {
+    assert!(!(head && capture.is_some()), "the registered head is the pipelined engine's queue's, not a capturing one's");
     // One entry only behind a sequential engine that captures into it (the sequential span
     // path's form, `Hw::queue_depth`): the walker copies the head as it takes it. Its pointers
     // then stay 0 (synthesis drops them and the read multiplexer).
@@ -29,7 +40,11 @@ pub(crate) fn module(names: &Names, w: u32, depth: u32, capture: Option<&[u32]>)
     match capture {
         None => header.extend([
             "push takes din at the tail (never when full: the engine freezes, or the front-end's credits hold a triangle back);".into(),
-            "pop drops the head; dout is the head while nonempty. Both in one clock are allowed.".into(),
+            if head {
+                "pop drops the head; dout is the head, a register, while nonempty. Both in one clock are allowed.".into()
+            } else {
+                "pop drops the head; dout is the head while nonempty. Both in one clock are allowed.".into()
+            },
         ]),
         Some(f) => header.extend([
             format!("we[k] writes field k of din into the tail entry ({} fields, W fixed by them); push makes the tail an", f.len()),
@@ -56,6 +71,12 @@ pub(crate) fn module(names: &Names, w: u32, depth: u32, capture: Option<&[u32]>)
         assert_eq!(f.iter().sum::<u32>(), w, "the fields fill the entry");
         ports.insert(4, Port::input("we", f.len() as u32, "", "per field: its bits of din into the tail entry"));
     }
+    if head {
+        header.extend([
+            "The head is a register (hd, hv: holds an entry), refilled from the memory while empty: an entry pushed into".into(),
+            "an empty queue is the head two clocks later, and a pop leaves the head empty for a clock.".into(),
+        ]);
+    }
     let mut body = vec![comment("Storage, pointers and the count.")];
     body.push(sized(Kind::Reg, "mem [0:DEPTH-1]", "W", None));
     body.push(sized(Kind::Reg, "rd", "PW", None));
@@ -69,11 +90,14 @@ pub(crate) fn module(names: &Names, w: u32, depth: u32, capture: Option<&[u32]>)
     body.push(sized(Kind::Localparam, "LAST", "PW", Some("DEPTH - 1".into())));
     body.push(sized(Kind::Localparam, "ALL", "PW+1", Some("DEPTH".into())));
     body.push(comment("verilator lint_on WIDTH"));
+    body.push(Item::Assign("full".into(), "cnt == ALL".into()));
+    let next = |p: &str| format!("({p} == LAST) ? {{PW{{1'b0}}}} : {p} + 1'b1");
+    if head {
+        return Module { name: names.fe_queue.clone(), header, params, ports, body: registered_head(body, &next) };
+    }
     body.push(Item::Assign("dout".into(), "mem[rd]".into()));
     body.push(Item::Assign("nonempty".into(), "ne".into()));
-    body.push(Item::Assign("full".into(), "cnt == ALL".into()));
     body.push(wire("do_pop", 1, "pop && ne"));
-    let next = |p: &str| format!("({p} == LAST) ? {{PW{{1'b0}}}} : {p} + 1'b1");
     let write = match capture {
         None => vec![Stmt::If("push".into(), vec![set("mem[wr]", "din")], vec![])],
         Some(f) => field_writes(f, "mem[wr]"),
@@ -96,6 +120,55 @@ pub(crate) fn module(names: &Names, w: u32, depth: u32, capture: Option<&[u32]>)
     ));
     body.push(Item::Always(st));
     Module { name: names.fe_queue.clone(), header, params, ports, body }
+}
+
+/// The registered head's storage and moves after the declarations `body` has (`ne` there is
+/// the memory's nonempty): `hd`/`hv` the head, `mc` the memory's count; `cnt` counts both, as
+/// the credits and `full` read it. The head loads (`ld`) only while empty, so its enable,
+/// fanned out to every bit of an entry, is one LUT of registers.
+fn registered_head(mut body: Vec<Item>, next: &dyn Fn(&str) -> String) -> Vec<Item> {
+    body.push(comment("The head register and the memory's count (cnt counts the head's entry too)."));
+    body.push(sized(Kind::Reg, "hd", "W", None));
+    body.push(reg("hv", 1));
+    body.push(sized(Kind::Reg, "mc", "PW+1", None));
+    body.push(Item::Assign("dout".into(), "hd".into()));
+    body.push(Item::Assign("nonempty".into(), "hv".into()));
+    body.push(wire("do_pop", 1, "pop && hv"));
+    body.push(wire("ld", 1, "!hv && ne"));
+    let count = |c: &str, up: &str, down: &str| {
+        Stmt::If(
+            format!("{up} && !{down}"),
+            vec![set(c, format!("{c} + 1'b1"))],
+            vec![Stmt::If(format!("{down} && !{up}"), vec![set(c, format!("{c} - 1'b1"))], vec![])],
+        )
+    };
+    let st = vec![
+        Stmt::If("push".into(), vec![set("mem[wr]", "din")], vec![]),
+        Stmt::If("ld".into(), vec![set("hd", "mem[rd]")], vec![]),
+        Stmt::If(
+            "rst".into(),
+            vec![
+                set("rd", "{PW{1'b0}}"),
+                set("wr", "{PW{1'b0}}"),
+                set("cnt", "{(PW+1){1'b0}}"),
+                set("mc", "{(PW+1){1'b0}}"),
+                set("ne", "1'b0"),
+                set("hv", "1'b0"),
+            ],
+            vec![
+                // The memory's nonempty after this clock: an entry in, two or more held, or the
+                // one held kept.
+                set("ne", "push || |mc[PW:1] || (ne && !ld)"),
+                set("hv", "ld || (hv && !do_pop)"),
+                Stmt::If("push".into(), vec![set("wr", next("wr"))], vec![]),
+                Stmt::If("ld".into(), vec![set("rd", next("rd"))], vec![]),
+                count("mc", "push", "ld"),
+                count("cnt", "push", "do_pop"),
+            ],
+        ),
+    ];
+    body.push(Item::Always(st));
+    body
 }
 
 /// Per field `k` of the entry (`fields`' widths, least significant first): `we[k]` writes its

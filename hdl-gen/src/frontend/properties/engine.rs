@@ -27,7 +27,25 @@ pub(super) fn engine_probes(e: &EngineShape) -> Vec<(String, String, u32)> {
         v.extend([("f_q_rd".into(), "u_queue.rd".into(), pw), ("f_q_wr".into(), "u_queue.wr".into(), pw)]);
     }
     v.extend((0..e.depth).map(|k| (format!("f_q_mem{k}"), format!("u_queue.mem[{k}]"), e.entry_w)));
+    if e.head {
+        v.extend([
+            ("f_q_hd".into(), "u_queue.hd".into(), e.entry_w),
+            ("f_q_hv".into(), "u_queue.hv".into(), 1),
+            ("f_q_mc".into(), "u_queue.mc".into(), pw + 1),
+            ("f_q_mne".into(), "u_queue.ne".into(), 1),
+        ]);
+    }
     v
+}
+
+/// Whether the reference's queue has a head the walker can take: an entry, or with a
+/// registered head ([`EngineShape::head`]) the head register's (`f_qh`).
+pub(super) fn head_ready(e: &EngineShape) -> String {
+    if e.head {
+        "f_qh".into()
+    } else {
+        format!("f_qn != {}", lit(e.qw(), 0))
+    }
 }
 
 /// The probes a one-entry queue has no register for: its pointers, always 0.
@@ -61,6 +79,10 @@ impl Reference<'_> {
         ];
         b.extend([reg("f_vf", 1), reg("f_ph", e.phw()), reg("f_vld", e.periods()), reg("f_qn", e.qw())]);
         b.extend([wire("f_pick", 1, "$anyseq"), reg("f_tin", 1), reg("f_tp", bits_for(e.depth - 1)), reg("f_tv", e.entry_w)]);
+        if e.head {
+            b.push(comment("The registered head holds an entry (f_qh): refilled from the memory only while empty."));
+            b.push(reg("f_qh", 1));
+        }
         b
     }
 
@@ -104,16 +126,23 @@ impl Reference<'_> {
         // Its place, below the depth (a result enters only with room), so within the pointer's bits.
         let place = format!("f_qn - {}", zext("f_take", 1, qw));
         st.push(when("f_qin && !f_tin && f_pick", vec![set("f_tin", "1'b1"), set("f_tv", pushed), set("f_tp", place)]));
+        if e.head {
+            // Empty, the head takes the memory's oldest entry (with no head, all f_qn are there).
+            st.push(Stmt::If("f_qh".into(), vec![set("f_qh", "!f_take")], vec![set("f_qh", format!("f_qn != {}", lit(qw, 0)))]));
+        }
         st.push(set("f_qn", format!("f_qn + {} - {}", zext("f_qin", 1, qw), zext("f_take", 1, qw))));
-        let reset =
+        let mut reset =
             vec![set("f_vf", "1'b0"), set("f_ph", lit(phw, 0)), set("f_vld", lit(n, 0)), set("f_qn", lit(qw, 0)), set("f_tin", "1'b0")];
+        if e.head {
+            reset.push(set("f_qh", "1'b0"));
+        }
         (reset, st)
     }
 
     /// The engine and its queue at their boundary with the front-end: results due when the
     /// reference says, the freeze, the queue's writes and reads, its order.
     pub(super) fn engine_ports(&self, e: &EngineShape) -> Vec<Item> {
-        let (depth, none) = (lit(e.qw(), e.depth as u64), lit(e.qw(), 0));
+        let depth = lit(e.qw(), e.depth as u64);
         let mut b = vec![comment("The engine: a result is due exactly at its schedule's latency after its entry plus the clocks")];
         if e.credit {
             b.push(comment("frozen (none: it never freezes, and the queue never holds more than its entries and those"));
@@ -135,9 +164,12 @@ impl Reference<'_> {
                 assert(format!("f_q_cnt <= {depth}")),
                 assert("q_in == f_qin"),
                 assert("take == f_take"),
-                assert(format!("q_ne == (f_qn != {none})")),
+                assert(format!("q_ne == ({})", head_ready(e))),
                 assert(format!("q_full == (f_qn == {depth})")),
-                when(format!("f_tin && f_tp == {}", lit(bits_for(e.depth - 1), 0)), vec![assert("q_head == f_tv")]),
+                when(
+                    format!("f_tin && f_tp == {}{}", lit(bits_for(e.depth - 1), 0), if e.head { " && f_qh" } else { "" }),
+                    vec![assert("q_head == f_tv")],
+                ),
             ],
         )]));
         if !e.credit {
@@ -193,14 +225,37 @@ impl Reference<'_> {
             let last = lit(pw, (e.depth - 1) as u64);
             link.extend([assert(format!("f_q_rd <= {last}")), assert(format!("f_q_wr <= {last}"))]);
         }
+        // The memory's count: every entry, or with a registered head those behind it.
+        let mem_cnt = if e.head { "f_q_mc" } else { "f_q_cnt" };
         link.extend([
             assert(format!("f_q_cnt == {}", zext("f_qn", qw, pw + 1))),
-            assert(format!("{rd} + f_q_cnt == {{1'b0, f_q_wr}} || {rd} + f_q_cnt == {{1'b0, f_q_wr}} + {}", lit(pw + 1, e.depth as u64))),
+            assert(format!(
+                "{rd} + {mem_cnt} == {{1'b0, f_q_wr}} || {rd} + {mem_cnt} == {{1'b0, f_q_wr}} + {}",
+                lit(pw + 1, e.depth as u64)
+            )),
         ]);
-        // The tracked entry is one the queue holds, in its memory word (rd + place) mod depth.
+        // The tracked entry is one the queue holds, in its memory word (rd + place) mod depth;
+        // with a registered head the head's entry is in hd, the others a place nearer rd.
         link.push(when("f_tin", vec![assert(format!("{} < f_qn", zext("f_tp", pw, qw)))]));
+        let mut place = format!("{rd} + {{1'b0, f_tp}}");
+        if e.head {
+            let qh = zext("f_qh", 1, pw + 1);
+            link.extend([
+                assert("f_q_hv == f_qh"),
+                assert(format!("!f_qh || f_qn != {}", lit(qw, 0))),
+                assert(format!("f_q_mc == {} - {qh}", zext("f_qn", qw, pw + 1))),
+                assert(format!("f_q_mne == (f_q_mc != {})", lit(pw + 1, 0))),
+                when(format!("f_tin && f_qh && f_tp == {}", lit(pw, 0)), vec![assert("f_q_hd == f_tv")]),
+            ]);
+            place = format!("{place} - {qh}");
+        }
         for k in 0..e.depth {
-            link.push(when(format!("f_tin && {}", wrap(format!("{rd} + {{1'b0, f_tp}}"), k)), vec![assert(format!("f_q_mem{k} == f_tv"))]));
+            let at = if e.head {
+                format!("f_tin && !(f_qh && f_tp == {}) && {}", lit(pw, 0), wrap(place.clone(), k))
+            } else {
+                format!("f_tin && {}", wrap(place.clone(), k))
+            };
+            link.push(when(at, vec![assert(format!("f_q_mem{k} == f_tv"))]));
         }
         if e.credit {
             // The credits: the entries neither held nor reserved.

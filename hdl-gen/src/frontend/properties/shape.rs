@@ -102,6 +102,9 @@ pub struct EngineShape {
     /// The walk's constants in block RAM (`span_seq::walk_ram`): its two slots, the engine's
     /// and the walked triangle's, are one exactly while the queue is full.
     pub walk_ram: bool,
+    /// The queue's head is a register of its own (`u_queue.hd`, valid `hv`), refilled from its
+    /// memory while empty: an entry is the head a clock after it is in the memory.
+    pub head: bool,
 }
 
 /// A register stage of the front-end's span path: where it holds a span's valid, row, columns
