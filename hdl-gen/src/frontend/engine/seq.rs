@@ -132,6 +132,7 @@ pub fn module(hw: &Hw, s: &SeqSchedule, name: &str) -> SeqEngine {
     assert_eq!(s.plan.units.div_bits, 1, "the RTL's divider takes a bit a clock");
     let pipe = hw.engine().expect("an engine form");
     let fields: Vec<Field> = fields(hw, &pipe);
+    assert!(fields.iter().all(|f| f.lo == 0), "the sequential engine writes whole values");
     assert_eq!(pipe.prog.out, s.prog.out, "one program");
     let w = s.cost.ram_width;
     let (words, flags) = s.words();
