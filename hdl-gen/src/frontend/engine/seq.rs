@@ -132,7 +132,6 @@ pub fn module(hw: &Hw, s: &SeqSchedule, name: &str) -> SeqEngine {
     assert_eq!(s.plan.units.div_bits, 1, "the RTL's divider takes a bit a clock");
     let pipe = hw.engine().expect("an engine form");
     let fields: Vec<Field> = fields(hw, &pipe);
-    assert!(fields.iter().all(|f| f.lo == 0), "the sequential engine writes whole values");
     assert_eq!(pipe.prog.out, s.prog.out, "one program");
     let w = s.cost.ram_width;
     let (words, flags) = s.words();
@@ -444,11 +443,12 @@ fn results(cx: &Cx, fields: &[Field], groups: &[V], b: &mut Vec<Item>) {
         match ops[f.v.0 as usize].kind {
             // A constant rides with the first computed field's write.
             Kind::Const(k) => {
-                parts.push(format!("{}'d{}", f.w, k));
+                parts.push(format!("{}'d{}", f.w, k >> f.lo));
                 we.push(format!("cap_ok && {}", cap(first)));
             }
             _ => {
-                parts.push(if f.w == 1 { "bus[0]".to_string() } else { format!("bus[{}:0]", f.w - 1) });
+                // A field's bits from `lo` up (the edges' D, rem, rs256 behind the row stages).
+                parts.push(if f.w == 1 { format!("bus[{}]", f.lo) } else { format!("bus[{}:{}]", f.lo + f.w - 1, f.lo) });
                 we.push(format!("cap_ok && {}", cap(f.v)));
             }
         }
