@@ -260,16 +260,12 @@ pub(super) fn module(hw: &Hw, names: &Names) -> Module {
     ports.extend(walker_ports(&e));
     ports.extend(state_ports(hw));
     let mut body = vec![comment("Set-up: the edge's rows, side and divisor, held until the walker takes them.")];
-    body.extend([reg("s_act", 1), reg("s_right", 1), reg("s_rs", row_w), reg("s_re", row_w), reg("s_d", ediv_w)]);
+    // Behind the row stages the DDA takes D's high bits alone (`held_w`): |dy| itself.
+    let s_d = if e.tracked { "ady".to_string() } else { format!("{{ady, {SCALE_BITS}'d0}}") };
+    body.extend([reg("s_act", 1), reg("s_right", 1), reg("s_rs", row_w), reg("s_re", row_w), reg("s_d", e.held_w())]);
     body.push(Item::Always(vec![Stmt::If(
         "calc_go".into(),
-        vec![
-            set("s_act", "act"),
-            set("s_right", "right"),
-            set("s_rs", "rs"),
-            set("s_re", "re"),
-            set("s_d", format!("{{ady, {SCALE_BITS}'d0}}")),
-        ],
+        vec![set("s_act", "act"), set("s_right", "right"), set("s_rs", "rs"), set("s_re", "re"), set("s_d", s_d)],
         vec![],
     )]));
     body.push(comment("Its divisions: the first bound (ei) and the step (es), q - B = g."));
@@ -284,7 +280,7 @@ pub(super) fn module(hw: &Hw, names: &Names) -> Module {
     // Behind the row stages the DDA holds the bits above SCALE_BITS (`held_w`): rs256's are the
     // step's remainder itself, D's |dy|.
     let (rs256, rem, d) = if e.tracked {
-        (format!("es_p[{}:0]", vy_w - 1), format!("ei_p[{}:{SCALE_BITS}]", ediv_w - 1), format!("s_d[{}:{SCALE_BITS}]", ediv_w - 1))
+        (format!("es_p[{}:0]", vy_w - 1), format!("ei_p[{}:{SCALE_BITS}]", ediv_w - 1), "s_d".to_string())
     } else {
         (format!("{{es_p[{}:0], {SCALE_BITS}'d0}}", vy_w - 1), format!("ei_p[{}:0]", ediv_w - 1), "s_d".to_string())
     };
