@@ -121,11 +121,11 @@ fn engine_planted_faults_are_caught() {
 /// Negative controls of the walker behind the row stages (`--pipeline 1`, the ECP5 plan at
 /// 37x23, each a model built on first use): an edge's place among its rows moved onto its first
 /// row a row late, an edge starting at the walk's first row never entered, the DDA's carry read
-/// from the bit under the sign of its offset remainder `t = rem - thr`, `t` loaded without the
-/// `+ 1` of `-D` (carry-save), the span's left end taken from one slot alone in the row stages,
-/// the walk's registered end made a row early (12,387, 17,918, 8,746, 12,054, 15,168 and
-/// 13,517 mismatches before the slots), and the right end's slot a always edge 0 (edge 1 lost
-/// where it and edge 2 are the right edges). Caught on the triangles the clean model passes
+/// from the bit under the sign of its offset remainder `t = rem - thr`, `t` loaded one too
+/// large, the engine's `t` formed with the previous triangle's `thr`, the span's left end taken
+/// from one slot alone in the row stages, the walk's registered end made a row early, and the
+/// right end's slot a always edge 0 (edge 1 lost where it and edge 2 are the right edges).
+/// Caught on the triangles the clean model passes
 /// (`engine_spans_equal_golden_at_the_targets_pipeline_level`). (The place not moved past an
 /// edge's last row is no fault: beyond its end vertex an edge's line lies outside the triangle,
 /// so its bound never wins.) Slow tier: seven models, about 15 s of CPU each to build.
@@ -140,14 +140,23 @@ fn walker_planted_faults_are_caught() {
     let one = step.split(" + ").nth(1).and_then(|t| t.split(" == ").next()).expect("the step's row + 1").to_string();
     let carry = line(&edge, "the carry from t's sign", &|l| l.contains("wire cy = !w_t["));
     let sign: u32 = carry.split("!w_t[").nth(1).and_then(|t| t.split(']').next()).and_then(|b| b.parse().ok()).expect("t's sign bit");
-    let t_load = line(&edge, "t's carry-save load", &|l| l.contains("w_t <= t_x + {t_m, 1'b1};"));
+    let t_load = line(&edge, "t's load from the engine", &|l| l.contains("w_t <= t;"));
     let faults = [
         (step.clone(), step.replacen(&format!(" + {one}"), "", 1), "an edge's first row entered a row late"),
         (load.clone(), load.replacen(">=", ">", 1), "an edge starting at the walk's first row never entered"),
         (carry.clone(), carry.replacen(&format!("[{sign}]"), &format!("[{}]", sign - 1), 1), "the carry from the bit under t's sign"),
-        (t_load.clone(), t_load.replacen("1'b1}", "1'b0}", 1), "t loaded without the + 1 of -D"),
+        (t_load.clone(), t_load.replacen("t;", "t + 1'b1;", 1), "t loaded one too large"),
     ];
     assert_faults_caught(&base, "tri_fe_edge.v", "wfault", faults, seed, &tris);
+    // The engine's DDA start (golden's `Plan::edge_t`): t = (rem >> 8) - thr with the previous
+    // triangle's thr (a copy off by one period).
+    let engine = text("tri_fe_engine.v");
+    let t_op = line(&engine, "the engine's t = (rem >> 8) - thr", &|l| {
+        l.trim_start().starts_with("wire [") && l.contains("_rem_0} - ") && l.contains("_thr")
+    });
+    let (head, tail) = t_op.rsplit_once("_0}").expect("thr's copy 0");
+    let faults = [(t_op.clone(), format!("{head}_1}}{tail}"), "t formed with the previous triangle's thr")];
+    assert_faults_caught(&base, "tri_fe_engine.v", "tfault", faults, seed, &tris);
     let fe_text = text("tri_frontend.v");
     let mg = line(&fe_text, "the span's left end", &|l| l.contains("we_mg <= mg_w;"));
     let end = line(&fe_text, "the walk's end stepped", &|l| l.contains("w_end <= w_row + ") && l.contains(" == w_last;"));

@@ -87,6 +87,12 @@ pub struct Plan {
     /// `(Nx g) << s` and `(Nx Qs) << s` modulo 2^(K-10), six products and six shifts more.
     #[serde(default, skip_serializing_if = "std::ops::Not::not")]
     pub run_sums: bool,
+    /// Each edge's DDA start in the form the walker's edges hold behind the row stages
+    /// ([`EdgeOut::dda`]): `thr = (D - rs256) / 256` and `t = rem / 256 - thr`, two subtracts
+    /// on the engine's carry chains where each edge's load formed `rem + rs256 - D` carry-save
+    /// and `D - rs256` (docs/fpga.md).
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub edge_t: bool,
     /// Shared barrel shifters for the normalising shifts by a value (`ShlBy`: `2A`, and the
     /// plane's terms by `s`); 0: each shift its own logic, as CALC's. Five 64-bit shifts by a
     /// 6-bit amount were about 1,560 of the ECP5 plan's engine LUT4 (docs/fpga.md).
@@ -121,6 +127,7 @@ impl Plan {
         reciprocal: true,
         i0_steps: false,
         run_sums: true,
+        edge_t: true,
         shifters: 1,
     };
     /// For the iCE40 UP5K: 2 of its SB_MAC16 and one 1-bit divider, the smallest engine. 15-bit
@@ -134,6 +141,7 @@ impl Plan {
         reciprocal: true,
         i0_steps: false,
         run_sums: false,
+        edge_t: false,
         shifters: 1,
     };
     /// For the iCE40 HX8K, which has no multiplier: one shift-add unit and one divider, a bit a clock.
@@ -146,6 +154,7 @@ impl Plan {
         reciprocal: false,
         i0_steps: false,
         run_sums: false,
+        edge_t: false,
         shifters: 1,
     };
 }
@@ -245,6 +254,10 @@ pub struct EdgeOut {
     pub d: V,
     pub qs: V,
     pub rs256: V,
+    /// With [`Plan::edge_t`]: the DDA's start on the bits above D's eight zero bits, `(thr, t)`
+    /// with `thr = (D - rs256) >> 8` (`|dy|` bits) and `t = (rem >> 8) - thr` (one more,
+    /// signed). `rem >= D - rs256` exactly when `t >= 0`: the walker's carry is `t`'s sign.
+    pub dda: Option<(V, V)>,
 }
 
 /// A step's results: whether it is in range, its quotient and normalised remainder.
@@ -286,6 +299,7 @@ impl Outputs {
         v.extend([self.tn, self.dyn_, self.gxn, self.i0a, self.nx, self.ny, self.a]);
         for e in &self.edges {
             v.extend([e.dyz, e.right, e.active, e.rs, e.re, e.g, e.rem, e.d, e.qs, e.rs256]);
+            v.extend(e.dda.iter().flat_map(|&(thr, t)| [thr, t]));
         }
         if let Some((c0, edge)) = &self.steps {
             for s in std::iter::once(c0).chain(edge.iter().flatten()) {
@@ -366,6 +380,12 @@ impl Program {
 
     /// Evaluates the program in order, every operand ready: the reference for the schedule.
     pub fn eval(&self, t: &super::FixedTriangle) -> (Outcome, Option<TriSetup>, Option<Steps>) {
+        let val = self.values(t);
+        self.out.extract(t, |v| val[v.0 as usize])
+    }
+
+    /// Every operation's value, in order, each wrapped to its width.
+    pub fn values(&self, t: &super::FixedTriangle) -> Vec<i128> {
         let inputs = Self::inputs(t);
         let mut val = vec![0i128; self.ops.len()];
         let mut rem = vec![0i128; self.ops.len()];
@@ -376,7 +396,7 @@ impl Program {
             };
             (val[o], rem[o]) = compute(op, &x, &inputs);
         }
-        self.out.extract(t, |v| val[v.0 as usize])
+        val
     }
 }
 

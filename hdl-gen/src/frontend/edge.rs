@@ -32,6 +32,9 @@ struct EdgeWidths {
     tracked: bool,
     /// The lean DDA behind the sequential span path (the iCE40 forms): see [`dda`].
     lean: bool,
+    /// The engine forms the DDA's start, `thr` and `t` (golden's `Plan::edge_t`): the edge
+    /// loads them as they come, without `D` and `rem` (see [`dda`]).
+    engine_t: bool,
 }
 
 impl EdgeWidths {
@@ -50,6 +53,7 @@ impl EdgeWidths {
             cnt_w: counter_width(&wd),
             tracked: hw.row_stage(),
             lean: hw.engine_form() && hw.fe.span_seq().is_some() && !hw.row_stage(),
+            engine_t: hw.row_stage() && hw.fe.setup.plan().is_some_and(|p| p.edge_t),
         }
     }
 
@@ -57,6 +61,29 @@ impl EdgeWidths {
     fn high_w(&self) -> u32 {
         self.ediv_w - SCALE_BITS
     }
+
+    /// The width the edge takes and holds `D`, `rem` and `rs256` in: their bits above
+    /// [`SCALE_BITS`] behind the row stages (see [`dda`]), else whole.
+    fn held_w(&self) -> u32 {
+        if self.tracked {
+            self.high_w()
+        } else {
+            self.ediv_w
+        }
+    }
+}
+
+/// How many low bits of `D`, `rem` and `rs256` the edges never read: the set-up result leaves
+/// them out (`engine::result::fields`). Behind the row stages the DDA holds the high bits alone.
+pub(super) fn dropped_low_bits(hw: &Hw) -> u32 {
+    let e = EdgeWidths::new(hw);
+    e.ediv_w - e.held_w()
+}
+
+/// Whether the edges take the DDA's start `thr` and `t` from the engine, in place of `D` and
+/// `rem` (`engine::result::fields`).
+pub(super) fn start_from_engine(hw: &Hw) -> bool {
+    EdgeWidths::new(hw).engine_t
 }
 
 /// The per-edge values CALC hands on and the edges' bounds the walker reads: buses of three lanes,
@@ -71,17 +98,19 @@ pub(super) fn input_buses(hw: &Hw) -> EdgeBuses {
     let e = EdgeWidths::new(hw);
     if hw.engine_form() {
         // The shared engine's result: the edge's set-up complete, divisions made.
+        let dw = e.held_w();
+        let (d, rem) = if e.engine_t { (("thr", "e_thr", dw), ("t", "e_t", dw + 1)) } else { (("d", "e_d", dw), ("rem", "e_rem", dw)) };
         return EdgeBuses {
             inputs: vec![
                 ("act", "e_act", 1),
                 ("right", "e_right", 1),
                 ("rs", "e_rs", e.row_w),
                 ("re", "e_re", e.row_w),
-                ("d", "e_d", e.ediv_w),
+                d,
                 ("g", "e_g", e.bound_w),
-                ("rem", "e_rem", e.ediv_w),
+                rem,
                 ("qs", "e_qs", e.bound_w),
-                ("rs256", "e_rs256", e.ediv_w),
+                ("rs256", "e_rs256", dw),
             ],
         };
     }
@@ -231,16 +260,12 @@ pub(super) fn module(hw: &Hw, names: &Names) -> Module {
     ports.extend(walker_ports(&e));
     ports.extend(state_ports(hw));
     let mut body = vec![comment("Set-up: the edge's rows, side and divisor, held until the walker takes them.")];
-    body.extend([reg("s_act", 1), reg("s_right", 1), reg("s_rs", row_w), reg("s_re", row_w), reg("s_d", ediv_w)]);
+    // Behind the row stages the DDA takes D's high bits alone (`held_w`): |dy| itself.
+    let s_d = if e.tracked { "ady".to_string() } else { format!("{{ady, {SCALE_BITS}'d0}}") };
+    body.extend([reg("s_act", 1), reg("s_right", 1), reg("s_rs", row_w), reg("s_re", row_w), reg("s_d", e.held_w())]);
     body.push(Item::Always(vec![Stmt::If(
         "calc_go".into(),
-        vec![
-            set("s_act", "act"),
-            set("s_right", "right"),
-            set("s_rs", "rs"),
-            set("s_re", "re"),
-            set("s_d", format!("{{ady, {SCALE_BITS}'d0}}")),
-        ],
+        vec![set("s_act", "act"), set("s_right", "right"), set("s_rs", "rs"), set("s_re", "re"), set("s_d", s_d)],
         vec![],
     )]));
     body.push(comment("Its divisions: the first bound (ei) and the step (es), q - B = g."));
@@ -252,16 +277,22 @@ pub(super) fn module(hw: &Hw, names: &Names) -> Module {
         body.extend(d.instance(&names.fe_div, hw.div_bits, cnt_w, &conns, &["q"]));
     }
     let flip = |q: &str| offset_to_signed(q, bound_w);
-    let rs256 = format!("{{es_p[{}:0], {SCALE_BITS}'d0}}", vy_w - 1);
+    // Behind the row stages the DDA holds the bits above SCALE_BITS (`held_w`): rs256's are the
+    // step's remainder itself, D's |dy|.
+    let (rs256, rem, d) = if e.tracked {
+        (format!("es_p[{}:0]", vy_w - 1), format!("ei_p[{}:{SCALE_BITS}]", ediv_w - 1), "s_d".to_string())
+    } else {
+        (format!("{{es_p[{}:0], {SCALE_BITS}'d0}}", vy_w - 1), format!("ei_p[{}:0]", ediv_w - 1), "s_d".to_string())
+    };
     body.extend(dda(&e));
     let load = vec![
         set("w_act", "s_act"),
         set("w_right", "s_right"),
         set("w_rs", "s_rs"),
         set("w_re", "s_re"),
-        set("w_thr", format!("s_d - {rs256}")),
+        set("w_thr", format!("{d} - {rs256}")),
         set("w_g", flip("ei_q")),
-        rem_load(&e, &mut body, (&format!("ei_p[{}:0]", ediv_w - 1), &rs256, "s_d")),
+        rem_load(&e, &mut body, (&rem, &rs256, &d)),
         set("w_qs", flip("es_q")),
         set("w_qs1", format!("{} + {}", flip("es_q"), zext("1'b1", 1, bound_w))),
         set("w_rs256", rs256),
@@ -306,12 +337,19 @@ fn dda(e: &EdgeWidths) -> Vec<Item> {
         // the add, compare, add it chained was the staged front-end's clock once the row stage
         // took the span's decision off the walker (docs/fpga.md).
         body.push(comment("thr = D - rs256 (> 0: rs256 < D), qs1 = qs + 1: the carry and both steps side by side."));
-        body.extend([reg("w_act", 1), reg("w_right", 1), reg("w_rs", row_w), reg("w_re", row_w), reg("w_thr", ediv_w)]);
+        if tracked {
+            body.push(comment("D, rs256 and thr end in eight zero bits: rem's low byte never carries nor moves, so rem, thr and rs256 are their high bits."));
+        }
+        // Behind the row stages only the bits above SCALE_BITS are held (`held_w`): thr is a
+        // multiple of 256, so rem >= thr is decided by rem's high bits, and the low byte of
+        // rem + rs256 never changes.
+        let dw = e.held_w();
+        body.extend([reg("w_act", 1), reg("w_right", 1), reg("w_rs", row_w), reg("w_re", row_w), reg("w_thr", dw)]);
         // Behind the row stages the remainder is held offset by the threshold, so the carry is
         // that register's sign: the compare on the carry chain, then the walker's running sums'
         // enables, was the ECP5 target's critical path (docs/fpga.md).
-        body.push(if tracked { sreg("w_t", ediv_w + 1) } else { reg("w_rem", ediv_w) });
-        body.extend([reg("w_rs256", ediv_w), sreg("w_g", bound_w), sreg("w_qs", bound_w), sreg("w_qs1", bound_w)]);
+        body.push(if tracked { sreg("w_t", dw + 1) } else { reg("w_rem", dw) });
+        body.extend([reg("w_rs256", dw), sreg("w_g", bound_w), sreg("w_qs", bound_w), sreg("w_qs1", bound_w)]);
     }
     if tracked {
         body.push(comment("The walked row among the edge's rows, moved with it: w_ge = row >= rs, w_le = row <= re."));
@@ -348,10 +386,11 @@ fn dda(e: &EdgeWidths) -> Vec<Item> {
     if tracked {
         // The carry rem >= thr is t >= 0 for t = rem - thr: a register's sign. Both next t side by
         // side, rem - thr - thr and rem + rs256 - thr; t's range is -thr..rs256 - 1 (0 <= rem < D).
-        let t = |e: &str| zext(e, ediv_w, ediv_w + 1);
+        let dw = e.held_w();
+        let t = |e: &str| zext(e, dw, dw + 1);
         body.push(comment("w_t = rem - thr: the carry is its sign."));
-        body.push(wire("cy", 1, format!("!w_t[{ediv_w}]")));
-        body.push(swire("tnext", ediv_w + 1, format!("cy ? w_t - {} : w_t + {}", t("w_thr"), t("w_rs256"))));
+        body.push(wire("cy", 1, format!("!w_t[{dw}]")));
+        body.push(swire("tnext", dw + 1, format!("cy ? w_t - {} : w_t + {}", t("w_thr"), t("w_rs256"))));
     } else {
         body.push(wire("cy", 1, "w_rem >= w_thr"));
         body.push(wire("rnext", ediv_w, "cy ? w_rem - w_thr : w_rem + w_rs256"));
@@ -365,7 +404,7 @@ fn dda(e: &EdgeWidths) -> Vec<Item> {
 /// `rem + rs256 + ~D + 1` as the bits' sum plus their majority a place up with the 1 below it:
 /// one LUT then one carry chain from the queue head, as the load's `D - rs256`, not two chains.
 fn rem_load(e: &EdgeWidths, body: &mut Vec<Item>, (rem, rs256, d): (&str, &str, &str)) -> Stmt {
-    let w = e.ediv_w;
+    let w = e.held_w();
     if !e.tracked {
         return set("w_rem", rem);
     }
@@ -433,9 +472,14 @@ fn module_engine(hw: &Hw, names: &Names) -> Module {
     } else {
         ["act", "right", "rs", "re", "g", "qs", "rs256"].map(|p| set(format!("w_{p}"), p)).to_vec()
     };
-    if !e.lean {
+    if e.engine_t {
+        load.extend([set("w_t", "t"), set("w_thr", "thr")]);
+    } else if !e.lean {
         load.push(rem_load(&e, &mut body, ("rem", "rs256", "d")));
-        load.extend([set("w_thr", "d - rs256"), set("w_qs1", format!("qs + {}", zext("1'b1", 1, bound_w)))]);
+        load.push(set("w_thr", "d - rs256"));
+    }
+    if !e.lean {
+        load.push(set("w_qs1", format!("qs + {}", zext("1'b1", 1, bound_w))));
     }
     body.push(walk(&e, load, ("rs", "re")));
     body.extend(state_outputs(hw).into_iter().map(|(port, _, _, signal, _)| Item::Assign(port.into(), signal)));

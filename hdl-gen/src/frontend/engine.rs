@@ -184,7 +184,8 @@ pub(super) fn module(hw: &Hw, names: &Names) -> Module {
     let at = |x: V, w: u32| v.at(x, s.latency).ext(w);
     body.push(Item::Assign("res_guard".into(), at(s.prog.out.guard_ok, 1)));
     body.push(Item::Assign("res_cull".into(), at(s.prog.out.cull, 1)));
-    let parts: Vec<String> = fields.iter().rev().map(|f| at(f.v, f.w)).collect();
+    let parts: Vec<String> =
+        fields.iter().rev().map(|f| if f.lo == 0 { at(f.v, f.w) } else { v.at(f.v, s.latency).bits(f.lo, f.w) }).collect();
     body.push(Item::Assign("res".into(), format!("{{{}}}", parts.join(", "))));
     Module { name: names.fe_engine.clone(), header, params: vec![], ports, body }
 }

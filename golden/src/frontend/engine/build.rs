@@ -202,8 +202,11 @@ impl Program {
         // |dy| (`edge`); today's (`DivForm::ShiftDivisor`, the parallel form's, which the LUT
         // estimate's calibration counts) by D.
         let short_g = plan.div_form == DivForm::ShiftRemainder;
-        let edges: Vec<EdgeOut> =
-            dirs.iter().enumerate().map(|(k, dir)| edge(&mut b, &wd, k, dir, &x, &y, (&rt, &rb), (first, last), short_g)).collect();
+        let edges: Vec<EdgeOut> = dirs
+            .iter()
+            .enumerate()
+            .map(|(k, dir)| edge(&mut b, &wd, k, dir, &x, &y, (&rt, &rb), (first, last), (short_g, plan.edge_t)))
+            .collect();
         // The plane: the normal from unoriented products, oriented.
         let d1 = b.sub("d1", i[1], i[0], iw + 1);
         let d2 = b.sub("d2", i[2], i[0], iw + 1);
@@ -419,7 +422,7 @@ fn edge(
     y: &[V; 3],
     (rt, rb): (&[V; 3], &[V; 3]),
     (first, last): (V, V),
-    short_g: bool,
+    (short_g, edge_t): (bool, bool),
 ) -> EdgeOut {
     let Widths { cx, cy, gw, .. } = *wd;
     let Dir { ea, dx, dy, up, dyz, ntl } = *dir;
@@ -454,7 +457,7 @@ fn edge(
     let e = b.sub(&format!("et{k}"), e, ntl, cx + cy + 5);
     let bd = b.shl(&format!("BD{k}"), d, gw - 1, wd.dw_edge + gw, false);
     let n = b.add(&format!("n{k}"), e, bd, cx + cy + 5);
-    let (gb, rem) = if short_g {
+    let (gb, rem, rh) = if short_g {
         // D = 256 |dy| has eight zero bits: floor(n / D) = floor((n >> 8) / |dy|), and the
         // remainder is that division's, shifted back, with n's low byte. So the divider is as
         // wide as |dy| (CY bits, as Qs's), not as D (CY + 8): Qs's and g's dividers are one width.
@@ -463,10 +466,18 @@ fn edge(
         let nl = b.op(format!("n{k}lo"), Kind::Add(n, zero), 8, false);
         let (gb, rh) = b.div(&format!("g{k}"), nh, ady, gw, gw + cy, cy);
         let rh8 = b.shl(&format!("rem8_{k}"), rh, 8, wd.dw_edge, false);
-        (gb, b.op(format!("rem{k}"), Kind::Add(rh8, nl), wd.dw_edge, false))
+        (gb, b.op(format!("rem{k}"), Kind::Add(rh8, nl), wd.dw_edge, false), Some(rh))
     } else {
-        b.div(&format!("g{k}"), n, d, gw, gw + wd.dw_edge, wd.dw_edge)
+        let (gb, rem) = b.div(&format!("g{k}"), n, d, gw, gw + wd.dw_edge, wd.dw_edge);
+        (gb, rem, None)
     };
     let g = b.add_c(&format!("g{k}-B"), gb, -bias, gw);
-    EdgeOut { dyz, right, active, rs, re, g, rem, d, qs, rs256 }
+    // thr = (D - rs256) >> 8 = |dy| - (Qs's remainder) in 1..=|dy| on a stepped edge; rem's bits
+    // above the eight: g's remainder before its shift back.
+    let dda = edge_t.then(|| {
+        let thr = b.op(format!("thr{k}"), Kind::Sub(ady, srem), cy, false);
+        let rh = rh.unwrap_or_else(|| b.op(format!("rem{k}>>8"), Kind::Shr(rem, 8), cy, false));
+        (thr, b.sub(&format!("t{k}"), rh, thr, cy + 1))
+    });
+    EdgeOut { dyz, right, active, rs, re, g, rem, d, qs, rs256, dda }
 }

@@ -475,6 +475,7 @@ pub fn today_pw() -> u32 {
         reciprocal: false,
         i0_steps: false,
         run_sums: false,
+        edge_t: false,
         shifters: 0,
     };
     Program::setup(&fe, &plan).ops.iter().map(|o| if let Kind::Div { pw, .. } = o.kind { pw } else { 0 }).sum()

@@ -8,18 +8,23 @@ use golden::frontend::engine::V;
 use golden::frontend::Widths;
 
 /// One field of the set-up result the walker reads: its name, the program's value and its
-/// width in the queue.
+/// width in the queue, the value's bits from `lo` up.
 pub(crate) struct Field {
     pub name: String,
     pub v: V,
     pub w: u32,
+    /// Low bits of the value no reader takes (the edges' `D`, `rem`, `rs256` behind the row
+    /// stages: `edge::dropped_low_bits`).
+    pub lo: u32,
 }
 
 /// The set-up result's fields, in the queue entry's order (the first least significant).
 pub(crate) fn fields(hw: &Hw, s: &Schedule) -> Vec<Field> {
     let Widths { yw, aw, k, rw, gw, dw_edge, .. } = hw.fe.widths();
     let o = &s.prog.out;
-    let f = |name: &str, v: V, w: u32| Field { name: name.into(), v, w };
+    let f = |name: &str, v: V, w: u32| Field { name: name.into(), v, w, lo: 0 };
+    // The edges take D, rem and rs256 without the low bits they never read.
+    let cut = crate::frontend::edge::dropped_low_bits(hw);
     let mut v = vec![
         f("first", o.first, yw),
         f("last", o.last, yw),
@@ -41,19 +46,25 @@ pub(crate) fn fields(hw: &Hw, s: &Schedule) -> Vec<Field> {
             v.extend([f(&format!("pg{slot}"), pg, hw.fe.widths().sum_bits()), f(&format!("pq{slot}"), pq, hw.fe.widths().sum_bits())]);
         }
     }
+    let from_engine = crate::frontend::edge::start_from_engine(hw);
     for (j, e) in o.edges.iter().enumerate() {
-        for (n, x, w) in [
-            ("act", e.active, 1),
-            ("right", e.right, 1),
-            ("rs", e.rs, yw),
-            ("re", e.re, yw),
-            ("d", e.d, dw_edge),
-            ("g", e.g, gw),
-            ("rem", e.rem, dw_edge),
-            ("qs", e.qs, gw),
-            ("rs256", e.rs256, dw_edge),
+        // The DDA's start thr and t (`Plan::edge_t`) in place of D and rem, where the edges take it.
+        let (d, rem) = match e.dda {
+            Some((thr, t)) if from_engine => (("thr", thr, dw_edge - cut, 0), ("t", t, dw_edge - cut + 1, 0)),
+            _ => (("d", e.d, dw_edge - cut, cut), ("rem", e.rem, dw_edge - cut, cut)),
+        };
+        for (n, x, w, lo) in [
+            ("act", e.active, 1, 0),
+            ("right", e.right, 1, 0),
+            ("rs", e.rs, yw, 0),
+            ("re", e.re, yw, 0),
+            d,
+            ("g", e.g, gw, 0),
+            rem,
+            ("qs", e.qs, gw, 0),
+            ("rs256", e.rs256, dw_edge - cut, cut),
         ] {
-            v.push(f(&format!("e{j}_{n}"), x, w));
+            v.push(Field { lo, ..f(&format!("e{j}_{n}"), x, w) });
         }
     }
     v

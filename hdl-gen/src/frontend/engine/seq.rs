@@ -459,11 +459,12 @@ fn results(cx: &Cx, fields: &[Field], groups: &[V], b: &mut Vec<Item>) {
         match ops[f.v.0 as usize].kind {
             // A constant rides with the first computed field's write.
             Kind::Const(k) => {
-                parts.push(format!("{}'d{}", f.w, k));
+                parts.push(format!("{}'d{}", f.w, k >> f.lo));
                 we.push(format!("cap_ok && {}", cap(first)));
             }
             _ => {
-                parts.push(if f.w == 1 { "bus[0]".to_string() } else { format!("bus[{}:0]", f.w - 1) });
+                // A field's bits from `lo` up (the edges' D, rem, rs256 behind the row stages).
+                parts.push(if f.w == 1 { format!("bus[{}]", f.lo) } else { format!("bus[{}:{}]", f.lo + f.w - 1, f.lo) });
                 we.push(format!("cap_ok && {}", cap(f.v)));
             }
         }
