@@ -122,8 +122,8 @@ fn sequential_incremental_i0_spans_equal_golden() {
 
 /// The sequential span path (`--fe-span sequential`, the iCE40 targets' choice) behind both
 /// iCE40 engines, 1,000 triangles each (37x23 and 640x480, levels 0 and 1; both targets, 640x480
-/// at level 0, with the edges' lean DDA, the span's ends from their bounds side by side and the
-/// walk's constants in block RAM), as [`engine_spans_of`]; a fault (the correction's `q~ + 1`
+/// at level 0, with the edges' lean DDA, the span's ends from their bounds side by side and, on
+/// the UP5K, the walk's constants in block RAM), as [`engine_spans_of`]; a fault (the correction's `q~ + 1`
 /// made `q~`), one in the lean DDA (the bound's step with its carry subtracted), two in the
 /// side-by-side ends (an edge's bound the right end without its side test; the pixel test
 /// without one pair's sum) and three in the walk's memories (`Gxn`'s read addressed as `An`'s;

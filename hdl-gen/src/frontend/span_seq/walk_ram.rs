@@ -1,4 +1,4 @@
-//! The walk's constants in block RAM (the iCE40 targets at level 0: the sequential engine
+//! The walk's constants in block RAM (the UP5K's target at level 0: the sequential engine
 //! and span path, no row stages). `An`, `Gxn` and `Rn`, which the span path reads one at a
 //! time at its phases' loads, and `dYn`, which the walker adds once a row, are constant
 //! through a triangle's walk. Held in flip-flops they were stored twice, in the queue's entry
@@ -18,6 +18,7 @@
 use crate::frontend::hw::Hw;
 use crate::verilog::{comment, lit, reg, set, wire, Item, Stmt};
 use crate::widths::bits_for;
+use golden::frontend::engine::SetupForm;
 use golden::frontend::span_seq::{Multiplicand, Multiplier, SpanSeq};
 use golden::frontend::{I0Form, Widths};
 
@@ -34,9 +35,17 @@ const TAKE_FIELD: &str = "tn";
 /// fields written one at a time, `res_we`) behind the sequential span path without row stages
 /// (whose reads are the walker's registers' own), the reciprocal `I0` (the incremental one reads
 /// them every row) and no running sums (which read `Gxn` at the take; without them the walker
-/// reads it).
+/// reads it). Only on the UP5K's plan, which needs the cells: on the HX8K, which has them, the
+/// walker's row step reading `dYn` straight out of block RAM into its 64-bit add of `Tn` was
+/// every seed's critical path (51.9 MHz against 62.3 with the registers, docs/fpga.md, *Stop
+/// 34's changes together*).
 pub(crate) fn on(hw: &Hw) -> bool {
-    hw.sequential().is_some() && hw.fe.span_seq().is_some() && !hw.row_stage() && hw.fe.i0 == I0Form::Reciprocal && !hw.run_sums()
+    hw.fe.setup == SetupForm::Ice40Up5k
+        && hw.sequential().is_some()
+        && hw.fe.span_seq().is_some()
+        && !hw.row_stage()
+        && hw.fe.i0 == I0Form::Reciprocal
+        && !hw.run_sums()
 }
 
 /// The write enable of field `name` (a bit of the engine's `res_we`), as the set-up names it.
