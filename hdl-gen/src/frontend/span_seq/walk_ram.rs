@@ -18,6 +18,7 @@
 use crate::frontend::hw::Hw;
 use crate::verilog::{comment, lit, reg, set, wire, Item, Stmt};
 use crate::widths::bits_for;
+use golden::frontend::engine::sequential::SeqPlan;
 use golden::frontend::engine::SetupForm;
 use golden::frontend::span_seq::{Multiplicand, Multiplier, SpanSeq};
 use golden::frontend::{I0Form, Widths};
@@ -40,8 +41,9 @@ const TAKE_FIELD: &str = "tn";
 /// every seed's critical path (51.9 MHz against 62.3 with the registers, docs/fpga.md, *Stop
 /// 34's changes together*).
 pub(crate) fn on(hw: &Hw) -> bool {
+    // The plan, not `hw.sequential()`: that schedules the engine, and this is asked per field.
     hw.fe.setup == SetupForm::Ice40Up5k
-        && hw.sequential().is_some()
+        && SeqPlan::for_form(hw.fe.setup).is_some()
         && hw.fe.span_seq().is_some()
         && !hw.row_stage()
         && hw.fe.i0 == I0Form::Reciprocal
