@@ -38,7 +38,7 @@ const TAKE_FIELD: &str = "tn";
 /// them every row) and no running sums (which read `Gxn` at the take; without them the walker
 /// reads it). Only on the UP5K's plan, which needs the cells: on the HX8K, which has them, the
 /// walker's row step reading `dYn` straight out of block RAM into its 64-bit add of `Tn` was
-/// every seed's critical path (51.9 MHz against 62.3 with the registers, docs/fpga.md, *Stop
+/// every seed's critical path (51.9 MHz against 64.0 with the registers, docs/fpga.md, *Stop
 /// 34's changes together*).
 pub(crate) fn on(hw: &Hw) -> bool {
     // The plan, not `hw.sequential()`: that schedules the engine, and this is asked per field.
