@@ -18,7 +18,6 @@
 use crate::frontend::hw::Hw;
 use crate::verilog::{comment, lit, reg, set, wire, Item, Stmt};
 use crate::widths::bits_for;
-use golden::frontend::engine::sequential::SeqPlan;
 use golden::frontend::engine::SetupForm;
 use golden::frontend::span_seq::{Multiplicand, Multiplier, SpanSeq};
 use golden::frontend::{I0Form, Widths};
@@ -41,13 +40,9 @@ const TAKE_FIELD: &str = "tn";
 /// every seed's critical path (51.9 MHz against 64.0 with the registers, docs/fpga.md, *Stop
 /// 34's changes together*).
 pub(crate) fn on(hw: &Hw) -> bool {
-    // The plan, not `hw.sequential()`: that schedules the engine, and this is asked per field.
-    hw.fe.setup == SetupForm::Ice40Up5k
-        && SeqPlan::for_form(hw.fe.setup).is_some()
-        && hw.fe.span_seq().is_some()
-        && !hw.row_stage()
-        && hw.fe.i0 == I0Form::Reciprocal
-        && !hw.run_sums()
+    // The UP5K's plan is a sequential engine's; `hw.sequential()` would schedule it again for
+    // every field this is asked about.
+    hw.fe.setup == SetupForm::Ice40Up5k && hw.fe.span_seq().is_some() && !hw.row_stage() && hw.fe.i0 == I0Form::Reciprocal && !hw.run_sums()
 }
 
 /// The write enable of field `name` (a bit of the engine's `res_we`), as the set-up names it.
