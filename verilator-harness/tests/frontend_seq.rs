@@ -126,12 +126,12 @@ fn sequential_incremental_i0_spans_equal_golden() {
 /// walk's constants in block RAM), as [`engine_spans_of`]; a fault (the correction's `q~ + 1`
 /// made `q~`), one in the lean DDA (the bound's step with its carry subtracted), two in the
 /// side-by-side ends (an edge's bound the right end without its side test; the pixel test
-/// without one pair's sum) and six in the walk's memories (`Gxn`'s read addressed as `An`'s;
-/// the read slot not moved on at the take, so a triangle's first row reads the one before's;
-/// `Tn` read at the take from the walked triangle's slot; the walker's `dYn` register not
-/// loaded at the take, so it steps by the triangle before's; `dYn` read from the walked
-/// triangle's slot; `dYn` read while the last row waits for the span path, whose next load then
-/// reads it) are caught. Slow tier: `cargo nextest run -p verilator-harness --run-ignored only
+/// without one pair's sum) and seven in the walk's memories (on the UP5K: `Gxn`'s read
+/// addressed as `An`'s; the read slot not moved on at the take, so a triangle's first row reads
+/// the one before's; `Tn` read at the take from the walked triangle's slot; on the HX8K, whose
+/// walker holds `dYn` in a register: `Tn` so again, the register not loaded at the take, so it
+/// steps by the triangle before's `dYn`; `dYn` read from the walked triangle's slot; `dYn` read
+/// while the last row waits for the span path, whose next load then reads it) are caught. Slow tier: `cargo nextest run -p verilator-harness --run-ignored only
 /// -E 'test(/sequential_span/)'`.
 #[test]
 #[ignore]
@@ -173,10 +173,18 @@ fn sequential_span_path_spans_equal_golden() {
     fault.caught(&opts, "frontend walk ram fault", "walkramfault", "Gxn's read addressed as An's");
     let fault = LineFault { file: "tri_frontend.v", line: " wk_slot = wk_rs ^ take", from: "^ take", to: "^ 1'b0" };
     fault.caught(&opts, "frontend walk ram slot fault", "walkslotfault", "the read slot not moved on at the take");
-    let fault = LineFault { file: "tri_frontend.v", line: " wk_dq <= wk_d[{!wk_rs", from: "{!wk_rs", to: "{wk_rs" };
+    let fault = LineFault { file: "tri_frontend.v", line: " wk_da = wk_tnr ? {!wk_rs", from: "{!wk_rs", to: "{wk_rs" };
     fault.caught(&opts, "frontend walk ram tn fault", "walktnfault", "Tn read from the walked triangle's slot, not the queued one's");
-    // The walker's dYn register: a stale dYn, the one before's, must be caught.
+    // The HX8K's walker holds dYn in a register loaded at the take: a stale dYn, the one
+    // before's, must be caught, and so must its reads' slot and clock.
     let Some(opts) = form(small, Ice40Hx8k, 0) else { return };
+    let fault = LineFault { file: "tri_frontend.v", line: " wk_dq <= wk_d[{!wk_rs", from: "{!wk_rs", to: "{wk_rs" };
+    fault.caught(
+        &opts,
+        "frontend walk ram hx8k tn fault",
+        "walktnhxfault",
+        "Tn read from the walked triangle's slot, not the queued one's",
+    );
     let fault = LineFault { file: "tri_frontend.v", line: " w_dyn <= wk_dyn;", from: "<= wk_dyn", to: "<= w_dyn" };
     fault.caught(&opts, "frontend walk ram dyn fault", "walkdynfault", "dYn not loaded at the take: the triangle before's");
     let fault = LineFault { file: "tri_frontend.v", line: " wk_ma = wk_dnr ? {!wk_rs", from: "{!wk_rs", to: "{wk_rs" };
