@@ -122,14 +122,17 @@ fn sequential_incremental_i0_spans_equal_golden() {
 
 /// The sequential span path (`--fe-span sequential`, the iCE40 targets' choice) behind both
 /// iCE40 engines, 1,000 triangles each (37x23 and 640x480, levels 0 and 1; both targets, 640x480
-/// at level 0, with the edges' lean DDA, the span's ends from their bounds side by side and, on
-/// the UP5K, the walk's constants in block RAM), as [`engine_spans_of`]; a fault (the correction's `q~ + 1`
+/// at level 0, with the edges' lean DDA, the span's ends from their bounds side by side and the
+/// walk's constants in block RAM), as [`engine_spans_of`]; a fault (the correction's `q~ + 1`
 /// made `q~`), one in the lean DDA (the bound's step with its carry subtracted), two in the
 /// side-by-side ends (an edge's bound the right end without its side test; the pixel test
-/// without one pair's sum) and three in the walk's memories (`Gxn`'s read addressed as `An`'s;
-/// the read slot not moved on at the take, so a triangle's first row reads the one before's;
-/// `Tn` read at the take from the walked triangle's slot) are caught. Slow tier: `cargo nextest
-/// run -p verilator-harness --run-ignored only -E 'test(/sequential_span/)'`.
+/// without one pair's sum) and seven in the walk's memories (on the UP5K: `Gxn`'s read
+/// addressed as `An`'s; the read slot not moved on at the take, so a triangle's first row reads
+/// the one before's; `Tn` read at the take from the walked triangle's slot; on the HX8K, whose
+/// walker holds `dYn` in a register: `Tn` so again, the register not loaded at the take, so it
+/// steps by the triangle before's `dYn`; `dYn` read from the walked triangle's slot; `dYn` read
+/// while the last row waits for the span path, whose next load then reads it) are caught. Slow tier: `cargo nextest run -p verilator-harness --run-ignored only
+/// -E 'test(/sequential_span/)'`.
 #[test]
 #[ignore]
 fn sequential_span_path_spans_equal_golden() {
@@ -172,4 +175,30 @@ fn sequential_span_path_spans_equal_golden() {
     fault.caught(&opts, "frontend walk ram slot fault", "walkslotfault", "the read slot not moved on at the take");
     let fault = LineFault { file: "tri_frontend.v", line: " wk_da = wk_tnr ? {!wk_rs", from: "{!wk_rs", to: "{wk_rs" };
     fault.caught(&opts, "frontend walk ram tn fault", "walktnfault", "Tn read from the walked triangle's slot, not the queued one's");
+    // The HX8K's walker holds dYn in a register loaded at the take: a stale dYn, the one
+    // before's, must be caught, and so must its reads' slot and clock.
+    let Some(opts) = form(small, Ice40Hx8k, 0) else { return };
+    let fault = LineFault { file: "tri_frontend.v", line: " wk_dq <= wk_d[{!wk_rs", from: "{!wk_rs", to: "{wk_rs" };
+    fault.caught(
+        &opts,
+        "frontend walk ram hx8k tn fault",
+        "walktnhxfault",
+        "Tn read from the walked triangle's slot, not the queued one's",
+    );
+    let fault = LineFault { file: "tri_frontend.v", line: " w_dyn <= wk_dyn;", from: "<= wk_dyn", to: "<= w_dyn" };
+    fault.caught(&opts, "frontend walk ram dyn fault", "walkdynfault", "dYn not loaded at the take: the triangle before's");
+    let fault = LineFault { file: "tri_frontend.v", line: " wk_ma = wk_dnr ? {!wk_rs", from: "{!wk_rs", to: "{wk_rs" };
+    fault.caught(
+        &opts,
+        "frontend walk ram dyn slot fault",
+        "walkdynslotfault",
+        "dYn read from the walked triangle's slot, not the queued one's",
+    );
+    let fault = LineFault { file: "tri_frontend.v", line: " wk_dnr = ", from: "w_end && adv", to: "w_end" };
+    fault.caught(
+        &opts,
+        "frontend walk ram dyn read fault",
+        "walkdynreadfault",
+        "dYn read while the span path may load the last row's field",
+    );
 }

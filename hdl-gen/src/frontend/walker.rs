@@ -443,7 +443,7 @@ pub(super) fn emit(hw: &Hw, names: &Names, body: &mut Vec<Item>) {
         set("w_rn", if engine { "r_rn" } else { "drn_q" }),
         set("w_tn", super::span_seq::walk_ram::take_value(hw, "tn").unwrap_or("s_tn")),
         set("w_gxn", "s_gxn"),
-        set("w_dyn", "s_dyn"),
+        set("w_dyn", super::span_seq::walk_ram::take_value(hw, "dyn").unwrap_or("s_dyn")),
     ]);
     load.retain(|st| !matches!(st, Stmt::Set(l, _) if (l == "w_gxn" && !reads_gxn(hw)) || (l.starts_with("w_") && held(l))));
     load.extend(sum_load);

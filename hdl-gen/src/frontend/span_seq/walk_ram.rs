@@ -1,14 +1,20 @@
-//! The walk's constants in block RAM (the UP5K's target at level 0: the sequential engine
-//! and span path, no row stages). `An`, `Gxn` and `Rn`, which the span path reads one at a
-//! time at its phases' loads, and `dYn`, which the walker adds once a row, are constant
-//! through a triangle's walk. Held in flip-flops they were stored twice, in the queue's entry
-//! and in the walker's copy (about 360 logic cells on the UP5K, each a flip-flop no LUT
-//! feeds): here the engine writes each of them into a two-slot memory as it produces it (the
-//! slot the queue's next push takes) and the span path and the walker read them from the slot
-//! of the triangle being walked, which changes at the take. `Tn`, which the walker loads at the
-//! take and steps, is beside `dYn`: read in the clock before a take can come. A slot is never read where it is
-//! written: the engine writes only while the queue is empty, and its slot is then the one the
-//! walker does not hold (`no_rw_check`, so Yosys adds no collision logic).
+//! The walk's constants in block RAM (the iCE40 targets at level 0: the sequential engine and
+//! span path, no row stages). `An`, `Gxn` and `Rn`, which the span path reads one at a time at
+//! its phases' loads, and `dYn`, which the walker adds once a row, are constant through a
+//! triangle's walk. Held in flip-flops they were stored twice, in the queue's entry and in the
+//! walker's copy (about 360 logic cells on the UP5K, each a flip-flop no LUT feeds): here the
+//! engine writes each of them into a two-slot memory as it produces it (the slot the queue's
+//! next push takes) and the span path reads `An`, `Gxn`, `Rn` from the slot of the triangle
+//! being walked, which changes at the take. `Tn`, which the walker loads at the take and steps,
+//! is in a second memory, read from the queued triangle's slot in the clock before a take can
+//! come. Where `dYn` is depends on the plan ([`registered`]): on the HX8K beside `An`, `Gxn`,
+//! `Rn`, read from the queued triangle's slot in the clock before a take can come and loaded at
+//! the take into the walker's register, so that the row step's 64-bit add starts from a
+//! flip-flop (read straight from the memory's RDATA it was every HX8K seed's critical path,
+//! 51.9 MHz, docs/fpga.md, *Stop 34's changes together*); on the UP5K, which needs the cells,
+//! beside `Tn`, read every clock the walker steps, the add's operand itself. A slot is never read
+//! where it is written: the engine writes only while the queue is empty, and its slot is then the
+//! one the walker does not hold (`no_rw_check`, so Yosys adds no collision logic).
 //!
 //! The memories' reads are registered, so each read is addressed a clock before its load: the
 //! span path's phase names the field its next load reads ([`read_order`]), and the slot is the
@@ -24,25 +30,43 @@ use golden::frontend::{I0Form, Widths};
 
 /// The fields the span path reads from the first memory, in its address order.
 const SPAN_FIELDS: [&str; 3] = ["an", "gxn", "rn"];
-/// The field the walker's row step reads, alone in the second memory (a read port of its own:
-/// the walker steps while the span path reads).
+/// The field the walker's row step adds: where [`registered`], the first memory's fourth word,
+/// read from the queued triangle's slot in the clock before a take can come (when the span path
+/// reads none of its fields in the next clock); else the second memory's first, read every
+/// clock the walker steps (a read port of its own: the walker steps while the span path reads).
 const STEP_FIELD: &str = "dyn";
-/// The field the walker loads at the take and then steps, beside `dYn` in the second memory:
-/// read there, from the queued triangle's slot, in the clock before a take can come.
+/// The field the walker loads at the take and then steps, in the second memory (its second word
+/// beside `dYn`, or alone where `dYn` is [`registered`]).
 const TAKE_FIELD: &str = "tn";
 
 /// Whether this front-end holds the walk's constants in block RAM: the sequential engine (its
 /// fields written one at a time, `res_we`) behind the sequential span path without row stages
 /// (whose reads are the walker's registers' own), the reciprocal `I0` (the incremental one reads
 /// them every row) and no running sums (which read `Gxn` at the take; without them the walker
-/// reads it). Only on the UP5K's plan, which needs the cells: on the HX8K, which has them, the
-/// walker's row step reading `dYn` straight out of block RAM into its 64-bit add of `Tn` was
-/// every seed's critical path (51.9 MHz against 64.0 with the registers, docs/fpga.md, *Stop
-/// 34's changes together*).
+/// reads it). Both iCE40 plans: the UP5K needs the cells, and on the HX8K (88 % with them, 92 %
+/// without) the placer did not place every seed without them (docs/fpga.md).
 pub(crate) fn on(hw: &Hw) -> bool {
-    // The UP5K's plan is a sequential engine's; `hw.sequential()` would schedule it again for
+    // Both iCE40 plans are a sequential engine's; `hw.sequential()` would schedule it again for
     // every field this is asked about.
-    hw.fe.setup == SetupForm::Ice40Up5k && hw.fe.span_seq().is_some() && !hw.row_stage() && hw.fe.i0 == I0Form::Reciprocal && !hw.run_sums()
+    matches!(hw.fe.setup, SetupForm::Ice40Up5k | SetupForm::Ice40Hx8k)
+        && hw.fe.span_seq().is_some()
+        && !hw.row_stage()
+        && hw.fe.i0 == I0Form::Reciprocal
+        && !hw.run_sums()
+}
+
+/// Whether the walker holds `dYn` in a register loaded at the take (the HX8K's plan), not
+/// reading it from the memory every row (the UP5K's): the register costs the UP5K, which
+/// does not fit, about 110 logic cells (7,205 against 7,095), and it is the HX8K's clock
+/// (docs/fpga.md, *The walk memories on the HX8K*).
+fn registered(hw: &Hw) -> bool {
+    hw.fe.setup == SetupForm::Ice40Hx8k
+}
+
+/// The fields of the first memory, in its address order.
+fn span_memory(hw: &Hw) -> Vec<&'static str> {
+    let step = registered(hw).then_some(STEP_FIELD);
+    SPAN_FIELDS.iter().copied().chain(step).collect()
 }
 
 /// The write enable of field `name` (a bit of the engine's `res_we`), as the set-up names it.
@@ -58,12 +82,16 @@ pub(crate) fn holds(hw: &Hw, name: &str) -> bool {
 
 /// Whether the walker's register for field `name` is gone: the memories' read is it.
 pub(crate) fn replaces(hw: &Hw, name: &str) -> bool {
-    holds(hw, name) && name != TAKE_FIELD
+    holds(hw, name) && (SPAN_FIELDS.contains(&name) || (name == STEP_FIELD && !registered(hw)))
 }
 
 /// What the walker loads field `name` from at the take, where the memories hold it.
 pub(crate) fn take_value(hw: &Hw, name: &str) -> Option<&'static str> {
-    (holds(hw, name) && name == TAKE_FIELD).then_some("wk_tn")
+    match name {
+        TAKE_FIELD if holds(hw, name) => Some("wk_tn"),
+        STEP_FIELD if holds(hw, name) && registered(hw) => Some("wk_dyn"),
+        _ => None,
+    }
 }
 
 /// The first memory's word: its widest field.
@@ -96,7 +124,8 @@ fn load_reads(k: usize) -> Option<&'static str> {
 
 /// The field addressed while the unit is in phase k (the one its next load reads), and while it
 /// is idle or in its last phase (the next accept's). A phase's load is at least a clock after
-/// the phase begins (it has steps), so the address is on the memory a clock before.
+/// the phase begins (it has steps), so the address is on the memory a clock before; the last
+/// phase has steps too, so the clock before the unit's result is done it loads nothing ([`dyn_read`]).
 fn read_order(q: &SpanSeq) -> (Vec<&'static str>, &'static str) {
     let n = SpanSeq::PHASES.len();
     let accept = load_reads(0).unwrap_or(SPAN_FIELDS[0]);
@@ -106,26 +135,55 @@ fn read_order(q: &SpanSeq) -> (Vec<&'static str>, &'static str) {
             load_reads(k + 1).unwrap_or(accept)
         })
         .collect();
+    assert!(q.steps(&SpanSeq::PHASES[n - 1]) > 0, "the last phase is done in its first clock");
     (during, accept)
 }
 
+/// The first memory's word of field `name` in a slot.
 fn index(name: &str) -> u64 {
+    if name == STEP_FIELD {
+        return SPAN_FIELDS.len() as u64;
+    }
     SPAN_FIELDS.iter().position(|f| *f == name).expect("a field of the first memory") as u64
 }
 
+/// When the first memory reads `dYn` of the queued triangle instead of the span path's field:
+/// a take can come next clock (the queue is full or being pushed, no take now, and the walker
+/// has no row next clock: idle, or accepting its last row now), and the span path loads nothing
+/// next clock (idle, in its last phase, or accepting now: the phase it starts has steps). A take
+/// needs all of these the clock before, so the walker's `dYn` is on `wk_q` at every take.
+fn dyn_read(last_phase: &str) -> String {
+    format!("(q_full || q_in) && !take && (w_valid ? w_end && adv : !sq_busy || sq_ph == {last_phase})")
+}
+
+/// The address bits of a field in a slot: the first memory's fields'.
+fn field_bits(hw: &Hw) -> u32 {
+    bits_for(span_memory(hw).len() as u32 - 1)
+}
+
 /// The memories, their writes from the engine (`res_bus`, a field's `we` bit of `res_we`) and
-/// their reads, the walker's `w_an`, `w_gxn`, `w_rn` (the span path's, valid at its loads) and
-/// `w_dyn` (the walked triangle's, from the clock after the take), `wk_tn` (the queued one's, at
-/// the take). After the span path's control (`sq_busy`, `sq_ph`), the queue's `q_in` and the
-/// fields' write enables ([`we`]); [`emit_ports`] after the walker.
+/// their reads, the walker's `w_an`, `w_gxn`, `w_rn` (the span path's, valid at its loads),
+/// `wk_tn` (the queued triangle's, at the take) and `wk_dyn` (the same, where [`registered`]) or
+/// `w_dyn` (the walked or taken one's, from the clock after the take). After the span path's
+/// control (`sq_busy`, `sq_ph`), the queue's `q_in` and the fields' write enables ([`we`]);
+/// [`emit_ports`] after the walker.
 pub(crate) fn emit(hw: &Hw, body: &mut Vec<Item>) {
     let q = hw.fe.span_seq().expect("the sequential span path");
     let Widths { aw, k, rw, .. } = hw.fe.widths();
-    let (sw, aw_ram) = (span_width(hw), 1 + bits_for(SPAN_FIELDS.len() as u32 - 1));
-    let fw = aw_ram - 1;
-    body.push(comment("The walk's constants in block RAM: An, Gxn, Rn (the span path's, one a load), dYn (the walker's step's)"));
-    body.push(comment("and Tn (its load at the take), written by the engine into the slot of the queue's next push (wk_ws), read"));
-    body.push(comment("from the walked triangle's (wk_rs, the taken one's from the take; Tn the queued one's), a clock ahead."));
+    let fw = field_bits(hw);
+    let (sw, aw_ram) = (span_width(hw), 1 + fw);
+    let reg_dyn = registered(hw);
+    if reg_dyn {
+        body.push(comment("The walk's constants in block RAM: An, Gxn, Rn (the span path's, one a load) and dYn (the walker's step's),"));
+        body.push(comment("and Tn (its load at the take), written by the engine into the slot of the queue's next push (wk_ws), read"));
+        body.push(comment(
+            "from the walked triangle's (wk_rs, the taken one's from the take; dYn and Tn the queued one's), a clock ahead.",
+        ));
+    } else {
+        body.push(comment("The walk's constants in block RAM: An, Gxn, Rn (the span path's, one a load), dYn (the walker's step's)"));
+        body.push(comment("and Tn (its load at the take), written by the engine into the slot of the queue's next push (wk_ws), read"));
+        body.push(comment("from the walked triangle's (wk_rs, the taken one's from the take; Tn the queued one's), a clock ahead."));
+    }
     body.push(Item::Memory { name: "wk_m".into(), width: sw, depth: 1 << aw_ram, no_rw_check: true });
     // As deep as the first: Yosys keeps a two-word memory in flip-flops.
     body.push(Item::Memory { name: "wk_d".into(), width: k, depth: 1 << aw_ram, no_rw_check: true });
@@ -137,32 +195,44 @@ pub(crate) fn emit(hw: &Hw, body: &mut Vec<Item>) {
         format!("(sq_busy && sq_ph == {}) ? {} : {acc}", lit(phase_w, p as u64), lit(fw, index(f)))
     });
     body.push(wire("wk_ra", fw, ra));
-    let wa =
-        SPAN_FIELDS.iter().enumerate().skip(1).rev().fold(lit(fw, 0), |acc, (j, f)| format!("{} ? {} : {acc}", we(f), lit(fw, j as u64)));
+    let wa = span_memory(hw).iter().skip(1).rev().fold(lit(fw, 0), |acc, f| format!("{} ? {} : {acc}", we(f), lit(fw, index(f))));
     body.push(wire("wk_wa", fw, wa));
-    for (n, w, from) in [("w_an", aw, "wk_q"), ("w_gxn", k, "wk_q"), ("w_rn", rw, "wk_q"), ("w_dyn", k, "wk_dq"), ("wk_tn", k, "wk_dq")] {
+    let step = if reg_dyn { ("wk_dyn", k, "wk_q") } else { ("w_dyn", k, "wk_dq") };
+    for (n, w, from) in [("w_an", aw, "wk_q"), ("w_gxn", k, "wk_q"), ("w_rn", rw, "wk_q"), step, ("wk_tn", k, "wk_dq")] {
         body.push(wire(n, w, format!("{from}[{}:0]", w - 1)));
     }
     body.push(Item::Blank);
 }
 
-/// The memories' writes and reads, after the walker (whose `w_valid`, `w_end` choose the second
-/// memory's word): `Tn` of the queued triangle (the slot the walker does not hold) while a take
-/// can come next clock and the walker does not step, else `dYn` of the walked (or taken) one.
-/// Neither is written then: the engine writes no field while the queue is full nor at its push.
+/// The memories' writes and reads, after the walker (whose `w_valid`, `w_end` choose a word).
+/// Where `dYn` is [`registered`]: the first memory reads `dYn` of the queued triangle (the slot
+/// the walker does not hold) while a take can come next clock ([`dyn_read`]), else the span
+/// path's field, and the second `Tn` of the queued triangle always. Else the second memory
+/// reads `Tn` of the queued triangle while a take can come next clock and the walker does not
+/// step, else `dYn` of the walked (or taken) one. Neither is written then: the engine writes no
+/// field while the queue is full nor at its push.
 pub(crate) fn emit_ports(hw: &Hw, body: &mut Vec<Item>) {
     let k = hw.fe.widths().k;
-    let (sw, fw) = (span_width(hw), bits_for(SPAN_FIELDS.len() as u32 - 1));
-    let span_we: Vec<String> = SPAN_FIELDS.iter().map(|f| we(f)).collect();
-    body.push(wire("wk_tnr", 1, "(q_full || q_in) && !take && !(w_valid && !w_end)"));
-    body.push(wire("wk_da", fw + 1, format!("wk_tnr ? {{!wk_rs, {}}} : {{wk_slot, {}}}", lit(fw, 1), lit(fw, 0))));
-    let dwe = format!("{} || {}", we(STEP_FIELD), we(TAKE_FIELD));
-    let dwa = format!("{{wk_ws, {} ? {} : {}}}", we(TAKE_FIELD), lit(fw, 1), lit(fw, 0));
+    let (sw, fw) = (span_width(hw), field_bits(hw));
+    let m_we: Vec<String> = span_memory(hw).into_iter().map(we).collect();
+    let (m_read, d_write, d_read) = if registered(hw) {
+        let phase_w = bits_for(SpanSeq::PHASES.len() as u32 - 1);
+        body.push(wire("wk_dnr", 1, dyn_read(&lit(phase_w, SpanSeq::PHASES.len() as u64 - 1))));
+        body.push(wire("wk_ma", fw + 1, format!("wk_dnr ? {{!wk_rs, {}}} : {{wk_slot, wk_ra}}", lit(fw, index(STEP_FIELD)))));
+        let tn = lit(fw, 0);
+        ("wk_m[wk_ma]".to_string(), (we(TAKE_FIELD), format!("wk_d[{{wk_ws, {tn}}}]")), format!("wk_d[{{!wk_rs, {tn}}}]"))
+    } else {
+        body.push(wire("wk_tnr", 1, "(q_full || q_in) && !take && !(w_valid && !w_end)"));
+        body.push(wire("wk_da", fw + 1, format!("wk_tnr ? {{!wk_rs, {}}} : {{wk_slot, {}}}", lit(fw, 1), lit(fw, 0))));
+        let dwe = format!("{} || {}", we(STEP_FIELD), we(TAKE_FIELD));
+        let dwa = format!("{{wk_ws, {} ? {} : {}}}", we(TAKE_FIELD), lit(fw, 1), lit(fw, 0));
+        ("wk_m[{wk_slot, wk_ra}]".to_string(), (dwe, format!("wk_d[{dwa}]")), "wk_d[wk_da]".to_string())
+    };
     body.push(Item::Always(vec![
-        Stmt::If(span_we.join(" || "), vec![set("wk_m[{wk_ws, wk_wa}]", format!("res_bus[{}:0]", sw - 1))], vec![]),
-        Stmt::If(dwe, vec![set(format!("wk_d[{dwa}]"), format!("res_bus[{}:0]", k - 1))], vec![]),
-        set("wk_q", "wk_m[{wk_slot, wk_ra}]"),
-        set("wk_dq", "wk_d[wk_da]"),
+        Stmt::If(m_we.join(" || "), vec![set("wk_m[{wk_ws, wk_wa}]", format!("res_bus[{}:0]", sw - 1))], vec![]),
+        Stmt::If(d_write.0, vec![set(d_write.1, format!("res_bus[{}:0]", k - 1))], vec![]),
+        set("wk_q", m_read),
+        set("wk_dq", d_read),
         Stmt::If(
             "rst".into(),
             vec![set("wk_ws", "1'b0"), set("wk_rs", "1'b1")],
