@@ -483,7 +483,10 @@ pub(super) fn dividers(v: &Values, seq: &Seq, body: &mut Vec<Item>) -> Vec<Captu
             g.push(wire(&t, wd + 1, format!("{{{rm}, {top}}}")));
             // The compare is the subtract's borrow: one carry chain a step, not a compare's
             // beside the subtract's (373 LUT4 and 150 CCU2C of the ECP5 plan's engine).
+            // Its bit wd is the remainder's, which the borrow below it decides is unused.
+            g.push(comment("verilator lint_off UNUSEDSIGNAL"));
             g.push(wire(&df, wd + 2, format!("{{1'b0, {t}}} - {{2'b0, dv}}")));
+            g.push(comment("verilator lint_on UNUSEDSIGNAL"));
             g.push(wire(&ge, 1, format!("!{df}[{}]", wd + 1)));
             let (rn, ln) = (format!("rm{}", step + 1), format!("lo{}", step + 1));
             g.push(wire(&rn, wd, format!("{ge} ? {df}[{}:0] : {t}[{}:0]", wd - 1, wd - 1)));
