@@ -14,7 +14,8 @@
 //!   triangle ([`per_tile`]: a search over their clocks and tiles at the least latency; when it
 //!   finds none, the tiles are counted by kind as the dividers are). Divisions and shifts keep
 //!   one unit each, or a division busier than II alternates over a pair by the triangle's
-//!   parity, where the units' two-period tables allow (`fixed_rotation`); otherwise they are
+//!   parity (or runs on both in series: [`Plan::div_chain`]), where the units' two-period
+//!   tables allow (`fixed_rotation`); otherwise they are
 //!   bound by start time over an unrolled stretch of triangles (a unit that ran the same
 //!   operation is preferred), and a division may rotate over three units or more.
 
