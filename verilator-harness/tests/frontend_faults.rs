@@ -36,7 +36,9 @@ fn row_stage_base(label: &str) -> Option<(verilator_harness::models::Model, u64,
 /// triangle's copy, the leading-zero count's lowest bit stuck at one (an even count one too
 /// large: the normalised `|A|` loses its top bit; stuck at zero, 0 mismatches at 37x23), a
 /// tile's operand register loaded on every clock (its registered load ignored: a held chunk
-/// overwritten), a tile port's registered select bit stuck at zero (a source never selected);
+/// overwritten), a tile port's registered select bit stuck at zero (a source never selected),
+/// a chained division's second divider taking the first's loaded dividend bits for its
+/// quotient bits so far;
 /// and in `tri_frontend.v`, a triangle taken with no queue entry reserved for its
 /// result (the credits ignored), and in `tri_fe_queue.v` the registered head refilled from the
 /// memory while it holds an entry (that entry lost), under backpressure heavy enough to fill
@@ -68,6 +70,21 @@ fn engine_planted_faults_are_caught() {
         line(engine, "a tile operand register's registered load", &|l| l.trim_start().starts_with("m") && l.contains("_la0 <= "));
     let sel_line = line(engine, "a tile port's registered select", &|l| l.trim_start().starts_with("m") && l.contains("_sa0[0] <= "));
     let lzc_odd = format!("{}, 1'b1}};", lzc_line.rsplit_once(", |(").expect("the count's lowest bit").0);
+    // A chained division's second divider (its divisor the first's `_dv`) taking its quotient
+    // bits from the first's load port (the dividend's low bits) instead of the first's step:
+    // two lines on. (Its load a clock early or late is no fault: the first keeps stepping.)
+    let lines: Vec<&str> = engine.lines().collect();
+    let chained = lines
+        .iter()
+        .position(|l| l.trim_start().starts_with("assign d") && l.contains("_d[") && l.contains("_dv["))
+        .expect("a chained division");
+    let chain_q = lines[chained + 2].to_string();
+    assert!(
+        chain_q.contains("_lo[") && chain_q.contains("= d") && chain_q.contains("_q["),
+        "the second divider's quotient bits: {chain_q}"
+    );
+    let (lhs, rhs) = chain_q.split_once('=').unwrap();
+    let chain_bad = format!("{lhs}={}", rhs.replacen("_q[", "_lo[", 1));
     let faults = [
         (copy_line.to_string(), copy_line.replacen("_1 ", "_0 ", 1), "an operand's copy off by one period"),
         (
@@ -80,6 +97,7 @@ fn engine_planted_faults_are_caught() {
         (lzc_line.to_string(), lzc_odd, "the leading-zero count's lowest bit stuck at one"),
         (load_line.clone(), format!("{}<= 1'b1;", load_line.split_once("<=").unwrap().0), "a tile's operand register loaded every clock"),
         (sel_line.clone(), format!("{}<= 1'b0;", sel_line.split_once("<=").unwrap().0), "a tile port's select bit stuck at zero"),
+        (chain_q, chain_bad, "a chained division's second divider taking the dividend's bits for the first's quotient bits"),
     ];
     assert_faults_caught(&base, "tri_fe_engine.v", "fault", faults, seed, &tris);
     // The credits: with out_ready high a clock in ten, triangles arrive faster than they are

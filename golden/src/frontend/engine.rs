@@ -93,6 +93,15 @@ pub struct Plan {
     /// and `D - rs256` (docs/fpga.md).
     #[serde(default, skip_serializing_if = "std::ops::Not::not")]
     pub edge_t: bool,
+    /// A division busier than II runs on its pair of dividers in series, not alternating
+    /// between them by the triangle's parity: the first divider takes the load and the first
+    /// half of the steps, the second the rest from the first's partial remainder
+    /// ([`super::engine::schedule::Schedule::div_stages`]). Both then serve every triangle, so
+    /// no value register chooses its quotient or remainder between two dividers by epoch
+    /// (those selects were about 980 of the ECP5 plan's engine LUT4, docs/fpga.md); the
+    /// clocks are the same.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub div_chain: bool,
     /// Shared barrel shifters for the normalising shifts by a value (`ShlBy`: `2A`, and the
     /// plane's terms by `s`); 0: each shift its own logic, as CALC's. Five 64-bit shifts by a
     /// 6-bit amount were about 1,560 of the ECP5 plan's engine LUT4 (docs/fpga.md).
@@ -115,9 +124,10 @@ impl Plan {
     /// front-end with the span path's 9 per-row tiles has 17 MULT18X18D, within the
     /// LFE5U-25F's 28. 14 dividers, not the 12 that 120 divider clocks need at II = 12: each
     /// edge's `Qs` and `g` (16 clocks) and `Rn` (24) then alternate over a pair of dividers of
-    /// their own, by the triangle's parity, where 12 rotated `Qs` and `g` over three dividers
-    /// each: the dividers' operand multiplexers go, and `Qs`'s dividers are 19 bits wide, not
-    /// 27 (tri_frontend 6,092 -> 5,252 LUT4, docs/fpga.md).
+    /// their own, where 12 rotated `Qs` and `g` over three dividers each: the dividers' operand
+    /// multiplexers go, and `Qs`'s dividers are 19 bits wide, not 27 (tri_frontend 6,092 ->
+    /// 5,252 LUT4, docs/fpga.md). Each pair runs its division in series ([`Plan::div_chain`]),
+    /// not by the triangle's parity.
     pub const ECP5_25F: Plan = Plan {
         mults: 8,
         mul: Plan::TILE18_RTL,
@@ -128,6 +138,7 @@ impl Plan {
         i0_steps: false,
         run_sums: true,
         edge_t: true,
+        div_chain: true,
         shifters: 1,
     };
     /// For the iCE40 UP5K: 2 of its SB_MAC16 and one 1-bit divider, the smallest engine. 15-bit
@@ -142,6 +153,7 @@ impl Plan {
         i0_steps: false,
         run_sums: false,
         edge_t: false,
+        div_chain: false,
         shifters: 1,
     };
     /// For the iCE40 HX8K, which has no multiplier: one shift-add unit and one divider, a bit a clock.
@@ -155,6 +167,7 @@ impl Plan {
         i0_steps: false,
         run_sums: false,
         edge_t: false,
+        div_chain: false,
         shifters: 1,
     };
 }

@@ -70,9 +70,10 @@ fn plan_text(s: &Schedule) -> String {
         DivForm::ShiftDivisor => "divisor shifted",
     };
     format!(
-        "{mul}, {} restoring dividers of {} quotient bit(s) a clock ({form}), {}, division by 2A {}",
+        "{mul}, {} restoring dividers of {} quotient bit(s) a clock ({form}{}), {}, division by 2A {}",
         p.dividers,
         p.div_bits,
+        if p.div_chain { "; a division busier than II on two of them in series" } else { "" },
         match p.shifters {
             0 => "each shift by a value its own logic".to_string(),
             k => format!("{k} shared barrel shifter(s)"),

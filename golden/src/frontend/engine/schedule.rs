@@ -14,7 +14,8 @@
 //!   triangle ([`per_tile`]: a search over their clocks and tiles at the least latency; when it
 //!   finds none, the tiles are counted by kind as the dividers are). Divisions and shifts keep
 //!   one unit each, or a division busier than II alternates over a pair by the triangle's
-//!   parity, where the units' two-period tables allow (`fixed_rotation`); otherwise they are
+//!   parity (or runs on both in series: [`Plan::div_chain`]), where the units' two-period
+//!   tables allow (`fixed_rotation`); otherwise they are
 //!   bound by start time over an unrolled stretch of triangles (a unit that ran the same
 //!   operation is preferred), and a division may rotate over three units or more.
 
@@ -476,6 +477,7 @@ pub fn today_pw() -> u32 {
         i0_steps: false,
         run_sums: false,
         edge_t: false,
+        div_chain: false,
         shifters: 0,
     };
     Program::setup(&fe, &plan).ops.iter().map(|o| if let Kind::Div { pw, .. } = o.kind { pw } else { 0 }).sum()
@@ -550,7 +552,8 @@ impl Schedule {
     pub fn epochs(&self) -> Option<u32> {
         let mut r = 1u32;
         for o in 0..self.binding.len() {
-            if !self.binding[o].is_empty() {
+            // A chained division runs on both its dividers for every triangle.
+            if !self.binding[o].is_empty() && self.div_stages(o).is_none() {
                 let p = self.period(o)?;
                 r = r / gcd(r, p) * p;
             }
@@ -575,8 +578,14 @@ impl Schedule {
             let mut iv: Vec<(u32, u32, u32, usize)> = Vec::new();
             for j in 0..r * (span + 2) {
                 for (o, s) in self.slots.iter().enumerate().filter(|(_, s)| s.class == c) {
-                    let u = self.unit_of(o, j % r).ok_or("an operation on no unit")?;
-                    iv.push((u, j * self.ii + s.start, j * self.ii + s.start + s.busy, o));
+                    let at = j * self.ii;
+                    match self.div_stages(o) {
+                        Some(stages) => stages.iter().for_each(|&(u, a, b)| iv.push((u, at + a, at + b, o))),
+                        None => {
+                            let u = self.unit_of(o, j % r).ok_or("an operation on no unit")?;
+                            iv.push((u, at + s.start, at + s.start + s.busy, o));
+                        }
+                    }
                 }
             }
             iv.sort();
@@ -600,6 +609,23 @@ impl Schedule {
             .collect()
     }
 
+    /// With [`Plan::div_chain`], a division that alternates between two dividers by the
+    /// triangle's parity runs on both in series instead: `(unit, from, to)` per stage, the
+    /// schedule clocks each holds it. The first takes the load clock and the steps up to half
+    /// the division's clocks (at most II: a division alternates only when busier than II, and
+    /// never busier than 2 II); the second loads the first's partial remainder, quotient bits
+    /// and divisor as the first's next step forms them, and takes the remaining steps, its last
+    /// step the value's as before. `None` for any other operation.
+    pub fn div_stages(&self, o: usize) -> Option<[(u32, u32, u32); 2]> {
+        let s = &self.slots[o];
+        if !self.plan.div_chain || s.class != Class::Div || self.period(o) != Some(2) {
+            return None;
+        }
+        let (u0, u1) = (self.binding[o][0], self.binding[o][1]);
+        let a = s.start + s.busy.div_ceil(2);
+        (u0 != u1).then_some([(u0, s.start, a), (u1, a, s.start + s.busy)])
+    }
+
     /// The unit operation `o` runs on for a triangle of epoch `e` (its number modulo
     /// [`Schedule::epochs`]).
     pub fn unit_of(&self, o: usize, e: u32) -> Option<u32> {
@@ -609,10 +635,15 @@ impl Schedule {
 
     /// The unit operations in start order: `clock unit name (busy)`, for documents and reviews.
     pub fn listing(&self) -> String {
-        let mut rows: Vec<(u32, Class, u32, &str, u32)> = Vec::new();
-        for (s, op) in self.slots.iter().zip(&self.prog.ops) {
+        let mut rows: Vec<(u32, Class, u32, &str, String)> = Vec::new();
+        for (o, (s, op)) in self.slots.iter().zip(&self.prog.ops).enumerate() {
             if let Some(u) = s.unit {
-                rows.push((s.start, s.class, u, &op.name, s.busy));
+                // A chained division: its first divider, then the second's clock and unit.
+                let (u, busy) = match self.div_stages(o) {
+                    Some([(u0, _, _), (u1, a, _)]) => (u0, format!("{}, then div{u1} from clock {a}", s.busy)),
+                    None => (u, s.busy.to_string()),
+                };
+                rows.push((s.start, s.class, u, &op.name, busy));
             }
         }
         rows.sort_by_key(|r| (r.0, r.1 == Class::Div, r.2));

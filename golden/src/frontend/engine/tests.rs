@@ -20,6 +20,7 @@ fn plan(mults: u32, dividers: u32, div_bits: u32, reciprocal: bool) -> Plan {
         i0_steps: true,
         run_sums: false,
         edge_t: false,
+        div_chain: false,
         shifters: 0,
     }
 }
@@ -252,6 +253,7 @@ fn engine_grid() {
         i0_steps: false,
         run_sums: false,
         edge_t: false,
+        div_chain: false,
         shifters: 0,
     };
     println!("{} (today)", row(&today.schedule(&fe).unwrap()));
@@ -281,6 +283,7 @@ fn engine_grid() {
                                 i0_steps: steps,
                                 run_sums: false,
                                 edge_t: false,
+                                div_chain: false,
                                 shifters: 1,
                             };
                             let s = p.schedule(&fe).unwrap();
@@ -386,10 +389,12 @@ fn the_products_keep_their_tiles() {
     assert_eq!(bad.rotating_products(), vec![bad.prog.ops[o].name.as_str()]);
 }
 
-/// The ECP5 plan's dividers each run one division, its `Qs`, `g` and `Rn` alternating over a
-/// pair of their own by the triangle's parity (so no divider needs an operand multiplexer);
-/// negative control: on 12 dividers, the fewest 120 divider clocks need at II = 12, divisions
-/// share dividers and rotate over three.
+/// The ECP5 plan's dividers each run one division, its `Qs`, `g` and `Rn` on a pair of their
+/// own (so no divider needs an operand multiplexer), in series (`Plan::div_chain`): each stage
+/// at most II clocks, back to back, every triangle on the same dividers (one epoch); without
+/// the chain the pair alternates by the triangle's parity (two epochs). Negative control: on 12
+/// dividers, the fewest 120 divider clocks need at II = 12, divisions share dividers and rotate
+/// over three.
 #[test]
 fn the_ecp5_divisions_keep_their_pairs() {
     let sharing = |s: &Schedule| -> usize {
@@ -404,11 +409,34 @@ fn the_ecp5_divisions_keep_their_pairs() {
         ops_on.iter().filter(|v| v.len() > 1).count()
     };
     let s = Plan::ECP5_25F.schedule(&fe640()).unwrap();
-    assert_eq!((s.ii, s.epochs()), (12, Some(2)));
+    assert_eq!((s.ii, s.epochs(), s.verify_binding()), (12, Some(1), Ok(1)));
     assert_eq!(sharing(&s), 0, "{:?}", s.binding);
-    let twelve = Plan { dividers: 12, ..Plan::ECP5_25F }.schedule(&fe640()).unwrap();
+    for o in (0..s.slots.len()).filter(|&o| s.slots[o].class == schedule::Class::Div) {
+        let (t, b) = (s.slots[o].start, s.slots[o].busy);
+        let [(u0, a0, b0), (u1, a1, b1)] = s.div_stages(o).expect("every ECP5 division is chained");
+        assert!(u0 != u1 && a0 == t && b0 == a1 && b1 == t + b, "{}", s.prog.ops[o].name);
+        assert!(b0 - a0 <= s.ii && b1 - a1 <= s.ii, "{}: stages of {} and {} clocks", s.prog.ops[o].name, b0 - a0, b1 - a1);
+    }
+    let parity = Plan { div_chain: false, ..Plan::ECP5_25F }.schedule(&fe640()).unwrap();
+    assert_eq!((parity.epochs(), parity.verify_binding()), (Some(2), Ok(2)));
+    assert!((0..parity.slots.len()).all(|o| parity.div_stages(o).is_none()));
+    let twelve = Plan { dividers: 12, div_chain: false, ..Plan::ECP5_25F }.schedule(&fe640()).unwrap();
     assert_eq!(twelve.ii, 12);
     assert!(sharing(&twelve) > 0 && twelve.epochs() > Some(2), "{:?}", twelve.epochs());
+}
+
+/// The binding's check sees a chained division's stages: two divisions chained on the same
+/// pair of dividers (edge 0's `Qs` on `g`'s, the stages overlapping) fail it.
+#[test]
+fn a_chained_division_on_a_busy_divider_fails_the_binding() {
+    let mut bad = Plan::ECP5_25F.schedule(&fe640()).unwrap();
+    let name = |s: &Schedule, n: &str| (0..s.slots.len()).find(|&o| s.prog.ops[o].name == n).unwrap();
+    let (qs, g) = (name(&bad, "qs0"), name(&bad, "g0"));
+    assert!(bad.verify_binding().is_ok());
+    bad.binding[qs] = bad.binding[g].clone();
+    assert!(bad.div_stages(qs).is_some());
+    let e = bad.verify_binding().unwrap_err();
+    assert!(e.contains("overlap"), "{e}");
 }
 
 /// The estimate sees the barrel shifters: the ECP5 plan's five shifts by `s` (four of 64 bits)

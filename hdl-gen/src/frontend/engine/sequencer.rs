@@ -63,9 +63,11 @@ impl Seq {
 pub(super) fn emit(seq: &Seq, wd: &Widths, iw: u32, latency: u32, body: &mut Vec<Item>) {
     let (ii, r) = (seq.ii, seq.epochs);
     let periods = latency / ii + 1;
-    body.push(comment(format!(
-        "Sequencer: phase ring ph (II = {ii}), epoch ring ep ({r} triangles: the units' binding repeats), a valid bit per period in flight."
-    )));
+    body.push(comment(if r > 1 {
+        format!("Sequencer: phase ring ph (II = {ii}), epoch ring ep ({r} triangles: the units' binding repeats), a valid bit per period in flight.")
+    } else {
+        format!("Sequencer: phase ring ph (II = {ii}; every triangle on the same units), a valid bit per period in flight.")
+    }));
     if ii > 1 {
         body.push(reg("ph", ii));
     }

@@ -15,7 +15,9 @@
 //! - **Divider** (restoring, the textbook form: the remainder shifted past a fixed divisor): a
 //!   load clock takes the divisor, the dividend's top bits as the first remainder and its low
 //!   quotient-width bits, left-aligned, in the quotient register; then `bits` compare-subtract
-//!   steps a clock, each shifting a quotient bit in. Ready after its last step.
+//!   steps a clock, each shifting a quotient bit in. Ready after its last step. A chained
+//!   division (golden's `Schedule::div_stages`) runs on two dividers in series: the second
+//!   loads the first's next step and its divisor, so its value has one source, not one a parity.
 
 use super::sequencer::Seq;
 use super::values::{Src, Values};
@@ -374,10 +376,16 @@ pub(super) fn dividers(v: &Values, seq: &Seq, body: &mut Vec<Item>) -> Vec<Captu
     }
     let rem_of = |o: usize| (0..s.prog.ops.len()).find(|&k| matches!(s.prog.ops[k].kind, Kind::Rem(x) if x.0 as usize == o));
     let qpad = |qb: u32| qb.div_ceil(r) * r;
+    // The units a division runs on: both of a chained one's (golden's `div_stages`), every
+    // triangle; else by epoch.
+    let units = |o: usize| match s.div_stages(o) {
+        Some(st) => st.iter().map(|x| (x.0, (0..seq.epochs).collect())).collect(),
+        None => seq.units_of(s, o),
+    };
     let mut keys: Vec<Option<Vec<u32>>> = vec![None; d];
     for &o in &ops {
         let Kind::Div { d: dv, qb, .. } = v.op(o).kind else { unreachable!() };
-        for (u, _) in seq.units_of(s, o) {
+        for (u, _) in units(o) {
             let k = keys[u as usize].get_or_insert(vec![1, 1]);
             k[0] = k[0].max(v.op(dv.0 as usize).w);
             k[1] = k[1].max(qpad(qb));
@@ -394,6 +402,29 @@ pub(super) fn dividers(v: &Values, seq: &Seq, body: &mut Vec<Item>) -> Vec<Captu
         let (nn, dd) = (v.at(n, st), v.at(dv, st));
         let t = st + s.slots[o].busy - 1;
         let (mut fq, mut fr) = (Vec::new(), Vec::new());
+        if let Some([(u0, _, _), (u1, at, _)]) = s.div_stages(o) {
+            // In series: the second divider loads the first's next step (its remainder and
+            // quotient bits) and divisor; the value is the second's last step.
+            let ((g0, l0), (g1, l1)) = (groups.of[u0 as usize].expect("a unit"), groups.of[u1 as usize].expect("a unit"));
+            assert_eq!(groups.keys[g0], groups.keys[g1], "{}: a chained division's dividers are as wide", v.op(o).name);
+            let (wd, qm) = (groups.keys[g0][0], groups.keys[g0][1]);
+            let lo = if qm > qp { format!("{{{}, {}'d0}}", nn.bits(0, qp), qm - qp) } else { nn.bits(0, qp) };
+            let (c0, c1) = (seq.phase(st % s.ii), seq.phase(at % s.ii));
+            src[u0 as usize][0].push((c0.clone(), "1'b1".into()));
+            src[u0 as usize][1].push((c0.clone(), dd.ext(wd)));
+            src[u0 as usize][2].push((c0.clone(), nn.bits(qp, wd)));
+            src[u0 as usize][3].push((c0, lo));
+            src[u1 as usize][0].push((c1.clone(), "1'b1".into()));
+            src[u1 as usize][1].push((c1.clone(), lane_bits(&format!("d{g0}_dv"), l0, wd, wd)));
+            src[u1 as usize][2].push((c1.clone(), lane_bits(&format!("d{g0}_r"), l0, wd, wd)));
+            src[u1 as usize][3].push((c1, lane_bits(&format!("d{g0}_q"), l0, qm, qm)));
+            let all: Vec<u32> = (0..seq.epochs).collect();
+            caps.push(Capture { op: o, t, from: vec![(all.clone(), lane_bits(&format!("d{g1}_q"), l1, qm, qb))] });
+            if let Some(ro) = rem_of(o) {
+                caps.push(Capture { op: ro, t, from: vec![(all, lane_bits(&format!("d{g1}_r"), l1, wd, v.op(ro).w))] });
+            }
+            continue;
+        }
         for (u, es) in seq.units_of(s, o) {
             let (gi, li) = groups.of[u as usize].expect("a unit with operations");
             let (wd, qm) = (groups.keys[gi][0], groups.keys[gi][1]);
@@ -432,6 +463,7 @@ pub(super) fn dividers(v: &Values, seq: &Seq, body: &mut Vec<Item>) -> Vec<Captu
         body.push(comment("verilator lint_off UNUSEDSIGNAL"));
         body.push(crate::verilog::bus(&bus("q"), n * qm));
         body.push(crate::verilog::bus(&bus("r"), n * wd));
+        body.push(crate::verilog::bus(&bus("dv"), n * wd));
         body.push(comment("verilator lint_on UNUSEDSIGNAL"));
         for (li, &u) in members.iter().enumerate() {
             let (li, sr) = (li as u32, &src[u as usize]);
@@ -446,17 +478,24 @@ pub(super) fn dividers(v: &Values, seq: &Seq, body: &mut Vec<Item>) -> Vec<Captu
         let mut g = vec![reg("dv", wd), reg("rm", wd), reg("lo", qm)];
         let (mut rm, mut lo) = ("rm".to_string(), "lo".to_string());
         for step in 0..r {
-            let (t, ge) = (format!("t{step}"), format!("ge{step}"));
+            let (t, ge, df) = (format!("t{step}"), format!("ge{step}"), format!("df{step}"));
             let top = if qm == 1 { lo.clone() } else { format!("{lo}[{}]", qm - 1) };
             g.push(wire(&t, wd + 1, format!("{{{rm}, {top}}}")));
-            g.push(wire(&ge, 1, format!("{t} >= {{1'b0, dv}}")));
+            // The compare is the subtract's borrow: one carry chain a step, not a compare's
+            // beside the subtract's (373 LUT4 and 150 CCU2C of the ECP5 plan's engine).
+            // Its bit wd is the remainder's, which the borrow below it decides is unused.
+            g.push(comment("verilator lint_off UNUSEDSIGNAL"));
+            g.push(wire(&df, wd + 2, format!("{{1'b0, {t}}} - {{2'b0, dv}}")));
+            g.push(comment("verilator lint_on UNUSEDSIGNAL"));
+            g.push(wire(&ge, 1, format!("!{df}[{}]", wd + 1)));
             let (rn, ln) = (format!("rm{}", step + 1), format!("lo{}", step + 1));
-            g.push(wire(&rn, wd, format!("{ge} ? {t}[{}:0] - dv : {t}[{}:0]", wd - 1, wd - 1)));
+            g.push(wire(&rn, wd, format!("{ge} ? {df}[{}:0] : {t}[{}:0]", wd - 1, wd - 1)));
             g.push(wire(&ln, qm, if qm == 1 { ge.clone() } else { format!("{{{lo}[{}:0], {ge}}}", qm - 2) }));
             (rm, lo) = (rn, ln);
         }
         g.push(Item::Assign(lane("q", qm), lo.clone()));
         g.push(Item::Assign(lane("r", wd), rm.clone()));
+        g.push(Item::Assign(lane("dv", wd), "dv".into()));
         g.push(Item::Always(vec![Stmt::If(
             lane("ld", 1),
             vec![set("dv", lane("d", wd)), set("rm", lane("n", wd)), set("lo", lane("lo", qm))],

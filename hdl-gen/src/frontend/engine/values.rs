@@ -193,8 +193,15 @@ impl<'a> Values<'a> {
     /// logic (43 selects, 11-12.5 ns on the 25F); here it is the carry and an OR of the one-hot.
     /// ABC then maps the rest of the block under a smaller depth, in more LUT4, unless given the
     /// chain's depth as its target (`scripts/synth --abc-depth 7`, docs/fpga.md).
+    ///
+    /// A compare of two values' difference: its sign (`wide` bits hold it without overflow), a
+    /// subtract on the carry chain. As `$signed(a) < $signed(b)` Yosys 0.23 mapped each into
+    /// LUT4 beside its carry chain (a 19-bit compare 36-38 LUT4).
     pub fn logic_nets(&self, o: usize) -> Vec<(String, u32, String)> {
         let op = self.op(o);
+        if let Some((a, b, wide)) = self.lt_by_difference(o) {
+            return vec![(format!("t{o}_d"), wide, format!("{a} - {b}"))];
+        }
         let Kind::Lzc(a, n) = op.kind else { return vec![] };
         let v = self.at(a, self.s.slots[o].start);
         let r = format!("t{o}_r");
@@ -203,6 +210,19 @@ impl<'a> Values<'a> {
             (r.clone(), n + 1, format!("{{1'b1, {}}}", rev.join(", "))),
             (format!("t{o}_h"), n + 1, format!("{r} & (~{r} + {}'d1)", n + 1)),
         ]
+    }
+
+    /// A compare of two values (no constant) as its operands extended to the width its
+    /// difference needs, and that width.
+    fn lt_by_difference(&self, o: usize) -> Option<(String, String, u32)> {
+        let Kind::Lt(a, b) = self.op(o).kind else { return None };
+        let t = self.s.slots[o].start;
+        let (x, y) = (self.at(a, t), self.at(b, t));
+        if matches!(x, Src::Const(_)) || matches!(y, Src::Const(_)) {
+            return None;
+        }
+        let wide = self.op(a.0 as usize).w.max(self.op(b.0 as usize).w).max(self.op(o).w) + 2;
+        Some((x.ext(wide), y.ext(wide), wide))
     }
 
     /// A logic operation's result from its operands read at its start, and the result's width.
@@ -214,6 +234,7 @@ impl<'a> Values<'a> {
         match op.kind {
             Kind::Add(a, b) => (format!("{} + {}", x(a).ext(wide), x(b).ext(wide)), wide),
             Kind::Sub(a, b) => (format!("{} - {}", x(a).ext(wide), x(b).ext(wide)), wide),
+            Kind::Lt(..) if self.lt_by_difference(o).is_some() => (format!("t{o}_d[{}]", wide - 1), 1),
             Kind::Lt(a, b) => (format!("$signed({}) < $signed({})", x(a).ext(wide), x(b).ext(wide)), 1),
             Kind::Eq(a, b) => (format!("{} == {}", x(a).ext(wide), x(b).ext(wide)), 1),
             Kind::And(a, b) => (format!("(|{}) && (|{})", x(a).ext(self.op(a.0 as usize).w), x(b).ext(self.op(b.0 as usize).w)), 1),
