@@ -155,9 +155,11 @@ fn split(cx: &Cx, b: &mut Vec<Item>) {
     let hw = w - h;
     let one = |e: &str| format!("{{{{{}{{1'b0}}}}, {e}}}", w - 1);
     b.push(comment("The ALU over three clocks. 1: the operands and the function registered (ax*, af, ai; the select's choice"));
-    b.push(comment("into ax1). 2: the low half's sum with its carry and both sums of the high half (carry in 0 and 1); the zero"));
-    b.push(comment("tests; the shift by the amount's low bits; the leading zeros of each group of bits; select, right shift or"));
-    b.push(comment("pass (b*). 3: the high half chosen by the carry and the compare; the shift by the amount's high bits; the"));
+    b.push(comment("into ax0, ax1 zero for a pass or a select). 2: the low half's sum with its carry and both sums of the high"));
+    b.push(comment("half (carry in 0 and 1); the zero tests; the shift by the amount's low bits; the leading zeros of each group"));
+    b.push(comment(
+        "of bits; the right shift (b*). 3: the high half chosen by the carry and the compare; the shift by the amount's high bits; the",
+    ));
     b.push(comment("count; the wide result in one register (c*). Then ar, the result, in the write bus's source select."));
     b.extend([reg("ax0", w), reg("ax1", w), reg("af", 4), reg("ai", sw)]);
     b.push(wire("sub", 1, format!("af == 4'd{FN_SUB} || af == 4'd{FN_LT}")));
@@ -200,8 +202,9 @@ fn split(cx: &Cx, b: &mut Vec<Item>) {
     // zeroes the second's, so their value comes through the adder (`ax0 + 0`): no third operand
     // register and no move multiplexer beside the sum (a word of logic cells each on the UP5K,
     // which is short of cells). Each register's bits above the flag's are a port or zero (a
-    // flip-flop's synchronous reset), not a choice among the operands. The units load from
-    // `ax0` and `ax1` only on their own read clocks, whose function is no ALU's (0).
+    // flip-flop's synchronous reset), not a choice among the operands. The divider (and the
+    // HX8K's shift-add unit) loads from `ax0` and `ax1` only on its own read clocks, whose
+    // function is no ALU's (0).
     let (sel, pass) = (format!("u_fn == 4'd{FN_SEL}"), format!("u_fn == 4'd{FN_PASS}"));
     b.push(wire("sc", 1, format!("u_fl0 ? fl[u_fa0] : {}", if bit { "da[0]" } else { "|da" })));
     b.push(wire("a_b", 1, format!("{sel} && sc")));
