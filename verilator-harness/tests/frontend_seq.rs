@@ -13,9 +13,11 @@ use verilator_harness::frontend::random_triangles;
 /// SB_MAC16 tile passes) at 37x23 level 0 and 640x480 level 1 (its target's); 1,000 triangles
 /// each (about 340 clocks a triangle); a fault planted in the HX8K's ALU (the subtract made an
 /// add; the vertex register freed at the period's first clocks, before the entered triangle's
-/// inputs are read) and seven in the UP5K's engine (the tiles' sum not shifted a chunk up where
+/// inputs are read) and nine in the UP5K's engine (the tiles' sum not shifted a chunk up where
 /// the pass's weight drops, its high half or the split ALU's without the low half's carry, the
-/// divider's dividend bits not shifted in, the select's second choice never taken into `ax1`, a
+/// divider's dividend bits not shifted in, the select's first choice never taken into `ax0`,
+/// its second operand not zeroed before the adder that passes the choice, the
+/// equality with zero a test of bit 0 alone, a
 /// tile's held operand, only as wide as its unit's widest, without its top bit, the vertex
 /// register freed early) are caught. Slow tier: `cargo nextest run -p verilator-harness --run-ignored only -E
 /// 'test(/sequential_engine/)'`.
@@ -49,13 +51,10 @@ fn sequential_engine_spans_equal_golden() {
                 fault(" m0his = ", ", m0c2}", ", 1'b0}", "the tile's high half without the low half's carry"),
                 fault(" addsub = ", "{bc ? ", "{1'b0 ? ", "the split ALU's high half without the low half's carry"),
                 fault(" dt = ", "{dr, dl[", "{dr, 1'b0 & dl[", "the divider's dividend bits not shifted in"),
-                fault(" ax1 <= ", "sel2 ? x2", "1'b0 ? x2", "the select's second choice not taken into the operand register"),
-                fault(
-                    " m1b <= ",
-                    "m1b <= m1xb",
-                    "m1b <= m1xb << 1 >> 1",
-                    "a tile's held operand without its top bit, the sign above its chunks",
-                ),
+                fault(" a_b = ", "&& sc", "&& 1'b0", "the select's first choice (port B) never taken into the operand register"),
+                fault(" b_z = ", "== 4'd8 ||", "== 4'd15 ||", "the select's second operand not zeroed, so the adder adds it to the choice"),
+                fault(" bfl <= ", "~|ax0", "~ax0[0]", "the equality with zero a test of bit 0 alone"),
+                fault(" m1b <= ", "];", "] << 1 >> 1;", "a tile's held operand without its top bit, the sign above its chunks"),
                 fault("&& vld[0]) begin", "en && pc == ", "en && pc != ", "the vertex register freed before its inputs are read"),
             ]
         } else {

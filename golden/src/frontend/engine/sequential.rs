@@ -46,8 +46,9 @@ pub const READ: u32 = 1;
 pub const ALU_LAT: u32 = 1;
 /// The split ALU's latency: the operands registered, the adder in two halves with the carry
 /// registered between them (and the shift and the leading-zero count in two steps), the
-/// result multiplexer a clock of its own.
-pub const ALU_LAT_SPLIT: u32 = 4;
+/// result's kinds chosen among in the write bus's source select (a clock and a word of
+/// flip-flops of their own until issue 27's stop 35: about 60 logic cells on the UP5K).
+pub const ALU_LAT_SPLIT: u32 = 3;
 
 /// iCE40 SB_LUT4 a bit of the ALU, not calibrated (the estimate puts the HX8K plan's engine at
 /// 2,182 SB_LUT4; its RTL measures 3,281, docs/fpga.md): the adder-subtractor with its operand

@@ -21,8 +21,8 @@ use super::units::bits_for;
 use crate::frontend::hw::Hw;
 use crate::verilog::{comment, reg, set, sreg, wire, Item, Module, Param, Port, Stmt};
 use cx::{
-    operands, Cx, FN_ADD, FN_AND, FN_EQ, FN_LT, FN_LZC, FN_NOT, FN_OR, FN_PASS, FN_SEL, FN_SHL, FN_SHLV, FN_SHR, FN_SUB, SRC_ALU, SRC_DIVQ,
-    SRC_DIVR, SRC_IN, SRC_MUL, SRC_MUL1,
+    Cx, FN_ADD, FN_AND, FN_EQ, FN_LT, FN_LZC, FN_NOT, FN_OR, FN_PASS, FN_SEL, FN_SHL, FN_SHLV, FN_SHR, FN_SUB, SRC_ALU, SRC_DIVQ, SRC_DIVR,
+    SRC_IN, SRC_MUL, SRC_MUL1,
 };
 use datapath::{divider, shift_add, write_bus};
 use golden::frontend::engine::schedule::Class;
@@ -44,9 +44,6 @@ impl Layout {
             ("fl0", 1),
             ("fl1", 1),
             ("fl2", 1),
-            ("pb0", 1),
-            ("pb1", 1),
-            ("pb2", 1),
             ("fa0", fb),
             ("fa1", fb),
             ("fa2", fb),
@@ -171,7 +168,7 @@ pub fn module(hw: &Hw, s: &SeqSchedule, name: &str) -> SeqEngine {
     memories(&cx, &l, &micro, &consts, &mut b);
     alu::alu(&cx, &mut b);
     match tile::Tiles::new(s) {
-        Some(t) => t.units(w, operands(&cx), &mut b),
+        Some(t) => t.units(w, ("da", "db"), &mut b),
         None => shift_add(&cx, &mut b),
     }
     divider(&cx, &mut b);
@@ -213,7 +210,9 @@ fn microprogram(cx: &Cx, fields: &[Field]) -> Micro {
     for (o, op) in ops.iter().enumerate() {
         let sl = s.slots[o];
         let t = sl.issue;
-        // Operands: the wide ones on ports A then B, the flags from the flag file.
+        // Operands: a flag from the flag file, else the port of its position (the first and
+        // the third on port A, the second on B), so the ALU's operand registers need no choice
+        // of port (the choice between two ports was a LUT level on all 66 bits of each).
         let mut args = op.kind.args();
         if let (Kind::Mul(a, b), None) = (op.kind, &tiles) {
             // The shift-add unit steps through its second operand: the narrower.
@@ -223,18 +222,17 @@ fn microprogram(cx: &Cx, fields: &[Field]) -> Micro {
         }
         let exec = sl.exec;
         if matches!(exec, Exec::Alu | Exec::Unit(..)) {
-            let mut port = 0;
             for (j, a) in args.iter().enumerate() {
-                let (fl, pb, fa) = (["fl0", "fl1", "fl2"][j], ["pb0", "pb1", "pb2"][j], ["fa0", "fa1", "fa2"][j]);
+                let (fl, fa) = (["fl0", "fl1", "fl2"][j], ["fa0", "fa1", "fa2"][j]);
                 match s.slots[a.0 as usize].loc {
                     Loc::Flag(k) => {
                         mw[t as usize + 1].set(fl, 1, t + 1);
                         mw[t as usize + 1].set(fa, k as u64, t + 1);
                     }
                     _ => {
-                        mw[t as usize].set(["ra", "rb"][port], addr(*a) as u64, t);
-                        mw[t as usize + 1].set(pb, port as u64, t + 1);
-                        port += 1;
+                        let port = ["ra", "rb", "ra"][j];
+                        assert!(!mw[t as usize].0.contains_key(port), "{}: its first and third operands both wide", op.name);
+                        mw[t as usize].set(port, addr(*a) as u64, t);
                     }
                 }
             }
@@ -243,6 +241,8 @@ fn microprogram(cx: &Cx, fields: &[Field]) -> Micro {
             let x = &mut mw[e as usize];
             match (exec, op.kind) {
                 (Exec::Unit(Class::Mul, u), _) if tiles.is_some() => {
+                    // The tiles hold their operands from the ports themselves (`tile`).
+                    assert!(args.iter().all(|a| !matches!(s.slots[a.0 as usize].loc, Loc::Flag(_))), "{}: a flag on a tile", op.name);
                     for (t, k, v) in tiles.as_ref().expect("tiles").passes(o, u) {
                         mw[t as usize].set(k, v, t);
                     }

@@ -93,7 +93,7 @@ fn planted_sequencing_faults_are_caught() {
     assert!(v.is_err() && m.is_some(), "a constant overwritten: {v:?}");
 }
 
-/// The UP5K plan's latencies (the ALU over four clocks, a registered write bus) are its
+/// The UP5K plan's latencies (the ALU over three clocks, a registered write bus) are its
 /// schedule's, and `verify` holds it to them: an ALU result planted a clock early (where the
 /// RTL's result is not there yet) fails it.
 #[test]

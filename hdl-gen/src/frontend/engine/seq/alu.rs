@@ -1,7 +1,7 @@
 //! The sequential engine's ALU: add, subtract and the signed compare on one adder, equal,
 //! and, or, not, select, the leading-zero count, one left shifter and the right shifts by
-//! their constants, its result registered in `ar`, which the write bus reads at golden's
-//! write clock (`issue + READ + SeqPlan::alu_lat`).
+//! their constants, its result `ar`, which the write bus reads at golden's write clock
+//! (`issue + READ + SeqPlan::alu_lat`, less its own `bus_lat`).
 //!
 //! - **One clock** ([`ALU_LAT`], the HX8K's until issue 27's stop 34, no plan's since): the
 //!   operand select, the whole adder and the result multiplexer in one path, as first written.
@@ -13,10 +13,12 @@
 //!   half (carry in 0 and 1, a carry select), tests the operands for zero, shifts by the
 //!   amount's low bits and counts each group's leading zeros; clock 3 picks the high half by
 //!   the low half's carry, forms the compare from the signs, shifts by the amount's high bits,
-//!   finds the first group that is not zero and registers the wide result; clock 4
-//!   multiplexes the result into `ar`.
+//!   finds the first group that is not zero and registers the wide result; `ar` chooses among
+//!   the results' kinds, in the write bus's source select (a register and a clock of its own
+//!   until issue 27's stop 35).
 
-use super::cx::{Cx, FN_ADD, FN_AND, FN_EQ, FN_LT, FN_LZC, FN_NOT, FN_OR, FN_SEL, FN_SHL, FN_SHLV, FN_SHR, FN_SUB};
+use super::cx::{Cx, FN_ADD, FN_AND, FN_EQ, FN_LT, FN_LZC, FN_NOT, FN_OR, FN_PASS, FN_SEL, FN_SHL, FN_SHLV, FN_SHR, FN_SUB};
+use crate::frontend::engine::units::bits_for;
 use crate::verilog::{comment, reg, set, wire, Item, Stmt};
 use golden::frontend::engine::sequential::{Exec, ALU_LAT, ALU_LAT_SPLIT};
 use golden::frontend::engine::Kind;
@@ -24,9 +26,20 @@ use golden::frontend::engine::Kind;
 /// The ALU of the plan's latency.
 pub(super) fn alu(cx: &Cx, b: &mut Vec<Item>) {
     let w = cx.w;
-    b.push(comment("Operands: a flag from the flag file, else the port the microword names."));
-    for j in 0..3 {
-        b.push(wire(&format!("x{j}"), w, format!("u_fl{j} ? {{{{{}{{1'b0}}}}, fl[u_fa{j}]}} : (u_pb{j} ? db : da)", w - 1)));
+    b.push(comment("Operands: a flag from the flag file, else the port of the operand's position (A, B, A)."));
+    // The split ALU reads the first and the third from the ports and the flags themselves
+    // (`ax0`); units loading on the read clock read the first.
+    let two = cx.s.plan.alu_lat == ALU_LAT_SPLIT;
+    let xs: &[usize] = if !two {
+        &[0, 1, 2]
+    } else if cx.s.plan.load_lag == 0 {
+        &[0, 1]
+    } else {
+        &[1]
+    };
+    for &j in xs {
+        let port = ["da", "db", "da"][j];
+        b.push(wire(&format!("x{j}"), w, format!("u_fl{j} ? {{{{{}{{1'b0}}}}, fl[u_fa{j}]}} : {port}", w - 1)));
     }
     match cx.s.plan.alu_lat {
         ALU_LAT => one_clock(cx, b),
@@ -134,18 +147,20 @@ fn one_clock(cx: &Cx, b: &mut Vec<Item>) {
     b.push(Item::Always(vec![Stmt::If("en".into(), vec![set("ar", "alu")], vec![])]));
 }
 
-/// The ALU over four clocks (module doc): each clock's logic a few LUT levels on the UP5K.
+/// The ALU over three clocks (module doc): each clock's logic a few LUT levels on the UP5K.
 fn split(cx: &Cx, b: &mut Vec<Item>) {
     let (w, sw) = (cx.w, cx.sw);
     // The low half as wide as the high one or one bit wider: the two carry chains even.
     let h = w.div_ceil(2);
     let hw = w - h;
     let one = |e: &str| format!("{{{{{}{{1'b0}}}}, {e}}}", w - 1);
-    b.push(comment("The ALU over four clocks. 1: the operands and the function registered (ax*, af, ai; the select's choice"));
-    b.push(comment("into ax1). 2: the low half's sum with its carry and both sums of the high half (carry in 0 and 1); the zero"));
-    b.push(comment("tests; the shift by the amount's low bits; the leading zeros of each group of bits; select, right shift or"));
-    b.push(comment("pass (b*). 3: the high half chosen by the carry and the compare; the shift by the amount's high bits; the"));
-    b.push(comment("count; the wide result in one register (c*). 4: the result into ar."));
+    b.push(comment("The ALU over three clocks. 1: the operands and the function registered (ax*, af, ai; the select's choice"));
+    b.push(comment("into ax0, ax1 zero for a pass or a select). 2: the low half's sum with its carry and both sums of the high"));
+    b.push(comment("half (carry in 0 and 1); the zero tests; the shift by the amount's low bits; the leading zeros of each group"));
+    b.push(comment(
+        "of bits; the right shift (b*). 3: the high half chosen by the carry and the compare; the shift by the amount's high bits; the",
+    ));
+    b.push(comment("count; the wide result in one register (c*). Then ar, the result, in the write bus's source select."));
     b.extend([reg("ax0", w), reg("ax1", w), reg("af", 4), reg("ai", sw)]);
     b.push(wire("sub", 1, format!("af == 4'd{FN_SUB} || af == 4'd{FN_LT}")));
     b.push(wire("ay1", w, format!("ax1 ^ {{{w}{{sub}}}}")));
@@ -164,32 +179,64 @@ fn split(cx: &Cx, b: &mut Vec<Item>) {
         Kind::Sel(c, ..) if sl.exec == Exec::Alu => ops[c.0 as usize].w == 1,
         _ => true,
     });
-    b.push(wire("nz0", 1, "|ax0"));
-    b.push(wire("nz1", 1, "|ax1"));
-    // The select chooses on clock 1, into the second operand's register: no third operand
-    // register (a word of flip-flops on the UP5K, which is short of cells). The units load
-    // from `ax1` only on their own read clocks, whose function is never the select.
-    b.push(wire("sel2", 1, format!("u_fn == 4'd{FN_SEL} && !{}", if bit { "x0[0]" } else { "(|x0)" })));
-    let flag = format!("(af == 4'd{FN_EQ}) ? (ax0 == ax1) : (af == 4'd{FN_AND}) ? (nz0 && nz1) : (af == 4'd{FN_OR}) ? (nz0 || nz1) : !nz0");
+    // The and, or and not of values whose bit 0 is their truth (one-bit values, as golden's
+    // are, and constants such as 1), and equality with a constant 0 (golden's only): each from
+    // a bit or one zero test, not a word's ORs and compare (about 70 LUTs on the UP5K).
+    let alu = |o: usize| cx.s.slots[o].exec == Exec::Alu;
+    let truth = |v: golden::frontend::engine::V| {
+        let a = &ops[v.0 as usize];
+        a.w == 1 || matches!(a.kind, Kind::Const(c) if (c != 0) == (c & 1 != 0))
+    };
+    let low = ops.iter().enumerate().all(|(o, op)| match op.kind {
+        Kind::And(..) | Kind::Or(..) | Kind::Not(_) if alu(o) => op.kind.args().into_iter().all(truth),
+        _ => true,
+    });
+    let eq0 = ops.iter().enumerate().all(|(o, op)| match op.kind {
+        Kind::Eq(_, z) if alu(o) => matches!(ops[z.0 as usize].kind, Kind::Const(0)),
+        _ => true,
+    });
+    let (t0, t1) = if low { ("ax0[0]", "ax1[0]") } else { ("|ax0", "|ax1") };
+    b.push(wire("nz0", 1, t0));
+    b.push(wire("nz1", 1, t1));
+    // The select chooses on clock 1, into the first operand's register, and a pass or a select
+    // zeroes the second's, so their value comes through the adder (`ax0 + 0`): no third operand
+    // register and no move multiplexer beside the sum (a word of logic cells each on the UP5K,
+    // which is short of cells). Each register's bits above the flag's are a port or zero (a
+    // flip-flop's synchronous reset), not a choice among the operands. The divider (and the
+    // HX8K's shift-add unit) loads from `ax0` and `ax1` only on its own read clocks, whose
+    // function is no ALU's (0).
+    let (sel, pass) = (format!("u_fn == 4'd{FN_SEL}"), format!("u_fn == 4'd{FN_PASS}"));
+    b.push(wire("sc", 1, format!("u_fl0 ? fl[u_fa0] : {}", if bit { "da[0]" } else { "|da" })));
+    b.push(wire("a_b", 1, format!("{sel} && sc")));
+    b.push(wire("a_fl", 1, format!("({sel}) ? (sc ? u_fl1 : u_fl2) : u_fl0")));
+    b.push(wire("a_fv", 1, format!("({sel}) ? (sc ? fl[u_fa1] : fl[u_fa2]) : fl[u_fa0]")));
+    b.push(wire("b_z", 1, format!("{sel} || {pass}")));
+    let eq = if eq0 { "~|ax0" } else { "(ax0 == ax1)" };
+    let flag = format!("(af == 4'd{FN_EQ}) ? {eq} : (af == 4'd{FN_AND}) ? (nz0 && nz1) : (af == 4'd{FN_OR}) ? (nz0 || nz1) : !nz0");
     // Right shifts are by constants, and few (one at the named screens): a multiplexer over them.
     let mut shrs: Vec<u32> = ops.iter().filter_map(|o| if let Kind::Shr(_, n) = o.kind { Some(n) } else { None }).collect();
     shrs.sort();
     shrs.dedup();
     b.push(reg("shr", w));
-    let arms = shrs.iter().map(|n| (format!("{sw}'d{n}"), vec![Stmt::Blocking("shr".into(), format!("$signed(ax0) >>> {n}"))])).collect();
-    b.push(Item::Comb(vec![Stmt::Case { sel: "ai".into(), arms, default: vec![Stmt::Blocking("shr".into(), "ax0".into())] }]));
-    let mv = format!("(af == 4'd{FN_SEL}) ? ax1 : (af == 4'd{FN_SHR}) ? shr : ax0");
+    // Read only for a right shift: its last constant is the default.
+    let by = |n: u32| vec![Stmt::Blocking("shr".into(), format!("$signed(ax0) >>> {n}"))];
+    let (arms, default) = match shrs.split_last() {
+        Some((&last, rest)) => (rest.iter().map(|&n| (format!("{sw}'d{n}"), by(n))).collect(), by(last)),
+        None => (Vec::new(), vec![Stmt::Blocking("shr".into(), "ax0".into())]),
+    };
+    b.push(Item::Comb(vec![Stmt::Case { sel: "ai".into(), arms, default }]));
+
     // The result's kind, for clock 4's multiplexer.
     let kind = format!(
-        "(af == 4'd{FN_ADD} || sub) ? {{af == 4'd{FN_LT}, 2'd0}} : (af == 4'd{FN_EQ} || af == 4'd{FN_AND} || af == 4'd{FN_OR} || af == 4'd{FN_NOT}) ? 3'd1 : (af == 4'd{FN_LZC}) ? 3'd2 : (af == 4'd{FN_SHL} || af == 4'd{FN_SHLV}) ? 3'd3 : 3'd5"
+        "(af == 4'd{FN_ADD} || sub || af == 4'd{FN_PASS} || af == 4'd{FN_SEL}) ? {{af == 4'd{FN_LT}, 2'd0}} : (af == 4'd{FN_EQ} || af == 4'd{FN_AND} || af == 4'd{FN_OR} || af == 4'd{FN_NOT}) ? 3'd1 : (af == 4'd{FN_LZC}) ? 3'd2 : (af == 4'd{FN_SHL} || af == 4'd{FN_SHLV}) ? 3'd3 : 3'd5"
     );
     b.extend([reg("blo", h), reg("bc", 1), reg("bhi0", hw), reg("bhi1", hw), reg("bs0", 1), reg("bs1", 1)]);
     b.extend([reg("bfl", 1), reg("bmv", w), reg("bk", 3), reg("ck", 3), reg("cfl", 1)]);
-    b.extend([reg("cv", w), reg("clt", 1), reg("ar", w)]);
+    b.extend([reg("cv", w), reg("clt", 1)]);
     b.push(wire("addsub", w, "{bc ? bhi1 : bhi0, blo}"));
     let mut regs = vec![
-        set("ax0", "x0"),
-        set("ax1", "sel2 ? x2 : x1"),
+        set("ax0", format!("a_fl ? {{{{{}{{1'b0}}}}, a_fv}} : (a_b ? db : da)", w - 1)),
+        set("ax1", format!("b_z ? {w}'d0 : x1")),
         set("af", "u_fn"),
         set("ai", "u_imm"),
         set("blo", format!("alo[{}:1]", h)),
@@ -199,40 +246,64 @@ fn split(cx: &Cx, b: &mut Vec<Item>) {
         set("bs0", format!("ax0[{}]", w - 1)),
         set("bs1", format!("ax1[{}]", w - 1)),
         set("bfl", flag),
-        set("bmv", mv),
+        set("bmv", "shr"),
         set("bk", kind),
         set("clt", format!("(bs0 != bs1) ? bs0 : addsub[{}]", w - 1)),
         set("cfl", "bfl"),
         set("ck", "bk"),
     ];
     // The wide results (the sum, the shift, the moves) share clock 3's register: a word of
-    // flip-flops each was a word of logic cells on the UP5K; clock 4 picks among it and the
-    // one-bit and count results.
+    // flip-flops each was a word of logic cells on the UP5K; `ar` picks among it and the
+    // one-bit and count results, in the write bus's source select.
     let (sh, lz) = (split_shift(cx, &mut regs, b), split_lzc(cx, &mut regs, b));
     regs.push(set("cv", format!("(bk == 3'd0) ? addsub : (bk == 3'd3) ? {sh} : bmv")));
     let ar =
         format!("(ck == 3'd4) ? {} : (ck == 3'd1) ? {} : (ck == 3'd2) ? {} : cv", one("clt"), one("cfl"), crate::verilog::zext(&lz, sw, w));
-    regs.push(set("ar", ar));
     b.push(Item::Always(vec![Stmt::If("en".into(), regs, vec![])]));
+    b.push(wire("ar", w, ar));
 }
 
 /// The left shift in two clocks: by the amount's low three bits on clock 2, by its high bits
 /// on clock 3 (all out at W or more: the amount's bits above its width ORed, not a compare of
-/// the whole word). Returns clock 3's shifted value, which [`split`] registers.
+/// the whole word). Where every amount is below W (the constants, and each variable amount's
+/// unsigned width: golden's are leading-zero counts), the amount is only as wide as the
+/// largest and nothing shifts out. Returns clock 3's shifted value, which [`split`] registers.
 fn split_shift(cx: &Cx, regs: &mut Vec<Stmt>, b: &mut Vec<Item>) -> String {
-    let (w, sw) = (cx.w, cx.sw);
-    let lo = sw.min(3);
+    let (w, sw, ops) = (cx.w, cx.sw, &cx.s.prog.ops);
+    let mut most = Some(0u64);
+    for (_, op) in ops.iter().enumerate().filter(|&(o, _)| cx.s.slots[o].exec == Exec::Alu) {
+        let n = match op.kind {
+            Kind::Shl(_, n) => Some(n as u64),
+            Kind::ShlBy(_, a) => {
+                let a = &ops[a.0 as usize];
+                (!a.signed && a.w < 32).then(|| (1u64 << a.w) - 1)
+            }
+            _ => continue,
+        };
+        most = most.zip(n).map(|(m, n)| m.max(n));
+    }
+    let bound = most.filter(|&m| m < w as u64).map(|m| bits_for(m.max(1)));
+    let aw = bound.unwrap_or(sw);
+    let lo = aw.min(3);
     b.push(wire("shl_by", 1, format!("af == 4'd{FN_SHLV}")));
-    b.push(wire("shl_amt", sw, format!("shl_by ? ax1[{}:0] : ai", sw - 1)));
-    b.push(wire("shl_out", 1, format!("shl_by && (|ax1[{}:{sw}] || ax1[{}:0] >= {sw}'d{w})", w - 1, sw - 1)));
-    b.extend([reg("bsh", w), reg("bout", 1)]);
-    regs.extend([set("bsh", format!("ax0 << shl_amt[{}:0]", lo - 1)), set("bout", "shl_out")]);
-    if sw > lo {
-        b.push(reg("bamt", sw - lo));
-        regs.push(set("bamt", format!("shl_amt[{}:{lo}]", sw - 1)));
-        b.push(wire("csh", w, format!("bout ? {w}'d0 : bsh << {{bamt, {lo}'d0}}")));
+    let ai = if aw < sw { format!("ai[{}:0]", aw - 1) } else { "ai".into() };
+    b.push(wire("shl_amt", aw, format!("shl_by ? ax1[{}:0] : {ai}", aw - 1)));
+    b.push(reg("bsh", w));
+    regs.push(set("bsh", format!("ax0 << shl_amt[{}:0]", lo - 1)));
+    let out = if bound.is_none() {
+        b.push(wire("shl_out", 1, format!("shl_by && (|ax1[{}:{sw}] || ax1[{}:0] >= {sw}'d{w})", w - 1, sw - 1)));
+        b.push(reg("bout", 1));
+        regs.push(set("bout", "shl_out"));
+        format!("bout ? {w}'d0 : ")
     } else {
-        b.push(wire("csh", w, format!("bout ? {w}'d0 : bsh")));
+        String::new()
+    };
+    if aw > lo {
+        b.push(reg("bamt", aw - lo));
+        regs.push(set("bamt", format!("shl_amt[{}:{lo}]", aw - 1)));
+        b.push(wire("csh", w, format!("{out}bsh << {{bamt, {lo}'d0}}")));
+    } else {
+        b.push(wire("csh", w, format!("{out}bsh")));
     }
     "csh".into()
 }

@@ -5,8 +5,10 @@ use crate::frontend::hw::Hw;
 use golden::frontend::engine::sequential::{Exec, SeqSchedule};
 use golden::frontend::engine::Kind;
 
-/// The ALU's functions (the microword's `fn` field).
-pub(super) const FN_PASS: u64 = 0;
+/// The ALU's functions (the microword's `fn` field). 0 is a clock that issues no ALU
+/// operation (a unit's load, or none): the split ALU zeroes its second operand for a pass and a
+/// select (their value then comes through the adder), never on a unit's load, which reads it.
+pub(super) const FN_PASS: u64 = 13;
 pub(super) const FN_ADD: u64 = 1;
 pub(super) const FN_SUB: u64 = 2;
 pub(super) const FN_LT: u64 = 3;

@@ -87,8 +87,10 @@ pub(super) fn divider(cx: &Cx, b: &mut Vec<Item>) {
         }
     };
     let low = |q: u32| if q < qm { format!("{{{x0}[{}:0], {}'d0}}", q - 1, qm - q) } else { format!("{x0}[{}:0]", q - 1) };
-    let mut top = vec![Stmt::Blocking("dr0".into(), format!("{x0}[{}:0]", wd - 1)), Stmt::Blocking("dl0".into(), format!("{qm}'d0"))];
-    for &q in qbs.iter().rev() {
+    // Read only at a load, whose quotient width is one of them: the widest is the default.
+    let (&last, rest) = qbs.split_last().expect("a division");
+    let mut top = vec![Stmt::Blocking("dr0".into(), high(last)), Stmt::Blocking("dl0".into(), low(last))];
+    for &q in rest.iter().rev() {
         top = vec![Stmt::If(
             format!("u_dqb == {sw}'d{q}"),
             vec![Stmt::Blocking("dr0".into(), high(q)), Stmt::Blocking("dl0".into(), low(q))],
@@ -154,14 +156,17 @@ pub(super) fn write_bus(cx: &Cx, widths: &[u32], b: &mut Vec<Item>) {
         // with a zero bit on top).
         let wi = (0..ins.len()).map(|k| kind(k).0 + !kind(k).1 as u32).max().expect("inputs");
         b.extend([reg("src_r", 4), reg("in_r", wi), reg("inp", wi), reg("wc_r", wb), reg("wsg_r", 1), reg("bus_r", w)]);
+        // Read only where the source is an input: the last input is the default.
         let arms = ins
             .iter()
             .enumerate()
+            .take(ins.len() - 1)
             .map(|(k, n)| (format!("4'd{}", SRC_IN + k as u64), vec![Stmt::Blocking("inp".into(), ext(n, kind(k), wi))]));
+        let last = ins.len() - 1;
         b.push(Item::Comb(vec![Stmt::Case {
             sel: "u_src".into(),
             arms: arms.collect(),
-            default: vec![Stmt::Blocking("inp".into(), format!("{wi}'d0"))],
+            default: vec![Stmt::Blocking("inp".into(), ext(ins[last], kind(last), wi))],
         }]));
         let labels: Vec<String> = (0..ins.len()).map(|k| format!("4'd{}", SRC_IN + k as u64)).collect();
         srcs.push((labels.join(", "), crate::verilog::sext("in_r", wi, w)));
@@ -175,19 +180,14 @@ pub(super) fn write_bus(cx: &Cx, widths: &[u32], b: &mut Vec<Item>) {
     b.push(Item::Comb(vec![Stmt::Case { sel: src.into(), arms, default: vec![Stmt::Blocking("raw".into(), "ar".into())] }]));
     b.push(reg("wmask", w));
     b.push(reg("wsign", 1));
-    let arms: Vec<(String, Vec<Stmt>)> = widths
-        .iter()
-        .enumerate()
-        .map(|(k, &x)| {
-            let m = if x >= w { format!("{{{w}{{1'b1}}}}") } else { format!("{{{{{}{{1'b0}}}}, {{{x}{{1'b1}}}}}}", w - x) };
-            (format!("{wb}'d{k}"), vec![Stmt::Blocking("wmask".into(), m), Stmt::Blocking("wsign".into(), format!("{val}[{}]", x - 1))])
-        })
-        .collect();
-    b.push(Item::Comb(vec![Stmt::Case {
-        sel: wc.into(),
-        arms,
-        default: vec![Stmt::Blocking("wmask".into(), format!("{{{w}{{1'b1}}}}")), Stmt::Blocking("wsign".into(), "1'b0".into())],
-    }]));
+    let arm = |x: u32| {
+        let m = if x >= w { format!("{{{w}{{1'b1}}}}") } else { format!("{{{{{}{{1'b0}}}}, {{{x}{{1'b1}}}}}}", w - x) };
+        vec![Stmt::Blocking("wmask".into(), m), Stmt::Blocking("wsign".into(), format!("{val}[{}]", x - 1))]
+    };
+    // Every write names one of the widths: the widest is the default.
+    let (&last, rest) = widths.split_last().expect("a width");
+    let arms: Vec<(String, Vec<Stmt>)> = rest.iter().enumerate().map(|(k, &x)| (format!("{wb}'d{k}"), arm(x))).collect();
+    b.push(Item::Comb(vec![Stmt::Case { sel: wc.into(), arms, default: arm(last) }]));
     let wrapped = format!("({val} & wmask) | (({wsg} && wsign) ? ~wmask : {{{w}{{1'b0}}}})");
     if reg_bus {
         b.push(Item::Always(vec![Stmt::If(

@@ -4,9 +4,11 @@
 //! SB_MAC16), accumulated as the pipelined engine's tiles are ([`super::super::units`]):
 //! heaviest chunk pair first, the sum shifted one chunk up where the pair's weight drops.
 //!
-//! - **Timing** (golden's `timing`: `p` passes, then `MUL_PIPE`): the unit loads at its issue's
-//!   read clock `L`, where the operands are on the read ports, and runs its first pass on them
-//!   there; the operands are held for the other passes (`L + 1 ..`). A pass's chunks are
+//! - **Timing** (golden's `timing`: `p` passes, then `MUL_PIPE`): the unit's first pass is at
+//!   `L`, `SeqPlan::load_lag` (1) clocks after its operands are on the read ports; it holds
+//!   them from the ports a clock before (`L - 1`, the clock golden reserves the unit from), so
+//!   every pass selects its chunks from the held operands alone (a choice between the ports'
+//!   word and the held one was a LUT a bit of each held operand on the UP5K). A pass's chunks are
 //!   registered, their product the clock after, the sum the clock after that: the product is
 //!   in the accumulator at `L + p + 2`, the clock golden writes it.
 //! - **Control**: every pass's chunk indices, whether each is its operand's signed top chunk
@@ -66,7 +68,8 @@ impl<'a> Tiles<'a> {
         n
     }
 
-    /// Product `o` on unit `u`: its passes' fields, `(clock, field, value)`, from its load on.
+    /// Product `o` on unit `u`: its passes' fields, `(clock, field, value)`, from its load (the
+    /// clock before its first pass) on.
     pub(super) fn passes(&self, o: usize, u: u32) -> Vec<(u32, &'static str, u64)> {
         let ops = &self.s.prog.ops;
         let sl = self.s.slots[o];
@@ -77,6 +80,7 @@ impl<'a> Tiles<'a> {
         let mut p: Vec<(u32, u32)> =
             (0..ca).flat_map(|i| (0..cb).map(move |j| (i, j))).filter(|&(i, j)| (i + j) * self.bits < ops[o].w).collect();
         p.sort_by_key(|&(i, j)| std::cmp::Reverse(i + j));
+        assert_eq!(self.s.plan.load_lag, 1, "the tiles hold their operands from the read ports, a clock before the first pass");
         let l = sl.issue + READ + self.s.plan.load_lag;
         assert_eq!(sl.exec, Exec::Unit(golden::frontend::engine::schedule::Class::Mul, u));
         let lag = self.s.plan.acc_lag;
@@ -87,7 +91,7 @@ impl<'a> Tiles<'a> {
         for (k, &(i, j)) in p.iter().enumerate() {
             let t = l + k as u32;
             set.extend([
-                (t, f[0], (k == 0) as u64),
+                (t - (k == 0) as u32, f[0], (k == 0) as u64),
                 (t, f[1], i as u64),
                 (t, f[2], j as u64),
                 (t, f[3], (i + 1 == ca && a.signed) as u64),
@@ -103,7 +107,8 @@ impl<'a> Tiles<'a> {
     }
 
     /// The units: per unit the held operands, the chunk selection, the tile and the sum.
-    /// `w`: the register file's word; `x0`, `x1`: where the operands load from.
+    /// `w`: the register file's word; `x0`, `x1`: the read ports, which the units hold (their
+    /// operands are never flags: the generator asserts it).
     pub(super) fn units(&self, w: u32, (x0, x1): (&str, &str), b: &mut Vec<Item>) {
         let bits = self.bits;
         let (pw, cbw) = (2 * bits + 2, self.cbw);
@@ -111,12 +116,13 @@ impl<'a> Tiles<'a> {
             "The tile multipliers: a product as golden's passes of {bits}-bit chunks on a {0} x {0} signed multiplier (SB_MAC16),",
             bits + 1
         )));
-        b.push(comment("the first pass at the load on the read ports' operands, the others on the operands held (m*a, m*b); the"));
+        b.push(comment("the operands held from the read ports a clock before the first pass (m*a, m*b), every pass on them; the"));
         b.push(comment("sum cleared for the first pass and shifted a chunk up where the weight drops, modulo W."));
         for u in 0..self.mults {
             let m = |x: &str| format!("m{u}{x}");
             let uf = |x: &str| format!("u_m{u}{x}");
             let held = self.held(u);
+            let mut loads = Vec::new();
             for (side, (o, x)) in [("a", x0), ("b", x1)].into_iter().enumerate() {
                 // The operand held only as wide as this unit's widest on this side needs: its
                 // chunks and the sign bit above them (a register-file word holds its value sign-
@@ -125,29 +131,28 @@ impl<'a> Tiles<'a> {
                 let n = held[side];
                 let (hw, ew) = ((n * bits + 1).min(w), n * bits + 1);
                 b.push(reg(&m(o), hw));
-                let src = m(&format!("x{o}"));
                 let at = if hw < w { format!("{x}[{}:0]", hw - 1) } else { x.to_string() };
-                b.push(wire(&src, hw, format!("{} ? {at} : {}", uf("ld"), m(o))));
-                b.push(wire(&m(&format!("e{o}")), ew, crate::verilog::sext(&src, hw, ew)));
+                loads.push(set(m(o), at));
+                b.push(wire(&m(&format!("e{o}")), ew, crate::verilog::sext(&m(o), hw, ew)));
                 // The chunk the microword names, its sign bit the operand's where it is the
                 // signed top chunk.
                 let c = m(&format!("c{o}"));
                 b.push(reg(&c, bits + 1));
                 let e = m(&format!("e{o}"));
                 let top = uf(&format!("t{o}"));
-                let arms = (0..n)
-                    .map(|i| {
-                        let x = format!("{{{top} & {e}[{}], {e}[{}:{}]}}", (i + 1) * bits, (i + 1) * bits - 1, i * bits);
-                        (format!("{cbw}'d{i}"), vec![Stmt::Blocking(c.clone(), x)])
-                    })
-                    .collect();
-                b.push(Item::Comb(vec![Stmt::Case {
-                    sel: uf(&format!("c{o}")),
-                    arms,
-                    default: vec![Stmt::Blocking(c.clone(), format!("{}'d0", bits + 1))],
-                }]));
+                let chunk = |i: u32| {
+                    let x = format!("{{{top} & {e}[{}], {e}[{}:{}]}}", (i + 1) * bits, (i + 1) * bits - 1, i * bits);
+                    vec![Stmt::Blocking(c.clone(), x)]
+                };
+                // No pass names a chunk beyond the held ones: the top one is the default.
+                let arms = (0..n - 1).map(|i| (format!("{cbw}'d{i}"), chunk(i))).collect();
+                b.push(Item::Comb(if n > 1 {
+                    vec![Stmt::Case { sel: uf(&format!("c{o}")), arms, default: chunk(n - 1) }]
+                } else {
+                    chunk(0)
+                }));
             }
-            b.extend([sreg(&m("ra"), bits + 1), sreg(&m("rb"), bits + 1), reg(&m("f1"), 1), reg(&m("s1"), 1)]);
+            b.extend([sreg(&m("ra"), bits + 1), sreg(&m("rb"), bits + 1), reg(&m("f0"), 1), reg(&m("f1"), 1), reg(&m("s1"), 1)]);
             if w < pw {
                 b.push(comment("verilator lint_off UNUSEDSIGNAL"));
                 b.push(sreg(&m("pr"), pw));
@@ -156,10 +161,12 @@ impl<'a> Tiles<'a> {
                 b.push(sreg(&m("pr"), pw));
             }
             let mut regs = vec![
-                Stmt::If(uf("ld"), vec![set(m("a"), m("xa")), set(m("b"), m("xb"))], vec![]),
+                Stmt::If(uf("ld"), loads, vec![]),
                 set(m("ra"), m("ca")),
                 set(m("rb"), m("cb")),
-                set(m("f1"), uf("ld")),
+                // The first pass is the clock after the load.
+                set(m("f0"), uf("ld")),
+                set(m("f1"), m("f0")),
                 set(m("s1"), uf("s")),
                 set(m("pr"), format!("{} * {}", m("ra"), m("rb"))),
             ];
