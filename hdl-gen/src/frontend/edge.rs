@@ -344,13 +344,21 @@ fn dda(e: &EdgeWidths) -> Vec<Item> {
         // multiple of 256, so rem >= thr is decided by rem's high bits, and the low byte of
         // rem + rs256 never changes.
         let dw = e.held_w();
-        body.extend([reg("w_act", 1), reg("w_rs", row_w), reg("w_re", row_w), reg("w_thr", dw)]);
+        body.push(reg("w_act", 1));
+        if !tracked {
+            body.push(reg("w_right", 1));
+        }
+        body.extend([reg("w_rs", row_w), reg("w_re", row_w), reg("w_thr", dw)]);
         // Behind the row stages the remainder is held offset by the threshold, so the carry is
         // that register's sign: the compare on the carry chain, then the walker's running sums'
         // enables, was the ECP5 target's critical path (docs/fpga.md).
         body.push(if tracked { sreg("w_t", dw + 1) } else { reg("w_rem", dw) });
-        body.extend([reg("w_rs256", dw), sreg("w_qs", bound_w), sreg("w_qs1", bound_w)]);
-        body.extend(side_and_bound(tracked, bound_w));
+        if tracked {
+            body.extend([reg("w_rs256", dw), sreg("w_qs", bound_w), sreg("w_qs1", bound_w)]);
+            body.push(side_and_bound(bound_w));
+        } else {
+            body.extend([reg("w_rs256", dw), sreg("w_g", bound_w), sreg("w_qs", bound_w), sreg("w_qs1", bound_w)]);
+        }
     }
     if tracked {
         body.push(comment("The walked row among the edge's rows, moved with it: w_ge = row >= rs, w_le = row <= re."));
@@ -405,21 +413,18 @@ fn dda(e: &EdgeWidths) -> Vec<Item> {
     body
 }
 
-/// The side-by-side DDA's side and bound registers, and behind the row stages `w_lt`, g against
+/// Behind the row stages, the side-by-side DDA's side and bound registers and `w_lt`, g against
 /// the screen's bound on its side ([`walk`]). A proof starts them as a load would leave them
 /// (g = 0, a left edge: 0 < lo is false, lo being 0) and asserts that `w_lt` is that compare,
 /// an invariant the span's ends' bounds (`wr_* <= hi0`) lean on; the product has no initial
 /// values.
-fn side_and_bound(tracked: bool, bound_w: u32) -> Vec<Item> {
-    if !tracked {
-        return vec![reg("w_right", 1), sreg("w_g", bound_w)];
-    }
+fn side_and_bound(bound_w: u32) -> Item {
     let init = |name: &str, width: u32, signed: bool| Item::RegInit { name: name.into(), width, signed, value: format!("{width}'d0") };
-    vec![Item::IfDef {
+    Item::IfDef {
         name: "FORMAL".into(),
         then: vec![init("w_right", 1, false), init("w_g", bound_w, true), init("w_lt", 1, false)],
         els: vec![reg("w_right", 1), sreg("w_g", bound_w), reg("w_lt", 1)],
-    }]
+    }
 }
 
 /// The load of the DDA's remainder `rem`: as itself, or behind the row stages as `t = rem - thr`
