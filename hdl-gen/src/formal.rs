@@ -55,8 +55,8 @@ pub(crate) fn when(cond: impl Into<String>, then: Vec<Stmt>) -> Stmt {
 pub(crate) fn past_flags() -> Vec<Item> {
     vec![
         comment("Clocks since the start: $past is meaningful once f_past is set."),
-        Item::RegInit { name: "f_past".into(), width: 1, signed: false, value: "1'b0".into() },
-        Item::RegInit { name: "f_past2".into(), width: 1, signed: false, value: "1'b0".into() },
+        Item::RegInit { name: "f_past".into(), width: 1, value: "1'b0".into() },
+        Item::RegInit { name: "f_past2".into(), width: 1, value: "1'b0".into() },
         Item::Always(vec![set("f_past", "1'b1"), set("f_past2", "f_past")]),
         comment("The one rule the environment keeps: reset in the first clock."),
         Item::Comb(vec![when("!f_past", vec![Stmt::Assume("rst".into())])]),

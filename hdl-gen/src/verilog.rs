@@ -204,7 +204,6 @@ pub enum Item {
     RegInit {
         name: String,
         width: u32,
-        signed: bool,
         value: String,
     },
     /// `` `ifdef FORMAL `` ... `` `endif ``: properties read by `read_verilog -formal` (Yosys
@@ -534,7 +533,7 @@ fn render_items(o: &mut String, items: &[Item], level: usize) {
                 indent(o, level);
                 o.push_str("end\n");
             }
-            Item::RegInit { name, width, signed, value } => writeln!(o, "reg {}{}{name} = {value};", sign(*signed), range(*width)).unwrap(),
+            Item::RegInit { name, width, value } => writeln!(o, "reg {}{name} = {value};", range(*width)).unwrap(),
             Item::Formal(items) => render_ifdef(o, "FORMAL", &labelled(items), &[], level),
             Item::IfDef { name, then, els } => render_ifdef(o, name, then, els, level),
         }

@@ -297,7 +297,7 @@ pub(super) fn module(hw: &Hw, names: &Names) -> Module {
         set("w_qs1", format!("{} + {}", flip("es_q"), zext("1'b1", 1, bound_w))),
         set("w_rs256", rs256),
     ];
-    body.extend(walk(&e, load, ("s_rs", "s_re")));
+    body.push(walk(&e, load, ("s_rs", "s_re")));
     body.extend(state_outputs(hw).into_iter().map(|(port, _, _, signal, _)| Item::Assign(port.into(), signal)));
     Module { name: names.fe_edge.clone(), header, params: vec![], ports, body }
 }
@@ -344,21 +344,12 @@ fn dda(e: &EdgeWidths) -> Vec<Item> {
         // multiple of 256, so rem >= thr is decided by rem's high bits, and the low byte of
         // rem + rs256 never changes.
         let dw = e.held_w();
-        body.push(reg("w_act", 1));
-        if !tracked {
-            body.push(reg("w_right", 1));
-        }
-        body.extend([reg("w_rs", row_w), reg("w_re", row_w), reg("w_thr", dw)]);
+        body.extend([reg("w_act", 1), reg("w_right", 1), reg("w_rs", row_w), reg("w_re", row_w), reg("w_thr", dw)]);
         // Behind the row stages the remainder is held offset by the threshold, so the carry is
         // that register's sign: the compare on the carry chain, then the walker's running sums'
         // enables, was the ECP5 target's critical path (docs/fpga.md).
         body.push(if tracked { sreg("w_t", dw + 1) } else { reg("w_rem", dw) });
-        if tracked {
-            body.extend([reg("w_rs256", dw), sreg("w_qs", bound_w), sreg("w_qs1", bound_w)]);
-            body.push(side_and_bound(bound_w));
-        } else {
-            body.extend([reg("w_rs256", dw), sreg("w_g", bound_w), sreg("w_qs", bound_w), sreg("w_qs1", bound_w)]);
-        }
+        body.extend([reg("w_rs256", dw), sreg("w_g", bound_w), sreg("w_qs", bound_w), sreg("w_qs1", bound_w)]);
     }
     if tracked {
         body.push(comment("The walked row among the edge's rows, moved with it: w_ge = row >= rs, w_le = row <= re."));
@@ -377,14 +368,9 @@ fn dda(e: &EdgeWidths) -> Vec<Item> {
         body.push(Item::Assign("bh".into(), "in_rows && w_right && gg < hi".into()));
     } else {
         // This edge's bound on its side of the row, or the screen's where it bounds none here;
-        // a left edge's bound is -g, kept as g (its smallest is the span's left end). Behind the
-        // row stages the compare with the screen's bound is held beside g (`w_lt`, [`walk`]).
-        let lt = |b: &str| if tracked { "w_lt".to_string() } else { format!("gg < {b}") };
-        body.push(Item::Assign("lg".into(), format!("(in_rows && !w_right && {}) ? gg : lo", lt("lo"))));
-        body.push(Item::Assign("ha".into(), format!("(in_rows && w_right && {}) ? gg : hi", lt("hi"))));
-        if tracked {
-            body.push(Item::Formal(vec![Item::Comb(vec![Stmt::Assert("w_lt == (w_right ? gg < hi : gg < lo)".into())])]));
-        }
+        // a left edge's bound is -g, kept as g (its smallest is the span's left end).
+        body.push(Item::Assign("lg".into(), "(in_rows && !w_right && gg < lo) ? gg : lo".into()));
+        body.push(Item::Assign("ha".into(), "(in_rows && w_right && gg < hi) ? gg : hi".into()));
     }
     if e.lean {
         // rem < D and rs256 < D: s < 2D fits HW + 1 bits, and s - D lies in (-D, D), so in
@@ -413,20 +399,6 @@ fn dda(e: &EdgeWidths) -> Vec<Item> {
     body
 }
 
-/// Behind the row stages, the side-by-side DDA's side and bound registers and `w_lt`, g against
-/// the screen's bound on its side ([`walk`]). A proof starts them as a load would leave them
-/// (g = 0, a left edge: 0 < lo is false, lo being 0) and asserts that `w_lt` is that compare,
-/// an invariant the span's ends' bounds (`wr_* <= hi0`) lean on; the product has no initial
-/// values.
-fn side_and_bound(bound_w: u32) -> Item {
-    let init = |name: &str, width: u32, signed: bool| Item::RegInit { name: name.into(), width, signed, value: format!("{width}'d0") };
-    Item::IfDef {
-        name: "FORMAL".into(),
-        then: vec![init("w_right", 1, false), init("w_g", bound_w, true), init("w_lt", 1, false)],
-        els: vec![reg("w_right", 1), sreg("w_g", bound_w), reg("w_lt", 1)],
-    }
-}
-
 /// The load of the DDA's remainder `rem`: as itself, or behind the row stages as `t = rem - thr`
 /// = `rem + rs256 - D` ([`dda`]), its wires into `body`. The three operands are added carry-save,
 /// `rem + rs256 + ~D + 1` as the bits' sum plus their majority a place up with the 1 below it:
@@ -448,49 +420,21 @@ fn rem_load(e: &EdgeWidths, body: &mut Vec<Item>, (rem, rs256, d): (&str, &str, 
 /// the stall and the choice together, fanned out to every register of the edges was the
 /// walker's other long path); the row's place moved on each row, `rs`/`re` the loaded rows'
 /// sources.
-fn walk(e: &EdgeWidths, load: Vec<Stmt>, (rs, re): (&str, &str)) -> Vec<Item> {
+fn walk(e: &EdgeWidths, load: Vec<Stmt>, (rs, re): (&str, &str)) -> Item {
     if !e.tracked {
         let step = vec![set("w_rem", "rnext"), set("w_g", "gnext")];
-        return vec![Item::Always(vec![Stmt::If(
-            "take".into(),
-            load,
-            vec![Stmt::If("step && w_act && row >= w_rs".into(), step, vec![])],
-        )])];
+        return Item::Always(vec![Stmt::If("take".into(), load, vec![Stmt::If("step && w_act && row >= w_rs".into(), step, vec![])])]);
     }
-    let mut body = Vec::new();
-    let mut step = vec![set("w_t", "tnext"), set("w_g", "gnext")];
+    let step = vec![set("w_t", "tnext"), set("w_g", "gnext")];
     let mut load = load;
     load.extend([set("w_ge", format!("first >= {rs}")), set("w_le", format!("first <= {re}"))]);
-    if !e.lean {
-        // g against the screen's bound on its side, decided as g is loaded or stepped and held
-        // beside it (`w_lt`): the compare on g's register, then the selects of the edge's side and
-        // of the running sums' slot, was the 25F's worst path on seed 2 of stop 34
-        // (`w_g -> wr_rb`, 10.75 ns, docs/fpga.md); lo and hi are the screen's constants.
-        let of = |x: &str| load.iter().find_map(|st| matches!(st, Stmt::Set(l, _) if l == x).then(|| st.clone()));
-        let (Some(Stmt::Set(_, g)), Some(Stmt::Set(_, right))) = (of("w_g"), of("w_right")) else {
-            unreachable!("the load sets g and right")
-        };
-        let EdgeWidths { bound_w, end_w, .. } = *e;
-        body.push(swire("g_ld", bound_w, g));
-        for (n, x, side) in [("lt_ld", "g_ld", right.as_str()), ("lt_nx", "gnext", "w_right")] {
-            let xe = sext(x, bound_w, end_w);
-            body.push(wire(n, 1, format!("{side} ? $signed({xe}) < hi : $signed({xe}) < lo")));
-        }
-        load.push(set("w_lt", "lt_ld"));
-        step.push(set("w_lt", "lt_nx"));
-    }
     let one = format!("{}'d1", e.row_w);
     let moved = vec![
         set("w_ge", format!("w_ge || row + {one} == w_rs")),
         set("w_le", "w_le && row != w_re"),
         Stmt::If("w_act && w_ge".into(), step, vec![]),
     ];
-    body.push(Item::Always(vec![Stmt::If(
-        "go".into(),
-        vec![Stmt::If("next".into(), load, vec![Stmt::If("more".into(), moved, vec![])])],
-        vec![],
-    )]));
-    body
+    Item::Always(vec![Stmt::If("go".into(), vec![Stmt::If("next".into(), load, vec![Stmt::If("more".into(), moved, vec![])])], vec![])])
 }
 
 /// `tri_fe_edge` behind the shared set-up engine: the set-up result arrives complete (the
@@ -537,7 +481,7 @@ fn module_engine(hw: &Hw, names: &Names) -> Module {
     if !e.lean {
         load.push(set("w_qs1", format!("qs + {}", zext("1'b1", 1, bound_w))));
     }
-    body.extend(walk(&e, load, ("rs", "re")));
+    body.push(walk(&e, load, ("rs", "re")));
     body.extend(state_outputs(hw).into_iter().map(|(port, _, _, signal, _)| Item::Assign(port.into(), signal)));
     Module { name: names.fe_edge.clone(), header, params: vec![], ports, body }
 }

@@ -175,7 +175,7 @@ pub fn segment_pipelined_properties(cfg: &Config, rw: u32, pipe: golden::pipelin
     b.extend(past_flags());
     // $past(x, k) needs k clocks of history: f_pastK is set once the solver has run K clocks.
     for k in 3..=lat {
-        b.push(Item::RegInit { name: format!("f_past{k}"), width: 1, signed: false, value: "1'b0".into() });
+        b.push(Item::RegInit { name: format!("f_past{k}"), width: 1, value: "1'b0".into() });
         b.push(Item::Always(vec![set(format!("f_past{k}"), if k == 3 { "f_past2".to_string() } else { format!("f_past{}", k - 1) })]));
     }
     let past_k = |k: u32| if k == 1 { "f_past".to_string() } else { format!("f_past{k}") };
