@@ -177,6 +177,9 @@ impl<'a> Seg<'a> {
                 reg("sp_i0", iw),
                 sreg("sp_di", dw),
             ]);
+            if screen {
+                body.push(sreg("sp_lead_di", aw));
+            }
             if split {
                 body.push(comment("The BFPI's first adder level, formed from the input's dI as the span enters."));
                 body.extend(first.iter().map(|c| sreg(&format!("sp_m{c}"), mw)));
@@ -253,19 +256,29 @@ impl<'a> Seg<'a> {
         let i0 = zext(&src("in_i0"), iw, aw);
         let start = if screen {
             body.push(wire(&src("in_lead"), log2p, format!("{}[{}:0]", src("in_x"), log2p - 1)));
-            body.push(swire(&src("in_di_ext"), aw, sext(&src("in_di"), dw, aw)));
+            // Behind the span register, lead * dI is formed from the input as the span enters and
+            // registered with it (`sp_lead_di`), so the start is one add from registers: the
+            // tree, the add and the select into `cur_acc` in one clock were the 25F chain's
+            // worst path on seed 1 of stop 34 (`sp_i0 -> cur_acc`, 10.1 ns, docs/fpga.md).
+            let staged = self.pipe.span_stage();
+            let from = "in";
+            if staged {
+                body.push(wire("in_lead", log2p, format!("in_x[{}:0]", log2p - 1)));
+            }
+            body.push(swire(&format!("{from}_di_ext"), aw, sext(&format!("{from}_di"), dw, aw)));
             let terms: Vec<String> = (0..log2p)
                 .map(|b| {
-                    let ext = src("in_di_ext");
+                    let ext = format!("{from}_di_ext");
                     let shifted = if b == 0 { ext } else { format!("({ext} << {b})") };
-                    format!("({} ? {shifted} : {})", bit(&src("in_lead"), log2p, b), lit(aw, 0))
+                    format!("({} ? {shifted} : {})", bit(&format!("{from}_lead"), log2p, b), lit(aw, 0))
                 })
                 .collect();
             // A balanced tree: log2(log2 P) adders deep, not log2 P - 1 in a row (the start
             // value into `cur_acc` was the level-2 shader's one path over 10 ns beside the
             // chain on the 25F, docs/fpga.md).
-            body.push(swire("lead_di", aw, crate::specular::tree(&terms)));
-            format!("{i0} + {half} - lead_di")
+            let (tree, lead_di) = if staged { ("in_lead_di", "sp_lead_di") } else { ("lead_di", "lead_di") };
+            body.push(swire(tree, aw, crate::specular::tree(&terms)));
+            format!("{i0} + {half} - {lead_di}")
         } else {
             format!("{i0} + {half}")
         };
@@ -516,6 +529,7 @@ impl<'a> Seg<'a> {
                     ]
                     .into_iter()
                     .chain(first_level.iter().map(|(c, e)| set(format!("sp_m{c}"), e.as_str())))
+                    .chain(screen.then(|| set("sp_lead_di", "in_lead_di")))
                     .collect(),
                     vec![Stmt::If("start".into(), vec![set("sp_valid", "1'b0")], vec![])],
                 )],

@@ -150,8 +150,14 @@ pub(super) fn module(hw: &Hw, names: &Names) -> Module {
     for &o in &roots {
         let op = v.op(o);
         if s.slots[o].class == Class::Logic {
-            for (name, w, e) in v.logic_nets(o) {
-                body.push(crate::verilog::wire(&name, w, e));
+            for n in v.logic_nets(o) {
+                match n.load {
+                    None => body.push(crate::verilog::wire(&n.name, n.w, n.e)),
+                    Some(t) => {
+                        body.push(reg(&n.name, n.w));
+                        loads[(t % s.ii) as usize].push(set(&n.name, n.e));
+                    }
+                }
             }
             let (e, w) = v.logic(o);
             let t = format!("t{o}");

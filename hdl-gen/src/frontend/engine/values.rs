@@ -78,6 +78,15 @@ impl Src {
     }
 }
 
+/// A net a logic operation's result reads: a wire, or a register loaded with `e` at schedule
+/// clock `load`.
+pub(super) struct LogicNet {
+    pub name: String,
+    pub w: u32,
+    pub e: String,
+    pub load: Option<u32>,
+}
+
 /// Where every value lives and how many copies it has.
 pub(super) struct Values<'a> {
     pub s: &'a Schedule,
@@ -185,31 +194,59 @@ impl<'a> Values<'a> {
         }
     }
 
-    /// The nets a logic operation's result reads besides its operands (name, width, value).
+    /// The nets a logic operation's result reads besides its operands: wires, and registers
+    /// loaded at a schedule clock (`load`).
     ///
     /// The leading-zero count's: its operand reversed above a one, `r`, and `r`'s lowest one,
     /// `r & (~r + 1)`, an add that maps to the carry chain (CCU2C on the ECP5). Its index is
     /// the count (`n` for zero). As a chain of selects the count was the engine's deepest
-    /// logic (43 selects, 11-12.5 ns on the 25F); here it is the carry and an OR of the one-hot.
-    /// ABC then maps the rest of the block under a smaller depth, in more LUT4, unless given the
-    /// chain's depth as its target (`scripts/synth --abc-depth 7`, docs/fpga.md).
+    /// logic (43 selects, 11-12.5 ns on the 25F); the carry and an OR of the one-hot in one
+    /// clock were still the 25F's worst path at stop 34 (`t290_r -> t290_h`, 9.8-10.2 ns). So
+    /// the one-hot is registered a clock before the count's start, from the operand as it will
+    /// be then ([`Values::early`]): the carry in one clock, the OR in the next, the same
+    /// schedule. ABC maps the rest of the block under a smaller depth, in more LUT4, unless
+    /// given the chain's depth as its target (`scripts/synth --abc-depth 7`, docs/fpga.md).
     ///
     /// A compare of two values' difference: its sign (`wide` bits hold it without overflow), a
     /// subtract on the carry chain. As `$signed(a) < $signed(b)` Yosys 0.23 mapped each into
     /// LUT4 beside its carry chain (a 19-bit compare 36-38 LUT4).
-    pub fn logic_nets(&self, o: usize) -> Vec<(String, u32, String)> {
+    pub fn logic_nets(&self, o: usize) -> Vec<LogicNet> {
         let op = self.op(o);
         if let Some((a, b, wide)) = self.lt_by_difference(o) {
-            return vec![(format!("t{o}_d"), wide, format!("{a} - {b}"))];
+            return vec![LogicNet { name: format!("t{o}_d"), w: wide, e: format!("{a} - {b}"), load: None }];
         }
         let Kind::Lzc(a, n) = op.kind else { return vec![] };
-        let v = self.at(a, self.s.slots[o].start);
-        let r = format!("t{o}_r");
+        let t = self.s.slots[o].start;
+        let early = self.early(a, t);
+        let v = early.clone().unwrap_or_else(|| self.at(a, t));
+        let (r, h) = (format!("t{o}_r"), format!("t{o}_h"));
         let rev: Vec<String> = (0..n).map(|i| v.bits(i, 1)).collect();
-        vec![
-            (r.clone(), n + 1, format!("{{1'b1, {}}}", rev.join(", "))),
-            (format!("t{o}_h"), n + 1, format!("{r} & (~{r} + {}'d1)", n + 1)),
-        ]
+        let one = format!("{r} & (~{r} + {}'d1)", n + 1);
+        let r_net = LogicNet { name: r.clone(), w: n + 1, e: format!("{{1'b1, {}}}", rev.join(", ")), load: None };
+        match early {
+            Some(_) => vec![
+                r_net,
+                LogicNet { name: format!("{h}n"), w: n + 1, e: one, load: None },
+                LogicNet { name: h.clone(), w: n + 1, e: format!("{h}n"), load: Some(t - 1) },
+            ],
+            None => vec![r_net, LogicNet { name: h, w: n + 1, e: one, load: None }],
+        }
+    }
+
+    /// Value `v` as it will be at clock `t`, read the clock before: its register's copy when
+    /// it is already held then, or the logic result its register loads then (its root a logic
+    /// operation ready at `t`, as wide as it); `None` otherwise.
+    fn early(&self, v: V, t: u32) -> Option<Src> {
+        let o = v.0 as usize;
+        let ready = self.s.slots[o].ready;
+        if t == 0 || matches!(self.op(o).kind, Kind::Const(_)) {
+            return None;
+        }
+        if t > ready {
+            return Some(self.at(v, t - 1));
+        }
+        let logic = self.root[o] == Some(o) && self.s.slots[o].class == Class::Logic && ready == t;
+        (logic && self.logic(o).1 >= self.op(o).w).then(|| Src::Net { name: format!("t{o}"), w: self.op(o).w, signed: self.op(o).signed })
     }
 
     /// A compare of two values (no constant) as its operands extended to the width its
