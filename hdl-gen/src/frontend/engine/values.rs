@@ -271,8 +271,10 @@ impl<'a> Values<'a> {
         match op.kind {
             Kind::Add(a, b) => (format!("{} + {}", x(a).ext(wide), x(b).ext(wide)), wide),
             Kind::Sub(a, b) => (format!("{} - {}", x(a).ext(wide), x(b).ext(wide)), wide),
-            Kind::Lt(..) if self.lt_by_difference(o).is_some() => (format!("t{o}_d[{}]", wide - 1), 1),
-            Kind::Lt(a, b) => (format!("$signed({}) < $signed({})", x(a).ext(wide), x(b).ext(wide)), 1),
+            Kind::Lt(a, b) => match self.lt_by_difference(o) {
+                Some((_, _, d)) => (format!("t{o}_d[{}]", d - 1), 1),
+                None => (format!("$signed({}) < $signed({})", x(a).ext(wide), x(b).ext(wide)), 1),
+            },
             Kind::Eq(a, b) => (format!("{} == {}", x(a).ext(wide), x(b).ext(wide)), 1),
             Kind::And(a, b) => (format!("(|{}) && (|{})", x(a).ext(self.op(a.0 as usize).w), x(b).ext(self.op(b.0 as usize).w)), 1),
             Kind::Or(a, b) => (format!("(|{}) || (|{})", x(a).ext(self.op(a.0 as usize).w), x(b).ext(self.op(b.0 as usize).w)), 1),
