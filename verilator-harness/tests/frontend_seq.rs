@@ -174,6 +174,10 @@ fn sequential_span_path_spans_equal_golden() {
     fault.caught(&opts, "frontend walk ram slot fault", "walkslotfault", "the read slot not moved on at the take");
     let fault = LineFault { file: "tri_frontend.v", line: " wk_da = wk_tnr ? {!wk_rs", from: "{!wk_rs", to: "{wk_rs" };
     fault.caught(&opts, "frontend walk ram tn fault", "walktnfault", "Tn read from the walked triangle's slot, not the queued one's");
+    // The UP5K's pixel test after the ends' picks (`Hw::fewest_cells`): a one-pixel row
+    // (hi3 + mg = 0) dropped.
+    let fault = LineFault { file: "tri_frontend.v", line: " room = ", from: "mg[15]}}, mg}", to: "mg[15]}}, mg} - 17'sd1" };
+    fault.caught(&opts, "frontend up5k pixel test fault", "uppixelfault", "the pixel test after the picks dropping one-pixel rows");
     // The HX8K's walker holds dYn in a register loaded at the take: a stale dYn, the one
     // before's, must be caught, and so must its reads' slot and clock.
     let Some(opts) = form(small, Ice40Hx8k, 0) else { return };

@@ -51,6 +51,15 @@ impl Hw {
         self.engine().map(|s| (s.ii, s.latency, s.epochs().expect("a periodic binding (golden's tests)")))
     }
 
+    /// Whether the plan takes the smaller of two equal forms where the larger one is only for
+    /// the clock: the UP5K's (`--fe-setup ice40-up5k`), which needs the cells (its aim is 40 MHz,
+    /// the HX8K's 60). Its choices keep golden's values and the front-end's clocks: no span FIFO
+    /// (`chain`), the row's pixel test after the ends' picks (`walker`). docs/fpga.md, issue 27,
+    /// stop 36.
+    pub fn fewest_cells(&self) -> bool {
+        self.fe.setup == golden::frontend::engine::SetupForm::Ice40Up5k
+    }
+
     /// Whether the engine never freezes (the pipelined engine): the front-end takes a triangle
     /// only with a queue entry reserved for its result (a credit), so no register of the engine
     /// has a clock enable wider than its phase (a freeze's fan-out was the 25F's critical path).

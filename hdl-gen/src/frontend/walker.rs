@@ -46,8 +46,10 @@ fn least_of_three(side: &str) -> String {
 /// or the screen's. The same ends as [`least_of_three`] of the bounds chosen first, whose
 /// compares followed the choice: the edge's test, its choice, the compare, the pick and the
 /// length's add in one clock were the HX8K's critical path once its engine's ALU was split
-/// (docs/fpga.md, issue 27).
-fn side_by_side_ends(end_w: u32, body: &mut Vec<Item>) {
+/// (docs/fpga.md, issue 27). With `pairwise` the row's pixel test is formed the same way, from
+/// the bounds' pairwise sums (`covered`); without (the plan's [`Hw::fewest_cells`]) it is the
+/// sign of `hi3 + mg` after the picks, one add where the pairs were ten.
+fn side_by_side_ends(end_w: u32, pairwise: bool, body: &mut Vec<Item>) {
     body.push(comment("The span's ends: the three bounds compared pairwise beside their side tests (bl: bounds the"));
     body.push(comment("left end, as -x; bh: the right), each end the least bound of its side, else the screen's."));
     let pairs = [(0, 1), (0, 2), (1, 2)];
@@ -70,6 +72,9 @@ fn side_by_side_ends(end_w: u32, body: &mut Vec<Item>) {
         let picks: Vec<String> = (0..3).map(|k| format!("({{{end_w}{{{side}w{k}}}}} & gb{k})")).collect();
         let none = format!("({{{end_w}{{!({side}w0 || {side}w1 || {side}w2)}}}} & {screen})");
         body.push(swire(end, end_w, format!("{} | {none}", picks.join(" | "))));
+    }
+    if !pairwise {
+        return;
     }
     // hi3 + mg >= 0 for the least bound on each side is every right bound plus every left bound
     // >= 0: the sums are formed from the registers beside the compares, not after the picks.
@@ -396,7 +401,7 @@ pub(super) fn emit(hw: &Hw, names: &Names, body: &mut Vec<Item>) {
         body.push(swire("mg", end_w, "we_mg"));
         body.push(swire("hi3", end_w, "we_hi3"));
     } else if edge::ends_side_by_side(hw) {
-        side_by_side_ends(end_w, body);
+        side_by_side_ends(end_w, !hw.fewest_cells(), body);
     } else {
         // Side by side rather than in a chain, and no negation before the pixel test or the
         // length: this was the walker's row clock, the staged front-end's limit at 2 and 1
@@ -429,7 +434,8 @@ pub(super) fn emit(hw: &Hw, names: &Names, body: &mut Vec<Item>) {
         body.push(wire("emit", 1, "px && !ie_wait"));
         body.push(assign("w_step", format!("{STEP_WHEN} && !ie_wait")));
     } else {
-        let covered = if edge::ends_side_by_side(hw) { "covered".to_string() } else { format!("!room[{end_w}]") };
+        let pairwise = edge::ends_side_by_side(hw) && !hw.fewest_cells();
+        let covered = if pairwise { "covered".to_string() } else { format!("!room[{end_w}]") };
         body.push(wire("emit", 1, format!("{row_valid} && {covered}")));
     }
     // Behind the lean edges the span path holds the ends, not x (span_seq).
