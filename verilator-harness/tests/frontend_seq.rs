@@ -12,14 +12,13 @@ use verilator_harness::frontend::random_triangles;
 /// 37x23 and 640x480, levels 0 and 1 (the target's), the UP5K's (`ice40-up5k`, its products as
 /// SB_MAC16 tile passes) at 37x23 level 0 and 640x480 level 1 (its target's); 1,000 triangles
 /// each (about 340 clocks a triangle); a fault planted in the HX8K's ALU (the subtract made an
-/// add; the vertex register freed at the period's first clocks, before the entered triangle's
-/// inputs are read) and nine in the UP5K's engine (the tiles' sum not shifted a chunk up where
+/// add; the triangle taken, `in_ready`, a clock before its inputs' last read from the ports) and nine in the UP5K's engine (the tiles' sum not shifted a chunk up where
 /// the pass's weight drops, its high half or the split ALU's without the low half's carry, the
 /// divider's dividend bits not shifted in, the select's first choice never taken into `ax0`,
 /// its second operand not zeroed before the adder that passes the choice, the
 /// equality with zero a test of bit 0 alone, a
-/// tile's held operand, only as wide as its unit's widest, without its top bit, the vertex
-/// register freed early) are caught. Slow tier: `cargo nextest run -p verilator-harness --run-ignored only -E
+/// tile's held operand, only as wide as its unit's widest, without its top bit, the triangle
+/// taken a clock early) are caught. Slow tier: `cargo nextest run -p verilator-harness --run-ignored only -E
 /// 'test(/sequential_engine/)'`.
 #[test]
 #[ignore]
@@ -55,12 +54,12 @@ fn sequential_engine_spans_equal_golden() {
                 fault(" b_z = ", "== 4'd8 ||", "== 4'd15 ||", "the select's second operand not zeroed, so the adder adds it to the choice"),
                 fault(" bfl <= ", "~|ax0", "~ax0[0]", "the equality with zero a test of bit 0 alone"),
                 fault(" m1b <= ", "];", "] << 1 >> 1;", "a tile's held operand without its top bit, the sign above its chunks"),
-                fault("&& vld[0]) begin", "en && pc == ", "en && pc != ", "the vertex register freed before its inputs are read"),
+                fault(" at_read = ", "pc == ", "pc_n == ", "the triangle taken a clock before its inputs' last read"),
             ]
         } else {
             vec![
                 fault(" sub = ", " == 4'd2 || ", " == 4'd15 || ", "the ALU's subtract made an add"),
-                fault("&& vld[0]) begin", "en && pc == ", "en && pc != ", "the vertex register freed before its inputs are read"),
+                fault(" at_read = ", "pc == ", "pc_n == ", "the triangle taken a clock before its inputs' last read"),
             ]
         };
         assert_faults_caught(&base, "tri_fe_engine.v", "seqfault", faults, seed, &tris);

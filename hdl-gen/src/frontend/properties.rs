@@ -188,7 +188,16 @@ pub fn frontend_properties(s: &FrontendShape) -> Item {
         // up to II (8 to 314): a cover search costs about a second a clock, so the covers are the
         // port's and, where II is short (the ECP5 plan), the entry's.
         SetupShape::Engine(e) => {
-            let mut c = vec![("Triangle taken at the port.", "in_valid && in_ready")];
+            // The sequential engine takes a triangle at its inputs' last read in the period after
+            // the boot one (II + held clocks, 350 cover clocks at 16x8): its port's cover is the
+            // triangle offered and waiting, which an environment offering none never reaches; the
+            // take itself is co-simulated.
+            let port = if e.held.is_some() {
+                ("Triangle offered, waiting for the engine's read.", "in_valid && !in_ready")
+            } else {
+                ("Triangle taken at the port.", "in_valid && in_ready")
+            };
+            let mut c = vec![port];
             if e.ii + 2 <= ENTRY_COVER_DEPTH {
                 c.push(("A triangle enters the schedule.", "f_enter && f_vf"));
             }
@@ -330,9 +339,11 @@ impl Reference<'_> {
                 }
                 b.push(wire("f_enter", 1, format!("f_en && f_ph == {}", lit(phw, (e.ii - 1) as u64))));
                 if let Some(h) = e.held {
-                    b.push(comment("The vertex register holds the entered triangle's inputs until their last read."));
-                    b.push(wire("f_hold", 1, format!("{} && f_ph <= {}", bit("f_vld", e.periods(), 0), lit(phw, h as u64))));
-                    b.push(wire("f_rdy", 1, "!f_vf && !f_hold && f_room"));
+                    assert!(!e.credit, "the sequential engine freezes, it takes no credits");
+                    b.push(comment("The entered triangle waits on the port (f_hold) and is taken at its inputs' last read."));
+                    let v0 = bit("f_vld", e.periods(), 0);
+                    b.push(wire("f_hold", 1, format!("{v0} && f_ph <= {}", lit(phw, h as u64))));
+                    b.push(wire("f_rdy", 1, format!("f_en && {v0} && f_ph == {}", lit(phw, h as u64))));
                 } else {
                     b.push(wire("f_rdy", 1, "(!f_vf || f_enter) && f_room"));
                 }
@@ -541,7 +552,9 @@ impl Reference<'_> {
             }
             SetupShape::Engine(e) => {
                 b.extend(self.engine_ports(e));
-                format!(" + {}", engine::held(e, cw))
+                // With `held`, a triangle in the engine's first phases is not yet taken.
+                let waiting = if e.held.is_some() { format!(" - {}", zext("f_hold", 1, cw)) } else { String::new() };
+                format!(" + {}{waiting}", engine::held(e, cw))
             }
         };
         b.push(comment("Nothing lost or invented: every accepted triangle was flagged, culled or walked, or is"));

@@ -17,7 +17,8 @@
 //!   wrapped to its width and sign as it is written. One operation issues a clock (reads its operands), the ALU's or a unit's.
 //!   One-bit unsigned values (compares, their `and`/`or`/`not`) live in a flag file of
 //!   flip-flops, read without a port. Constants are the RAM's initial contents, never
-//!   overwritten; the triangle's nine inputs are written first, from the vertex register.
+//!   overwritten; the triangle's nine inputs are written first, from the input ports (the stream
+//!   holds the triangle there until the engine takes it, after their last read).
 //! - **The microprogram** ([`SeqSchedule`]): a list schedule by each operation's longest path
 //!   to the results, under one issue, `read_ports` RAM reads and one write (the register
 //!   file's or the flag file's: one write bus) a clock and each unit busy from its load to its
@@ -150,7 +151,7 @@ pub enum Exec {
     Dead,
     /// A constant: the register file's initial contents.
     Const,
-    /// An input, written from the vertex register.
+    /// An input, written from its input port.
     Input,
     Alu,
     /// A shift, a product or a division on unit `n` of its class.
@@ -490,9 +491,9 @@ impl SeqSchedule {
     }
 
     /// The last clock of a period on which an input of the period's triangle is read, where
-    /// its write is selected (`2 * bus_lat` clocks before the write): the vertex register must
-    /// hold the triangle until then, and may take the next one after it, so the engine needs
-    /// no second copy of the inputs.
+    /// its write is selected (`2 * bus_lat` clocks before the write): the engine reads the
+    /// inputs from the ports and takes the triangle (`in_ready`) at this clock, so it keeps no
+    /// copy of them.
     pub fn inputs_read_by(&self) -> u32 {
         let last = self.slots.iter().filter(|s| s.exec == Exec::Input).map(|s| s.write - 2 * self.plan.bus_lat).max();
         let last = last.expect("a program with inputs");

@@ -19,7 +19,7 @@ mod tile;
 use super::result::{fields, ports, Field};
 use super::units::bits_for;
 use crate::frontend::hw::Hw;
-use crate::verilog::{comment, reg, set, sreg, wire, Item, Module, Param, Port, Stmt};
+use crate::verilog::{comment, reg, set, wire, Item, Module, Param, Port, Stmt};
 use cx::{
     Cx, FN_ADD, FN_AND, FN_EQ, FN_LT, FN_LZC, FN_NOT, FN_OR, FN_PASS, FN_SEL, FN_SHL, FN_SHLV, FN_SHR, FN_SUB, SRC_ALU, SRC_DIVQ, SRC_DIVR,
     SRC_IN, SRC_MUL, SRC_MUL1,
@@ -331,48 +331,42 @@ fn microprogram(cx: &Cx, fields: &[Field]) -> Micro {
     Micro { l, micro, groups, widths }
 }
 
-/// The sequencer: `pc`, the vertex register, the valid bits, boot. The entered triangle's
-/// inputs are read from the vertex register itself, which takes the next triangle only after
-/// the last of them is read ([`SeqSchedule::inputs_read_by`], early in the period): a second
-/// copy of the inputs was 183 flip-flops at 640x480, on devices short of cells.
+/// The sequencer: `pc`, the valid bits, boot. The engine keeps no copy of a triangle: the
+/// stream contract (SPEC §3) holds a triangle offered on `in_valid` and its inputs unchanged
+/// until it is taken, so a triangle on the port at a period's last clock enters the next period,
+/// whose microprogram reads its inputs from the ports themselves, and is taken (`in_ready`) at
+/// the clock of their last read ([`SeqSchedule::inputs_read_by`], early in the period). A
+/// vertex register was 183 flip-flops alone at 640x480, on devices short of cells.
 fn sequencer(cx: &Cx, b: &mut Vec<Item>) {
-    let (wd, iw, cw, c) = (cx.hw.fe.widths(), cx.hw.fe.cfg.iw(), cx.cw, cx.c);
+    let (cw, c) = (cx.cw, cx.c);
     let held = cx.s.inputs_read_by();
-    b.push(comment("Sequencer: the clock of the triangle (pc), the vertex register (v*: a triangle waiting, then the entered"));
-    b.push(comment(format!("one's inputs until clock {held}, their last read), a valid bit per period in flight, boot (the first")));
-    b.push(comment("period after reset)."));
+    b.push(comment("Sequencer: the clock of the triangle (pc), a valid bit per period in flight, boot (the first period"));
+    b.push(comment(format!("after reset). The entered triangle stays on the ports until it is taken at clock {held}, its inputs' last")));
+    b.push(comment("read; one gone from the port by then (against the stream contract) is dropped, a bubble, so no result"));
+    b.push(comment("leaves for a triangle not taken."));
     b.push(reg("pc", cw));
     b.push(reg("vld", 2));
-    b.push(reg("v_full", 1));
     b.push(reg("boot", 1));
-    for k in 0..3 {
-        for (v, wv, sg) in [("x", wd.cx, true), ("y", wd.cy, true), ("i", iw, false)] {
-            let n = format!("v{v}{k}");
-            b.push(if sg { sreg(&n, wv) } else { reg(&n, wv) });
-        }
-    }
     let last = format!("pc == {cw}'d{}", c - 1);
     b.push(wire("pc_n", cw, format!("({last}) ? {cw}'d0 : pc + {cw}'d1")));
-    b.push(Item::Assign("in_ready".into(), "!v_full".into()));
+    b.push(wire("at_read", 1, format!("pc == {cw}'d{held} && vld[0]")));
+    b.push(Item::Assign("in_ready".into(), "en && at_read".into()));
     b.push(Item::Assign("res_v".into(), format!("pc == {cw}'d0 && vld[1]")));
-    let mut take = vec![set("v_full", "1'b1")];
-    for k in 0..3 {
-        for (v, p) in [("x", "in_x"), ("y", "in_y"), ("i", "in_i")] {
-            take.push(set(format!("v{v}{k}"), format!("{p}{k}")));
-        }
-    }
-    let free = format!("en && pc == {cw}'d{held} && vld[0]");
     b.push(Item::Always(vec![Stmt::If(
         "rst".into(),
-        vec![set("v_full", "1'b0"), set("vld", "2'd0"), set("pc", format!("{cw}'d0")), set("boot", "1'b1")],
-        vec![
-            Stmt::If("in_valid && in_ready".into(), take, vec![Stmt::If(free, vec![set("v_full", "1'b0")], vec![])]),
-            Stmt::If(
-                "en".into(),
-                vec![set("pc", "pc_n"), Stmt::If(last, vec![set("vld", "{vld[0], v_full}"), set("boot", "1'b0")], vec![])],
-                vec![],
-            ),
-        ],
+        vec![set("vld", "2'd0"), set("pc", format!("{cw}'d0")), set("boot", "1'b1")],
+        vec![Stmt::If(
+            "en".into(),
+            vec![
+                set("pc", "pc_n"),
+                Stmt::If(
+                    last,
+                    vec![set("vld", "{vld[0], in_valid}"), set("boot", "1'b0")],
+                    vec![Stmt::If("at_read && !in_valid".into(), vec![set("vld[0]", "1'b0")], vec![])],
+                ),
+            ],
+            vec![],
+        )],
     )]));
     b.push(Item::Blank);
 }

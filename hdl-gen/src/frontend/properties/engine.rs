@@ -12,7 +12,9 @@ use crate::verilog::*;
 /// (`connect -set`), since Yosys reads no hierarchical reference.
 pub(super) fn engine_probes(e: &EngineShape) -> Vec<(String, String, u32)> {
     let pw = bits_for(e.depth - 1);
-    let mut v = vec![("f_e_vfull".to_string(), "u_engine.v_full".to_string(), 1), ("f_e_vld".into(), "u_engine.vld".into(), e.periods())];
+    // The sequential engine (`held`) keeps no triangle of its own: no vertex register to read.
+    let mut v = if e.held.is_some() { Vec::new() } else { vec![("f_e_vfull".to_string(), "u_engine.v_full".to_string(), 1)] };
+    v.push(("f_e_vld".into(), "u_engine.vld".into(), e.periods()));
     if e.binary_phase {
         v.push(("f_e_ph".into(), "u_engine.pc".into(), e.phw()));
     } else if e.ii > 1 {
@@ -93,20 +95,23 @@ impl Reference<'_> {
         let (phw, qw, n) = (e.phw(), e.qw(), e.periods());
         let inc1 = |x: &str| set(x, format!("{x} + {}", one(self.cw)));
         let last = lit(phw, (e.ii - 1) as u64);
-        let shift_in = if n == 1 { "f_vf".to_string() } else { format!("{{f_vld[{}:0], f_vf}}", n - 2) };
+        // With `held`, the triangle on the port at the last phase enters (the port holds it until
+        // it is taken, at phase `held`); one gone from the port by then is dropped, a bubble.
+        let entering = if e.held.is_some() { "in_valid" } else { "f_vf" };
+        let shift_in = if n == 1 { entering.to_string() } else { format!("{{f_vld[{}:0], {entering}}}", n - 2) };
+        let mut step = vec![set("f_ph", format!("f_ph + {}", one(phw)))];
+        if let Some(h) = e.held {
+            let v0 = bit("f_vld", n, 0);
+            step.push(when(format!("f_ph == {} && {v0} && !in_valid", lit(phw, h as u64)), vec![set(v0, "1'b0")]));
+        }
         let mut st = vec![
             set("f_errp", "f_due && !res_guard"),
             when("f_due && f_en && res_guard && res_cull", vec![inc1("f_ncull")]),
-            Stmt::If("f_acc".into(), vec![set("f_vf", "1'b1")], vec![when("f_enter", vec![set("f_vf", "1'b0")])]),
-            when(
-                "f_en",
-                vec![Stmt::If(
-                    format!("f_ph == {last}"),
-                    vec![set("f_ph", lit(phw, 0)), set("f_vld", shift_in)],
-                    vec![set("f_ph", format!("f_ph + {}", one(phw)))],
-                )],
-            ),
+            when("f_en", vec![Stmt::If(format!("f_ph == {last}"), vec![set("f_ph", lit(phw, 0)), set("f_vld", shift_in)], step)]),
         ];
+        if e.held.is_none() {
+            st.insert(2, Stmt::If("f_acc".into(), vec![set("f_vf", "1'b1")], vec![when("f_enter", vec![set("f_vf", "1'b0")])]));
+        }
         // The slot the pushed result lands in: behind the entries that stay. With the capture,
         // the result is the tail entry as the engine wrote it (the queue's word at wr), so a
         // field written over an entry still held breaks the queue's links.
@@ -202,12 +207,9 @@ impl Reference<'_> {
     /// registers only.
     pub(super) fn engine_links(&self, e: &EngineShape) -> Vec<Stmt> {
         let (phw, qw, pw) = (e.phw(), e.qw(), bits_for(e.depth - 1));
-        let vfull = if e.held.is_some() { "f_e_vfull == (f_vf || f_hold)" } else { "f_e_vfull == f_vf" };
+        // With `held` no triangle waits in the engine: the entered one waits on the port.
+        let vfull = if e.held.is_some() { "!f_vf" } else { "f_e_vfull == f_vf" };
         let mut link = vec![assert(vfull), assert("f_e_vld == f_vld"), assert(format!("f_ph <= {}", lit(phw, (e.ii - 1) as u64)))];
-        if e.held.is_some() {
-            // No triangle waits while the entered one holds the vertex register.
-            link.push(assert("!(f_vf && f_hold)"));
-        }
         if e.binary_phase {
             link.push(assert("f_e_ph == f_ph"));
         } else if e.ii > 1 {

@@ -95,9 +95,10 @@ pub struct EngineShape {
     /// The engine writes the result's fields into the queue's tail as it produces them (the
     /// sequential engine's `res_we`, taken as given), and the push makes the tail an entry.
     pub capture: bool,
-    /// The sequential engine's vertex register holds the entered triangle's inputs until this
-    /// phase (their last read) and takes the next triangle only after it; else it passes them
-    /// on at the entry and takes the next one then.
+    /// The sequential engine keeps no copy of a triangle: the one on the port at the last phase
+    /// enters, stays on the port and is taken at this phase (its inputs' last read); one gone
+    /// from the port by then is dropped. Else a vertex register takes a triangle whenever it is
+    /// free and passes it on at the entry.
     pub held: Option<u32>,
     /// The walk's constants in block RAM (`span_seq::walk_ram`): its two slots, the engine's
     /// and the walked triangle's, are one exactly while the queue is full.

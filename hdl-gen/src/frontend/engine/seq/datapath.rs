@@ -122,7 +122,7 @@ pub(super) fn divider(cx: &Cx, b: &mut Vec<Item>) {
 pub(super) fn write_bus(cx: &Cx, widths: &[u32], b: &mut Vec<Item>) {
     let (wd, iw, w) = (cx.hw.fe.widths(), cx.hw.fe.cfg.iw(), cx.w);
     b.push(comment("The write bus: the source the microword names, wrapped to the value's width and sign."));
-    let ins = ["vx0", "vx1", "vx2", "vy0", "vy1", "vy2", "vi0", "vi1", "vi2"];
+    let ins = ["in_x0", "in_x1", "in_x2", "in_y0", "in_y1", "in_y2", "in_i0", "in_i1", "in_i2"];
     let mut srcs: Vec<(u64, String)> = match cx.s.plan.units.mul {
         MulUnit::Tile { .. } => (0..cx.s.plan.units.mults).map(|u| ([SRC_MUL, SRC_MUL1][u as usize], format!("m{u}acc"))).collect(),
         MulUnit::ShiftAdd { .. } => vec![(SRC_MUL, "macc".into())],
@@ -141,10 +141,10 @@ pub(super) fn write_bus(cx: &Cx, widths: &[u32], b: &mut Vec<Item>) {
     };
     let ext = |n: &str, (wv, sg): (u32, bool), to: u32| if sg { crate::verilog::sext(n, wv, to) } else { crate::verilog::zext(n, wv, to) };
     // Registered (`SeqPlan::bus_lat`): the source from the microword two clocks before the
-    // write (registered; the input it names picked then, as the vertex register holds them
-    // until then), the source's value registered a clock before the write, and at the write
-    // wrapped to its width and sign (from the microword the clock before): no path through
-    // both multiplexers.
+    // write (registered; the input it names picked then from the port, which holds the
+    // triangle until its last read: `sequencer`), the source's value registered a clock before
+    // the write, and at the write wrapped to its width and sign (from the microword the clock
+    // before): no path through both multiplexers.
     let reg_bus = match cx.s.plan.bus_lat {
         0 => false,
         1 => true,
