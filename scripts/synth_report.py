@@ -47,22 +47,33 @@ def level(tag):
     return f"--pipeline {tag[3:]}" if tag else ""
 
 
+def tag_option(t):
+    """One '+'-separated tag of a front-end or chain label as the option it stands for:
+    'pl1' --pipeline 1, 'div2' --fe-div-bits 2, 'span-sequential' --fe-span sequential,
+    'spec2' the specular unit's --pipeline 2, any other the --fe-setup plan."""
+    if t.startswith("pl"):
+        return level("+" + t)
+    if t.startswith("div"):
+        return f"--fe-div-bits {t[3:]}"
+    if t.startswith("span-"):
+        return f"--fe-span {t[5:]}"
+    if t.startswith("spec") and t[4:].isdigit():
+        return f"specular --pipeline {t[4:]}"
+    return f"--fe-setup {t}"
+
+
 def block_form(r):
     """The block and form columns of a row: 'shift-add+pl2/p8' reads P = 8, shift-add, --pipeline 2."""
     if r["label"].startswith("frontend"):
         # 'frontend+pl1+div2': --pipeline 1 --fe-div-bits 2; '+ecp5-25f': --fe-setup ecp5-25f
         tags = r["label"].split("+")[1:]
-        form = [
-            level("+" + t) if t.startswith("pl") else f"--fe-div-bits {t[3:]}" if t.startswith("div") else f"--fe-setup {t}"
-            for t in tags
-        ]
-        return r["top"], ", ".join(form) or "—"
+        return r["top"], ", ".join(map(tag_option, tags)) or "—"
     if r["label"].startswith("chain-"):
         # 'chain-screen+pl1+ecp5-25f/p16': tri_fb_p16 (and specular_unit), screen alignment,
         # --pipeline 1, --fe-setup ecp5-25f
         form, _, _ = r["label"].partition("/")
         align, *tags = form[len("chain-"):].split("+")
-        parts = [f"--align {align}"] + [level("+" + t) if t.startswith("pl") else f"--fe-setup {t}" for t in tags]
+        parts = [f"--align {align}"] + [tag_option(t) for t in tags]
         return " + ".join(r["top"].split("+")), ", ".join(parts)
     if r["label"].startswith("specular"):
         return r["top"], level(r["label"][len("specular"):]) or "—"

@@ -126,6 +126,7 @@ fn synth_and_check_rtl_dir_show_the_generators_message() {
         (&["--abc-depth", "7", "--out", o], &["--abc-depth is for --family ecp5 only"]),
         (&["--family", "ecp5", "--abc-depth", "x", "--out", o], &["--abc-depth takes", "'x'"]),
         (&["--abc-depth"], &["--abc-depth needs a value"]),
+        (&["--family", "ecp5", "--abc9", "--out", o], &["--abc9 is for --family ice40 only"]),
     ];
     for (args, needles) in cases {
         assert_refused("synth", args, needles, &dir);
