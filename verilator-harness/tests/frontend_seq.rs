@@ -171,8 +171,13 @@ fn sequential_span_path_spans_equal_golden() {
     fault.caught(&opts, "frontend walk ram fault", "walkramfault", "Gxn's read addressed as An's");
     let fault = LineFault { file: "tri_frontend.v", line: " wk_slot = wk_rs ^ take", from: "^ take", to: "^ 1'b0" };
     fault.caught(&opts, "frontend walk ram slot fault", "walkslotfault", "the read slot not moved on at the take");
-    let fault = LineFault { file: "tri_frontend.v", line: " wk_da = wk_tnr ? {!wk_rs", from: "{!wk_rs", to: "{wk_rs" };
-    fault.caught(&opts, "frontend walk ram tn fault", "walktnfault", "Tn read from the walked triangle's slot, not the queued one's");
+    // The UP5K's edges' fields in the second memory, preloaded one a clock before the take:
+    // read (and Tn with them) from the walked triangle's slot, and each read a word early, so
+    // that every field is loaded a clock late (the word before's).
+    let fault = LineFault { file: "tri_frontend.v", line: " wk_da = wk_pre ? {!wk_rs", from: "{!wk_rs", to: "{wk_rs" };
+    fault.caught(&opts, "frontend walk ram tn fault", "walktnfault", "the edges' fields and Tn read from the walked triangle's slot");
+    let fault = LineFault { file: "tri_frontend.v", line: " wk_da = wk_pre ? {!wk_rs", from: "wk_lk + 5'd2", to: "wk_lk + 5'd1" };
+    fault.caught(&opts, "frontend walk ram preload fault", "walkpreloadfault", "each edge field loaded a clock after its read");
     // The UP5K's pixel test after the ends' picks (`Hw::fewest_cells`): a one-pixel row
     // (hi3 + mg = 0) dropped.
     let fault = LineFault { file: "tri_frontend.v", line: " room = ", from: "mg[15]}}, mg}", to: "mg[15]}}, mg} - 17'sd1" };

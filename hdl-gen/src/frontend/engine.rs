@@ -346,7 +346,10 @@ pub(super) fn setup(hw: &Hw, names: &Names, body: &mut Vec<Item>) {
             }
         }
     }
-    for (port, bus, w) in super::edge::input_buses(hw).inputs {
+    if super::span_seq::walk_ram::edges_in_ram(hw) {
+        super::span_seq::walk_ram::edge_inputs(hw, body);
+    }
+    for (port, bus, w) in super::edge::input_buses(hw).inputs.into_iter().filter(|_| !super::span_seq::walk_ram::edges_in_ram(hw)) {
         let l = &lanes[port];
         body.push(crate::verilog::wire(bus, 3 * w, format!("{{{}, {}, {}}}", l[2], l[1], l[0])));
     }

@@ -166,9 +166,19 @@ impl Hw {
     /// figure is the worst case of the slot's wait.
     pub fn latency(&self) -> u32 {
         if let Some((ii, latency, _)) = self.engine_timing() {
-            return ii + latency + 2 + self.queue_head_clocks() + self.i0_stages() + self.start_clocks();
+            return ii + latency + 2 + self.queue_head_clocks() + self.i0_stages() + self.start_clocks() + self.preload_clocks();
         }
         self.calc_clocks() + self.div_clocks() + 2 + self.i0_stages() + self.span_div_clocks() + self.start_clocks()
+    }
+
+    /// Clocks the walker waits after a push into an empty queue while it reads the edges' fields
+    /// from the walk memory (`span_seq::walk_ram::edges_in_ram`, the UP5K's plan), else 0.
+    pub fn preload_clocks(&self) -> u32 {
+        if super::span_seq::walk_ram::edges_in_ram(self) {
+            super::span_seq::walk_ram::PRELOAD_CLOCKS
+        } else {
+            0
+        }
     }
 
     /// Clocks a start takes in the incremental I0 (at most: a start at an edge; one at column 0

@@ -16,6 +16,12 @@
 //! where it is written: the engine writes only while the queue is empty, and its slot is then the
 //! one the walker does not hold (`no_rw_check`, so Yosys adds no collision logic).
 //!
+//! On the UP5K ([`edges_in_ram`]) the second memory also holds the edges' set-up fields, which
+//! were the queue entry's 354 flip-flops: the walker reads them into the edges' registers, one a
+//! clock, while it is idle and a triangle is queued, and takes the triangle after the last
+//! ([`PRELOAD_CLOCKS`] after a push into an empty queue; behind a covered last row the span path's
+//! 36 clocks cover them). docs/wip-queue-in-walk-ram.md (issue 27, stop 36: work in progress).
+//!
 //! The memories' reads are registered, so each read is addressed a clock before its load: the
 //! span path's phase names the field its next load reads ([`read_order`]), and the slot is the
 //! walked triangle's, or at the take already the taken one's. docs/fpga.md, *The walk's
@@ -77,7 +83,36 @@ pub(crate) fn we(name: &str) -> String {
 /// Whether set-up result field `name` is in the memories, not in the queue's entry nor the
 /// walker's registers.
 pub(crate) fn holds(hw: &Hw, name: &str) -> bool {
-    on(hw) && (SPAN_FIELDS.contains(&name) || name == STEP_FIELD || name == TAKE_FIELD)
+    on(hw) && (SPAN_FIELDS.contains(&name) || name == STEP_FIELD || name == TAKE_FIELD || edge_field(hw, name).is_some())
+}
+
+/// Whether the edges' set-up fields are in the second memory too, not in the queue's entry (the
+/// UP5K's plan, [`Hw::fewest_cells`]: the entry's 354 flip-flops, each a logic cell no LUT
+/// feeds). The walker reads them one a clock into the edges' registers while it is idle and a
+/// triangle is queued (the preload, [`PRELOAD_CLOCKS`]), then takes it.
+/// WORK IN PROGRESS (issue 27, stop 36, helper u5q): not yet covered by the proofs;
+/// docs/wip-queue-in-walk-ram.md.
+pub(crate) fn edges_in_ram(hw: &Hw) -> bool {
+    on(hw) && hw.fewest_cells()
+}
+
+/// The edges' fields in the second memory, per edge in the edge's input order
+/// ([`crate::frontend::edge::input_buses`]): field `j` of edge `k` is number `EDGE_FIELDS * k + j`.
+const EDGE_FIELDS: [&str; 9] = ["act", "right", "rs", "re", "d", "g", "rem", "qs", "rs256"];
+
+/// The second memory's word of the first edge field: after `dYn` (0) and `Tn` (1).
+const EDGE_BASE: u64 = 2;
+
+/// Clocks from the queue's push to the earliest take where the edges' fields are preloaded: one
+/// a field (27 reads), and the clock the last one is loaded, which reads `Tn`.
+pub(crate) const PRELOAD_CLOCKS: u32 = 3 * EDGE_FIELDS.len() as u32 + 1;
+
+/// The number of edge field `name` (`e<k>_<port>`), where the memory holds the edges' fields.
+fn edge_field(hw: &Hw, name: &str) -> Option<u64> {
+    let (e, port) = name.split_once('_')?;
+    let k: u64 = e.strip_prefix('e')?.parse().ok()?;
+    let j = EDGE_FIELDS.iter().position(|f| *f == port)? as u64;
+    (edges_in_ram(hw) && k < 3).then_some(EDGE_FIELDS.len() as u64 * k + j)
 }
 
 /// Whether the walker's register for field `name` is gone: the memories' read is it.
@@ -161,6 +196,38 @@ fn field_bits(hw: &Hw) -> u32 {
     bits_for(span_memory(hw).len() as u32 - 1)
 }
 
+/// Where [`edges_in_ram`]: the second memory's read register (`wk_dq`, declared here, before the
+/// edges read it), the preload's count (`wk_lk`: the field read, then 27 and 28 reading `Tn`;
+/// `wk_ldd`, the take's condition) and the edges' inputs, every one the read register's low bits,
+/// each field loaded by its bit of `e_ld` in the clock after its read. With the queue's head
+/// fields, before the walker.
+pub(crate) fn edge_inputs(hw: &Hw, body: &mut Vec<Item>) {
+    let k = hw.fe.widths().k;
+    let n = 3 * EDGE_FIELDS.len() as u64;
+    let lw = bits_for(n as u32 + 1);
+    body.push(comment("The edges' fields from the second walk memory, one a clock while the walker is idle and a triangle"));
+    body.push(comment("queued (wk_lk the field read, then Tn's read): a field is loaded (e_ld) the clock after its read."));
+    body.push(reg("wk_dq", k));
+    body.push(reg("wk_lk", lw));
+    body.push(wire("wk_ldd", 1, format!("wk_lk == {}", lit(lw, n + 1))));
+    let ld: Vec<String> = (0..n).rev().map(|j| format!("wk_lk == {}", lit(lw, j + 1))).collect();
+    body.push(wire("e_ld", n as u32, format!("{{{}}}", ld.join(", "))));
+    for (port, bus, w) in crate::frontend::edge::input_buses(hw).inputs {
+        assert!(EDGE_FIELDS.contains(&port), "edge field {port} in the memory");
+        let lane = if w == 1 { "wk_dq[0]".to_string() } else { format!("wk_dq[{}:0]", w - 1) };
+        body.push(wire(bus, 3 * w, format!("{{3{{{lane}}}}}")));
+    }
+}
+
+/// The second memory's address bits in a slot.
+fn d_bits(hw: &Hw) -> u32 {
+    if edges_in_ram(hw) {
+        bits_for((EDGE_BASE + 3 * EDGE_FIELDS.len() as u64) as u32 - 1)
+    } else {
+        field_bits(hw)
+    }
+}
+
 /// The memories, their writes from the engine (`res_bus`, a field's `we` bit of `res_we`) and
 /// their reads, the walker's `w_an`, `w_gxn`, `w_rn` (the span path's, valid at its loads),
 /// `wk_tn` (the queued triangle's, at the take) and `wk_dyn` (the same, where [`registered`]) or
@@ -186,8 +253,12 @@ pub(crate) fn emit(hw: &Hw, body: &mut Vec<Item>) {
     }
     body.push(Item::Memory { name: "wk_m".into(), width: sw, depth: 1 << aw_ram, no_rw_check: true });
     // As deep as the first: Yosys keeps a two-word memory in flip-flops.
-    body.push(Item::Memory { name: "wk_d".into(), width: k, depth: 1 << aw_ram, no_rw_check: true });
-    body.extend([reg("wk_q", sw), reg("wk_dq", k), reg("wk_ws", 1), reg("wk_rs", 1)]);
+    body.push(Item::Memory { name: "wk_d".into(), width: k, depth: 1 << (1 + d_bits(hw)), no_rw_check: true });
+    body.push(reg("wk_q", sw));
+    if !edges_in_ram(hw) {
+        body.push(reg("wk_dq", k));
+    }
+    body.extend([reg("wk_ws", 1), reg("wk_rs", 1)]);
     body.push(wire("wk_slot", 1, "wk_rs ^ take"));
     let (during, accept) = read_order(&q);
     let phase_w = bits_for(SpanSeq::PHASES.len() as u32 - 1);
@@ -221,6 +292,33 @@ pub(crate) fn emit_ports(hw: &Hw, body: &mut Vec<Item>) {
         body.push(wire("wk_ma", fw + 1, format!("wk_dnr ? {{!wk_rs, {}}} : {{wk_slot, wk_ra}}", lit(fw, index(STEP_FIELD)))));
         let tn = lit(fw, 0);
         ("wk_m[wk_ma]".to_string(), (we(TAKE_FIELD), format!("wk_d[{{wk_ws, {tn}}}]")), format!("wk_d[{{!wk_rs, {tn}}}]"))
+    } else if edges_in_ram(hw) {
+        // Tn's read (the walked triangle's dYn otherwise) waits for the edges' fields: a take
+        // comes only once they are loaded.
+        let db = d_bits(hw);
+        let lw = bits_for(3 * EDGE_FIELDS.len() as u32 + 1);
+        let n = 3 * EDGE_FIELDS.len() as u64;
+        body.push(wire("wk_pre", 1, "q_full && !w_valid && !take"));
+        let lk = if db > lw { format!("{{{}, wk_lk}}", lit(db - lw, 0)) } else { "wk_lk".to_string() };
+        let field = format!("wk_lk < {} ? {lk} + {} : {}", lit(lw, n), lit(db, EDGE_BASE), lit(db, 1));
+        body.push(wire("wk_da", db + 1, format!("wk_pre ? {{!wk_rs, {field}}} : {{wk_slot, {}}}", lit(db, 0))));
+        let mut wa = lit(db, 0);
+        let mut wes = vec![we(STEP_FIELD), we(TAKE_FIELD)];
+        for kk in (0..3).rev() {
+            for (j, f) in EDGE_FIELDS.iter().enumerate().rev() {
+                let name = format!("e{kk}_{f}");
+                wa = format!("{} ? {} : {wa}", we(&name), lit(db, EDGE_BASE + EDGE_FIELDS.len() as u64 * kk + j as u64));
+                wes.push(we(&name));
+            }
+        }
+        wa = format!("{} ? {} : {wa}", we(TAKE_FIELD), lit(db, 1));
+        body.push(wire("wk_dwa", db, wa));
+        body.push(Item::Always(vec![Stmt::If(
+            "rst || take".into(),
+            vec![set("wk_lk", lit(lw, 0))],
+            vec![Stmt::If("q_full && !w_valid && !wk_ldd".into(), vec![set("wk_lk", format!("wk_lk + {}", lit(lw, 1)))], vec![])],
+        )]));
+        ("wk_m[{wk_slot, wk_ra}]".to_string(), (wes.join(" || "), "wk_d[{wk_ws, wk_dwa}]".to_string()), "wk_d[wk_da]".to_string())
     } else {
         body.push(wire("wk_tnr", 1, "(q_full || q_in) && !take && !(w_valid && !w_end)"));
         body.push(wire("wk_da", fw + 1, format!("wk_tnr ? {{!wk_rs, {}}} : {{wk_slot, {}}}", lit(fw, 1), lit(fw, 0))));
