@@ -287,8 +287,12 @@ impl Reference<'_> {
             link.push(assert(format!("{} == {} - f_held", zext("cr", bits_for(e.depth), w), lit(w, e.depth as u64))));
         }
         link.extend([assert("w_valid == f_wv"), when("f_wv", vec![assert("w_row == f_wrow"), assert("w_last == f_wlast")])]);
-        if e.preload.is_some() {
+        if let Some(n) = e.preload {
+            // The preload runs only while a triangle is queued and none walked, until the take.
+            let w = bits_for(n);
             link.push(assert("wk_lk == f_lk"));
+            link.push(assert(format!("f_lk <= {}", lit(w, n as u64))));
+            link.push(assert(format!("f_lk == {} || (f_qn != {} && !f_wv)", lit(w, 0), lit(qw, 0))));
         }
         link
     }
