@@ -302,16 +302,18 @@ pub(crate) fn emit_ports(hw: &Hw, body: &mut Vec<Item>) {
         let lk = if db > lw { format!("{{{}, wk_lk}}", lit(db - lw, 0)) } else { "wk_lk".to_string() };
         let field = format!("wk_lk < {} ? {lk} + {} : {}", lit(lw, n), lit(db, EDGE_BASE), lit(db, 1));
         body.push(wire("wk_da", db + 1, format!("wk_pre ? {{!wk_rs, {field}}} : {{wk_slot, {}}}", lit(db, 0))));
-        let mut wa = lit(db, 0);
+        // The engine writes one field a clock (its microword's capture, `res_we` one-hot or
+        // zero), so the word is an OR of the enables' indices, not a priority chain.
         let mut wes = vec![we(STEP_FIELD), we(TAKE_FIELD)];
-        for kk in (0..3).rev() {
-            for (j, f) in EDGE_FIELDS.iter().enumerate().rev() {
+        let mut terms = vec![format!("({{{db}{{{}}}}} & {})", we(TAKE_FIELD), lit(db, 1))];
+        for kk in 0..3 {
+            for (j, f) in EDGE_FIELDS.iter().enumerate() {
                 let name = format!("e{kk}_{f}");
-                wa = format!("{} ? {} : {wa}", we(&name), lit(db, EDGE_BASE + EDGE_FIELDS.len() as u64 * kk + j as u64));
+                terms.push(format!("({{{db}{{{}}}}} & {})", we(&name), lit(db, EDGE_BASE + EDGE_FIELDS.len() as u64 * kk + j as u64)));
                 wes.push(we(&name));
             }
         }
-        wa = format!("{} ? {} : {wa}", we(TAKE_FIELD), lit(db, 1));
+        let wa = terms.join(" | ");
         body.push(wire("wk_dwa", db, wa));
         body.push(Item::Always(vec![Stmt::If(
             "rst || take".into(),
