@@ -124,9 +124,10 @@ fn sequential_incremental_i0_spans_equal_golden() {
 /// walk's constants in block RAM), as [`engine_spans_of`]; a fault (the correction's `q~ + 1`
 /// made `q~`), one in the lean DDA (the bound's step with its carry subtracted), two in the
 /// side-by-side ends (an edge's bound the right end without its side test; the pixel test
-/// without one pair's sum) and seven in the walk's memories (on the UP5K: `Gxn`'s read
+/// without one pair's sum) and eight in the walk's memories (on the UP5K: `Gxn`'s read
 /// addressed as `An`'s; the read slot not moved on at the take, so a triangle's first row reads
-/// the one before's; `Tn` read at the take from the walked triangle's slot; on the HX8K, whose
+/// the one before's; the edges' fields, preloaded from the second memory, and `Tn` read from
+/// the walked triangle's slot; each edge field loaded a clock after its read; on the HX8K, whose
 /// walker holds `dYn` in a register: `Tn` so again, the register not loaded at the take, so it
 /// steps by the triangle before's `dYn`; `dYn` read from the walked triangle's slot; `dYn` read
 /// while the last row waits for the span path, whose next load then reads it) are caught. Slow tier: `cargo nextest run -p verilator-harness --run-ignored only

@@ -32,7 +32,7 @@ use crate::verilog::{comment, lit, reg, set, wire, Item, Stmt};
 use crate::widths::bits_for;
 use golden::frontend::engine::SetupForm;
 use golden::frontend::span_seq::{Multiplicand, Multiplier, SpanSeq};
-use golden::frontend::{I0Form, Widths};
+use golden::frontend::Widths;
 
 /// The fields the span path reads from the first memory, in its address order.
 const SPAN_FIELDS: [&str; 3] = ["an", "gxn", "rn"];
@@ -45,20 +45,10 @@ const STEP_FIELD: &str = "dyn";
 /// beside `dYn`, or alone where `dYn` is [`registered`]).
 const TAKE_FIELD: &str = "tn";
 
-/// Whether this front-end holds the walk's constants in block RAM: the sequential engine (its
-/// fields written one at a time, `res_we`) behind the sequential span path without row stages
-/// (whose reads are the walker's registers' own), the reciprocal `I0` (the incremental one reads
-/// them every row) and no running sums (which read `Gxn` at the take; without them the walker
-/// reads it). Both iCE40 plans: the UP5K needs the cells, and on the HX8K (88 % with them, 92 %
-/// without) the placer did not place every seed without them (docs/fpga.md).
+/// Whether this front-end holds the walk's constants in block RAM ([`Hw::walk_ram`], which says
+/// when and why).
 pub(crate) fn on(hw: &Hw) -> bool {
-    // Both iCE40 plans are a sequential engine's; `hw.sequential()` would schedule it again for
-    // every field this is asked about.
-    matches!(hw.fe.setup, SetupForm::Ice40Up5k | SetupForm::Ice40Hx8k)
-        && hw.fe.span_seq().is_some()
-        && !hw.row_stage()
-        && hw.fe.i0 == I0Form::Reciprocal
-        && !hw.run_sums()
+    hw.walk_ram()
 }
 
 /// Whether the walker holds `dYn` in a register loaded at the take (the HX8K's plan), not
@@ -93,7 +83,7 @@ pub(crate) fn holds(hw: &Hw, name: &str) -> bool {
 /// WORK IN PROGRESS (issue 27, stop 36, helper u5q): not yet covered by the proofs;
 /// docs/wip-queue-in-walk-ram.md.
 pub(crate) fn edges_in_ram(hw: &Hw) -> bool {
-    on(hw) && hw.fewest_cells()
+    hw.edges_in_walk_ram()
 }
 
 /// The edges' fields in the second memory, per edge in the edge's input order
@@ -105,7 +95,8 @@ const EDGE_BASE: u64 = 2;
 
 /// Clocks from the queue's push to the earliest take where the edges' fields are preloaded: one
 /// a field (27 reads), and the clock the last one is loaded, which reads `Tn`.
-pub(crate) const PRELOAD_CLOCKS: u32 = 3 * EDGE_FIELDS.len() as u32 + 1;
+pub(crate) const PRELOAD_CLOCKS: u32 = crate::frontend::hw::PRELOAD_CLOCKS;
+const _: () = assert!(PRELOAD_CLOCKS == 3 * EDGE_FIELDS.len() as u32 + 1, "a read a field, then Tn's");
 
 /// The number of edge field `name` (`e<k>_<port>`), where the memory holds the edges' fields.
 fn edge_field(hw: &Hw, name: &str) -> Option<u64> {
@@ -198,9 +189,8 @@ fn field_bits(hw: &Hw) -> u32 {
 
 /// Where [`edges_in_ram`]: the second memory's read register (`wk_dq`, declared here, before the
 /// edges read it), the preload's count (`wk_lk`: the field read, then 27 and 28 reading `Tn`;
-/// `wk_ldd`, the take's condition) and the edges' inputs, every one the read register's low bits,
-/// each field loaded by its bit of `e_ld` in the clock after its read. With the queue's head
-/// fields, before the walker.
+/// `wk_ldd`, the take's condition) and each field's load, its bit of `e_ld` in the clock after
+/// its read. With the queue's head fields, before the walker.
 pub(crate) fn edge_inputs(hw: &Hw, body: &mut Vec<Item>) {
     let k = hw.fe.widths().k;
     let n = 3 * EDGE_FIELDS.len() as u64;
@@ -212,11 +202,12 @@ pub(crate) fn edge_inputs(hw: &Hw, body: &mut Vec<Item>) {
     body.push(wire("wk_ldd", 1, format!("wk_lk == {}", lit(lw, n + 1))));
     let ld: Vec<String> = (0..n).rev().map(|j| format!("wk_lk == {}", lit(lw, j + 1))).collect();
     body.push(wire("e_ld", n as u32, format!("{{{}}}", ld.join(", "))));
-    for (port, bus, w) in crate::frontend::edge::input_buses(hw).inputs {
-        assert!(EDGE_FIELDS.contains(&port), "edge field {port} in the memory");
-        let lane = if w == 1 { "wk_dq[0]".to_string() } else { format!("wk_dq[{}:0]", w - 1) };
-        body.push(wire(bus, 3 * w, format!("{{3{{{lane}}}}}")));
-    }
+}
+
+/// Whether `port` is an edge field the memory holds, in the edge's input order (`engine.rs`
+/// wires every edge's input `port` from the read register's low bits).
+pub(crate) fn edge_port(port: &str) -> bool {
+    EDGE_FIELDS.contains(&port)
 }
 
 /// The second memory's address bits in a slot.
