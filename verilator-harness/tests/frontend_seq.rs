@@ -124,9 +124,10 @@ fn sequential_incremental_i0_spans_equal_golden() {
 /// walk's constants in block RAM), as [`engine_spans_of`]; a fault (the correction's `q~ + 1`
 /// made `q~`), one in the lean DDA (the bound's step with its carry subtracted), two in the
 /// side-by-side ends (an edge's bound the right end without its side test; the pixel test
-/// without one pair's sum) and seven in the walk's memories (on the UP5K: `Gxn`'s read
+/// without one pair's sum) and eight in the walk's memories (on the UP5K: `Gxn`'s read
 /// addressed as `An`'s; the read slot not moved on at the take, so a triangle's first row reads
-/// the one before's; `Tn` read at the take from the walked triangle's slot; on the HX8K, whose
+/// the one before's; the edges' fields, preloaded from the second memory, and `Tn` read from
+/// the walked triangle's slot; each edge field loaded a clock after its read; on the HX8K, whose
 /// walker holds `dYn` in a register: `Tn` so again, the register not loaded at the take, so it
 /// steps by the triangle before's `dYn`; `dYn` read from the walked triangle's slot; `dYn` read
 /// while the last row waits for the span path, whose next load then reads it) are caught. Slow tier: `cargo nextest run -p verilator-harness --run-ignored only
@@ -171,8 +172,13 @@ fn sequential_span_path_spans_equal_golden() {
     fault.caught(&opts, "frontend walk ram fault", "walkramfault", "Gxn's read addressed as An's");
     let fault = LineFault { file: "tri_frontend.v", line: " wk_slot = wk_rs ^ take", from: "^ take", to: "^ 1'b0" };
     fault.caught(&opts, "frontend walk ram slot fault", "walkslotfault", "the read slot not moved on at the take");
-    let fault = LineFault { file: "tri_frontend.v", line: " wk_da = wk_tnr ? {!wk_rs", from: "{!wk_rs", to: "{wk_rs" };
-    fault.caught(&opts, "frontend walk ram tn fault", "walktnfault", "Tn read from the walked triangle's slot, not the queued one's");
+    // The UP5K's edges' fields in the second memory, preloaded one a clock before the take:
+    // read (and Tn with them) from the walked triangle's slot, and each read a word early, so
+    // that every field is loaded a clock late (the word before's).
+    let fault = LineFault { file: "tri_frontend.v", line: " wk_da = wk_pre ? {!wk_rs", from: "{!wk_rs", to: "{wk_rs" };
+    fault.caught(&opts, "frontend walk ram tn fault", "walktnfault", "the edges' fields and Tn read from the walked triangle's slot");
+    let fault = LineFault { file: "tri_frontend.v", line: " wk_da = wk_pre ? {!wk_rs", from: "wk_lk + 5'd2", to: "wk_lk + 5'd1" };
+    fault.caught(&opts, "frontend walk ram preload fault", "walkpreloadfault", "each edge field loaded a clock after its read");
     // The UP5K's pixel test after the ends' picks (`Hw::fewest_cells`): a one-pixel row
     // (hi3 + mg = 0) dropped.
     let fault = LineFault { file: "tri_frontend.v", line: " room = ", from: "mg[15]}}, mg}", to: "mg[15]}}, mg} - 17'sd1" };

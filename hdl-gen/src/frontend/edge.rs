@@ -202,6 +202,9 @@ pub(super) fn instances(hw: &Hw, names: &Names, buses: &EdgeBuses) -> Item {
     } else {
         &[("take", "w_load"), ("step", "w_step")]
     };
+    // Loaded a field a clock from the walk memory: each edge's nine bits of e_ld.
+    let walker: &[(&str, &str)] =
+        if super::span_seq::walk_ram::edges_in_ram(hw) { &[("ld", "e_ld[k*9 +: 9]"), ("step", "w_step")] } else { walker };
     let mut conns: Vec<(String, String)> = [("clk", "clk"), ("calc_go", "calc_go"), ("div_run", "div_run"), ("div_cnt", "div_cnt")]
         .iter()
         .chain(walker)
@@ -481,9 +484,36 @@ fn module_engine(hw: &Hw, names: &Names) -> Module {
     if !e.lean {
         load.push(set("w_qs1", format!("qs + {}", zext("1'b1", 1, bound_w))));
     }
-    body.push(walk(&e, load, ("rs", "re")));
+    if super::span_seq::walk_ram::edges_in_ram(hw) {
+        body.push(walk_by_field(&mut ports, load));
+    } else {
+        body.push(walk(&e, load, ("rs", "re")));
+    }
     body.extend(state_outputs(hw).into_iter().map(|(port, _, _, signal, _)| Item::Assign(port.into(), signal)));
     Module { name: names.fe_edge.clone(), header, params: vec![], ports, body }
+}
+
+/// The lean DDA loaded a field a clock (the set-up result's fields in the walk memory,
+/// `span_seq::walk_ram::edges_in_ram`): `take` is `ld`, a bit a field in the edge's input
+/// order, and `g`, `rem` step where their bit is clear.
+fn walk_by_field(ports: &mut [Port], load: Vec<Stmt>) -> Item {
+    const ORDER: [&str; 9] = ["act", "right", "rs", "re", "d", "g", "rem", "qs", "rs256"];
+    let take = ports.iter_mut().find(|p| p.name == "take").expect("the take port");
+    *take = Port::input("ld", ORDER.len() as u32, "", "per field, in the input order: load it (the walker is idle)");
+    let st = load
+        .into_iter()
+        .map(|st| {
+            let Stmt::Set(l, _) = &st else { unreachable!("a load is a set") };
+            let j = ORDER.iter().position(|f| l[2..] == **f).expect("an edge field");
+            let step = match &l[2..] {
+                "g" => vec![Stmt::If("step && w_act && row >= w_rs".into(), vec![set("w_g", "gnext")], vec![])],
+                "rem" => vec![Stmt::If("step && w_act && row >= w_rs".into(), vec![set("w_rem", "rnext")], vec![])],
+                _ => vec![],
+            };
+            Stmt::If(format!("ld[{j}]"), vec![st], step)
+        })
+        .collect();
+    Item::Always(st)
 }
 
 /// How the walker's ports load and step the edge, for its header.

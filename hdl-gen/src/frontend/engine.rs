@@ -346,7 +346,16 @@ pub(super) fn setup(hw: &Hw, names: &Names, body: &mut Vec<Item>) {
             }
         }
     }
-    for (port, bus, w) in super::edge::input_buses(hw).inputs {
+    if super::span_seq::walk_ram::edges_in_ram(hw) {
+        super::span_seq::walk_ram::edge_inputs(hw, body);
+        // Every edge field from the walk memory's read register, loaded a field a clock.
+        for (port, bus, w) in super::edge::input_buses(hw).inputs {
+            assert!(super::span_seq::walk_ram::edge_port(port), "edge field {port} in the walk memory");
+            let lane = if w == 1 { "wk_dq[0]".to_string() } else { format!("wk_dq[{}:0]", w - 1) };
+            body.push(crate::verilog::wire(bus, 3 * w, format!("{{3{{{lane}}}}}")));
+        }
+    }
+    for (port, bus, w) in super::edge::input_buses(hw).inputs.into_iter().filter(|_| !super::span_seq::walk_ram::edges_in_ram(hw)) {
         let l = &lanes[port];
         body.push(crate::verilog::wire(bus, 3 * w, format!("{{{}, {}, {}}}", l[2], l[1], l[0])));
     }

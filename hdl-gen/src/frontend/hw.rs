@@ -18,6 +18,11 @@ pub struct Hw {
     pub pipeline: golden::pipeline::Pipeline,
 }
 
+/// Clocks from a push into an empty queue to the earliest take where the walk memory holds the
+/// edges' fields ([`Hw::edges_in_walk_ram`]): a read a field (three edges of nine), then the
+/// clock the last is loaded, which reads `Tn`.
+pub const PRELOAD_CLOCKS: u32 = 3 * 9 + 1;
+
 /// Entries of the set-up result queue behind the sequential engine (`--fe-setup ice40-hx8k`):
 /// two, so the next triangle's set-up waits behind the one being walked without freezing the
 /// engine. The pipelined engine's queue is deeper ([`Hw::queue_depth`]).
@@ -166,9 +171,43 @@ impl Hw {
     /// figure is the worst case of the slot's wait.
     pub fn latency(&self) -> u32 {
         if let Some((ii, latency, _)) = self.engine_timing() {
-            return ii + latency + 2 + self.queue_head_clocks() + self.i0_stages() + self.start_clocks();
+            return ii + latency + 2 + self.queue_head_clocks() + self.i0_stages() + self.start_clocks() + self.preload_clocks();
         }
         self.calc_clocks() + self.div_clocks() + 2 + self.i0_stages() + self.span_div_clocks() + self.start_clocks()
+    }
+
+    /// Clocks the walker waits after a push into an empty queue while it reads the edges' fields
+    /// from the walk memory (`span_seq::walk_ram::edges_in_ram`, the UP5K's plan), else 0.
+    pub fn preload_clocks(&self) -> u32 {
+        if self.edges_in_walk_ram() {
+            PRELOAD_CLOCKS
+        } else {
+            0
+        }
+    }
+
+    /// Whether this front-end holds the walk's constants in block RAM (`span_seq::walk_ram`,
+    /// whose doc says why): the sequential engine (its fields written one at a time, `res_we`)
+    /// behind the sequential span path without row stages (whose reads are the walker's
+    /// registers' own), the reciprocal `I0` (the incremental one reads them every row) and no
+    /// running sums (which read `Gxn` at the take; without them the walker reads it). Both iCE40
+    /// plans: the UP5K needs the cells, and on the HX8K (88 % with them, 92 % without) the placer
+    /// did not place every seed without them (docs/fpga.md).
+    pub fn walk_ram(&self) -> bool {
+        // Both iCE40 plans are a sequential engine's; `self.sequential()` would schedule it again
+        // for every field this is asked about.
+        use golden::frontend::engine::SetupForm;
+        matches!(self.fe.setup, SetupForm::Ice40Up5k | SetupForm::Ice40Hx8k)
+            && self.fe.span_seq().is_some()
+            && !self.row_stage()
+            && self.fe.i0 == I0Form::Reciprocal
+            && !self.run_sums()
+    }
+
+    /// Whether the walk memory also holds the edges' set-up fields, not the queue's entry: the
+    /// UP5K's plan ([`Hw::fewest_cells`]), the walker preloading them ([`PRELOAD_CLOCKS`]).
+    pub fn edges_in_walk_ram(&self) -> bool {
+        self.walk_ram() && self.fewest_cells()
     }
 
     /// Clocks a start takes in the incremental I0 (at most: a start at an edge; one at column 0

@@ -67,6 +67,7 @@ pub(super) fn emit_engine(hw: &Hw, sp: &Stager) -> Item {
         capture: hw.sequential().is_some(),
         held: hw.sequential().map(|s| s.inputs_read_by()),
         walk_ram: super::span_seq::walk_ram::on(hw),
+        preload: super::span_seq::walk_ram::edges_in_ram(hw).then_some(super::span_seq::walk_ram::PRELOAD_CLOCKS),
         head: hw.queue_head(),
     };
     let mut shape = shape(hw, sp, SetupShape::Engine(engine));
@@ -293,7 +294,7 @@ impl Reference<'_> {
         b.push(wire("f_wend", 1, "f_wrow == f_wlast"));
         let empty = self.s.span_unit.as_ref().is_some_and(|u| u.take_when_empty);
         let take = match (&self.s.setup, self.s.starts) {
-            (SetupShape::Engine(e), None) if empty => format!("{} && f_adv && !f_wv", engine::head_ready(e)),
+            (SetupShape::Engine(e), None) if empty => format!("{} && f_adv && !f_wv{}", engine::head_ready(e), engine::preloaded(e)),
             (SetupShape::Engine(e), None) => format!("{} && f_adv && (!f_wv || f_wend)", engine::head_ready(e)),
             (SetupShape::Engine(e), Some(_)) => format!("{} && ie_pv && f_adv && !ie_wait && (!f_wv || f_wend)", engine::head_ready(e)),
             (_, Some(_)) => "f_sb && f_sh && ie_pv && f_adv && !ie_wait && (!f_wv || f_wend)".into(),
@@ -519,7 +520,8 @@ impl Reference<'_> {
             ),
             if self.s.span_unit.as_ref().is_some_and(|u| u.take_when_empty) {
                 // The next triangle is taken once the last row has left the walker.
-                when(format!("$past(!w_valid && adv && {waiting})"), vec![assert("w_valid"), assert("w_row == $past(s_first)")])
+                let preloaded = if let SetupShape::Engine(e) = &self.s.setup { engine::preloaded(e) } else { String::new() };
+                when(format!("$past(!w_valid && adv && {waiting}{preloaded})"), vec![assert("w_valid"), assert("w_row == $past(s_first)")])
             } else {
                 when(
                     format!("$past(w_valid && adv && w_end && {waiting}{held}{go})"),

@@ -297,8 +297,10 @@ fn control(hw: &Hw, body: &mut Vec<Item>) {
     let inc = super::incremental::on(hw);
     let engine = hw.engine_form();
     let waiting = if engine { "q_ne" } else { "st == HOLD" };
+    // Where the edges' fields are in the walk memory, the take waits for their preload.
+    let preloaded = if super::span_seq::walk_ram::edges_in_ram(hw) { " && wk_ldd" } else { "" };
     if !inc {
-        body.push(assign("take", format!("{waiting} && adv && {free}")));
+        body.push(assign("take", format!("{waiting} && adv && {free}{preloaded}")));
     }
     let end_w = edge::end_width(hw);
     body.push(swire("lo0", end_w, slit(end_w, 0)));
@@ -314,7 +316,9 @@ fn control(hw: &Hw, body: &mut Vec<Item>) {
         body.push(wire("w_next", 1, format!("{waiting} && {free}")));
         body.push(wire("w_more", 1, "!w_end"));
     } else {
-        body.push(wire("w_load", 1, "!rst && take"));
+        if !super::span_seq::walk_ram::edges_in_ram(hw) {
+            body.push(wire("w_load", 1, "!rst && take"));
+        }
         if inc {
             body.push(net("w_step", 1));
         } else {

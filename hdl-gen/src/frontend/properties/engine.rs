@@ -50,6 +50,12 @@ pub(super) fn head_ready(e: &EngineShape) -> String {
     }
 }
 
+/// The take's wait for the edges' preload from the walk memory (`EngineShape::preload`): the
+/// reference's count at its end, else nothing.
+pub(super) fn preloaded(e: &EngineShape) -> String {
+    e.preload.map(|n| format!(" && f_lk == {}", lit(bits_for(n), n as u64))).unwrap_or_default()
+}
+
 /// The probes a one-entry queue has no register for: its pointers, always 0.
 pub(super) fn constant_probes(e: &EngineShape) -> Vec<Item> {
     if e.depth > 1 {
@@ -84,6 +90,10 @@ impl Reference<'_> {
         if e.head {
             b.push(comment("The registered head holds an entry (f_qh): refilled from the memory only while empty."));
             b.push(reg("f_qh", 1));
+        }
+        if let Some(n) = e.preload {
+            b.push(comment("The edges' preload (f_lk): a field a clock while a triangle is queued and none walked."));
+            b.push(reg("f_lk", bits_for(n)));
         }
         b
     }
@@ -140,6 +150,15 @@ impl Reference<'_> {
             vec![set("f_vf", "1'b0"), set("f_ph", lit(phw, 0)), set("f_vld", lit(n, 0)), set("f_qn", lit(qw, 0)), set("f_tin", "1'b0")];
         if e.head {
             reset.push(set("f_qh", "1'b0"));
+        }
+        if let Some(n) = e.preload {
+            let w = bits_for(n);
+            let more = when(
+                format!("f_qn != {} && !f_wv && f_lk != {}", lit(qw, 0), lit(w, n as u64)),
+                vec![set("f_lk", format!("f_lk + {}", one(w)))],
+            );
+            st.push(Stmt::If("f_take".into(), vec![set("f_lk", lit(w, 0))], vec![more]));
+            reset.push(set("f_lk", lit(w, 0)));
         }
         (reset, st)
     }
@@ -198,6 +217,9 @@ impl Reference<'_> {
             // The memories have no collision logic (`no_rw_check`): their write slot is never read.
             b.push(comment("The walk's memories: the engine's slot is the walked one's exactly while the queue is full, so it never writes the slot read."));
             b.push(Item::Comb(vec![when("f_past", vec![assert("(wk_ws == wk_rs) == q_full"), assert("wk_ws != wk_slot || q_full")])]));
+        }
+        if let Some(n) = e.preload {
+            b.extend(preload_reads(n));
         }
         b
     }
@@ -265,6 +287,32 @@ impl Reference<'_> {
             link.push(assert(format!("{} == {} - f_held", zext("cr", bits_for(e.depth), w), lit(w, e.depth as u64))));
         }
         link.extend([assert("w_valid == f_wv"), when("f_wv", vec![assert("w_row == f_wrow"), assert("w_last == f_wlast")])]);
+        if let Some(n) = e.preload {
+            // The preload runs only while a triangle is queued and none walked, until the take.
+            let w = bits_for(n);
+            link.push(assert("wk_lk == f_lk"));
+            link.push(assert(format!("f_lk <= {}", lit(w, n as u64))));
+            link.push(assert(format!("f_lk == {} || (f_qn != {} && !f_wv)", lit(w, 0), lit(qw, 0))));
+        }
         link
     }
+}
+
+/// The preload's reads (`EngineShape::preload`, `n` the count at its end): each edge field is
+/// loaded (its bit of `e_ld`) only from its own word of the queued triangle's slot, read in the
+/// clock before, and the take's `Tn` likewise. The second memory's words: `dYn`, `Tn`, then
+/// the fields, edge by edge (`span_seq::walk_ram`).
+fn preload_reads(n: u32) -> Vec<Item> {
+    let fields = n - 1;
+    let db = bits_for(fields + 1);
+    let word = |j: u32| format!("$past(wk_pre) && $past(wk_da) == {{!$past(wk_rs), {}}}", lit(db, j as u64));
+    let mut per = vec![assert(format!("(e_ld & (e_ld - {})) == {}", lit(fields, 1), lit(fields, 0)))];
+    per.extend((0..fields).map(|j| when(format!("e_ld[{j}]"), vec![assert(word(j + 2))])));
+    per.push(when("take", vec![assert(word(1))]));
+    vec![
+        comment(
+            "The edges' preload: every field loaded from its word of the queued triangle's slot, read the clock before; Tn so at the take.",
+        ),
+        Item::Always(vec![when("f_past && !$past(rst)", per)]),
+    ]
 }

@@ -103,6 +103,10 @@ pub struct EngineShape {
     /// The walk's constants in block RAM (`span_seq::walk_ram`): its two slots, the engine's
     /// and the walked triangle's, are one exactly while the queue is full.
     pub walk_ram: bool,
+    /// The edges' fields in the walk's second memory (`span_seq::walk_ram::edges_in_ram`): the
+    /// walker reads them one a clock while idle and a triangle is queued, and takes it once its
+    /// preload count (`wk_lk`) is this, the fields' count + 1.
+    pub preload: Option<u32>,
     /// The queue's head is a register of its own (`u_queue.hd`, valid `hv`), refilled from its
     /// memory while empty: an entry is the head a clock after it is in the memory.
     pub head: bool,

@@ -16,6 +16,12 @@
 //! where it is written: the engine writes only while the queue is empty, and its slot is then the
 //! one the walker does not hold (`no_rw_check`, so Yosys adds no collision logic).
 //!
+//! On the UP5K ([`edges_in_ram`]) the second memory also holds the edges' set-up fields, which
+//! were the queue entry's 354 flip-flops: the walker reads them into the edges' registers, one a
+//! clock, while it is idle and a triangle is queued, and takes the triangle after the last
+//! ([`PRELOAD_CLOCKS`] after a push into an empty queue; behind a covered last row the span path's
+//! 36 clocks cover them). docs/wip-queue-in-walk-ram.md (issue 27, stop 36: work in progress).
+//!
 //! The memories' reads are registered, so each read is addressed a clock before its load: the
 //! span path's phase names the field its next load reads ([`read_order`]), and the slot is the
 //! walked triangle's, or at the take already the taken one's. docs/fpga.md, *The walk's
@@ -26,7 +32,7 @@ use crate::verilog::{comment, lit, reg, set, wire, Item, Stmt};
 use crate::widths::bits_for;
 use golden::frontend::engine::SetupForm;
 use golden::frontend::span_seq::{Multiplicand, Multiplier, SpanSeq};
-use golden::frontend::{I0Form, Widths};
+use golden::frontend::Widths;
 
 /// The fields the span path reads from the first memory, in its address order.
 const SPAN_FIELDS: [&str; 3] = ["an", "gxn", "rn"];
@@ -39,20 +45,10 @@ const STEP_FIELD: &str = "dyn";
 /// beside `dYn`, or alone where `dYn` is [`registered`]).
 const TAKE_FIELD: &str = "tn";
 
-/// Whether this front-end holds the walk's constants in block RAM: the sequential engine (its
-/// fields written one at a time, `res_we`) behind the sequential span path without row stages
-/// (whose reads are the walker's registers' own), the reciprocal `I0` (the incremental one reads
-/// them every row) and no running sums (which read `Gxn` at the take; without them the walker
-/// reads it). Both iCE40 plans: the UP5K needs the cells, and on the HX8K (88 % with them, 92 %
-/// without) the placer did not place every seed without them (docs/fpga.md).
+/// Whether this front-end holds the walk's constants in block RAM ([`Hw::walk_ram`], which says
+/// when and why).
 pub(crate) fn on(hw: &Hw) -> bool {
-    // Both iCE40 plans are a sequential engine's; `hw.sequential()` would schedule it again for
-    // every field this is asked about.
-    matches!(hw.fe.setup, SetupForm::Ice40Up5k | SetupForm::Ice40Hx8k)
-        && hw.fe.span_seq().is_some()
-        && !hw.row_stage()
-        && hw.fe.i0 == I0Form::Reciprocal
-        && !hw.run_sums()
+    hw.walk_ram()
 }
 
 /// Whether the walker holds `dYn` in a register loaded at the take (the HX8K's plan), not
@@ -77,7 +73,37 @@ pub(crate) fn we(name: &str) -> String {
 /// Whether set-up result field `name` is in the memories, not in the queue's entry nor the
 /// walker's registers.
 pub(crate) fn holds(hw: &Hw, name: &str) -> bool {
-    on(hw) && (SPAN_FIELDS.contains(&name) || name == STEP_FIELD || name == TAKE_FIELD)
+    on(hw) && (SPAN_FIELDS.contains(&name) || name == STEP_FIELD || name == TAKE_FIELD || edge_field(hw, name).is_some())
+}
+
+/// Whether the edges' set-up fields are in the second memory too, not in the queue's entry (the
+/// UP5K's plan, [`Hw::fewest_cells`]: the entry's 354 flip-flops, each a logic cell no LUT
+/// feeds). The walker reads them one a clock into the edges' registers while it is idle and a
+/// triangle is queued (the preload, [`PRELOAD_CLOCKS`]), then takes it.
+/// WORK IN PROGRESS (issue 27, stop 36, helper u5q): not yet covered by the proofs;
+/// docs/wip-queue-in-walk-ram.md.
+pub(crate) fn edges_in_ram(hw: &Hw) -> bool {
+    hw.edges_in_walk_ram()
+}
+
+/// The edges' fields in the second memory, per edge in the edge's input order
+/// ([`crate::frontend::edge::input_buses`]): field `j` of edge `k` is number `EDGE_FIELDS * k + j`.
+const EDGE_FIELDS: [&str; 9] = ["act", "right", "rs", "re", "d", "g", "rem", "qs", "rs256"];
+
+/// The second memory's word of the first edge field: after `dYn` (0) and `Tn` (1).
+const EDGE_BASE: u64 = 2;
+
+/// Clocks from the queue's push to the earliest take where the edges' fields are preloaded: one
+/// a field (27 reads), and the clock the last one is loaded, which reads `Tn`.
+pub(crate) const PRELOAD_CLOCKS: u32 = crate::frontend::hw::PRELOAD_CLOCKS;
+const _: () = assert!(PRELOAD_CLOCKS == 3 * EDGE_FIELDS.len() as u32 + 1, "a read a field, then Tn's");
+
+/// The number of edge field `name` (`e<k>_<port>`), where the memory holds the edges' fields.
+fn edge_field(hw: &Hw, name: &str) -> Option<u64> {
+    let (e, port) = name.split_once('_')?;
+    let k: u64 = e.strip_prefix('e')?.parse().ok()?;
+    let j = EDGE_FIELDS.iter().position(|f| *f == port)? as u64;
+    (edges_in_ram(hw) && k < 3).then_some(EDGE_FIELDS.len() as u64 * k + j)
 }
 
 /// Whether the walker's register for field `name` is gone: the memories' read is it.
@@ -161,6 +187,38 @@ fn field_bits(hw: &Hw) -> u32 {
     bits_for(span_memory(hw).len() as u32 - 1)
 }
 
+/// Where [`edges_in_ram`]: the second memory's read register (`wk_dq`, declared here, before the
+/// edges read it), the preload's count (`wk_lk`: the field read, then 27 and 28 reading `Tn`;
+/// `wk_ldd`, the take's condition) and each field's load, its bit of `e_ld` in the clock after
+/// its read. With the queue's head fields, before the walker.
+pub(crate) fn edge_inputs(hw: &Hw, body: &mut Vec<Item>) {
+    let k = hw.fe.widths().k;
+    let n = 3 * EDGE_FIELDS.len() as u64;
+    let lw = bits_for(n as u32 + 1);
+    body.push(comment("The edges' fields from the second walk memory, one a clock while the walker is idle and a triangle"));
+    body.push(comment("queued (wk_lk the field read, then Tn's read): a field is loaded (e_ld) the clock after its read."));
+    body.push(reg("wk_dq", k));
+    body.push(reg("wk_lk", lw));
+    body.push(wire("wk_ldd", 1, format!("wk_lk == {}", lit(lw, n + 1))));
+    let ld: Vec<String> = (0..n).rev().map(|j| format!("wk_lk == {}", lit(lw, j + 1))).collect();
+    body.push(wire("e_ld", n as u32, format!("{{{}}}", ld.join(", "))));
+}
+
+/// Whether `port` is an edge field the memory holds, in the edge's input order (`engine.rs`
+/// wires every edge's input `port` from the read register's low bits).
+pub(crate) fn edge_port(port: &str) -> bool {
+    EDGE_FIELDS.contains(&port)
+}
+
+/// The second memory's address bits in a slot.
+fn d_bits(hw: &Hw) -> u32 {
+    if edges_in_ram(hw) {
+        bits_for((EDGE_BASE + 3 * EDGE_FIELDS.len() as u64) as u32 - 1)
+    } else {
+        field_bits(hw)
+    }
+}
+
 /// The memories, their writes from the engine (`res_bus`, a field's `we` bit of `res_we`) and
 /// their reads, the walker's `w_an`, `w_gxn`, `w_rn` (the span path's, valid at its loads),
 /// `wk_tn` (the queued triangle's, at the take) and `wk_dyn` (the same, where [`registered`]) or
@@ -186,8 +244,12 @@ pub(crate) fn emit(hw: &Hw, body: &mut Vec<Item>) {
     }
     body.push(Item::Memory { name: "wk_m".into(), width: sw, depth: 1 << aw_ram, no_rw_check: true });
     // As deep as the first: Yosys keeps a two-word memory in flip-flops.
-    body.push(Item::Memory { name: "wk_d".into(), width: k, depth: 1 << aw_ram, no_rw_check: true });
-    body.extend([reg("wk_q", sw), reg("wk_dq", k), reg("wk_ws", 1), reg("wk_rs", 1)]);
+    body.push(Item::Memory { name: "wk_d".into(), width: k, depth: 1 << (1 + d_bits(hw)), no_rw_check: true });
+    body.push(reg("wk_q", sw));
+    if !edges_in_ram(hw) {
+        body.push(reg("wk_dq", k));
+    }
+    body.extend([reg("wk_ws", 1), reg("wk_rs", 1)]);
     body.push(wire("wk_slot", 1, "wk_rs ^ take"));
     let (during, accept) = read_order(&q);
     let phase_w = bits_for(SpanSeq::PHASES.len() as u32 - 1);
@@ -221,6 +283,35 @@ pub(crate) fn emit_ports(hw: &Hw, body: &mut Vec<Item>) {
         body.push(wire("wk_ma", fw + 1, format!("wk_dnr ? {{!wk_rs, {}}} : {{wk_slot, wk_ra}}", lit(fw, index(STEP_FIELD)))));
         let tn = lit(fw, 0);
         ("wk_m[wk_ma]".to_string(), (we(TAKE_FIELD), format!("wk_d[{{wk_ws, {tn}}}]")), format!("wk_d[{{!wk_rs, {tn}}}]"))
+    } else if edges_in_ram(hw) {
+        // Tn's read (the walked triangle's dYn otherwise) waits for the edges' fields: a take
+        // comes only once they are loaded.
+        let db = d_bits(hw);
+        let lw = bits_for(3 * EDGE_FIELDS.len() as u32 + 1);
+        let n = 3 * EDGE_FIELDS.len() as u64;
+        body.push(wire("wk_pre", 1, "q_full && !w_valid && !take"));
+        let lk = if db > lw { format!("{{{}, wk_lk}}", lit(db - lw, 0)) } else { "wk_lk".to_string() };
+        let field = format!("wk_lk < {} ? {lk} + {} : {}", lit(lw, n), lit(db, EDGE_BASE), lit(db, 1));
+        body.push(wire("wk_da", db + 1, format!("wk_pre ? {{!wk_rs, {field}}} : {{wk_slot, {}}}", lit(db, 0))));
+        // The engine writes one field a clock (its microword's capture, `res_we` one-hot or
+        // zero), so the word is an OR of the enables' indices, not a priority chain.
+        let mut wes = vec![we(STEP_FIELD), we(TAKE_FIELD)];
+        let mut terms = vec![format!("({{{db}{{{}}}}} & {})", we(TAKE_FIELD), lit(db, 1))];
+        for kk in 0..3 {
+            for (j, f) in EDGE_FIELDS.iter().enumerate() {
+                let name = format!("e{kk}_{f}");
+                terms.push(format!("({{{db}{{{}}}}} & {})", we(&name), lit(db, EDGE_BASE + EDGE_FIELDS.len() as u64 * kk + j as u64)));
+                wes.push(we(&name));
+            }
+        }
+        let wa = terms.join(" | ");
+        body.push(wire("wk_dwa", db, wa));
+        body.push(Item::Always(vec![Stmt::If(
+            "rst || take".into(),
+            vec![set("wk_lk", lit(lw, 0))],
+            vec![Stmt::If("q_full && !w_valid && !wk_ldd".into(), vec![set("wk_lk", format!("wk_lk + {}", lit(lw, 1)))], vec![])],
+        )]));
+        ("wk_m[{wk_slot, wk_ra}]".to_string(), (wes.join(" || "), "wk_d[{wk_ws, wk_dwa}]".to_string()), "wk_d[wk_da]".to_string())
     } else {
         body.push(wire("wk_tnr", 1, "(q_full || q_in) && !take && !(w_valid && !w_end)"));
         body.push(wire("wk_da", fw + 1, format!("wk_tnr ? {{!wk_rs, {}}} : {{wk_slot, {}}}", lit(fw, 1), lit(fw, 0))));
