@@ -20,7 +20,7 @@
 //! were the queue entry's 354 flip-flops: the walker reads them into the edges' registers, one a
 //! clock, while it is idle and a triangle is queued, and takes the triangle after the last
 //! ([`PRELOAD_CLOCKS`] after a push into an empty queue; behind a covered last row the span path's
-//! 36 clocks cover them). docs/wip-queue-in-walk-ram.md (issue 27, stop 36: work in progress).
+//! 36 clocks cover them). docs/queue-in-walk-ram.md (issue 27, stop 36).
 //!
 //! The memories' reads are registered, so each read is addressed a clock before its load: the
 //! span path's phase names the field its next load reads ([`read_order`]), and the slot is the
@@ -81,7 +81,7 @@ pub(crate) fn holds(hw: &Hw, name: &str) -> bool {
 /// feeds). The walker reads them one a clock into the edges' registers while it is idle and a
 /// triangle is queued (the preload, [`PRELOAD_CLOCKS`]), then takes it.
 /// WORK IN PROGRESS (issue 27, stop 36, helper u5q): not yet covered by the proofs;
-/// docs/wip-queue-in-walk-ram.md.
+/// docs/queue-in-walk-ram.md.
 pub(crate) fn edges_in_ram(hw: &Hw) -> bool {
     hw.edges_in_walk_ram()
 }
