@@ -297,7 +297,9 @@ pub(super) fn module(hw: &Hw, names: &Names) -> Module {
         set("w_qs1", format!("{} + {}", flip("es_q"), zext("1'b1", 1, bound_w))),
         set("w_rs256", rs256),
     ];
-    body.push(walk(&e, load, ("s_rs", "s_re")));
+    // The first bound g = q - B extended: q's top bit inverted, repeated.
+    let g0 = format!("{{{{{}{{~ei_q[{}]}}}}, ei_q[{}:0]}}", end_w + 2 - bound_w, bound_w - 1, bound_w - 2);
+    body.push(walk(&e, load, ("s_rs", "s_re"), (&g0, "s_right")));
     body.extend(state_outputs(hw).into_iter().map(|(port, _, _, signal, _)| Item::Assign(port.into(), signal)));
     Module { name: names.fe_edge.clone(), header, params: vec![], ports, body }
 }
@@ -350,6 +352,13 @@ fn dda(e: &EdgeWidths) -> Vec<Item> {
         // enables, was the ECP5 target's critical path (docs/fpga.md).
         body.push(if tracked { sreg("w_t", dw + 1) } else { reg("w_rem", dw) });
         body.extend([reg("w_rs256", dw), sreg("w_g", bound_w), sreg("w_qs", bound_w), sreg("w_qs1", bound_w)]);
+        if tracked {
+            // g's distance to the screen's bound on its side, stepped beside g: its sign is
+            // `g < bound`, where the compare on the carry chain behind g, then the running sums'
+            // slot select, was the 25F's critical path (docs/fpga.md).
+            body.push(comment("w_gd = g - (right ? hi : lo), stepped with g: its sign is g < the screen's bound on the edge's side."));
+            body.push(sreg("w_gd", end_w + 1));
+        }
     }
     if tracked {
         body.push(comment("The walked row among the edge's rows, moved with it: w_ge = row >= rs, w_le = row <= re."));
@@ -369,8 +378,10 @@ fn dda(e: &EdgeWidths) -> Vec<Item> {
     } else {
         // This edge's bound on its side of the row, or the screen's where it bounds none here;
         // a left edge's bound is -g, kept as g (its smallest is the span's left end).
-        body.push(Item::Assign("lg".into(), "(in_rows && !w_right && gg < lo) ? gg : lo".into()));
-        body.push(Item::Assign("ha".into(), "(in_rows && w_right && gg < hi) ? gg : hi".into()));
+        let (below_lo, below_hi) =
+            if tracked { (format!("w_gd[{end_w}]"), format!("w_gd[{end_w}]")) } else { ("gg < lo".into(), "gg < hi".into()) };
+        body.push(Item::Assign("lg".into(), format!("(in_rows && !w_right && {below_lo}) ? gg : lo")));
+        body.push(Item::Assign("ha".into(), format!("(in_rows && w_right && {below_hi}) ? gg : hi")));
     }
     if e.lean {
         // rem < D and rs256 < D: s < 2D fits HW + 1 bits, and s - D lies in (-D, D), so in
@@ -391,10 +402,14 @@ fn dda(e: &EdgeWidths) -> Vec<Item> {
         body.push(comment("w_t = rem - thr: the carry is its sign."));
         body.push(wire("cy", 1, format!("!w_t[{dw}]")));
         body.push(swire("tnext", dw + 1, format!("cy ? w_t - {} : w_t + {}", t("w_thr"), t("w_rs256"))));
-    } else {
-        body.push(wire("cy", 1, "w_rem >= w_thr"));
-        body.push(wire("rnext", ediv_w, "cy ? w_rem - w_thr : w_rem + w_rs256"));
+        // One step for g and its distance: the select of qs or qs + 1 is shared.
+        body.push(swire("gstep", bound_w, "cy ? w_qs1 : w_qs"));
+        body.push(swire("gnext", bound_w, "w_g + gstep"));
+        body.push(swire("gdnext", end_w + 1, format!("w_gd + {}", sext("gstep", bound_w, end_w + 1))));
+        return body;
     }
+    body.push(wire("cy", 1, "w_rem >= w_thr"));
+    body.push(wire("rnext", ediv_w, "cy ? w_rem - w_thr : w_rem + w_rs256"));
     body.push(swire("gnext", bound_w, "cy ? w_g + w_qs1 : w_g + w_qs"));
     body
 }
@@ -420,14 +435,17 @@ fn rem_load(e: &EdgeWidths, body: &mut Vec<Item>, (rem, rs256, d): (&str, &str, 
 /// the stall and the choice together, fanned out to every register of the edges was the
 /// walker's other long path); the row's place moved on each row, `rs`/`re` the loaded rows'
 /// sources.
-fn walk(e: &EdgeWidths, load: Vec<Stmt>, (rs, re): (&str, &str)) -> Item {
+fn walk(e: &EdgeWidths, load: Vec<Stmt>, (rs, re): (&str, &str), (g, right): (&str, &str)) -> Item {
+    // `g` comes extended to the distance's width, `w_gd`'s (end_w + 1).
     if !e.tracked {
         let step = vec![set("w_rem", "rnext"), set("w_g", "gnext")];
         return Item::Always(vec![Stmt::If("take".into(), load, vec![Stmt::If("step && w_act && row >= w_rs".into(), step, vec![])])]);
     }
-    let step = vec![set("w_t", "tnext"), set("w_g", "gnext")];
+    let step = vec![set("w_t", "tnext"), set("w_g", "gnext"), set("w_gd", "gdnext")];
     let mut load = load;
     load.extend([set("w_ge", format!("first >= {rs}")), set("w_le", format!("first <= {re}"))]);
+    let x = |v: &str| sext(v, e.end_w, e.end_w + 1);
+    load.push(set("w_gd", format!("{g} - ({right} ? {} : {})", x("hi"), x("lo"))));
     let one = format!("{}'d1", e.row_w);
     let moved = vec![
         set("w_ge", format!("w_ge || row + {one} == w_rs")),
@@ -481,7 +499,7 @@ fn module_engine(hw: &Hw, names: &Names) -> Module {
     if !e.lean {
         load.push(set("w_qs1", format!("qs + {}", zext("1'b1", 1, bound_w))));
     }
-    body.push(walk(&e, load, ("rs", "re")));
+    body.push(walk(&e, load, ("rs", "re"), (&sext("g", bound_w, end_w + 1), "right")));
     body.extend(state_outputs(hw).into_iter().map(|(port, _, _, signal, _)| Item::Assign(port.into(), signal)));
     Module { name: names.fe_edge.clone(), header, params: vec![], ports, body }
 }
