@@ -42,6 +42,8 @@ impl EdgeWidths {
         let wd = hw.fe.widths();
         let Widths { yw: row_w, cy: vy_w, gw: bound_w, dw_edge: ediv_w, .. } = wd;
         assert_eq!(ediv_w, vy_w + 8, "an edge's divisor is |dy| in sub-pixels, 8 fraction bits");
+        // g's distance to the screen's right bound fits the bounds' width (see `dda`).
+        assert!(u64::from(hw.fe.screen.width) <= 1 << (bound_w - 1), "the screen is wider than 2^(GW-1)");
         EdgeWidths {
             row_w,
             vy_w,
@@ -298,7 +300,7 @@ pub(super) fn module(hw: &Hw, names: &Names) -> Module {
         set("w_rs256", rs256),
     ];
     // The first bound g = q - B extended: q's top bit inverted, repeated.
-    let g0 = format!("{{{{{}{{~ei_q[{}]}}}}, ei_q[{}:0]}}", end_w + 2 - bound_w, bound_w - 1, bound_w - 2);
+    let g0 = format!("{{{{{}{{~ei_q[{}]}}}}, ei_q[{}:0]}}", end_w + 1 - bound_w, bound_w - 1, bound_w - 2);
     body.push(walk(&e, load, ("s_rs", "s_re"), (&g0, "s_right")));
     body.extend(state_outputs(hw).into_iter().map(|(port, _, _, signal, _)| Item::Assign(port.into(), signal)));
     Module { name: names.fe_edge.clone(), header, params: vec![], ports, body }
@@ -355,9 +357,12 @@ fn dda(e: &EdgeWidths) -> Vec<Item> {
         if tracked {
             // g's distance to the screen's bound on its side, stepped beside g: its sign is
             // `g < bound`, where the compare on the carry chain behind g, then the running sums'
-            // slot select, was the 25F's critical path (docs/fpga.md).
+            // slot select, was the 25F's critical path (docs/fpga.md). It fits the bounds' width
+            // (g in GW bits, the bound 0 or at most 2^(GW-1)), and a step that wraps g flips its
+            // top bit, so it is g's distance in every state a load leads to: the proof's
+            // invariant ([`formal_probes`]).
             body.push(comment("w_gd = g - (right ? hi : lo), stepped with g: its sign is g < the screen's bound on the edge's side."));
-            body.push(sreg("w_gd", end_w + 1));
+            body.push(sreg("w_gd", end_w));
         }
     }
     if tracked {
@@ -379,7 +384,7 @@ fn dda(e: &EdgeWidths) -> Vec<Item> {
         // This edge's bound on its side of the row, or the screen's where it bounds none here;
         // a left edge's bound is -g, kept as g (its smallest is the span's left end).
         let (below_lo, below_hi) =
-            if tracked { (format!("w_gd[{end_w}]"), format!("w_gd[{end_w}]")) } else { ("gg < lo".into(), "gg < hi".into()) };
+            if tracked { (format!("w_gd[{}]", end_w - 1), format!("w_gd[{}]", end_w - 1)) } else { ("gg < lo".into(), "gg < hi".into()) };
         body.push(Item::Assign("lg".into(), format!("(in_rows && !w_right && {below_lo}) ? gg : lo")));
         body.push(Item::Assign("ha".into(), format!("(in_rows && w_right && {below_hi}) ? gg : hi")));
     }
@@ -405,7 +410,10 @@ fn dda(e: &EdgeWidths) -> Vec<Item> {
         // One step for g and its distance: the select of qs or qs + 1 is shared.
         body.push(swire("gstep", bound_w, "cy ? w_qs1 : w_qs"));
         body.push(swire("gnext", bound_w, "w_g + gstep"));
-        body.push(swire("gdnext", end_w + 1, format!("w_gd + {}", sext("gstep", bound_w, end_w + 1))));
+        body.push(swire("gdsum", end_w, format!("w_gd + {}", sext("gstep", bound_w, end_w))));
+        let top = bound_w - 1;
+        body.push(wire("gwrap", 1, format!("w_g[{top}] == gstep[{top}] && gnext[{top}] != w_g[{top}]")));
+        body.push(swire("gdnext", end_w, format!("{{gdsum[{top_d}] ^ gwrap, gdsum[{top}:0]}}", top_d = end_w - 1)));
         return body;
     }
     body.push(wire("cy", 1, "w_rem >= w_thr"));
@@ -436,7 +444,7 @@ fn rem_load(e: &EdgeWidths, body: &mut Vec<Item>, (rem, rs256, d): (&str, &str, 
 /// walker's other long path); the row's place moved on each row, `rs`/`re` the loaded rows'
 /// sources.
 fn walk(e: &EdgeWidths, load: Vec<Stmt>, (rs, re): (&str, &str), (g, right): (&str, &str)) -> Item {
-    // `g` comes extended to the distance's width, `w_gd`'s (end_w + 1).
+    // `g` comes extended to the distance's width, `w_gd`'s (end_w).
     if !e.tracked {
         let step = vec![set("w_rem", "rnext"), set("w_g", "gnext")];
         return Item::Always(vec![Stmt::If("take".into(), load, vec![Stmt::If("step && w_act && row >= w_rs".into(), step, vec![])])]);
@@ -444,8 +452,7 @@ fn walk(e: &EdgeWidths, load: Vec<Stmt>, (rs, re): (&str, &str), (g, right): (&s
     let step = vec![set("w_t", "tnext"), set("w_g", "gnext"), set("w_gd", "gdnext")];
     let mut load = load;
     load.extend([set("w_ge", format!("first >= {rs}")), set("w_le", format!("first <= {re}"))]);
-    let x = |v: &str| sext(v, e.end_w, e.end_w + 1);
-    load.push(set("w_gd", format!("{g} - ({right} ? {} : {})", x("hi"), x("lo"))));
+    load.push(set("w_gd", format!("{g} - ({right} ? hi : lo)")));
     let one = format!("{}'d1", e.row_w);
     let moved = vec![
         set("w_ge", format!("w_ge || row + {one} == w_rs")),
@@ -499,7 +506,7 @@ fn module_engine(hw: &Hw, names: &Names) -> Module {
     if !e.lean {
         load.push(set("w_qs1", format!("qs + {}", zext("1'b1", 1, bound_w))));
     }
-    body.push(walk(&e, load, ("rs", "re"), (&sext("g", bound_w, end_w + 1), "right")));
+    body.push(walk(&e, load, ("rs", "re"), (&sext("g", bound_w, end_w), "right")));
     body.extend(state_outputs(hw).into_iter().map(|(port, _, _, signal, _)| Item::Assign(port.into(), signal)));
     Module { name: names.fe_edge.clone(), header, params: vec![], ports, body }
 }
@@ -567,4 +574,27 @@ pub(super) fn end_ports(hw: &Hw) -> Vec<(&'static str, u32)> {
 /// form.
 pub(super) fn ends_side_by_side(hw: &Hw) -> bool {
     EdgeWidths::new(hw).lean
+}
+
+/// The proof's view of each edge behind the row stages (`scripts/prove` drives each formal-only
+/// wire from the flattened design's register, `(wire, register, width)`), and what holds of them
+/// while the walker walks a triangle: `w_gd` is `g`'s distance to the screen's bound on its side
+/// ([`dda`]), so the flag it gives is the compare `g < bound` and the row stages' bounds lie within
+/// the screen's. Empty without the row stages.
+pub(super) fn formal_probes(hw: &Hw) -> (Vec<(String, String, u32)>, Vec<String>) {
+    let e = EdgeWidths::new(hw);
+    if !e.tracked || e.lean {
+        return (Vec::new(), Vec::new());
+    }
+    let (mut probes, mut holds) = (Vec::new(), Vec::new());
+    for k in 0..3 {
+        let reg = |r: &str| format!("g_edge[{k}].u_edge.{r}");
+        probes.extend([
+            (format!("f_eg{k}"), reg("w_g"), e.bound_w),
+            (format!("f_egd{k}"), reg("w_gd"), e.end_w),
+            (format!("f_eright{k}"), reg("w_right"), 1),
+        ]);
+        holds.push(format!("f_egd{k} == {} - (f_eright{k} ? hi0 : lo0)", sext(&format!("f_eg{k}"), e.bound_w, e.end_w)));
+    }
+    (probes, holds)
 }

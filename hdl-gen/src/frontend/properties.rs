@@ -110,6 +110,7 @@ fn row_stage(hw: &Hw, j: u32) -> RowStage {
 /// What both forms share: widths, screen, the span path's stages.
 fn shape(hw: &Hw, sp: &Stager, setup: SetupShape) -> FrontendShape {
     let fe = &hw.fe;
+    let (edge_probes, edge_holds) = super::edge::formal_probes(hw);
     let wd = fe.widths();
     FrontendShape {
         yw: wd.yw,
@@ -133,6 +134,8 @@ fn shape(hw: &Hw, sp: &Stager, setup: SetupShape) -> FrontendShape {
         },
         starts: None,
         span_unit: super::span_seq::shape(hw),
+        edge_probes,
+        edge_holds,
     }
 }
 
@@ -223,6 +226,10 @@ impl Reference<'_> {
                 b
             }
         };
+        for (w, r, n) in &self.s.edge_probes {
+            b.push(comment(format!("{CUT_TAG}connect -set {w} {r}")));
+            b.push(net(w, *n));
+        }
         b.extend(past_flags());
         b.extend(reset_and_stability("span", OUT, &["out_y", "out_x", "out_len", "out_i0", "out_di"]));
         b.push(comment("Reset: no error pulse out of reset either."));
@@ -611,6 +618,8 @@ impl Reference<'_> {
             // Behind the row stages the walk's end is a register: its row's compare, set while
             // no row is walked.
             link.push(assert("w_end == (!f_wv || f_wend)"));
+            // The edges' state the row stages' bounds are made of (`edge::formal_probes`).
+            link.push(when("w_valid", self.s.edge_holds.iter().map(assert).collect()));
         }
         for sp in span_stages {
             link.push(on_screen(&sp.valid, &sp.x, &sp.len, xw, width));
