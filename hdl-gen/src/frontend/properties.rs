@@ -201,6 +201,12 @@ pub fn frontend_properties(s: &FrontendShape) -> Item {
     Item::Formal(b)
 }
 
+/// Formal-only wires `scripts/prove` drives from the flattened design's registers, `(wire,
+/// register, width)`: Yosys reads no hierarchical reference.
+fn probe_nets(probes: &[(String, String, u32)]) -> Vec<Item> {
+    probes.iter().flat_map(|(w, r, n)| [comment(format!("{CUT_TAG}connect -set {w} {r}")), net(w, *n)]).collect()
+}
+
 impl Reference<'_> {
     /// The reference's registers and the wires it reads.
     fn declarations(&self) -> Vec<Item> {
@@ -218,18 +224,12 @@ impl Reference<'_> {
                     comment("(the multipliers, the engine's tiles and the span path's: the values are left to co-simulation)"),
                     comment("The engine's and the queue's registers, each driven by scripts/prove from the flattened design:"),
                 ];
-                for (w, r, n) in engine::engine_probes(e) {
-                    b.push(comment(format!("{CUT_TAG}connect -set {w} {r}")));
-                    b.push(net(&w, n));
-                }
+                b.extend(probe_nets(&engine::engine_probes(e)));
                 b.extend(engine::constant_probes(e));
                 b
             }
         };
-        for (w, r, n) in &self.s.edge_probes {
-            b.push(comment(format!("{CUT_TAG}connect -set {w} {r}")));
-            b.push(net(w, *n));
-        }
+        b.extend(probe_nets(&self.s.edge_probes));
         b.extend(past_flags());
         b.extend(reset_and_stability("span", OUT, &["out_y", "out_x", "out_len", "out_i0", "out_di"]));
         b.push(comment("Reset: no error pulse out of reset either."));
