@@ -38,7 +38,7 @@ fn row_stage_base(label: &str) -> Option<(verilator_harness::models::Model, u64,
 /// tile's operand register loaded on every clock (its registered load ignored: a held chunk
 /// overwritten), a tile port's registered select bit stuck at zero (a source never selected),
 /// a chained division's second divider taking the first's loaded dividend bits for its
-/// quotient bits so far;
+/// quotient bits so far, an edge's `dy < 0` (its sign bit, not a compare) read inverted;
 /// and in `tri_frontend.v`, a triangle taken with no queue entry reserved for its
 /// result (the credits ignored), and in `tri_fe_queue.v` the registered head refilled from the
 /// memory while it holds an entry (that entry lost), under backpressure heavy enough to fill
@@ -70,6 +70,12 @@ fn engine_planted_faults_are_caught() {
         line(engine, "a tile operand register's registered load", &|l| l.trim_start().starts_with("m") && l.contains("_la0 <= "));
     let sel_line = line(engine, "a tile port's registered select", &|l| l.trim_start().starts_with("m") && l.contains("_sa0[0] <= "));
     let lzc_odd = format!("{}, 1'b1}};", lzc_line.rsplit_once(", |(").expect("the count's lowest bit").0);
+    let below_zero = line(engine, "an edge's dy below zero as its sign bit", &|l| {
+        let l = l.trim();
+        l.starts_with("wire t")
+            && l.contains("_dy")
+            && l.split_once(" = ").is_some_and(|(_, r)| r.starts_with('v') && r.ends_with("];") && !r.contains(' '))
+    });
     // A chained division's second divider (its divisor the first's `_dv`) taking its quotient
     // bits from the first's load port (the dividend's low bits) instead of the first's step:
     // two lines on. (Its load a clock early or late is no fault: the first keeps stepping.)
@@ -98,6 +104,7 @@ fn engine_planted_faults_are_caught() {
         (load_line.clone(), format!("{}<= 1'b1;", load_line.split_once("<=").unwrap().0), "a tile's operand register loaded every clock"),
         (sel_line.clone(), format!("{}<= 1'b0;", sel_line.split_once("<=").unwrap().0), "a tile port's select bit stuck at zero"),
         (chain_q, chain_bad, "a chained division's second divider taking the dividend's bits for the first's quotient bits"),
+        (below_zero.clone(), below_zero.replacen(" = v", " = !v", 1), "an edge's dy below zero read as at or above it"),
     ];
     assert_faults_caught(&base, "tri_fe_engine.v", "fault", faults, seed, &tris);
     // The credits: with out_ready high a clock in ten, triangles arrive faster than they are
@@ -140,13 +147,15 @@ fn engine_planted_faults_are_caught() {
 /// 37x23, each a model built on first use): an edge's place among its rows moved onto its first
 /// row a row late, an edge starting at the walk's first row never entered, the DDA's carry read
 /// from the bit under the sign of its offset remainder `t = rem - thr`, `t` loaded one too
-/// large, the engine's `t` formed with the previous triangle's `thr`, the span's left end taken
+/// large, `g`'s distance to the screen's bound (its sign the compare `g < bound`) never
+/// stepped or loaded against the other side's bound, the engine's `t` formed with the previous
+/// triangle's `thr`, the span's left end taken
 /// from one slot alone in the row stages, the walk's registered end made a row early, and the
 /// right end's slot a always edge 0 (edge 1 lost where it and edge 2 are the right edges).
 /// Caught on the triangles the clean model passes
 /// (`engine_spans_equal_golden_at_the_targets_pipeline_level`). (The place not moved past an
 /// edge's last row is no fault: beyond its end vertex an edge's line lies outside the triangle,
-/// so its bound never wins.) Slow tier: seven models, about 15 s of CPU each to build.
+/// so its bound never wins.) Slow tier: nine models, about 15 s of CPU each to build.
 #[test]
 #[ignore]
 fn walker_planted_faults_are_caught() {
@@ -159,11 +168,15 @@ fn walker_planted_faults_are_caught() {
     let carry = line(&edge, "the carry from t's sign", &|l| l.contains("wire cy = !w_t["));
     let sign: u32 = carry.split("!w_t[").nth(1).and_then(|t| t.split(']').next()).and_then(|b| b.parse().ok()).expect("t's sign bit");
     let t_load = line(&edge, "t's load from the engine", &|l| l.contains("w_t <= t;"));
+    let gd_step = line(&edge, "g's distance to the screen's bound stepped", &|l| l.contains("w_gd <= gdnext;"));
+    let gd_load = line(&edge, "g's distance to the screen's bound loaded", &|l| l.contains("w_gd <= ") && l.contains("(right ?"));
     let faults = [
         (step.clone(), step.replacen(&format!(" + {one}"), "", 1), "an edge's first row entered a row late"),
         (load.clone(), load.replacen(">=", ">", 1), "an edge starting at the walk's first row never entered"),
         (carry.clone(), carry.replacen(&format!("[{sign}]"), &format!("[{}]", sign - 1), 1), "the carry from the bit under t's sign"),
         (t_load.clone(), t_load.replacen("t;", "t + 1'b1;", 1), "t loaded one too large"),
+        (gd_step.clone(), gd_step.replacen("gdnext", "w_gd", 1), "g's distance to the screen's bound never stepped"),
+        (gd_load.clone(), gd_load.replacen("(right ?", "(!right ?", 1), "g's distance loaded against the other side's bound"),
     ];
     assert_faults_caught(&base, "tri_fe_edge.v", "wfault", faults, seed, &tris);
     // The engine's DDA start (golden's `Plan::edge_t`): t = (rem >> 8) - thr with the previous

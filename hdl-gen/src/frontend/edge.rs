@@ -42,6 +42,8 @@ impl EdgeWidths {
         let wd = hw.fe.widths();
         let Widths { yw: row_w, cy: vy_w, gw: bound_w, dw_edge: ediv_w, .. } = wd;
         assert_eq!(ediv_w, vy_w + 8, "an edge's divisor is |dy| in sub-pixels, 8 fraction bits");
+        // g's distance to the screen's right bound fits the bounds' width (see `dda`).
+        assert!(u64::from(hw.fe.screen.width) <= 1 << (bound_w - 1), "the screen is wider than 2^(GW-1)");
         EdgeWidths {
             row_w,
             vy_w,
@@ -300,7 +302,9 @@ pub(super) fn module(hw: &Hw, names: &Names) -> Module {
         set("w_qs1", format!("{} + {}", flip("es_q"), zext("1'b1", 1, bound_w))),
         set("w_rs256", rs256),
     ];
-    body.push(walk(&e, load, ("s_rs", "s_re")));
+    // The first bound g = q - B extended: q's top bit inverted, repeated.
+    let g0 = format!("{{{{{}{{~ei_q[{}]}}}}, ei_q[{}:0]}}", end_w + 1 - bound_w, bound_w - 1, bound_w - 2);
+    body.push(walk(&e, load, ("s_rs", "s_re"), (&g0, "s_right")));
     body.extend(state_outputs(hw).into_iter().map(|(port, _, _, signal, _)| Item::Assign(port.into(), signal)));
     Module { name: names.fe_edge.clone(), header, params: vec![], ports, body }
 }
@@ -353,6 +357,16 @@ fn dda(e: &EdgeWidths) -> Vec<Item> {
         // enables, was the ECP5 target's critical path (docs/fpga.md).
         body.push(if tracked { sreg("w_t", dw + 1) } else { reg("w_rem", dw) });
         body.extend([reg("w_rs256", dw), sreg("w_g", bound_w), sreg("w_qs", bound_w), sreg("w_qs1", bound_w)]);
+        if tracked {
+            // g's distance to the screen's bound on its side, stepped beside g: its sign is
+            // `g < bound`, where the compare on the carry chain behind g, then the running sums'
+            // slot select, was the 25F's critical path (docs/fpga.md). It fits the bounds' width
+            // (g in GW bits, the bound 0 or at most 2^(GW-1)), and a step that wraps g flips its
+            // top bit, so it is g's distance in every state a load leads to: the proof's
+            // invariant ([`formal_probes`]).
+            body.push(comment("w_gd = g - (right ? hi : lo), stepped with g: its sign is g < the screen's bound on the edge's side."));
+            body.push(sreg("w_gd", end_w));
+        }
     }
     if tracked {
         body.push(comment("The walked row among the edge's rows, moved with it: w_ge = row >= rs, w_le = row <= re."));
@@ -372,8 +386,10 @@ fn dda(e: &EdgeWidths) -> Vec<Item> {
     } else {
         // This edge's bound on its side of the row, or the screen's where it bounds none here;
         // a left edge's bound is -g, kept as g (its smallest is the span's left end).
-        body.push(Item::Assign("lg".into(), "(in_rows && !w_right && gg < lo) ? gg : lo".into()));
-        body.push(Item::Assign("ha".into(), "(in_rows && w_right && gg < hi) ? gg : hi".into()));
+        let (below_lo, below_hi) =
+            if tracked { (format!("w_gd[{}]", end_w - 1), format!("w_gd[{}]", end_w - 1)) } else { ("gg < lo".into(), "gg < hi".into()) };
+        body.push(Item::Assign("lg".into(), format!("(in_rows && !w_right && {below_lo}) ? gg : lo")));
+        body.push(Item::Assign("ha".into(), format!("(in_rows && w_right && {below_hi}) ? gg : hi")));
     }
     if e.lean {
         // rem < D and rs256 < D: s < 2D fits HW + 1 bits, and s - D lies in (-D, D), so in
@@ -394,10 +410,17 @@ fn dda(e: &EdgeWidths) -> Vec<Item> {
         body.push(comment("w_t = rem - thr: the carry is its sign."));
         body.push(wire("cy", 1, format!("!w_t[{dw}]")));
         body.push(swire("tnext", dw + 1, format!("cy ? w_t - {} : w_t + {}", t("w_thr"), t("w_rs256"))));
-    } else {
-        body.push(wire("cy", 1, "w_rem >= w_thr"));
-        body.push(wire("rnext", ediv_w, "cy ? w_rem - w_thr : w_rem + w_rs256"));
+        // One step for g and its distance: the select of qs or qs + 1 is shared.
+        body.push(swire("gstep", bound_w, "cy ? w_qs1 : w_qs"));
+        body.push(swire("gnext", bound_w, "w_g + gstep"));
+        body.push(swire("gdsum", end_w, format!("w_gd + {}", sext("gstep", bound_w, end_w))));
+        let top = bound_w - 1;
+        body.push(wire("gwrap", 1, format!("w_g[{top}] == gstep[{top}] && gnext[{top}] != w_g[{top}]")));
+        body.push(swire("gdnext", end_w, format!("{{gdsum[{top_d}] ^ gwrap, gdsum[{top}:0]}}", top_d = end_w - 1)));
+        return body;
     }
+    body.push(wire("cy", 1, "w_rem >= w_thr"));
+    body.push(wire("rnext", ediv_w, "cy ? w_rem - w_thr : w_rem + w_rs256"));
     body.push(swire("gnext", bound_w, "cy ? w_g + w_qs1 : w_g + w_qs"));
     body
 }
@@ -423,14 +446,16 @@ fn rem_load(e: &EdgeWidths, body: &mut Vec<Item>, (rem, rs256, d): (&str, &str, 
 /// the stall and the choice together, fanned out to every register of the edges was the
 /// walker's other long path); the row's place moved on each row, `rs`/`re` the loaded rows'
 /// sources.
-fn walk(e: &EdgeWidths, load: Vec<Stmt>, (rs, re): (&str, &str)) -> Item {
+fn walk(e: &EdgeWidths, load: Vec<Stmt>, (rs, re): (&str, &str), (g, right): (&str, &str)) -> Item {
+    // `g` comes extended to the distance's width, `w_gd`'s (end_w).
     if !e.tracked {
         let step = vec![set("w_rem", "rnext"), set("w_g", "gnext")];
         return Item::Always(vec![Stmt::If("take".into(), load, vec![Stmt::If("step && w_act && row >= w_rs".into(), step, vec![])])]);
     }
-    let step = vec![set("w_t", "tnext"), set("w_g", "gnext")];
+    let step = vec![set("w_t", "tnext"), set("w_g", "gnext"), set("w_gd", "gdnext")];
     let mut load = load;
     load.extend([set("w_ge", format!("first >= {rs}")), set("w_le", format!("first <= {re}"))]);
+    load.push(set("w_gd", format!("{g} - ({right} ? hi : lo)")));
     let one = format!("{}'d1", e.row_w);
     let moved = vec![
         set("w_ge", format!("w_ge || row + {one} == w_rs")),
@@ -487,7 +512,7 @@ fn module_engine(hw: &Hw, names: &Names) -> Module {
     if super::span_seq::walk_ram::edges_in_ram(hw) {
         body.push(walk_by_field(&mut ports, load));
     } else {
-        body.push(walk(&e, load, ("rs", "re")));
+        body.push(walk(&e, load, ("rs", "re"), (&sext("g", bound_w, end_w), "right")));
     }
     body.extend(state_outputs(hw).into_iter().map(|(port, _, _, signal, _)| Item::Assign(port.into(), signal)));
     Module { name: names.fe_edge.clone(), header, params: vec![], ports, body }
@@ -579,4 +604,27 @@ pub(super) fn end_ports(hw: &Hw) -> Vec<(&'static str, u32)> {
 /// form.
 pub(super) fn ends_side_by_side(hw: &Hw) -> bool {
     EdgeWidths::new(hw).lean
+}
+
+/// The proof's view of each edge behind the row stages (`scripts/prove` drives each formal-only
+/// wire from the flattened design's register, `(wire, register, width)`), and what holds of them
+/// while the walker walks a triangle: `w_gd` is `g`'s distance to the screen's bound on its side
+/// ([`dda`]), so the flag it gives is the compare `g < bound` and the row stages' bounds lie within
+/// the screen's. Empty without the row stages.
+pub(super) fn formal_probes(hw: &Hw) -> (Vec<(String, String, u32)>, Vec<String>) {
+    let e = EdgeWidths::new(hw);
+    if !e.tracked || e.lean {
+        return (Vec::new(), Vec::new());
+    }
+    let (mut probes, mut holds) = (Vec::new(), Vec::new());
+    for k in 0..3 {
+        let reg = |r: &str| format!("g_edge[{k}].u_edge.{r}");
+        probes.extend([
+            (format!("f_eg{k}"), reg("w_g"), e.bound_w),
+            (format!("f_egd{k}"), reg("w_gd"), e.end_w),
+            (format!("f_eright{k}"), reg("w_right"), 1),
+        ]);
+        holds.push(format!("f_egd{k} == {} - (f_eright{k} ? hi0 : lo0)", sext(&format!("f_eg{k}"), e.bound_w, e.end_w)));
+    }
+    (probes, holds)
 }

@@ -111,6 +111,7 @@ fn row_stage(hw: &Hw, j: u32) -> RowStage {
 /// What both forms share: widths, screen, the span path's stages.
 fn shape(hw: &Hw, sp: &Stager, setup: SetupShape) -> FrontendShape {
     let fe = &hw.fe;
+    let (edge_probes, edge_holds) = super::edge::formal_probes(hw);
     let wd = fe.widths();
     FrontendShape {
         yw: wd.yw,
@@ -134,6 +135,8 @@ fn shape(hw: &Hw, sp: &Stager, setup: SetupShape) -> FrontendShape {
         },
         starts: None,
         span_unit: super::span_seq::shape(hw),
+        edge_probes,
+        edge_holds,
     }
 }
 
@@ -208,6 +211,12 @@ pub fn frontend_properties(s: &FrontendShape) -> Item {
     Item::Formal(b)
 }
 
+/// Formal-only wires `scripts/prove` drives from the flattened design's registers, `(wire,
+/// register, width)`: Yosys reads no hierarchical reference.
+fn probe_nets(probes: &[(String, String, u32)]) -> Vec<Item> {
+    probes.iter().flat_map(|(w, r, n)| [comment(format!("{CUT_TAG}connect -set {w} {r}")), net(w, *n)]).collect()
+}
+
 impl Reference<'_> {
     /// The reference's registers and the wires it reads.
     fn declarations(&self) -> Vec<Item> {
@@ -225,14 +234,12 @@ impl Reference<'_> {
                     comment("(the multipliers, the engine's tiles and the span path's: the values are left to co-simulation)"),
                     comment("The engine's and the queue's registers, each driven by scripts/prove from the flattened design:"),
                 ];
-                for (w, r, n) in engine::engine_probes(e) {
-                    b.push(comment(format!("{CUT_TAG}connect -set {w} {r}")));
-                    b.push(net(&w, n));
-                }
+                b.extend(probe_nets(&engine::engine_probes(e)));
                 b.extend(engine::constant_probes(e));
                 b
             }
         };
+        b.extend(probe_nets(&self.s.edge_probes));
         b.extend(past_flags());
         b.extend(reset_and_stability("span", OUT, &["out_y", "out_x", "out_len", "out_i0", "out_di"]));
         b.push(comment("Reset: no error pulse out of reset either."));
@@ -626,6 +633,8 @@ impl Reference<'_> {
             // Behind the row stages the walk's end is a register: its row's compare, set while
             // no row is walked.
             link.push(assert("w_end == (!f_wv || f_wend)"));
+            // The edges' state the row stages' bounds are made of (`edge::formal_probes`).
+            link.push(when("w_valid", self.s.edge_holds.iter().map(assert).collect()));
         }
         for sp in span_stages {
             link.push(on_screen(&sp.valid, &sp.x, &sp.len, xw, width));

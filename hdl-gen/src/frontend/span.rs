@@ -204,6 +204,25 @@ fn unused_sums(hw: &Hw, sum_w: u32, body: &mut Vec<Item>) {
     body.push(comment("verilator lint_on UNUSEDSIGNAL"));
 }
 
+/// `Tn + Gxn lo` with `Gxn lo = -(sum << 8)` from the running sums (`gxs`), subtracted a step
+/// before S2n, modulo 2^(K-2) as S2n doubles it: the subtract then S2n's add, two carry chains in
+/// one clock into the estimate tile's input, were a 25F critical path (`p3_gxs -> S2n`,
+/// docs/fpga.md).
+fn tn_less_sum(sp: &mut Stager, e: &End, s2_w: u32) {
+    let gx = format!("{{{}, {}}}", sp.at("gxs"), lit(Widths::GXN_ZEROS, 0));
+    sp.def(&format!("{}_t", e.s2), s2_w - 1, false, format!("{} - {gx}", sp.at("tn")));
+}
+
+/// S2n before its doubling, `Tn + Gxn lo` in S2n's width: `Gxn lo` by the product by the column,
+/// or from the running sums [`tn_less_sum`]'s.
+fn s2n_sum(sp: &Stager, e: &End, by_product: bool, s2_w: u32) -> String {
+    if !by_product {
+        return zext(&sp.at(&format!("{}_t", e.s2)), s2_w - 1, s2_w);
+    }
+    let gx = format!("{{{}, {}}}", sp.at(e.gx), lit(Widths::GXN_ZEROS, 0));
+    format!("{} + {}", zext(&sp.at("tn"), s2_w - 1, s2_w), zext(&gx, s2_w - 1, s2_w))
+}
+
 /// Span stage j's valid bit.
 pub(super) fn valid(j: usize) -> String {
     format!("p{j}_v")
@@ -289,13 +308,13 @@ pub(super) fn path(hw: &Hw, names: &Names, body: &mut Vec<Item>) -> Stager {
         sum_partials(&mut sp, e.gx, terms, gx_w);
     }
     sp.note(comment("verilator lint_on UNUSEDSIGNAL"));
+    for e in ends.iter().filter(|e| !by_product(e)) {
+        tn_less_sum(&mut sp, e, s2_w);
+    }
     sp.cut();
     i0_section(&mut sp);
     for e in &ends {
-        // Gxn lo = -(sum << 8) from the running sums: subtracted.
-        let (gx, op) = if by_product(e) { (sp.at(e.gx), "+") } else { (sp.at("gxs"), "-") };
-        let gx = format!("{{{gx}, {}}}", lit(zeros, 0));
-        let sum = format!("{} {op} {}", zext(&sp.at("tn"), s2_w - 1, s2_w), zext(&gx, s2_w - 1, s2_w));
+        let sum = s2n_sum(&sp, e, by_product(e), s2_w);
         sp.def(e.s2, s2_w, false, format!("(({sum}) << 1) + {}", zext(&sp.at("an"), area_w, s2_w)));
     }
     sp.cut();

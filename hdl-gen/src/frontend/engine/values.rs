@@ -271,9 +271,16 @@ impl<'a> Values<'a> {
         match op.kind {
             Kind::Add(a, b) => (format!("{} + {}", x(a).ext(wide), x(b).ext(wide)), wide),
             Kind::Sub(a, b) => (format!("{} - {}", x(a).ext(wide), x(b).ext(wide)), wide),
-            Kind::Lt(a, b) => match self.lt_by_difference(o) {
-                Some((_, _, d)) => (format!("t{o}_d[{}]", d - 1), 1),
-                None => (format!("$signed({}) < $signed({})", x(a).ext(wide), x(b).ext(wide)), 1),
+            Kind::Lt(a, b) => match (self.lt_by_difference(o), x(b)) {
+                (Some((_, _, d)), _) => (format!("t{o}_d[{}]", d - 1), 1),
+                // Below zero is the sign bit: Yosys 0.23 keeps `$signed(a) < 0` a compare, a carry
+                // chain the operand's width long with LUT4 beside it (the 25F's critical path
+                // `v75_dy1 -> v76_lt` at stop 35, docs/fpga.md).
+                (None, Src::Const(0)) => match x(a) {
+                    Src::Net { signed: true, w, .. } => (x(a).bits(w - 1, 1), 1),
+                    _ => ("1'b0".into(), 1),
+                },
+                (None, y) => (format!("$signed({}) < $signed({})", x(a).ext(wide), y.ext(wide)), 1),
             },
             Kind::Eq(a, b) => (format!("{} == {}", x(a).ext(wide), x(b).ext(wide)), 1),
             Kind::And(a, b) => (format!("(|{}) && (|{})", x(a).ext(self.op(a.0 as usize).w), x(b).ext(self.op(b.0 as usize).w)), 1),

@@ -38,6 +38,11 @@ pub struct FrontendShape {
     /// holds a covered row for its clocks, and the walker moves while it is idle or writing its
     /// result.
     pub span_unit: Option<SpanUnit>,
+    /// The edges' registers the proof reads (`(wire, register, width)`, driven by
+    /// `scripts/prove`) and what holds of them while the walker walks a triangle
+    /// (`edge::formal_probes`): none without the row stages.
+    pub edge_probes: Vec<(String, String, u32)>,
+    pub edge_holds: Vec<String>,
 }
 
 /// The sequential span path's shape: its clocks from an accept to its result's write, where the
