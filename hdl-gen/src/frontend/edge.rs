@@ -205,8 +205,7 @@ pub(super) fn instances(hw: &Hw, names: &Names, buses: &EdgeBuses) -> Item {
         &[("take", "w_load"), ("step", "w_step")]
     };
     // Loaded a field a clock from the walk memory: each edge's nine bits of e_ld.
-    let walker: &[(&str, &str)] =
-        if super::span_seq::walk_ram::edges_in_ram(hw) { &[("ld", "e_ld[k*9 +: 9]"), ("step", "w_step")] } else { walker };
+    let walker: &[(&str, &str)] = if hw.edges_in_walk_ram() { &[("ld", "e_ld[k*9 +: 9]"), ("step", "w_step")] } else { walker };
     let mut conns: Vec<(String, String)> = [("clk", "clk"), ("calc_go", "calc_go"), ("div_run", "div_run"), ("div_cnt", "div_cnt")]
         .iter()
         .chain(walker)
@@ -509,7 +508,7 @@ fn module_engine(hw: &Hw, names: &Names) -> Module {
     if !e.lean {
         load.push(set("w_qs1", format!("qs + {}", zext("1'b1", 1, bound_w))));
     }
-    if super::span_seq::walk_ram::edges_in_ram(hw) {
+    if hw.edges_in_walk_ram() {
         body.push(walk_by_field(&mut ports, load));
     } else {
         body.push(walk(&e, load, ("rs", "re"), (&sext("g", bound_w, end_w), "right")));

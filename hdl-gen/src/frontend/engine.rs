@@ -276,7 +276,7 @@ pub(super) fn setup(hw: &Hw, names: &Names, body: &mut Vec<Item>) {
             // the queue is full and it has a field to write.
             body.push(crate::verilog::net("res_we", fields.len() as u32));
             body.push(crate::verilog::net("res_wr", 1));
-            if super::span_seq::walk_ram::on(hw) {
+            if hw.walk_ram() {
                 walk_ram_entry(hw, &fields, body);
             }
             body.push(Item::Assign("en".into(), "!(q_full && (q_push || res_wr))".into()));
@@ -300,7 +300,7 @@ pub(super) fn setup(hw: &Hw, names: &Names, body: &mut Vec<Item>) {
     if capture {
         conns.extend(["res_we", "res_wr"].map(|p| (p.to_string(), p.to_string())));
     }
-    if super::span_seq::walk_ram::on(hw) {
+    if hw.walk_ram() {
         conns.push(("res_bus".into(), "res_bus".into()));
     }
     body.push(Item::Instance { module: names.fe_engine.clone(), name: "u_engine".into(), params: vec![], conns });
@@ -317,7 +317,7 @@ pub(super) fn setup(hw: &Hw, names: &Names, body: &mut Vec<Item>) {
     if capture {
         qc.insert(4, ("we", "res_we"));
     }
-    if super::span_seq::walk_ram::on(hw) {
+    if hw.walk_ram() {
         qc[3].1 = "q_din";
         qc[4].1 = "q_we";
     }
@@ -346,7 +346,7 @@ pub(super) fn setup(hw: &Hw, names: &Names, body: &mut Vec<Item>) {
             }
         }
     }
-    if super::span_seq::walk_ram::edges_in_ram(hw) {
+    if hw.edges_in_walk_ram() {
         super::span_seq::walk_ram::edge_inputs(hw, body);
         // Every edge field from the walk memory's read register, loaded a field a clock.
         for (port, bus, w) in super::edge::input_buses(hw).inputs {
@@ -355,7 +355,7 @@ pub(super) fn setup(hw: &Hw, names: &Names, body: &mut Vec<Item>) {
             body.push(crate::verilog::wire(bus, 3 * w, format!("{{3{{{lane}}}}}")));
         }
     }
-    for (port, bus, w) in super::edge::input_buses(hw).inputs.into_iter().filter(|_| !super::span_seq::walk_ram::edges_in_ram(hw)) {
+    for (port, bus, w) in super::edge::input_buses(hw).inputs.into_iter().filter(|_| !hw.edges_in_walk_ram()) {
         let l = &lanes[port];
         body.push(crate::verilog::wire(bus, 3 * w, format!("{{{}, {}, {}}}", l[2], l[1], l[0])));
     }

@@ -205,7 +205,7 @@ impl Hw {
     }
 
     /// Whether the walk memory also holds the edges' set-up fields, not the queue's entry: the
-    /// UP5K's plan ([`Hw::fewest_cells`]), the walker preloading them ([`PRELOAD_CLOCKS`]).
+    /// UP5K's plan ([`Hw::fewest_cells`]), the walker preloading them ([`PRELOAD_CLOCKS`], docs/queue-in-walk-ram.md).
     pub fn edges_in_walk_ram(&self) -> bool {
         self.walk_ram() && self.fewest_cells()
     }

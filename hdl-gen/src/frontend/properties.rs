@@ -66,8 +66,8 @@ pub(super) fn emit_engine(hw: &Hw, sp: &Stager) -> Item {
         binary_phase: hw.sequential().is_some(),
         capture: hw.sequential().is_some(),
         held: hw.sequential().map(|s| s.inputs_read_by()),
-        walk_ram: super::span_seq::walk_ram::on(hw),
-        preload: super::span_seq::walk_ram::edges_in_ram(hw).then_some(super::span_seq::walk_ram::PRELOAD_CLOCKS),
+        walk_ram: hw.walk_ram(),
+        preload: Some(hw.preload_clocks()).filter(|&n| n > 0),
         head: hw.queue_head(),
     };
     let mut shape = shape(hw, sp, SetupShape::Engine(engine));

@@ -69,7 +69,7 @@ pub(super) fn handshake(hw: &Hw, body: &mut Vec<Item>) {
     body.push(wire("sq_done", 1, format!("sq_busy && sq_ph == {last} && sq_cnt == {}", lit(count_bits(&q), 0))));
     body.push(wire("sq_fin", 1, "sq_done && (!out_valid || out_ready)"));
     body.push(wire("adv", 1, "!sq_busy || sq_fin"));
-    if walk_ram::on(hw) {
+    if hw.walk_ram() {
         walk_ram::emit(hw, body);
     }
 }
@@ -232,7 +232,7 @@ pub(super) fn emit(hw: &Hw, body: &mut Vec<Item>) -> Stager {
             vec![],
         )],
     )]));
-    if walk_ram::on(hw) {
+    if hw.walk_ram() {
         walk_ram::emit_ports(hw, body);
     }
     Stager::new("p", Vec::new())

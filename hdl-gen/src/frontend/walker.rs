@@ -298,7 +298,7 @@ fn control(hw: &Hw, body: &mut Vec<Item>) {
     let engine = hw.engine_form();
     let waiting = if engine { "q_ne" } else { "st == HOLD" };
     // Where the edges' fields are in the walk memory, the take waits for their preload.
-    let preloaded = if super::span_seq::walk_ram::edges_in_ram(hw) { " && wk_ldd" } else { "" };
+    let preloaded = if hw.edges_in_walk_ram() { " && wk_ldd" } else { "" };
     if !inc {
         body.push(assign("take", format!("{waiting} && adv && {free}{preloaded}")));
     }
@@ -316,7 +316,7 @@ fn control(hw: &Hw, body: &mut Vec<Item>) {
         body.push(wire("w_next", 1, format!("{waiting} && {free}")));
         body.push(wire("w_more", 1, "!w_end"));
     } else {
-        if !super::span_seq::walk_ram::edges_in_ram(hw) {
+        if !hw.edges_in_walk_ram() {
             body.push(wire("w_load", 1, "!rst && take"));
         }
         if inc {

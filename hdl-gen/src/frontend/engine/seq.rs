@@ -145,7 +145,7 @@ pub fn module(hw: &Hw, s: &SeqSchedule, name: &str) -> SeqEngine {
     let mut ports = ports(hw, res_w);
     ports.push(Port::output("res_we", fields.len() as u32, "", "per field of res: write it into the queue's tail this clock"));
     ports.push(Port::output("res_wr", 1, "", "a field of res is due this clock (whether or not en)"));
-    let walk_ram = crate::frontend::span_seq::walk_ram::on(hw).then(|| crate::frontend::span_seq::walk_ram::bus_width(hw));
+    let walk_ram = hw.walk_ram().then(|| crate::frontend::span_seq::walk_ram::bus_width(hw));
     if let Some(bw) = walk_ram {
         assert!(bw <= w, "the walk's constants are narrower than the word");
         ports.push(Port::output("res_bus", bw, "", "the write bus: the walk's constants in block RAM are written from it at res_we"));

@@ -16,7 +16,7 @@
 //! where it is written: the engine writes only while the queue is empty, and its slot is then the
 //! one the walker does not hold (`no_rw_check`, so Yosys adds no collision logic).
 //!
-//! On the UP5K ([`edges_in_ram`]) the second memory also holds the edges' set-up fields, which
+//! On the UP5K ([`Hw::edges_in_walk_ram`]) the second memory also holds the edges' set-up fields, which
 //! were the queue entry's 354 flip-flops: the walker reads them into the edges' registers, one a
 //! clock, while it is idle and a triangle is queued, and takes the triangle after the last
 //! ([`PRELOAD_CLOCKS`] after a push into an empty queue; behind a covered last row the span path's
@@ -27,7 +27,7 @@
 //! walked triangle's, or at the take already the taken one's. docs/fpga.md, *The walk's
 //! constants in block RAM*.
 
-use crate::frontend::hw::Hw;
+use crate::frontend::hw::{Hw, PRELOAD_CLOCKS};
 use crate::verilog::{comment, lit, reg, set, wire, Item, Stmt};
 use crate::widths::bits_for;
 use golden::frontend::engine::SetupForm;
@@ -44,12 +44,6 @@ const STEP_FIELD: &str = "dyn";
 /// The field the walker loads at the take and then steps, in the second memory (its second word
 /// beside `dYn`, or alone where `dYn` is [`registered`]).
 const TAKE_FIELD: &str = "tn";
-
-/// Whether this front-end holds the walk's constants in block RAM ([`Hw::walk_ram`], which says
-/// when and why).
-pub(crate) fn on(hw: &Hw) -> bool {
-    hw.walk_ram()
-}
 
 /// Whether the walker holds `dYn` in a register loaded at the take (the HX8K's plan), not
 /// reading it from the memory every row (the UP5K's): the register costs the UP5K, which
@@ -73,17 +67,7 @@ pub(crate) fn we(name: &str) -> String {
 /// Whether set-up result field `name` is in the memories, not in the queue's entry nor the
 /// walker's registers.
 pub(crate) fn holds(hw: &Hw, name: &str) -> bool {
-    on(hw) && (SPAN_FIELDS.contains(&name) || name == STEP_FIELD || name == TAKE_FIELD || edge_field(hw, name).is_some())
-}
-
-/// Whether the edges' set-up fields are in the second memory too, not in the queue's entry (the
-/// UP5K's plan, [`Hw::fewest_cells`]: the entry's 354 flip-flops, each a logic cell no LUT
-/// feeds). The walker reads them one a clock into the edges' registers while it is idle and a
-/// triangle is queued (the preload, [`PRELOAD_CLOCKS`]), then takes it.
-/// WORK IN PROGRESS (issue 27, stop 36, helper u5q): not yet covered by the proofs;
-/// docs/queue-in-walk-ram.md.
-pub(crate) fn edges_in_ram(hw: &Hw) -> bool {
-    hw.edges_in_walk_ram()
+    hw.walk_ram() && (SPAN_FIELDS.contains(&name) || name == STEP_FIELD || name == TAKE_FIELD || edge_field(hw, name).is_some())
 }
 
 /// The edges' fields in the second memory, per edge in the edge's input order
@@ -93,9 +77,8 @@ const EDGE_FIELDS: [&str; 9] = ["act", "right", "rs", "re", "d", "g", "rem", "qs
 /// The second memory's word of the first edge field: after `dYn` (0) and `Tn` (1).
 const EDGE_BASE: u64 = 2;
 
-/// Clocks from the queue's push to the earliest take where the edges' fields are preloaded: one
-/// a field (27 reads), and the clock the last one is loaded, which reads `Tn`.
-pub(crate) const PRELOAD_CLOCKS: u32 = crate::frontend::hw::PRELOAD_CLOCKS;
+// Hw's preload clocks are one read a field of these, then the clock the last one is loaded,
+// which reads `Tn`.
 const _: () = assert!(PRELOAD_CLOCKS == 3 * EDGE_FIELDS.len() as u32 + 1, "a read a field, then Tn's");
 
 /// The number of edge field `name` (`e<k>_<port>`), where the memory holds the edges' fields.
@@ -103,7 +86,7 @@ fn edge_field(hw: &Hw, name: &str) -> Option<u64> {
     let (e, port) = name.split_once('_')?;
     let k: u64 = e.strip_prefix('e')?.parse().ok()?;
     let j = EDGE_FIELDS.iter().position(|f| *f == port)? as u64;
-    (edges_in_ram(hw) && k < 3).then_some(EDGE_FIELDS.len() as u64 * k + j)
+    (hw.edges_in_walk_ram() && k < 3).then_some(EDGE_FIELDS.len() as u64 * k + j)
 }
 
 /// Whether the walker's register for field `name` is gone: the memories' read is it.
@@ -187,7 +170,7 @@ fn field_bits(hw: &Hw) -> u32 {
     bits_for(span_memory(hw).len() as u32 - 1)
 }
 
-/// Where [`edges_in_ram`]: the second memory's read register (`wk_dq`, declared here, before the
+/// Where [`Hw::edges_in_walk_ram`]: the second memory's read register (`wk_dq`, declared here, before the
 /// edges read it), the preload's count (`wk_lk`: the field read, then 27 and 28 reading `Tn`;
 /// `wk_ldd`, the take's condition) and each field's load, its bit of `e_ld` in the clock after
 /// its read. With the queue's head fields, before the walker.
@@ -214,7 +197,7 @@ pub(crate) fn edge_port(port: &str) -> bool {
 
 /// The second memory's address bits in a slot.
 fn d_bits(hw: &Hw) -> u32 {
-    if edges_in_ram(hw) {
+    if hw.edges_in_walk_ram() {
         bits_for((EDGE_BASE + 3 * EDGE_FIELDS.len() as u64) as u32 - 1)
     } else {
         field_bits(hw)
@@ -248,7 +231,7 @@ pub(crate) fn emit(hw: &Hw, body: &mut Vec<Item>) {
     // As deep as the first: Yosys keeps a two-word memory in flip-flops.
     body.push(Item::Memory { name: "wk_d".into(), width: k, depth: 1 << (1 + d_bits(hw)), no_rw_check: true });
     body.push(reg("wk_q", sw));
-    if !edges_in_ram(hw) {
+    if !hw.edges_in_walk_ram() {
         body.push(reg("wk_dq", k));
     }
     body.extend([reg("wk_ws", 1), reg("wk_rs", 1)]);
@@ -285,7 +268,7 @@ pub(crate) fn emit_ports(hw: &Hw, body: &mut Vec<Item>) {
         body.push(wire("wk_ma", fw + 1, format!("wk_dnr ? {{!wk_rs, {}}} : {{wk_slot, wk_ra}}", lit(fw, index(STEP_FIELD)))));
         let tn = lit(fw, 0);
         ("wk_m[wk_ma]".to_string(), (we(TAKE_FIELD), format!("wk_d[{{wk_ws, {tn}}}]")), format!("wk_d[{{!wk_rs, {tn}}}]"))
-    } else if edges_in_ram(hw) {
+    } else if hw.edges_in_walk_ram() {
         // Tn's read (the walked triangle's dYn otherwise) waits for the edges' fields: a take
         // comes only once they are loaded.
         let db = d_bits(hw);
