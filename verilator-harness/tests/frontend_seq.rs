@@ -12,7 +12,8 @@ use verilator_harness::frontend::random_triangles;
 /// 37x23 and 640x480, levels 0 and 1 (the target's), the UP5K's (`ice40-up5k`, its products as
 /// SB_MAC16 tile passes) at 37x23 level 0 and 640x480 level 1 (its target's); 1,000 triangles
 /// each (about 340 clocks a triangle); a fault planted in the HX8K's ALU (the subtract made an
-/// add; the triangle taken, `in_ready`, a clock before its inputs' last read from the ports) and nine in the UP5K's engine (the tiles' sum not shifted a chunk up where
+/// add; the triangle taken, `in_ready`, a clock before its inputs' last read from the ports) and eleven in the UP5K's engine (the left
+/// shift's power of two a place off, its SB_MAC16 products not joined, the tiles' sum not shifted a chunk up where
 /// the pass's weight drops, its high half or the split ALU's without the low half's carry, the
 /// divider's dividend bits not shifted in, the select's first choice never taken into `ax0`,
 /// its second operand not zeroed before the adder that passes the choice, the
@@ -55,6 +56,8 @@ fn sequential_engine_spans_equal_golden() {
                 fault(" bfl <= ", "~|ax0", "~ax0[0]", "the equality with zero a test of bit 0 alone"),
                 fault(" m1b <= ", "];", "] << 1 >> 1;", "a tile's held operand without its top bit, the sign above its chunks"),
                 fault(" at_read = ", "pc == ", "pc_n == ", "the triangle taken a clock before its inputs' last read"),
+                fault(" shl_p = ", "'d1 << ", "'d2 << ", "the left shift's power of two (its SB_MAC16 operand) a place too high"),
+                fault("shl_f = shl_f | ", "shl_f | ", "", "the left shift's products not joined: only the top 16 bits' kept"),
             ]
         } else {
             vec![

@@ -88,6 +88,12 @@ pub struct SeqPlan {
     /// load them from the split ALU's operand registers (on the UP5K the operand select, the
     /// flag file's read among it, then a tile's chunk select was the path after the ALU's).
     pub load_lag: u32,
+    /// Whether the left shift's low bits are products by `2^k` on 16 x 16 multipliers (the
+    /// UP5K's SB_MAC16, one a 16 bits of the widest shift, their output registers the shift's
+    /// first clock), its high bits a choice among 16-bit steps. The shifter's 8:1 multiplexers
+    /// were about 400 logic cells on the UP5K (docs/fpga.md), where 6 of its 8 SB_MAC16 were
+    /// idle; the HX8K has none. The same clocks either way: golden's schedule does not change.
+    pub shift_on_macs: bool,
 }
 
 impl SeqPlan {
@@ -104,8 +110,9 @@ impl SeqPlan {
         acc_lag: 1,
         bus_lat: 1,
         load_lag: 1,
+        shift_on_macs: false,
     };
-    /// The UP5K: 2 of its SB_MAC16 and one divider.
+    /// The UP5K: 2 of its SB_MAC16 as tiles, the left shift on 4 more, and one divider.
     pub const ICE40_UP5K: SeqPlan = SeqPlan {
         units: Plan::ICE40_UP5K,
         read_ports: 2,
@@ -115,6 +122,7 @@ impl SeqPlan {
         acc_lag: 1,
         bus_lat: 1,
         load_lag: 1,
+        shift_on_macs: true,
     };
 
     /// The forms whose engine is sequential: the iCE40s' (`--fe-setup ice40-hx8k`, whose

@@ -288,6 +288,9 @@ fn split_shift(cx: &Cx, regs: &mut Vec<Stmt>, b: &mut Vec<Item>) -> String {
     b.push(wire("shl_by", 1, format!("af == 4'd{FN_SHLV}")));
     let ai = if aw < sw { format!("ai[{}:0]", aw - 1) } else { "ai".into() };
     b.push(wire("shl_amt", aw, format!("shl_by ? ax1[{}:0] : {ai}", aw - 1)));
+    if cx.s.plan.shift_on_macs {
+        return shift_on_macs(cx, aw, bound.is_none(), regs, b);
+    }
     b.push(reg("bsh", w));
     regs.push(set("bsh", format!("ax0 << shl_amt[{}:0]", lo - 1)));
     let out = if bound.is_none() {
@@ -307,6 +310,78 @@ fn split_shift(cx: &Cx, regs: &mut Vec<Stmt>, b: &mut Vec<Item>) -> String {
     }
     "csh".into()
 }
+
+/// The same left shift with its low four bits on 16 x 16 multipliers (`SeqPlan::shift_on_macs`):
+/// on clock 2 each 16 bits of `ax0` times `2^k` into the multiplier's output register (Yosys
+/// maps each to an SB_MAC16 under `synth_ice40 -dsp`); the products do not overlap, so an OR
+/// joins them, and on clock 3 a choice among 16-bit steps. Only the widest shift's bits are
+/// formed: every value is wrapped to its width as it is written, so the bits above it are
+/// never read.
+fn shift_on_macs(cx: &Cx, aw: u32, shifts_out: bool, regs: &mut Vec<Stmt>, b: &mut Vec<Item>) -> String {
+    let (w, sw, ops) = (cx.w, cx.sw, &cx.s.prog.ops);
+    let shw = ops
+        .iter()
+        .zip(&cx.s.slots)
+        .filter(|(op, sl)| sl.exec == Exec::Alu && matches!(op.kind, Kind::Shl(..) | Kind::ShlBy(..)))
+        .map(|(op, _)| op.w)
+        .max()
+        .unwrap_or(1)
+        .min(w);
+    let n = shw.div_ceil(MAC_BITS);
+    let lo = aw.min(4);
+    b.push(comment(format!(
+        "The left shift's low {lo} bits as products by 2^k on {n} SB_MAC16 (each 16 bits of ax0, their output registers"
+    )));
+    b.push(comment(format!(
+        "clock 2's), joined by an OR (they do not overlap); its high bits in 16-bit steps; {shw} bits, the widest shift's."
+    )));
+    b.push(wire("shl_p", MAC_BITS, format!("{MAC_BITS}'d1 << shl_amt[{}:0]", lo - 1)));
+    let xw = n * MAC_BITS;
+    let x = if xw > shw { format!("{{{}'d0, ax0[{}:0]}}", xw - shw, shw - 1) } else { format!("ax0[{}:0]", shw - 1) };
+    b.push(wire("shl_x", xw, x));
+    b.push(reg("bfp", 2 * xw));
+    b.push(Item::Integer("shl_k".into()));
+    regs.push(Stmt::For {
+        var: "shl_k".into(),
+        count: n.to_string(),
+        body: vec![set("bfp[32*shl_k +: 32]", format!("{{16'd0, shl_x[{MAC_BITS}*shl_k +: {MAC_BITS}]}} * {{16'd0, shl_p}}"))],
+    });
+    // The products' sum: the OR of each at its 16 bits' place (16 bits above the last).
+    let fw = xw + MAC_BITS;
+    b.push(reg("shl_f", fw));
+    b.push(Item::Integer("shl_j".into()));
+    b.push(Item::Comb(vec![
+        Stmt::Blocking("shl_f".into(), format!("{fw}'d0")),
+        Stmt::For {
+            var: "shl_j".into(),
+            count: n.to_string(),
+            body: vec![Stmt::Blocking(
+                "shl_f".into(),
+                format!("shl_f | ({{{}'d0, bfp[32*shl_j +: 32]}} << ({MAC_BITS}*shl_j))", fw - 2 * MAC_BITS),
+            )],
+        },
+    ]));
+    let mut sh = format!("shl_f[{}:0]", shw - 1);
+    if aw > lo {
+        b.push(reg("bamt", aw - lo));
+        regs.push(set("bamt", format!("shl_amt[{}:{lo}]", aw - 1)));
+        sh = format!("({sh} << {{bamt, {lo}'d0}})");
+    }
+    let out = if shifts_out {
+        b.push(wire("shl_out", 1, format!("shl_by && (|ax1[{}:{sw}] || ax1[{}:0] >= {sw}'d{w})", w - 1, sw - 1)));
+        b.push(reg("bout", 1));
+        regs.push(set("bout", "shl_out"));
+        format!("bout ? {shw}'d0 : ")
+    } else {
+        String::new()
+    };
+    b.push(wire("csh_v", shw, format!("{out}{sh}")));
+    b.push(wire("csh", w, crate::verilog::zext("csh_v", shw, w)));
+    "csh".into()
+}
+
+/// The SB_MAC16's operand width.
+const MAC_BITS: u32 = 16;
 
 /// The leading-zero count in two clocks: on clock 2 each group of 8 bits' zero test and
 /// count, on clock 3 the first group that is not zero and its count. Returns clock 3's
