@@ -293,14 +293,7 @@ fn split_shift(cx: &Cx, regs: &mut Vec<Stmt>, b: &mut Vec<Item>) -> String {
     }
     b.push(reg("bsh", w));
     regs.push(set("bsh", format!("ax0 << shl_amt[{}:0]", lo - 1)));
-    let out = if bound.is_none() {
-        b.push(wire("shl_out", 1, format!("shl_by && (|ax1[{}:{sw}] || ax1[{}:0] >= {sw}'d{w})", w - 1, sw - 1)));
-        b.push(reg("bout", 1));
-        regs.push(set("bout", "shl_out"));
-        format!("bout ? {w}'d0 : ")
-    } else {
-        String::new()
-    };
+    let out = shifts_out(cx, bound.is_none(), w, regs, b);
     if aw > lo {
         b.push(reg("bamt", aw - lo));
         regs.push(set("bamt", format!("shl_amt[{}:{lo}]", aw - 1)));
@@ -317,8 +310,8 @@ fn split_shift(cx: &Cx, regs: &mut Vec<Stmt>, b: &mut Vec<Item>) -> String {
 /// joins them, and on clock 3 a choice among 16-bit steps. Only the widest shift's bits are
 /// formed: every value is wrapped to its width as it is written, so the bits above it are
 /// never read.
-fn shift_on_macs(cx: &Cx, aw: u32, shifts_out: bool, regs: &mut Vec<Stmt>, b: &mut Vec<Item>) -> String {
-    let (w, sw, ops) = (cx.w, cx.sw, &cx.s.prog.ops);
+fn shift_on_macs(cx: &Cx, aw: u32, out: bool, regs: &mut Vec<Stmt>, b: &mut Vec<Item>) -> String {
+    let (w, ops) = (cx.w, &cx.s.prog.ops);
     let shw = ops
         .iter()
         .zip(&cx.s.slots)
@@ -367,17 +360,23 @@ fn shift_on_macs(cx: &Cx, aw: u32, shifts_out: bool, regs: &mut Vec<Stmt>, b: &m
         regs.push(set("bamt", format!("shl_amt[{}:{lo}]", aw - 1)));
         sh = format!("({sh} << {{bamt, {lo}'d0}})");
     }
-    let out = if shifts_out {
-        b.push(wire("shl_out", 1, format!("shl_by && (|ax1[{}:{sw}] || ax1[{}:0] >= {sw}'d{w})", w - 1, sw - 1)));
-        b.push(reg("bout", 1));
-        regs.push(set("bout", "shl_out"));
-        format!("bout ? {shw}'d0 : ")
-    } else {
-        String::new()
-    };
+    let out = shifts_out(cx, out, shw, regs, b);
     b.push(wire("csh_v", shw, format!("{out}{sh}")));
     b.push(wire("csh", w, crate::verilog::zext("csh_v", shw, w)));
     "csh".into()
+}
+
+/// Where a variable amount can reach W (`out`): the shift's zero, its test registered beside
+/// the amount's low bits. Returns the prefix that zeroes a `width`-bit shift.
+fn shifts_out(cx: &Cx, out: bool, width: u32, regs: &mut Vec<Stmt>, b: &mut Vec<Item>) -> String {
+    if !out {
+        return String::new();
+    }
+    let (w, sw) = (cx.w, cx.sw);
+    b.push(wire("shl_out", 1, format!("shl_by && (|ax1[{}:{sw}] || ax1[{}:0] >= {sw}'d{w})", w - 1, sw - 1)));
+    b.push(reg("bout", 1));
+    regs.push(set("bout", "shl_out"));
+    format!("bout ? {width}'d0 : ")
 }
 
 /// The SB_MAC16's operand width.
