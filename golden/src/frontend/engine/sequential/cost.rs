@@ -42,8 +42,10 @@ impl SeqSchedule {
         };
         let lut_div = units.dividers * (per_bit * (div_w * units.div_bits) as f64).round() as u32;
         // Left by a value or a constant, right by a constant: one barrel shifter and the
-        // operand's reversal on each side.
-        let lut_shift = units.shifters * (ram_width * abits(ram_width) + 2 * ram_width);
+        // operand's reversal on each side; its four lowest stages products on SB_MAC16 where
+        // the plan puts them there.
+        let stages = abits(ram_width) - if self.plan.shift_on_macs { 4 } else { 0 };
+        let lut_shift = units.shifters * (ram_width * stages + 2 * ram_width);
         // The write bus: ALU, shifter, product, quotient, remainder, input.
         let lut_ctl = ram_width * 3 + flags * 3 + outs + abits(self.clocks) * 4;
         let result_bits: u32 = self.prog.out.all().iter().map(|&v| w(v)).sum();
