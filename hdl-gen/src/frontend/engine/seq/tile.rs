@@ -146,6 +146,12 @@ impl<'a> Tiles<'a> {
                 };
                 // No pass names a chunk beyond the held ones: the top one is the default.
                 let arms = (0..n - 1).map(|i| (format!("{cbw}'d{i}"), chunk(i))).collect();
+                if n == 1 {
+                    // One chunk: the microword's field for it (sized for the other unit's) is not read.
+                    b.push(comment("verilator lint_off UNUSEDSIGNAL"));
+                    b.push(wire(&format!("unused_{c}"), cbw, uf(&format!("c{o}"))));
+                    b.push(comment("verilator lint_on UNUSEDSIGNAL"));
+                }
                 b.push(Item::Comb(if n > 1 {
                     vec![Stmt::Case { sel: uf(&format!("c{o}")), arms, default: chunk(n - 1) }]
                 } else {
