@@ -182,6 +182,14 @@ fn sequential_span_path_spans_equal_golden() {
     fault.caught(&opts, "frontend walk ram tn fault", "walktnfault", "the edges' fields and Tn read from the walked triangle's slot");
     let fault = LineFault { file: "tri_frontend.v", line: " wk_da = wk_pre ? {!wk_rs", from: "wk_lk + 5'd2", to: "wk_lk + 5'd1" };
     fault.caught(&opts, "frontend walk ram preload fault", "walkpreloadfault", "each edge field loaded a clock after its read");
+    // The UP5K's dI beside An in the first memory (the output loads it from the read register
+    // with the span path's result): written into the walked triangle's slot, or into the free
+    // fourth word, which the span path's last phase does not read.
+    let di_write = "] <= {res_bus[15:0], res_bus[20:16]};";
+    let fault = LineFault { file: "tri_frontend.v", line: di_write, from: "{wk_ws,", to: "{!wk_ws," };
+    fault.caught(&opts, "frontend walk ram di slot fault", "walkdislotfault", "dI written into the walked triangle's slot");
+    let fault = LineFault { file: "tri_frontend.v", line: di_write, from: "wk_wa}", to: "2'd3}" };
+    fault.caught(&opts, "frontend walk ram di word fault", "walkdiwordfault", "dI written into the fourth word, not An's");
     // The UP5K's pixel test after the ends' picks (`Hw::fewest_cells`): a one-pixel row
     // (hi3 + mg = 0) dropped.
     let fault = LineFault { file: "tri_frontend.v", line: " room = ", from: "mg[15]}}, mg}", to: "mg[15]}}, mg} - 17'sd1" };

@@ -68,6 +68,7 @@ pub(super) fn emit_engine(hw: &Hw, sp: &Stager) -> Item {
         held: hw.sequential().map(|s| s.inputs_read_by()),
         walk_ram: hw.walk_ram(),
         preload: Some(hw.preload_clocks()).filter(|&n| n > 0),
+        di_in_ram: super::span_seq::walk_ram::formal_di(hw),
         head: hw.queue_head(),
     };
     let mut shape = shape(hw, sp, SetupShape::Engine(engine));
@@ -133,6 +134,7 @@ fn shape(hw: &Hw, sp: &Stager, setup: SetupShape) -> FrontendShape {
                 })
                 .collect(),
         },
+        walker_di: super::span_seq::walker_di(hw).into(),
         starts: None,
         span_unit: super::span_seq::shape(hw),
         edge_probes,
@@ -615,7 +617,7 @@ impl Reference<'_> {
         }
         let rows = &self.s.row_stages;
         if rows.is_empty() {
-            link.push(when("f_wv && !f_wnew", vec![assert(format!("w_di == ({})", ahead(1)))]));
+            link.push(when("f_wv && !f_wnew", vec![assert(format!("{} == ({})", self.s.walker_di, ahead(1)))]));
         }
         // The dI ahead of row stage j (1-based; j = rows.len() + 1: the span path's).
         let ahead_row = |j: usize| (j..=rows.len()).rev().fold(ahead(1), |acc, k| format!("f_r{k}v ? {} : {acc}", rows[k - 1].di));

@@ -21,8 +21,19 @@ pub(super) fn unit(hw: &Hw) -> Option<SpanSeq> {
 
 /// The unit as the properties' one span stage: busy while it holds a row.
 pub(super) fn stage(hw: &Hw) -> SpanStage {
-    let di = if hw.row_stage() { "sq_di" } else { "w_di" };
+    // Where the walk memory holds dI, the walked triangle's there (`walk_ram::formal_di`).
+    let di = if hw.row_stage() { "sq_di" } else { walker_di(hw) };
     SpanStage { valid: "sq_busy".into(), y: "sq_y".into(), x: "sq_x".into(), len: "sq_len".into(), di: di.into() }
+}
+
+/// Where the walker's triangle's `dI` is: its register, or the walk memory's word
+/// (`walk_ram::formal_di`'s `f_wdi`, for the proofs).
+pub(super) fn walker_di(hw: &Hw) -> &'static str {
+    if walk_ram::di_value(hw).is_some() {
+        "f_wdi"
+    } else {
+        "w_di"
+    }
 }
 
 /// The unit's shape for the properties: its clocks, the clocks left from its phase and count
@@ -85,6 +96,21 @@ fn span_of_ends(end_w: u32, xw: u32) -> Vec<Item> {
         wire("sq_x", xw, format!("sq_lo[{}:0]", xw - 1)),
         wire("sq_len", xw + 1, format!("sq_lw[{xw}:0]")),
     ]
+}
+
+/// The output register: the unit's result, `dI` from `di`.
+fn output_register(di: String, body: &mut Vec<Item>) {
+    body.push(comment("The output register: the unit's result, written when it is done and the output is free."));
+    let write = vec![set("out_y", "sq_y"), set("out_x", "sq_x"), set("out_len", "sq_len"), set("out_i0", "sq_i0"), set("out_di", di)];
+    body.push(Item::Always(vec![Stmt::If(
+        "rst".into(),
+        vec![set("out_valid", "1'b0")],
+        vec![Stmt::If(
+            "!out_valid || out_ready".into(),
+            vec![set("out_valid", "sq_done"), Stmt::If("sq_done".into(), write, vec![])],
+            vec![],
+        )],
+    )]));
 }
 
 /// The unit and the output register, after the walker: returns the span path's (empty) stages.
@@ -220,18 +246,8 @@ pub(super) fn emit(hw: &Hw, body: &mut Vec<Item>) -> Stager {
         vec![set("sq_busy", "1'b0")],
         vec![Stmt::If("adv".into(), on_accept, vec![Stmt::If("sq_busy".into(), busy, vec![])])],
     )]));
-    body.push(comment("The output register: the unit's result, written when it is done and the output is free."));
-    let write =
-        vec![set("out_y", "sq_y"), set("out_x", "sq_x"), set("out_len", "sq_len"), set("out_i0", "sq_i0"), set("out_di", tri("di"))];
-    body.push(Item::Always(vec![Stmt::If(
-        "rst".into(),
-        vec![set("out_valid", "1'b0")],
-        vec![Stmt::If(
-            "!out_valid || out_ready".into(),
-            vec![set("out_valid", "sq_done"), Stmt::If("sq_done".into(), write, vec![])],
-            vec![],
-        )],
-    )]));
+    // Where the walk memory holds dI, its read register's, `An`'s word when the unit is done.
+    output_register(walk_ram::di_value(hw).map_or_else(|| tri("di"), str::to_string), body);
     if hw.walk_ram() {
         walk_ram::emit_ports(hw, body);
     }

@@ -95,6 +95,7 @@ impl Reference<'_> {
             b.push(comment("The edges' preload (f_lk): a field a clock while a triangle is queued and none walked."));
             b.push(reg("f_lk", bits_for(n)));
         }
+        b.extend(e.di_in_ram.iter().flatten().cloned());
         b
     }
 
@@ -220,6 +221,11 @@ impl Reference<'_> {
         }
         if let Some(n) = e.preload {
             b.extend(preload_reads(n));
+        }
+        if e.di_in_ram.is_some() {
+            // The output register loads dI from the read register with the span path's result.
+            b.push(comment("Output dI: when the span path's result is done, the read register holds the walked triangle's An word."));
+            b.push(Item::Comb(vec![when("f_past && sq_done", vec![assert("wk_di == f_wdi")])]));
         }
         b
     }

@@ -4,7 +4,7 @@
 //! module that puts them together.
 
 use crate::formal::{assert, when};
-use crate::verilog::{lit, zext, Stmt};
+use crate::verilog::{lit, zext, Item, Stmt};
 pub(super) use crate::widths::bits_for;
 
 /// What the front-end's proof needs from its generator: widths, screen, its set-up's shape.
@@ -28,6 +28,9 @@ pub struct FrontendShape {
     pub row_stages: Vec<RowStage>,
     /// The span path's register stages between the walker (or the row stage) and the output, in order.
     pub span_stages: Vec<SpanStage>,
+    /// Where the walker holds its triangle's `dI` without row stages: `w_di`, or the walk
+    /// memory's (`span_seq::walker_di`).
+    pub walker_di: String,
     /// The incremental I0 (`--fe-i0 incremental`): its start engine's clocks a product (1, or
     /// the HX8K's shift-add's RW, counted by `ie_k`). The walker then
     /// waits while a source starts (`ie_wait`, a data decision taken as given, like a row's
@@ -112,6 +115,10 @@ pub struct EngineShape {
     /// walker reads them one a clock while idle and a triangle is queued, and takes it once its
     /// preload count (`wk_lk`) is this, the fields' count + 1.
     pub preload: Option<u32>,
+    /// `dI` in the walk's first memory (`span_seq::walk_ram::formal_di`): the declarations of
+    /// `f_wdi`, the walked triangle's there, which the read register's `wk_di` is when the span
+    /// path's result is done.
+    pub di_in_ram: Option<Vec<Item>>,
     /// The queue's head is a register of its own (`u_queue.hd`, valid `hv`), refilled from its
     /// memory while empty: an entry is the head a clock after it is in the memory.
     pub head: bool,

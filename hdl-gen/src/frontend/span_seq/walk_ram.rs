@@ -67,7 +67,118 @@ pub(crate) fn we(name: &str) -> String {
 /// Whether set-up result field `name` is in the memories, not in the queue's entry nor the
 /// walker's registers.
 pub(crate) fn holds(hw: &Hw, name: &str) -> bool {
-    hw.walk_ram() && (SPAN_FIELDS.contains(&name) || name == STEP_FIELD || name == TAKE_FIELD || edge_field(hw, name).is_some())
+    hw.walk_ram()
+        && (SPAN_FIELDS.contains(&name)
+            || name == STEP_FIELD
+            || name == TAKE_FIELD
+            || edge_field(hw, name).is_some()
+            || (name == DI_FIELD && hw.edges_in_walk_ram()))
+}
+
+/// The triangle's `dI`, which the output register loads with every span. Where
+/// [`Hw::edges_in_walk_ram`] it is in `An`'s word of the first memory, not in the queue's entry
+/// and the walker's copy (42 flip-flops, 41 UP5K logic cells): the span path's last phase
+/// addresses `An`'s word for the next accept, so `wk_q` holds both when its result is done, and
+/// the output loads `dI` from it in the same clock as the next row's accept loads `An`. `An`
+/// fills its word's low columns and `dI` its top ([`di_columns`]): a fifth block RAM's
+/// [`EBR_COLUMNS`] above the span fields' 64, then the columns above `An` and `Rn`.
+/// docs/queue-in-walk-ram.md, stop 37.
+const DI_FIELD: &str = "di";
+
+/// An iCE40 block RAM's columns at its widest (256 x 16).
+const EBR_COLUMNS: u32 = 16;
+
+/// Where [`DI_FIELD`] is in the first memory: its low bits (up to [`EBR_COLUMNS`]) in an added
+/// block RAM's columns, from the span fields' width up, and any above those at the top of the
+/// span fields' columns, above `An` and `Rn` (`Gxn` writes up to its own top, [`Hw::s2n_bits`],
+/// so only the columns below that take a select of the write's data).
+#[derive(Clone, Copy)]
+struct DiColumns {
+    /// The span fields' width: the low bits' first column.
+    sw: u32,
+    low: u32,
+    high: u32,
+}
+
+impl DiColumns {
+    /// The first and last columns dI's write covers.
+    fn span(self) -> (u32, u32) {
+        (self.sw - self.high, self.sw + self.low - 1)
+    }
+
+    /// `dI` from a word `w` of the first memory (`An`'s): its high columns, then its low.
+    fn of(self, w: &str) -> String {
+        let low = format!("{w}[{}:{}]", self.sw + self.low - 1, self.sw);
+        if self.high == 0 {
+            return low;
+        }
+        format!("{{{w}[{}:{}], {low}}}", self.sw - 1, self.sw - self.high)
+    }
+
+    /// The write's data over [`Self::span`]: `dI`'s low bits at the top, its high bits below.
+    fn data(self) -> String {
+        let low = format!("res_bus[{}:0]", self.low - 1);
+        if self.high == 0 {
+            return low;
+        }
+        format!("{{{low}, res_bus[{}:{}]}}", self.low + self.high - 1, self.low)
+    }
+}
+
+fn di_columns(hw: &Hw) -> Option<DiColumns> {
+    if !holds(hw, DI_FIELD) {
+        return None;
+    }
+    let (sw, dw) = (span_width(hw), hw.fe.cfg.dw());
+    let Widths { aw, rw, .. } = hw.fe.widths();
+    let low = dw.min(EBR_COLUMNS);
+    let high = dw - low;
+    assert!(sw - high >= aw.max(rw), "dI's high bits above An's and Rn's columns");
+    Some(DiColumns { sw, low, high })
+}
+
+/// The first memory's columns: the span fields', and [`DI_FIELD`]'s added block RAM's.
+fn m_width(hw: &Hw) -> u32 {
+    di_columns(hw).map_or(span_width(hw), |c| c.sw + c.low)
+}
+
+/// For the proofs, where `dI` is in the first memory: the declarations of `f_wdi`, the walked
+/// triangle's `dI` there (its slot `wk_rs`, `An`'s word), which the read register's `wk_di`
+/// equals whenever the span path's result is done.
+pub(crate) fn formal_di(hw: &Hw) -> Option<Vec<Item>> {
+    let cols = di_columns(hw)?;
+    let word = format!("wk_m[{{wk_rs, {}}}]", lit(field_bits(hw), index(SPAN_FIELDS[0])));
+    Some(vec![
+        comment("dI in the first walk memory: the walked triangle's, in its slot's An word."),
+        wire("f_wk_an", m_width(hw), word),
+        wire("f_wdi", hw.fe.cfg.dw(), cols.of("f_wk_an")),
+    ])
+}
+
+/// The output register's `dI` source, where the memory holds it: the read register's, `An`'s
+/// word when the span path is done.
+pub(crate) fn di_value(hw: &Hw) -> Option<&'static str> {
+    holds(hw, DI_FIELD).then_some("wk_di")
+}
+
+/// The first memory's writes: every span field's whole word; where it holds [`DI_FIELD`],
+/// `An` and `Rn` in their columns, `Gxn` up to its top, `dI` in its own (`An`'s word: the engine
+/// addresses a field's word by its enable, `An`'s being the default).
+fn m_writes(hw: &Hw) -> Vec<Stmt> {
+    let (sw, at) = (span_width(hw), "wk_m[{wk_ws, wk_wa}]");
+    let Some(cols) = di_columns(hw) else {
+        let m_we: Vec<String> = span_memory(hw).into_iter().map(we).collect();
+        return vec![Stmt::If(m_we.join(" || "), vec![set(at, format!("res_bus[{}:0]", sw - 1))], vec![])];
+    };
+    assert_eq!(span_memory(hw), SPAN_FIELDS, "dYn not in the first memory");
+    let Widths { aw, rw, .. } = hw.fe.widths();
+    let (low, gx) = (aw.max(rw) - 1, hw.s2n_bits() - 2);
+    let (first, last) = cols.span();
+    vec![
+        Stmt::If(format!("{} || {}", we("an"), we("rn")), vec![set(format!("{at}[{low}:0]"), format!("res_bus[{low}:0]"))], vec![]),
+        Stmt::If(we("gxn"), vec![set(format!("{at}[{gx}:0]"), format!("res_bus[{gx}:0]"))], vec![]),
+        Stmt::If(we(DI_FIELD), vec![set(format!("{at}[{last}:{first}]"), cols.data())], vec![]),
+    ]
 }
 
 /// The edges' fields in the second memory, per edge in the edge's input order
@@ -91,7 +202,7 @@ fn edge_field(hw: &Hw, name: &str) -> Option<u64> {
 
 /// Whether the walker's register for field `name` is gone: the memories' read is it.
 pub(crate) fn replaces(hw: &Hw, name: &str) -> bool {
-    holds(hw, name) && (SPAN_FIELDS.contains(&name) || (name == STEP_FIELD && !registered(hw)))
+    holds(hw, name) && (SPAN_FIELDS.contains(&name) || name == DI_FIELD || (name == STEP_FIELD && !registered(hw)))
 }
 
 /// What the walker loads field `name` from at the take, where the memories hold it.
@@ -214,7 +325,7 @@ pub(crate) fn emit(hw: &Hw, body: &mut Vec<Item>) {
     let q = hw.fe.span_seq().expect("the sequential span path");
     let Widths { aw, k, rw, .. } = hw.fe.widths();
     let fw = field_bits(hw);
-    let (sw, aw_ram) = (span_width(hw), 1 + fw);
+    let aw_ram = 1 + fw;
     let reg_dyn = registered(hw);
     if reg_dyn {
         body.push(comment("The walk's constants in block RAM: An, Gxn, Rn (the span path's, one a load) and dYn (the walker's step's),"));
@@ -227,10 +338,10 @@ pub(crate) fn emit(hw: &Hw, body: &mut Vec<Item>) {
         body.push(comment("and Tn (its load at the take), written by the engine into the slot of the queue's next push (wk_ws), read"));
         body.push(comment("from the walked triangle's (wk_rs, the taken one's from the take; Tn the queued one's), a clock ahead."));
     }
-    body.push(Item::Memory { name: "wk_m".into(), width: sw, depth: 1 << aw_ram, no_rw_check: true });
+    body.push(Item::Memory { name: "wk_m".into(), width: m_width(hw), depth: 1 << aw_ram, no_rw_check: true });
     // As deep as the first: Yosys keeps a two-word memory in flip-flops.
     body.push(Item::Memory { name: "wk_d".into(), width: k, depth: 1 << (1 + d_bits(hw)), no_rw_check: true });
-    body.push(reg("wk_q", sw));
+    body.push(reg("wk_q", m_width(hw)));
     if !hw.edges_in_walk_ram() {
         body.push(reg("wk_dq", k));
     }
@@ -248,6 +359,9 @@ pub(crate) fn emit(hw: &Hw, body: &mut Vec<Item>) {
     for (n, w, from) in [("w_an", aw, "wk_q"), ("w_gxn", k, "wk_q"), ("w_rn", rw, "wk_q"), step, ("wk_tn", k, "wk_dq")] {
         body.push(wire(n, w, format!("{from}[{}:0]", w - 1)));
     }
+    if let Some(cols) = di_columns(hw) {
+        body.push(wire("wk_di", hw.fe.cfg.dw(), cols.of("wk_q")));
+    }
     body.push(Item::Blank);
 }
 
@@ -260,8 +374,7 @@ pub(crate) fn emit(hw: &Hw, body: &mut Vec<Item>) {
 /// field while the queue is full nor at its push.
 pub(crate) fn emit_ports(hw: &Hw, body: &mut Vec<Item>) {
     let k = hw.fe.widths().k;
-    let (sw, fw) = (span_width(hw), field_bits(hw));
-    let m_we: Vec<String> = span_memory(hw).into_iter().map(we).collect();
+    let fw = field_bits(hw);
     let (m_read, d_write, d_read) = if registered(hw) {
         let phase_w = bits_for(SpanSeq::PHASES.len() as u32 - 1);
         body.push(wire("wk_dnr", 1, dyn_read(&lit(phase_w, SpanSeq::PHASES.len() as u64 - 1))));
@@ -304,8 +417,8 @@ pub(crate) fn emit_ports(hw: &Hw, body: &mut Vec<Item>) {
         let dwa = format!("{{wk_ws, {} ? {} : {}}}", we(TAKE_FIELD), lit(fw, 1), lit(fw, 0));
         ("wk_m[{wk_slot, wk_ra}]".to_string(), (dwe, format!("wk_d[{dwa}]")), "wk_d[wk_da]".to_string())
     };
-    body.push(Item::Always(vec![
-        Stmt::If(m_we.join(" || "), vec![set("wk_m[{wk_ws, wk_wa}]", format!("res_bus[{}:0]", sw - 1))], vec![]),
+    let mut ports = m_writes(hw);
+    ports.extend([
         Stmt::If(d_write.0, vec![set(d_write.1, format!("res_bus[{}:0]", k - 1))], vec![]),
         set("wk_q", m_read),
         set("wk_dq", d_read),
@@ -317,6 +430,7 @@ pub(crate) fn emit_ports(hw: &Hw, body: &mut Vec<Item>) {
                 Stmt::If("take".into(), vec![set("wk_rs", "!wk_rs")], vec![]),
             ],
         ),
-    ]));
+    ]);
+    body.push(Item::Always(ports));
     body.push(Item::Blank);
 }
