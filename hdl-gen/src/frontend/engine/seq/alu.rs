@@ -329,15 +329,18 @@ fn shift_on_macs(cx: &Cx, aw: u32, out: bool, regs: &mut Vec<Stmt>, b: &mut Vec<
         "clock 2's), joined by an OR (they do not overlap); its high bits in 16-bit steps; {shw} bits, the widest shift's."
     )));
     b.push(wire("shl_p", MAC_BITS, format!("{MAC_BITS}'d1 << shl_amt[{}:0]", lo - 1)));
-    let xw = n * MAC_BITS;
+    let (xw, pw) = (n * MAC_BITS, 2 * MAC_BITS);
     let x = if xw > shw { format!("{{{}'d0, ax0[{}:0]}}", xw - shw, shw - 1) } else { format!("ax0[{}:0]", shw - 1) };
     b.push(wire("shl_x", xw, x));
-    b.push(reg("bfp", 2 * xw));
+    b.push(reg("bfp", n * pw));
     b.push(Item::Integer("shl_k".into()));
     regs.push(Stmt::For {
         var: "shl_k".into(),
         count: n.to_string(),
-        body: vec![set("bfp[32*shl_k +: 32]", format!("{{16'd0, shl_x[{MAC_BITS}*shl_k +: {MAC_BITS}]}} * {{16'd0, shl_p}}"))],
+        body: vec![set(
+            format!("bfp[{pw}*shl_k +: {pw}]"),
+            format!("{{{MAC_BITS}'d0, shl_x[{MAC_BITS}*shl_k +: {MAC_BITS}]}} * {{{MAC_BITS}'d0, shl_p}}"),
+        )],
     });
     // The products' sum: the OR of each at its 16 bits' place (16 bits above the last).
     let fw = xw + MAC_BITS;
@@ -350,7 +353,7 @@ fn shift_on_macs(cx: &Cx, aw: u32, out: bool, regs: &mut Vec<Stmt>, b: &mut Vec<
             count: n.to_string(),
             body: vec![Stmt::Blocking(
                 "shl_f".into(),
-                format!("shl_f | ({{{}'d0, bfp[32*shl_j +: 32]}} << ({MAC_BITS}*shl_j))", fw - 2 * MAC_BITS),
+                format!("shl_f | ({{{}'d0, bfp[{pw}*shl_j +: {pw}]}} << ({MAC_BITS}*shl_j))", fw - pw),
             )],
         },
     ]));
