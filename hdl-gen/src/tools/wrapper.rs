@@ -204,27 +204,13 @@ pub fn modules(blocks: &[(String, Vec<BlockPort>)], outputs: Outputs) -> Result<
         let next = width.div_ceil(4);
         let next_name = format!("fold{level}");
         body.push(reg(&next_name, next));
-        // The whole groups of four in a loop, a last partial group after them.
-        let full = width / 4;
         let mut stmts = Vec::new();
-        let group = |b: u32, stmts: &mut Vec<Stmt>| {
+        for b in 0..next {
             let lo = 4 * b;
             let n = (width - lo).min(4);
             let rhs = if n == 1 { bit(&name, width, lo) } else { format!("^{name}[{lo} +: {n}]") };
             stmts.push(Stmt::Set(bit(&next_name, next, b), rhs));
-        };
-        if full > 1 {
-            let var = format!("f{level}");
-            body.push(Item::Integer(var.clone()));
-            stmts.push(Stmt::For {
-                var: var.clone(),
-                count: full.to_string(),
-                body: vec![Stmt::Set(format!("{next_name}[{var}]"), format!("^{name}[4*{var} +: 4]"))],
-            });
-        } else {
-            (0..full).for_each(|b| group(b, &mut stmts));
         }
-        (full..next).for_each(|b| group(b, &mut stmts));
         body.push(Item::Always(stmts));
         (name, width) = (next_name, next);
     }
