@@ -221,9 +221,14 @@ fn header(hw: &Hw, names: &Names) -> Vec<String> {
         if hw.preload_clocks() > 0 {
             // After the set-up's rate: where the queue's entry went (the UP5K's walk memory).
             let at = lines.iter().position(|l| l.contains("clocks per triangle")).map_or(lines.len(), |i| i + 1);
-            // The UP5K's plan holds dI beside An (`span_seq::walk_ram`).
+            // Where the walk memory holds dI too (`span_seq::walk_ram`), it waits beside An.
+            let (queue, di) = if span_seq::walk_ram::di_value(hw).is_some() {
+                ("first and last", "dI waits beside An in the walk memory, the edges' fields in the second")
+            } else {
+                ("first, last and dI", "the edges' fields wait in the second walk memory")
+            };
             let preload = format!(
-                "The queue holds first and last; dI waits beside An in the walk memory, the edges' fields in the second, loaded into the idle edges one a clock ({} clocks before a take).",
+                "The queue holds {queue}; {di}, loaded into the idle edges one a clock ({} clocks before a take).",
                 hw.preload_clocks()
             );
             lines.insert(at, preload);
